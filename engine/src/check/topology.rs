@@ -1,0 +1,183 @@
+//! Topology: feedback cycles, pruning and rates.
+
+use super::{CheckedNode, Edge, Pruned, Sink};
+use crate::graph::Graph;
+use crate::rate::Ratio;
+use crate::spec::{Direction, RateSpec, Role};
+use petgraph::algo::{kosaraju_scc, toposort};
+use petgraph::graph::{DiGraph, NodeIndex};
+use petgraph::visit::EdgeRef;
+use petgraph::Direction as PgDir;
+use std::collections::VecDeque;
+
+type Analysis = (Vec<usize>, Vec<Pruned>, Vec<usize>);
+
+/// Orders the nodes, finds what to leave out, and resolves every port's rate.
+pub(super) fn analyse(graph: &Graph, nodes: &mut [CheckedNode], edges: &[Edge], sink: &mut Sink) -> Analysis {
+    let n = nodes.len();
+    let mut full: DiGraph<usize, ()> = DiGraph::with_capacity(n, edges.len());
+    let mut reduced: DiGraph<usize, ()> = DiGraph::with_capacity(n, edges.len());
+    for i in 0..n {
+        full.add_node(i);
+        reduced.add_node(i);
+    }
+    for e in edges {
+        full.add_edge(NodeIndex::new(e.from.0), NodeIndex::new(e.to.0), ());
+        if !nodes[e.to.0].spec.breaks_cycles {
+            reduced.add_edge(NodeIndex::new(e.from.0), NodeIndex::new(e.to.0), ());
+        }
+    }
+
+    // Cycles must pass through a cycle-breaking node.
+    let topo: Vec<usize> = match toposort(&reduced, None) {
+        Ok(order) => order.into_iter().map(|ix| ix.index()).collect(),
+        Err(_) => {
+            for scc in kosaraju_scc(&reduced) {
+                let looped = scc.len() > 1 || reduced.contains_edge(scc[0], scc[0]);
+                if looped {
+                    let mut names: Vec<&str> = scc.iter().map(|ix| nodes[ix.index()].name.as_str()).collect();
+                    names.sort_unstable();
+                    let first = scc.iter().map(|ix| ix.index()).min().unwrap_or(0);
+                    sink.err(
+                        nodes[first].loc,
+                        Some(&nodes[first].name),
+                        format!("feedback cycle through {} is not broken by a `delay`", names.join(", ")),
+                        Some("a cycle must pass through a `delay` node of at least one sample".into()),
+                    );
+                }
+            }
+            return (Vec::new(), Vec::new(), Vec::new());
+        }
+    };
+    let mut in_cycle = Vec::new();
+    for scc in kosaraju_scc(&full) {
+        let looped = scc.len() > 1 || full.contains_edge(scc[0], scc[0]);
+        if looped {
+            in_cycle.extend(scc.iter().map(|ix| ix.index()).filter(|&i| nodes[i].spec.breaks_cycles));
+        }
+    }
+    in_cycle.sort_unstable();
+
+    resolve_rates(graph, nodes, edges, &topo, sink);
+
+    // Pruning: keep what can reach a sink.
+    let mut live = vec![false; n];
+    let mut queue: VecDeque<usize> = (0..n).filter(|&i| nodes[i].spec.role == Role::Sink).collect();
+    if queue.is_empty() {
+        sink.err(
+            graph.loc,
+            None,
+            "the graph has no sink, so running it would have no effect",
+            Some("add a sink such as `recording.out` or `metric`; `evflow nodes` lists them".into()),
+        );
+    }
+    for &i in &queue {
+        live[i] = true;
+    }
+    while let Some(i) = queue.pop_front() {
+        for e in full.edges_directed(NodeIndex::new(i), PgDir::Incoming) {
+            let j = e.source().index();
+            if !live[j] {
+                live[j] = true;
+                queue.push_back(j);
+            }
+        }
+    }
+    let pruned = (0..n)
+        .filter(|&i| !live[i])
+        .map(|i| Pruned { node: nodes[i].name.clone(), reason: "no sink is reachable from it".into() })
+        .collect();
+    let order = topo.into_iter().filter(|&i| live[i]).collect();
+    (order, pruned, in_cycle)
+}
+
+fn resolve_rates(graph: &Graph, nodes: &mut [CheckedNode], edges: &[Edge], topo: &[usize], sink: &mut Sink) {
+    let base = graph.rate;
+    let mut resolved = vec![false; nodes.len()];
+    let ratio_of = |hz: f64, node: &CheckedNode, what: &str, sink: &mut Sink| -> Ratio {
+        match Ratio::of(hz, base) {
+            Some(r) => r,
+            None => {
+                sink.err(node.loc, Some(&node.name), format!("{what} runs at {hz} Hz, which is not an integer multiple or divisor of the base rate {base} Hz"), Some("choose rates that divide or multiply the base rate exactly, e.g. 40 Hz or 10 kHz at a 1 kHz base".into()));
+                Ratio::ONE
+            }
+        }
+    };
+    for &i in topo {
+        let producer_ratio = |port: usize, nodes: &[CheckedNode], resolved: &[bool]| -> Option<Ratio> {
+            edges
+                .iter()
+                .find(|e| e.to == (i, port))
+                .filter(|e| resolved[e.from.0])
+                .map(|e| nodes[e.from.0].ports[e.from.1].ratio)
+        };
+        let node = &nodes[i];
+        let from_node_inputs = node
+            .ports
+            .iter()
+            .enumerate()
+            .filter(|(_, p)| p.dir == Direction::In && p.rate == RateSpec::Node)
+            .find_map(|(k, _)| producer_ratio(k, nodes, &resolved));
+        let from_any_inputs = || {
+            node.ports
+                .iter()
+                .enumerate()
+                .filter(|(_, p)| p.dir == Direction::In && p.rate == RateSpec::Any)
+                .find_map(|(k, _)| producer_ratio(k, nodes, &resolved))
+        };
+        let ratio = if let Some(r) = from_node_inputs {
+            r
+        } else if let Some(p) = node.spec.rate_param {
+            let hz = node.params.f64(p);
+            ratio_of(hz, node, "the node", sink)
+        } else if let Some(r) = from_any_inputs() {
+            r
+        } else {
+            Ratio::ONE
+        };
+        let mut port_ratios = Vec::with_capacity(node.ports.len());
+        for (k, p) in node.ports.iter().enumerate() {
+            let r = match p.rate {
+                RateSpec::Node => ratio,
+                RateSpec::Param(name) => ratio_of(node.params.f64(name), node, &format!("port `{}`", p.name), sink),
+                RateSpec::Any => producer_ratio(k, nodes, &resolved).unwrap_or(ratio),
+            };
+            port_ratios.push(r);
+        }
+        let node = &mut nodes[i];
+        node.ratio = ratio;
+        for (p, r) in node.ports.iter_mut().zip(port_ratios) {
+            p.ratio = r;
+        }
+        resolved[i] = true;
+    }
+    // Every connection joins equal rates (inputs of any rate take their producer's).
+    for e in edges {
+        let out = nodes[e.from.0].ports[e.from.1].ratio;
+        let inp = &nodes[e.to.0].ports[e.to.1];
+        if inp.rate == RateSpec::Any {
+            nodes[e.to.0].ports[e.to.1].ratio = out;
+            continue;
+        }
+        if inp.ratio != out {
+            let c = graph.connections.iter().find(|c| {
+                c.from.node == nodes[e.from.0].name && c.to.node == nodes[e.to.0].name && c.to.port == inp.name
+            });
+            let loc = c.map(|c| c.loc).unwrap_or(nodes[e.to.0].loc);
+            sink.err(
+                loc,
+                Some(&nodes[e.to.0].name),
+                format!(
+                    "rate mismatch: `{}.{}` runs at {} Hz but `{}.{}` at {} Hz",
+                    nodes[e.from.0].name,
+                    nodes[e.from.0].ports[e.from.1].name,
+                    out.hz(base),
+                    nodes[e.to.0].name,
+                    inp.name,
+                    inp.ratio.hz(base)
+                ),
+                Some("insert a rate node between them (`hold` to raise a rate, `decimate` to lower it, `resample` for other ratios)".into()),
+            );
+        }
+    }
+}

@@ -1,0 +1,90 @@
+//! Diagnostics: errors that name the file, the line and the node.
+
+use std::fmt;
+use std::path::PathBuf;
+
+/// A place in a graph file (1-based line and column).
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
+pub struct Loc {
+    /// Line, from 1 (0 when unknown, e.g. a command-line override).
+    pub line: usize,
+    /// Column, from 1.
+    pub col: usize,
+}
+
+/// One problem found in a graph file.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Diagnostic {
+    /// The file (or `<command line>`).
+    pub file: PathBuf,
+    /// Where in it.
+    pub loc: Loc,
+    /// The node concerned, if any.
+    pub node: Option<String>,
+    /// What is wrong.
+    pub message: String,
+    /// What would fix it (e.g. the closest valid name).
+    pub help: Option<String>,
+}
+
+impl fmt::Display for Diagnostic {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        write!(f, "{}", self.file.display())?;
+        if self.loc.line > 0 {
+            write!(f, ":{}:{}", self.loc.line, self.loc.col)?;
+        }
+        write!(f, ": ")?;
+        if let Some(n) = &self.node {
+            write!(f, "node `{n}`: ")?;
+        }
+        write!(f, "{}", self.message)?;
+        if let Some(h) = &self.help {
+            write!(f, "\n  help: {h}")?;
+        }
+        Ok(())
+    }
+}
+
+/// Every problem found in a graph file; loading stops before anything is built.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub struct Diagnostics(pub Vec<Diagnostic>);
+
+impl fmt::Display for Diagnostics {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        for (i, d) in self.0.iter().enumerate() {
+            if i > 0 {
+                writeln!(f)?;
+            }
+            write!(f, "error: {d}")?;
+        }
+        if self.0.len() > 1 {
+            write!(f, "\n{} errors", self.0.len())?;
+        }
+        Ok(())
+    }
+}
+
+/// Maps byte offsets of a text to line and column.
+pub struct LineIndex {
+    starts: Vec<usize>,
+}
+
+impl LineIndex {
+    /// Indexes `text`.
+    pub fn new(text: &str) -> Self {
+        let mut starts = vec![0];
+        starts.extend(text.match_indices('\n').map(|(i, _)| i + 1));
+        Self { starts }
+    }
+    /// The location of byte offset `at`.
+    pub fn loc(&self, text: &str, at: usize) -> Loc {
+        let at = at.min(text.len());
+        let line = match self.starts.binary_search(&at) {
+            Ok(i) => i,
+            Err(i) => i - 1,
+        };
+        let start = self.starts[line];
+        let col = text.get(start..at).map(|s| s.chars().count()).unwrap_or(0) + 1;
+        Loc { line: line + 1, col }
+    }
+}

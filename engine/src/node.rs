@@ -1,0 +1,253 @@
+//! The node trait and what a node sees while it runs.
+
+use std::path::{Path, PathBuf};
+
+/// An error raised by a node: at construction (bad file, inconsistent
+/// parameters), at `prepare`, while processing (I/O) or at `finish`.
+#[derive(Debug, thiserror::Error, Clone, PartialEq)]
+pub enum NodeError {
+    /// A parameter combination the declaration's limits cannot express.
+    #[error("parameter `{param}`: {message}")]
+    Param {
+        /// The parameter.
+        param: String,
+        /// What is wrong and what would be right.
+        message: String,
+    },
+    /// A file the node reads or writes.
+    #[error("{path}: {message}")]
+    File {
+        /// The file.
+        path: PathBuf,
+        /// What went wrong.
+        message: String,
+    },
+    /// Input data the node cannot use (e.g. a NaN in a recording).
+    #[error("{0}")]
+    Data(String),
+    /// Anything else, explained.
+    #[error("{0}")]
+    Other(String),
+}
+
+impl NodeError {
+    /// A parameter error.
+    pub fn param(param: &str, message: impl Into<String>) -> Self {
+        NodeError::Param { param: param.to_string(), message: message.into() }
+    }
+    /// A file error.
+    pub fn file(path: &Path, message: impl std::fmt::Display) -> Self {
+        NodeError::File { path: path.to_path_buf(), message: message.to_string() }
+    }
+}
+
+/// What a constructor knows besides its parameters.
+#[derive(Debug, Clone)]
+pub struct BuildContext {
+    /// The node's name in the graph.
+    pub node: String,
+    /// The graph's base rate in Hz.
+    pub base_rate: f64,
+    /// This node's rate in Hz (see [`crate::spec::RateSpec::Node`]).
+    pub rate: f64,
+    /// The rate of each port in Hz, in the order of the node's resolved ports.
+    pub port_rates: Vec<f64>,
+    /// The folder relative paths are taken from (the graph file's folder).
+    pub base_dir: PathBuf,
+    /// The run's seed; nodes that draw random numbers derive their stream from
+    /// it and their name, so runs are reproducible.
+    pub seed: u64,
+}
+
+impl BuildContext {
+    /// A path parameter resolved against the graph file's folder.
+    pub fn path(&self, p: &str) -> PathBuf {
+        let p = Path::new(p);
+        if p.is_absolute() {
+            p.to_path_buf()
+        } else {
+            self.base_dir.join(p)
+        }
+    }
+
+    /// A seed for this node: the run seed mixed with the node's name
+    /// (SplitMix64 finalizer over an FNV-1a hash), so two noise sources in
+    /// one graph draw different streams.
+    pub fn node_seed(&self) -> u64 {
+        let mut h: u64 = 0xcbf2_9ce4_8422_2325;
+        for b in self.node.bytes() {
+            h ^= b as u64;
+            h = h.wrapping_mul(0x0100_0000_01b3);
+        }
+        let mut z = h ^ self.seed.wrapping_mul(0x9E37_79B9_7F4A_7C15);
+        z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
+        z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
+        z ^ (z >> 31)
+    }
+}
+
+/// What `prepare` is told: the largest block the node will be asked for.
+#[derive(Debug, Clone, Copy)]
+pub struct PrepareContext {
+    /// The largest number of samples per port in one call, at the port's own
+    /// rate (index as the node's resolved ports).
+    pub max_block: usize,
+}
+
+/// Results a node reports when the run ends (metrics, files written).
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct Summary {
+    /// Named values with units, e.g. `("E_s", 0.12, "1")`.
+    pub values: Vec<(String, f64, String)>,
+    /// Free lines for people (e.g. `wrote out.wav (3066 frames)`).
+    pub lines: Vec<String>,
+}
+
+impl Summary {
+    /// Adds a named value.
+    pub fn value(mut self, name: &str, v: f64, unit: &str) -> Self {
+        self.values.push((name.to_string(), v, unit.to_string()));
+        self
+    }
+    /// Adds a line.
+    pub fn line(mut self, l: impl Into<String>) -> Self {
+        self.lines.push(l.into());
+        self
+    }
+    /// True when there is nothing to report.
+    pub fn is_empty(&self) -> bool {
+        self.values.is_empty() && self.lines.is_empty()
+    }
+}
+
+/// The ports of one node during one call: inputs to read, outputs to fill.
+///
+/// Each port has its own length for this call (ports at different rates
+/// carry different numbers of samples over the same span of base ticks).
+pub struct Io<'a> {
+    pub(crate) pool: &'a [Vec<f64>],
+    pub(crate) in_slots: &'a [usize],
+    pub(crate) in_lens: &'a [usize],
+    pub(crate) outs: &'a mut [Vec<f64>],
+    pub(crate) out_lens: &'a [usize],
+    pub(crate) start: u64,
+}
+
+impl<'a> Io<'a> {
+    /// Builds an `Io` over caller-owned buffers (used by the engine and the
+    /// single-node harness). `in_slots[i]` indexes `pool`; `outs[j]` must hold
+    /// at least `out_lens[j]` samples.
+    pub fn new(
+        pool: &'a [Vec<f64>],
+        in_slots: &'a [usize],
+        in_lens: &'a [usize],
+        outs: &'a mut [Vec<f64>],
+        out_lens: &'a [usize],
+        start: u64,
+    ) -> Self {
+        Self { pool, in_slots, in_lens, outs, out_lens, start }
+    }
+
+    /// Number of input ports.
+    pub fn n_inputs(&self) -> usize {
+        self.in_slots.len()
+    }
+    /// Number of output ports.
+    pub fn n_outputs(&self) -> usize {
+        self.outs.len()
+    }
+    /// The samples of input `i` for this call.
+    #[inline]
+    pub fn input(&self, i: usize) -> &[f64] {
+        &self.pool[self.in_slots[i]][..self.in_lens[i]]
+    }
+    /// The buffer of output `o` for this call, to be filled completely.
+    #[inline]
+    pub fn output(&mut self, o: usize) -> &mut [f64] {
+        let n = self.out_lens[o];
+        &mut self.outs[o][..n]
+    }
+    /// Input `i` and output `o` together.
+    #[inline]
+    pub fn io(&mut self, i: usize, o: usize) -> (&[f64], &mut [f64]) {
+        let n = self.out_lens[o];
+        (&self.pool[self.in_slots[i]][..self.in_lens[i]], &mut self.outs[o][..n])
+    }
+    /// All outputs at once (for nodes writing several ports in one loop).
+    #[inline]
+    pub fn outputs(&mut self) -> &mut [Vec<f64>] {
+        self.outs
+    }
+    /// Samples in this call at the node's own rate: the length of the first
+    /// output, or else of the first input.
+    #[inline]
+    pub fn len(&self) -> usize {
+        self.out_lens.first().or(self.in_lens.first()).copied().unwrap_or(0)
+    }
+    /// True when this call carries no samples.
+    pub fn is_empty(&self) -> bool {
+        self.len() == 0
+    }
+    /// Length of output `o` in this call.
+    pub fn output_len(&self, o: usize) -> usize {
+        self.out_lens[o]
+    }
+    /// Length of input `i` in this call.
+    pub fn input_len(&self, i: usize) -> usize {
+        self.in_lens[i]
+    }
+    /// Index, at the node's rate, of the first sample of this call since t = 0.
+    pub fn start(&self) -> u64 {
+        self.start
+    }
+}
+
+/// A node: a unit of signal processing with a fixed lifecycle.
+///
+/// * `prepare` may allocate (buffers sized for the largest block).
+/// * `process` handles one block; it must not allocate, lock, do blocking I/O
+///   (sinks hand I/O to buffered writers sized in `prepare`) or panic. Block
+///   processing and one-sample processing (the live tick, a block of one)
+///   give identical output — a generic test checks every node type.
+/// * `reset` returns the node to t = 0.
+pub trait Node: Send {
+    /// Sizes internal buffers; may allocate.
+    fn prepare(&mut self, _ctx: &PrepareContext) -> Result<(), NodeError> {
+        Ok(())
+    }
+
+    /// Processes one block (of one sample when live).
+    fn process(&mut self, io: &mut Io<'_>) -> Result<(), NodeError>;
+
+    /// Returns to the state at t = 0.
+    fn reset(&mut self);
+
+    /// For finite sources: samples left at the node's rate. `None` means
+    /// endless (the run needs a duration).
+    fn remaining(&self) -> Option<u64> {
+        None
+    }
+
+    /// Called once when a run ends normally: flush, rename, report.
+    fn finish(&mut self) -> Result<Summary, NodeError> {
+        Ok(Summary::default())
+    }
+
+    /// For cycle-breaking nodes inside a feedback cycle: write the outputs of
+    /// this block from past inputs only (called early in the step).
+    fn emit(&mut self, _io: &mut Io<'_>) -> Result<(), NodeError> {
+        Err(NodeError::Other("this node cannot break a feedback cycle".into()))
+    }
+
+    /// For cycle-breaking nodes inside a feedback cycle: take this block's
+    /// inputs (called at the end of the step).
+    fn absorb(&mut self, _io: &mut Io<'_>) -> Result<(), NodeError> {
+        Err(NodeError::Other("this node cannot break a feedback cycle".into()))
+    }
+
+    /// For cycle-breaking nodes: how many samples of delay they add (the
+    /// largest block a cycle through them allows).
+    fn cycle_delay(&self) -> usize {
+        0
+    }
+}

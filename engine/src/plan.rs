@@ -1,0 +1,347 @@
+//! The plan: a validated graph compiled into a flat schedule of constructed
+//! nodes and preallocated buffer slots. Both drivers (offline and live) call
+//! the same [`Plan::step`].
+
+use crate::check::{Checked, Pruned};
+use crate::diag::Loc;
+use crate::node::{BuildContext, Io, Node, NodeError, PrepareContext, Summary};
+use crate::rate::{lcm, Ratio};
+use std::path::PathBuf;
+use std::time::{Duration, Instant};
+
+/// A node that failed to build, prepare, process or finish.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+#[error("{}{}: node `{node}` ({kind}): {error}", file.display(), if loc.line > 0 { format!(":{}", loc.line) } else { String::new() })]
+pub struct NodeFailure {
+    /// The graph file.
+    pub file: PathBuf,
+    /// Where the node is declared.
+    pub loc: Loc,
+    /// The node's name.
+    pub node: String,
+    /// Its type.
+    pub kind: &'static str,
+    /// What went wrong.
+    pub error: NodeError,
+}
+
+/// How to build a plan.
+#[derive(Debug, Clone)]
+pub struct PlanOptions {
+    /// Largest block in base ticks (rounded to what the rates and feedback
+    /// delays allow). Live runs use 1.
+    pub max_block: usize,
+    /// Overrides the graph's seed.
+    pub seed: Option<u64>,
+    /// Folder relative paths are taken from (default: the graph file's).
+    pub base_dir: Option<PathBuf>,
+    /// Measure run time per node.
+    pub timing: bool,
+}
+
+impl Default for PlanOptions {
+    fn default() -> Self {
+        Self { max_block: 4096, seed: None, base_dir: None, timing: true }
+    }
+}
+
+struct Entry {
+    name: String,
+    kind: &'static str,
+    loc: Loc,
+    node: Box<dyn Node>,
+    ratio: Ratio,
+    in_slots: Vec<usize>,
+    in_ratios: Vec<Ratio>,
+    in_lens: Vec<usize>,
+    out_slots: Vec<usize>,
+    out_ratios: Vec<Ratio>,
+    out_lens: Vec<usize>,
+    scratch: Vec<Vec<f64>>,
+    split: bool,
+    elapsed: Duration,
+}
+
+/// Run time of one node.
+#[derive(Debug, Clone)]
+pub struct NodeTime {
+    /// Node name.
+    pub node: String,
+    /// Node type.
+    pub kind: &'static str,
+    /// Time spent in `process` (and `emit`/`absorb`).
+    pub elapsed: Duration,
+}
+
+/// A compiled graph.
+pub struct Plan {
+    name: String,
+    file: PathBuf,
+    base_rate: f64,
+    entries: Vec<Entry>,
+    late: Vec<usize>,
+    pool: Vec<Vec<f64>>,
+    tick: u64,
+    max_block: usize,
+    timing: bool,
+    pruned: Vec<Pruned>,
+    duration: Option<f64>,
+}
+
+impl Plan {
+    /// Constructs the nodes that survived pruning (and only those), sizes
+    /// every buffer, and prepares every node.
+    pub fn build(checked: &Checked, opts: &PlanOptions) -> Result<Plan, NodeFailure> {
+        let g = &checked.graph;
+        let base_dir =
+            opts.base_dir.clone().unwrap_or_else(|| g.file.parent().map(|p| p.to_path_buf()).unwrap_or_default());
+        let seed = opts.seed.unwrap_or(g.seed);
+        let fail = |i: usize, error: NodeError| {
+            let n = &checked.nodes[i];
+            NodeFailure { file: g.file.clone(), loc: n.loc, node: n.name.clone(), kind: n.spec.name, error }
+        };
+
+        // Block size: a multiple of every divided rate, within feedback delays.
+        let mut unit = 1u64;
+        for &i in &checked.order {
+            for p in &checked.nodes[i].ports {
+                unit = lcm(unit, p.ratio.div);
+            }
+        }
+        let mut max_block = (opts.max_block.max(1) as u64).div_ceil(unit) * unit;
+
+        // Slots: one per output of each live node.
+        let mut slot_of = vec![Vec::new(); checked.nodes.len()];
+        let mut n_slots = 0;
+        for &i in &checked.order {
+            slot_of[i] = checked.nodes[i]
+                .outputs()
+                .map(|_| {
+                    n_slots += 1;
+                    n_slots - 1
+                })
+                .collect();
+        }
+
+        let mut entries = Vec::with_capacity(checked.order.len());
+        let mut late = Vec::new();
+        for &i in &checked.order {
+            let n = &checked.nodes[i];
+            let ctx = BuildContext {
+                node: n.name.clone(),
+                base_rate: g.rate,
+                rate: n.ratio.hz(g.rate),
+                port_rates: n.ports.iter().map(|p| p.ratio.hz(g.rate)).collect(),
+                base_dir: base_dir.clone(),
+                seed,
+            };
+            let node = (n.spec.build)(&n.params, &ctx).map_err(|e| fail(i, e))?;
+            let mut in_slots = Vec::new();
+            let mut in_ratios = Vec::new();
+            for p in n.inputs() {
+                let e = checked.edges.iter().find(|e| e.to == (i, p)).expect("validated: every input has a producer");
+                let out_index =
+                    checked.nodes[e.from.0].outputs().position(|q| q == e.from.1).expect("producer port is an output");
+                in_slots.push(slot_of[e.from.0][out_index]);
+                in_ratios.push(n.ports[p].ratio);
+            }
+            let out_ratios: Vec<Ratio> = n.outputs().map(|p| n.ports[p].ratio).collect();
+            let split = checked.in_cycle.contains(&i);
+            if split {
+                let d = node.cycle_delay() as u64;
+                let limit = if n.ratio.div == 1 { d / n.ratio.mul } else { d * n.ratio.div };
+                if limit < unit {
+                    return Err(fail(i, NodeError::Other(format!("this feedback delay of {d} samples is shorter than the smallest block the graph's rates allow ({unit} base ticks)"))));
+                }
+                max_block = max_block.min(limit / unit * unit);
+                late.push(entries.len());
+            }
+            entries.push(Entry {
+                name: n.name.clone(),
+                kind: n.spec.name,
+                loc: n.loc,
+                node,
+                ratio: n.ratio,
+                in_lens: vec![0; in_slots.len()],
+                in_slots,
+                in_ratios,
+                out_lens: vec![0; out_ratios.len()],
+                scratch: (0..out_ratios.len()).map(|_| Vec::new()).collect(),
+                out_slots: slot_of[i].clone(),
+                out_ratios,
+                split,
+                elapsed: Duration::ZERO,
+            });
+        }
+        let cap = |r: &Ratio| if r.div == 1 { max_block * r.mul } else { max_block.div_ceil(r.div) } as usize;
+        let mut pool = vec![Vec::new(); n_slots];
+        for e in &entries {
+            for (s, r) in e.out_slots.iter().zip(&e.out_ratios) {
+                pool[*s] = vec![0.0; cap(r)];
+            }
+        }
+        for (k, e) in entries.iter_mut().enumerate() {
+            let largest = e.in_ratios.iter().chain(&e.out_ratios).map(cap).max().unwrap_or(cap(&e.ratio));
+            e.node.prepare(&PrepareContext { max_block: largest }).map_err(|err| {
+                let i = checked.order[k];
+                fail(i, err)
+            })?;
+        }
+        Ok(Plan {
+            name: g.name.clone(),
+            file: g.file.clone(),
+            base_rate: g.rate,
+            entries,
+            late,
+            pool,
+            tick: 0,
+            max_block: max_block as usize,
+            timing: opts.timing,
+            pruned: checked.pruned.clone(),
+            duration: g.duration,
+        })
+    }
+
+    /// Runs `n` base ticks (`1 ≤ n ≤ max_block`). Allocation-free.
+    pub fn step(&mut self, n: usize) -> Result<(), NodeFailure> {
+        debug_assert!(n <= self.max_block, "block larger than the plan allows");
+        let n = n.min(self.max_block) as u64;
+        let t0 = self.tick;
+        for k in 0..self.entries.len() {
+            let e = &mut self.entries[k];
+            let mut any = false;
+            for (len, r) in e.in_lens.iter_mut().zip(&e.in_ratios) {
+                *len = r.count(t0, n) as usize;
+                any |= *len > 0;
+            }
+            for (len, r) in e.out_lens.iter_mut().zip(&e.out_ratios) {
+                *len = r.count(t0, n) as usize;
+                any |= *len > 0;
+            }
+            if !any && e.ratio.count(t0, n) == 0 {
+                continue;
+            }
+            for (j, &s) in e.out_slots.iter().enumerate() {
+                std::mem::swap(&mut self.pool[s], &mut e.scratch[j]);
+            }
+            let started = self.timing.then(Instant::now);
+            let result = {
+                let mut io =
+                    Io::new(&self.pool, &e.in_slots, &e.in_lens, &mut e.scratch, &e.out_lens, e.ratio.first(t0));
+                if e.split {
+                    e.node.emit(&mut io)
+                } else {
+                    e.node.process(&mut io)
+                }
+            };
+            if let Some(s) = started {
+                e.elapsed += s.elapsed();
+            }
+            for (j, &s) in e.out_slots.iter().enumerate() {
+                std::mem::swap(&mut self.pool[s], &mut e.scratch[j]);
+            }
+            if let Err(err) = result {
+                return Err(self.failure(k, err));
+            }
+        }
+        for li in 0..self.late.len() {
+            let k = self.late[li];
+            let e = &mut self.entries[k];
+            let mut none: [Vec<f64>; 0] = [];
+            let result = {
+                let mut io = Io::new(&self.pool, &e.in_slots, &e.in_lens, &mut none, &[], e.ratio.first(t0));
+                e.node.absorb(&mut io)
+            };
+            if let Err(err) = result {
+                return Err(self.failure(k, err));
+            }
+        }
+        self.tick += n;
+        Ok(())
+    }
+
+    #[cold]
+    fn failure(&self, k: usize, error: NodeError) -> NodeFailure {
+        let e = &self.entries[k];
+        NodeFailure { file: self.file.clone(), loc: e.loc, node: e.name.clone(), kind: e.kind, error }
+    }
+
+    /// One base tick (the live runner's step).
+    #[inline]
+    pub fn tick(&mut self) -> Result<(), NodeFailure> {
+        self.step(1)
+    }
+
+    /// Ends the run: every node's `finish`, in plan order (sinks rename their
+    /// files here). Returns each node's summary.
+    pub fn finish(&mut self) -> Result<Vec<(String, Summary)>, NodeFailure> {
+        let mut out = Vec::new();
+        for k in 0..self.entries.len() {
+            match self.entries[k].node.finish() {
+                Ok(s) if !s.is_empty() => out.push((self.entries[k].name.clone(), s)),
+                Ok(_) => {}
+                Err(e) => return Err(self.failure(k, e)),
+            }
+        }
+        Ok(out)
+    }
+
+    /// Back to t = 0: every node reset, every buffer zeroed.
+    pub fn reset(&mut self) {
+        for e in &mut self.entries {
+            e.node.reset();
+            e.elapsed = Duration::ZERO;
+        }
+        for b in &mut self.pool {
+            b.fill(0.0);
+        }
+        self.tick = 0;
+    }
+
+    /// Base ticks left before the first finite source ends (`None`: all endless).
+    pub fn remaining_ticks(&self) -> Option<u64> {
+        self.entries.iter().filter_map(|e| e.node.remaining().map(|r| e.ratio.ticks_for(r))).min()
+    }
+
+    /// The samples an output port produced in the last step.
+    pub fn output(&self, node: &str, port_index: usize) -> Option<&[f64]> {
+        let e = self.entries.iter().find(|e| e.name == node)?;
+        let s = *e.out_slots.get(port_index)?;
+        Some(&self.pool[s][..e.out_lens[port_index]])
+    }
+
+    /// Run time of each node so far.
+    pub fn times(&self) -> Vec<NodeTime> {
+        self.entries.iter().map(|e| NodeTime { node: e.name.clone(), kind: e.kind, elapsed: e.elapsed }).collect()
+    }
+
+    /// Nodes in execution order: (name, type, rate in Hz).
+    pub fn schedule(&self) -> Vec<(String, &'static str, f64)> {
+        self.entries.iter().map(|e| (e.name.clone(), e.kind, e.ratio.hz(self.base_rate))).collect()
+    }
+
+    /// Nodes left out, and why.
+    pub fn pruned(&self) -> &[Pruned] {
+        &self.pruned
+    }
+    /// The graph's name.
+    pub fn name(&self) -> &str {
+        &self.name
+    }
+    /// The base rate in Hz.
+    pub fn base_rate(&self) -> f64 {
+        self.base_rate
+    }
+    /// The largest block in base ticks.
+    pub fn max_block(&self) -> usize {
+        self.max_block
+    }
+    /// Base ticks run since t = 0.
+    pub fn ticks(&self) -> u64 {
+        self.tick
+    }
+    /// The graph's `duration` in seconds, if set.
+    pub fn duration(&self) -> Option<f64> {
+        self.duration
+    }
+}

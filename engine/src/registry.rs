@@ -1,0 +1,36 @@
+//! The set of node types a loader knows.
+
+use crate::spec::NodeSpec;
+
+/// Node types by name. The node library provides the full registry; tests
+/// may build smaller ones.
+#[derive(Debug, Clone, Default)]
+pub struct Registry {
+    specs: Vec<&'static NodeSpec>,
+}
+
+impl Registry {
+    /// An empty registry.
+    pub fn new() -> Self {
+        Self::default()
+    }
+    /// Adds a node type. Panics on a duplicate name — a programming error in
+    /// the node library, caught by its tests.
+    pub fn add(&mut self, spec: &'static NodeSpec) -> &mut Self {
+        assert!(self.get(spec.name).is_none(), "node type `{}` registered twice", spec.name);
+        self.specs.push(spec);
+        self
+    }
+    /// The node type of that name.
+    pub fn get(&self, name: &str) -> Option<&'static NodeSpec> {
+        self.specs.iter().copied().find(|s| s.name == name)
+    }
+    /// All node types, in registration order.
+    pub fn specs(&self) -> impl Iterator<Item = &'static NodeSpec> + Clone + '_ {
+        self.specs.iter().copied()
+    }
+    /// All type names.
+    pub fn names(&self) -> impl Iterator<Item = &'static str> + Clone + '_ {
+        self.specs.iter().map(|s| s.name)
+    }
+}

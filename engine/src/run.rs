@@ -1,0 +1,84 @@
+//! The offline driver: runs a plan over its finite sources as fast as the
+//! machine allows, in large blocks, single-threaded and deterministic.
+
+use crate::node::Summary;
+use crate::plan::{NodeFailure, NodeTime, Plan};
+use std::time::{Duration, Instant};
+
+/// Why an offline run could not run or did not finish.
+#[derive(Debug, thiserror::Error)]
+pub enum RunError {
+    /// No finite source and no duration: the run would never end.
+    #[error("graph `{0}` has only endless sources; set `duration` in [graph] or pass --duration")]
+    Endless(String),
+    /// A node failed.
+    #[error(transparent)]
+    Node(#[from] NodeFailure),
+    /// Stopped by the caller (e.g. Ctrl-C); sinks were not finished, so no
+    /// partial output was kept.
+    #[error("interrupted after {0} base ticks; no output was written")]
+    Interrupted(u64),
+}
+
+/// What an offline run did.
+#[derive(Debug, Clone)]
+pub struct RunReport {
+    /// Base ticks run.
+    pub ticks: u64,
+    /// Wall-clock time of the processing loop.
+    pub elapsed: Duration,
+    /// Time per node.
+    pub times: Vec<NodeTime>,
+    /// What each node reported at the end (metrics, files written).
+    pub summaries: Vec<(String, Summary)>,
+}
+
+impl RunReport {
+    /// Base ticks per second of wall-clock time.
+    pub fn ticks_per_second(&self) -> f64 {
+        self.ticks as f64 / self.elapsed.as_secs_f64().max(1e-12)
+    }
+    /// A summary value by node and name.
+    pub fn value(&self, node: &str, name: &str) -> Option<f64> {
+        self.summaries.iter().find(|(n, _)| n == node)?.1.values.iter().find(|(k, _, _)| k == name).map(|(_, v, _)| *v)
+    }
+}
+
+/// Options of an offline run.
+#[derive(Default)]
+pub struct RunOptions<'a> {
+    /// Run length in seconds (overrides the graph's `duration`; finite
+    /// sources still end the run early).
+    pub duration: Option<f64>,
+    /// Called after each block with (ticks done, ticks in all); returning
+    /// `false` stops the run.
+    pub progress: Option<&'a mut dyn FnMut(u64, u64) -> bool>,
+}
+
+/// Runs a plan from t = 0 to the end of its shortest finite source (or the
+/// duration), then finishes every node.
+pub fn run_offline(plan: &mut Plan, mut opts: RunOptions<'_>) -> Result<RunReport, RunError> {
+    let by_duration = opts.duration.or(plan.duration()).map(|d| (d * plan.base_rate()).round() as u64);
+    let total = match (plan.remaining_ticks(), by_duration) {
+        (Some(a), Some(b)) => a.min(b),
+        (Some(a), None) => a,
+        (None, Some(b)) => b,
+        (None, None) => return Err(RunError::Endless(plan.name().to_string())),
+    };
+    let block = plan.max_block() as u64;
+    let started = Instant::now();
+    let mut done = 0;
+    while done < total {
+        let n = block.min(total - done);
+        plan.step(n as usize)?;
+        done += n;
+        if let Some(p) = opts.progress.as_mut() {
+            if !p(done, total) {
+                return Err(RunError::Interrupted(done));
+            }
+        }
+    }
+    let elapsed = started.elapsed();
+    let summaries = plan.finish()?;
+    Ok(RunReport { ticks: done, elapsed, times: plan.times(), summaries })
+}

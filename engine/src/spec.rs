@@ -1,0 +1,350 @@
+//! Node declarations as data.
+//!
+//! Every node type declares its ports, its parameters and its constructor once,
+//! in a [`NodeSpec`]. The loader, the validator, `evflow nodes` and the
+//! generated node reference (`docs/nodes.md`) all read that one declaration.
+
+use crate::node::{BuildContext, Node, NodeError};
+use crate::params::Params;
+
+/// Which way samples flow through a port.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Direction {
+    /// The node reads samples from this port.
+    In,
+    /// The node writes samples to this port.
+    Out,
+}
+
+/// The sample rate a port runs at.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum RateSpec {
+    /// The node's own rate: the rate of its `Node` inputs, or for a node
+    /// without such inputs the value of its rate parameter
+    /// ([`NodeSpec::rate_param`]), or else the graph's base rate.
+    Node,
+    /// An input that accepts any rate (used by rate-changing nodes).
+    Any,
+    /// The rate in Hz given by the named parameter (e.g. a resampler's output).
+    Param(&'static str),
+}
+
+/// One port of a node type.
+#[derive(Debug, Clone, Copy)]
+pub struct PortSpec {
+    /// Port name, as written in connections (`node.port`).
+    pub name: &'static str,
+    /// Input or output.
+    pub dir: Direction,
+    /// The port's rate.
+    pub rate: RateSpec,
+    /// Unit of the samples (e.g. `N`, `1` for normalized, `m/s`).
+    pub unit: &'static str,
+    /// One-line description.
+    pub doc: &'static str,
+    /// When set, this declaration stands for several ports whose names are
+    /// the entries of the named text-list parameter (e.g. one port per
+    /// channel of a recording).
+    pub multi: Option<&'static str>,
+}
+
+impl PortSpec {
+    /// An input port at the node's rate.
+    pub const fn input(name: &'static str, unit: &'static str, doc: &'static str) -> Self {
+        Self { name, dir: Direction::In, rate: RateSpec::Node, unit, doc, multi: None }
+    }
+    /// An output port at the node's rate.
+    pub const fn output(name: &'static str, unit: &'static str, doc: &'static str) -> Self {
+        Self { name, dir: Direction::Out, rate: RateSpec::Node, unit, doc, multi: None }
+    }
+    /// The same port with another rate.
+    pub const fn at(mut self, rate: RateSpec) -> Self {
+        self.rate = rate;
+        self
+    }
+    /// The same port repeated once per entry of a text-list parameter.
+    pub const fn per(mut self, list_param: &'static str) -> Self {
+        self.multi = Some(list_param);
+        self
+    }
+}
+
+/// The type and limits of a parameter.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum ParamKind {
+    /// A real number within `[min, max]` (inclusive).
+    Float {
+        /// Smallest accepted value.
+        min: f64,
+        /// Largest accepted value.
+        max: f64,
+    },
+    /// An integer within `[min, max]` (inclusive).
+    Int {
+        /// Smallest accepted value.
+        min: i64,
+        /// Largest accepted value.
+        max: i64,
+    },
+    /// `true` or `false`.
+    Bool,
+    /// Free text (e.g. a file path; relative paths are taken from the graph file's folder).
+    Text,
+    /// One of a fixed set of words.
+    Choice(&'static [&'static str]),
+    /// A list of words (e.g. channel names).
+    TextList,
+    /// A list of real numbers, each within `[min, max]`.
+    FloatList {
+        /// Smallest accepted element.
+        min: f64,
+        /// Largest accepted element.
+        max: f64,
+    },
+}
+
+impl ParamKind {
+    /// A short human name of the type, used in errors and docs.
+    pub fn type_name(&self) -> &'static str {
+        match self {
+            ParamKind::Float { .. } => "number",
+            ParamKind::Int { .. } => "integer",
+            ParamKind::Bool => "boolean",
+            ParamKind::Text => "text",
+            ParamKind::Choice(_) => "choice",
+            ParamKind::TextList => "list of text",
+            ParamKind::FloatList { .. } => "list of numbers",
+        }
+    }
+
+    /// The limits written for people, e.g. `0.001 ..= 1e6` or `lowpass | highpass`.
+    pub fn limits(&self) -> String {
+        match self {
+            ParamKind::Float { min, max } | ParamKind::FloatList { min, max } => {
+                format!("{} ..= {}", fmt_num(*min), fmt_num(*max))
+            }
+            ParamKind::Int { min, max } => format!("{min} ..= {max}"),
+            ParamKind::Choice(c) => c.join(" \\| "),
+            _ => String::new(),
+        }
+    }
+}
+
+fn fmt_num(x: f64) -> String {
+    if x == f64::INFINITY {
+        "inf".into()
+    } else if x == f64::NEG_INFINITY {
+        "-inf".into()
+    } else {
+        format!("{x}")
+    }
+}
+
+/// A parameter's default value (`Required` when the user must give it).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum ParamDefault {
+    /// No default: the graph file must set it.
+    Required,
+    /// Default real number.
+    Float(f64),
+    /// Default integer.
+    Int(i64),
+    /// Default boolean.
+    Bool(bool),
+    /// Default text or choice.
+    Text(&'static str),
+    /// Default empty list.
+    EmptyList,
+}
+
+/// One parameter of a node type.
+#[derive(Debug, Clone, Copy)]
+pub struct ParamSpec {
+    /// Parameter name, as written in the node's table.
+    pub name: &'static str,
+    /// Type and limits.
+    pub kind: ParamKind,
+    /// Default value, or [`ParamDefault::Required`].
+    pub default: ParamDefault,
+    /// Unit (e.g. `Hz`, `s`, `g`, `1`); empty for words and flags.
+    pub unit: &'static str,
+    /// One-line description.
+    pub doc: &'static str,
+}
+
+impl ParamSpec {
+    /// A real-number parameter.
+    pub const fn float(
+        name: &'static str,
+        min: f64,
+        max: f64,
+        default: f64,
+        unit: &'static str,
+        doc: &'static str,
+    ) -> Self {
+        Self { name, kind: ParamKind::Float { min, max }, default: ParamDefault::Float(default), unit, doc }
+    }
+    /// An integer parameter.
+    pub const fn int(
+        name: &'static str,
+        min: i64,
+        max: i64,
+        default: i64,
+        unit: &'static str,
+        doc: &'static str,
+    ) -> Self {
+        Self { name, kind: ParamKind::Int { min, max }, default: ParamDefault::Int(default), unit, doc }
+    }
+    /// A boolean parameter.
+    pub const fn flag(name: &'static str, default: bool, doc: &'static str) -> Self {
+        Self { name, kind: ParamKind::Bool, default: ParamDefault::Bool(default), unit: "", doc }
+    }
+    /// A choice among fixed words.
+    pub const fn choice(
+        name: &'static str,
+        words: &'static [&'static str],
+        default: &'static str,
+        doc: &'static str,
+    ) -> Self {
+        Self { name, kind: ParamKind::Choice(words), default: ParamDefault::Text(default), unit: "", doc }
+    }
+    /// A text parameter with a default.
+    pub const fn text(name: &'static str, default: &'static str, doc: &'static str) -> Self {
+        Self { name, kind: ParamKind::Text, default: ParamDefault::Text(default), unit: "", doc }
+    }
+    /// A list of words, empty by default.
+    pub const fn text_list(name: &'static str, doc: &'static str) -> Self {
+        Self { name, kind: ParamKind::TextList, default: ParamDefault::EmptyList, unit: "", doc }
+    }
+    /// A list of real numbers, empty by default.
+    pub const fn float_list(name: &'static str, min: f64, max: f64, unit: &'static str, doc: &'static str) -> Self {
+        Self { name, kind: ParamKind::FloatList { min, max }, default: ParamDefault::EmptyList, unit, doc }
+    }
+    /// The same parameter without a default: the graph file must set it.
+    pub const fn required(mut self) -> Self {
+        self.default = ParamDefault::Required;
+        self
+    }
+}
+
+/// What part a node plays in a graph.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Role {
+    /// Produces samples (no inputs).
+    Source,
+    /// Transforms samples.
+    Filter,
+    /// Consumes samples and has an effect outside the graph (file, device,
+    /// report). Only nodes from which a sink is reachable enter a plan.
+    Sink,
+}
+
+/// The constructor of a node type: validated parameters in, a node out.
+/// Called only for nodes that survive pruning.
+pub type Constructor = fn(&Params, &BuildContext) -> Result<Box<dyn Node>, NodeError>;
+
+/// The one declaration of a node type.
+#[derive(Debug, Clone, Copy)]
+pub struct NodeSpec {
+    /// Type name as written in graph files (e.g. `butterworth`, `sim.display`).
+    pub name: &'static str,
+    /// Family, for grouping in `evflow nodes` and the docs.
+    pub family: &'static str,
+    /// One-line summary.
+    pub summary: &'static str,
+    /// Longer description: behaviour, rates, the dissertation section it
+    /// implements and the references it was checked against (Markdown).
+    pub doc: &'static str,
+    /// Source, filter or sink.
+    pub role: Role,
+    /// Ports.
+    pub ports: &'static [PortSpec],
+    /// Parameters.
+    pub params: &'static [ParamSpec],
+    /// For nodes whose rate is set by a parameter (sources): its name.
+    pub rate_param: Option<&'static str>,
+    /// True for nodes whose output depends only on past input (`delay`):
+    /// the only nodes a feedback cycle may pass through.
+    pub breaks_cycles: bool,
+    /// True for nodes that drive hardware: each of their inputs must come
+    /// straight from a node with `safety_guard` (the `limit` node).
+    pub hardware: bool,
+    /// True for the safety limiter, the only node allowed to feed hardware.
+    pub safety_guard: bool,
+    /// A node table that works as-is (TOML body without the header), used by
+    /// the docs and by the generic tests that run every node type.
+    pub example: &'static str,
+    /// The constructor.
+    pub build: Constructor,
+}
+
+impl NodeSpec {
+    /// A declaration with no ports or parameters yet; chain the setters below.
+    pub const fn new(
+        name: &'static str,
+        family: &'static str,
+        role: Role,
+        summary: &'static str,
+        build: Constructor,
+    ) -> Self {
+        Self {
+            name,
+            family,
+            summary,
+            doc: "",
+            role,
+            ports: &[],
+            params: &[],
+            rate_param: None,
+            breaks_cycles: false,
+            hardware: false,
+            safety_guard: false,
+            example: "",
+            build,
+        }
+    }
+    /// Sets the long description.
+    pub const fn doc(mut self, doc: &'static str) -> Self {
+        self.doc = doc;
+        self
+    }
+    /// Sets the ports.
+    pub const fn ports(mut self, ports: &'static [PortSpec]) -> Self {
+        self.ports = ports;
+        self
+    }
+    /// Sets the parameters.
+    pub const fn params(mut self, params: &'static [ParamSpec]) -> Self {
+        self.params = params;
+        self
+    }
+    /// Names the parameter that sets the node's rate (sources).
+    pub const fn rate_param(mut self, p: &'static str) -> Self {
+        self.rate_param = Some(p);
+        self
+    }
+    /// Marks a node whose output depends only on past input.
+    pub const fn breaks_cycles(mut self) -> Self {
+        self.breaks_cycles = true;
+        self
+    }
+    /// Marks a hardware output.
+    pub const fn hardware(mut self) -> Self {
+        self.hardware = true;
+        self
+    }
+    /// Marks the safety limiter.
+    pub const fn safety_guard(mut self) -> Self {
+        self.safety_guard = true;
+        self
+    }
+    /// Sets the working example node table.
+    pub const fn example(mut self, example: &'static str) -> Self {
+        self.example = example;
+        self
+    }
+    /// The declared parameter of that name.
+    pub fn param(&self, name: &str) -> Option<&ParamSpec> {
+        self.params.iter().find(|p| p.name == name)
+    }
+}

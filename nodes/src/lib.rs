@@ -1,0 +1,34 @@
+//! # evflow-nodes
+//!
+//! The node library of evflow, one module per family. Each node type lives
+//! in its own file and declares itself once as a [`NodeSpec`]; [`registry`]
+//! gathers them for the loader, the validator, `evflow nodes` and the docs.
+#![deny(missing_docs)]
+
+pub mod filters;
+pub mod metric;
+pub mod output;
+pub mod recording;
+pub mod sources;
+
+use evflow_engine::{NodeSpec, Registry};
+
+/// Every node type of the library.
+pub fn registry() -> Registry {
+    let mut reg = Registry::new();
+    for spec in all_specs() {
+        reg.add(spec);
+    }
+    reg
+}
+
+/// Every node declaration, family by family.
+pub fn all_specs() -> Vec<&'static NodeSpec> {
+    let mut v = Vec::new();
+    v.extend_from_slice(sources::SPECS);
+    v.extend_from_slice(filters::SPECS);
+    v.extend_from_slice(output::SPECS);
+    v.extend_from_slice(recording::SPECS);
+    v.extend_from_slice(metric::SPECS);
+    v
+}

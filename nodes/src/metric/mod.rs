@@ -1,0 +1,6 @@
+//! metric family (being written).
+
+use evflow_engine::NodeSpec;
+
+/// The node types of this family.
+pub static SPECS: &[&NodeSpec] = &[];

@@ -185,7 +185,11 @@ pub fn check(graph: &Graph, registry: &Registry, overrides: &[Override]) -> Resu
     let mut edges = Vec::new();
     let mut producer: Vec<Vec<Option<(usize, crate::diag::Loc, Endpoint)>>> =
         nodes.iter().map(|n| n.as_ref().map(|n| vec![None; n.ports.len()]).unwrap_or_default()).collect();
+    // Inputs fed by a connection that could not be resolved (already
+    // reported) must not also be reported as having no producer.
+    let mut covered: Vec<(String, String)> = Vec::new();
     for c in &graph.connections {
+        covered.push((c.to.node.clone(), c.to.port.clone()));
         let from = endpoint(&graph, &nodes, &c.from, Direction::Out, c.loc, &mut sink);
         let to = endpoint(&graph, &nodes, &c.to, Direction::In, c.loc, &mut sink);
         if let (Some(f), Some(t)) = (from, to) {
@@ -212,7 +216,7 @@ pub fn check(graph: &Graph, registry: &Registry, overrides: &[Override]) -> Resu
     for (i, n) in nodes.iter().enumerate() {
         let Some(n) = n else { continue };
         for p in n.inputs() {
-            if producer[i][p].is_none() {
+            if producer[i][p].is_none() && !covered.iter().any(|(nn, pp)| *nn == n.name && *pp == n.ports[p].name) {
                 sink.err(
                     n.loc,
                     Some(&n.name),
@@ -329,3 +333,6 @@ fn apply_overrides(graph: &Graph, overrides: &[Override], sink: &mut Sink) -> Gr
     }
     g
 }
+
+#[cfg(test)]
+mod tests;

@@ -83,7 +83,7 @@ pub struct Single<'a> {
     pub ticks: u64,
     /// Base ticks per step (1 = the live tick).
     pub block: usize,
-    /// Folder for relative paths.
+    /// Folder for relative paths (inputs and outputs).
     pub base_dir: &'a Path,
 }
 
@@ -134,6 +134,7 @@ impl Single<'_> {
             max_block: self.block,
             seed: None,
             base_dir: Some(self.base_dir.to_path_buf()),
+            out_dir: Some(self.base_dir.to_path_buf()),
             timing: false,
         };
         let plan = Plan::build(&checked, &opts).map_err(|e| e.to_string())?;

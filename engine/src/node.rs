@@ -52,8 +52,11 @@ pub struct BuildContext {
     pub rate: f64,
     /// The rate of each port in Hz, in the order of the node's resolved ports.
     pub port_rates: Vec<f64>,
-    /// The folder relative paths are taken from (the graph file's folder).
+    /// The folder relative input paths are taken from (the graph file's folder).
     pub base_dir: PathBuf,
+    /// The folder relative output paths are written to (the run's output
+    /// folder: `--out`, by default the current directory).
+    pub out_dir: PathBuf,
     /// The run's seed; nodes that draw random numbers derive their stream from
     /// it and their name, so runs are reproducible.
     pub seed: u64,
@@ -67,6 +70,16 @@ impl BuildContext {
             p.to_path_buf()
         } else {
             self.base_dir.join(p)
+        }
+    }
+
+    /// An output path parameter resolved against the run's output folder.
+    pub fn out_path(&self, p: &str) -> PathBuf {
+        let p = Path::new(p);
+        if p.is_absolute() {
+            p.to_path_buf()
+        } else {
+            self.out_dir.join(p)
         }
     }
 

@@ -33,15 +33,17 @@ pub struct PlanOptions {
     pub max_block: usize,
     /// Overrides the graph's seed.
     pub seed: Option<u64>,
-    /// Folder relative paths are taken from (default: the graph file's).
+    /// Folder relative input paths are taken from (default: the graph file's).
     pub base_dir: Option<PathBuf>,
+    /// Folder relative output paths are written to (default: the current directory).
+    pub out_dir: Option<PathBuf>,
     /// Measure run time per node.
     pub timing: bool,
 }
 
 impl Default for PlanOptions {
     fn default() -> Self {
-        Self { max_block: 4096, seed: None, base_dir: None, timing: true }
+        Self { max_block: 4096, seed: None, base_dir: None, out_dir: None, timing: true }
     }
 }
 
@@ -133,6 +135,7 @@ impl Plan {
                 rate: n.ratio.hz(g.rate),
                 port_rates: n.ports.iter().map(|p| p.ratio.hz(g.rate)).collect(),
                 base_dir: base_dir.clone(),
+                out_dir: opts.out_dir.clone().unwrap_or_default(),
                 seed,
             };
             let node = (n.spec.build)(&n.params, &ctx).map_err(|e| fail(i, e))?;

@@ -1,1 +1,62 @@
-fn main() {}
+//! `evflow` — run, check and inspect evflow graph files.
+
+mod cli;
+
+use clap::{Parser, Subcommand};
+use std::process::ExitCode;
+
+/// evflow: a dataflow signal-processing engine for electrovibration haptics.
+///
+/// Graph files (TOML) wire nodes — sources, filters, models, the simulated
+/// lab, sinks — into chains that run offline as fast as the machine allows
+/// or live at 1 kHz. See docs/graph-format.md and `evflow nodes`.
+#[derive(Parser)]
+#[command(name = "evflow", version, about, long_about = None, propagate_version = true)]
+struct Cli {
+    #[command(subcommand)]
+    command: Command,
+}
+
+#[derive(Subcommand)]
+enum Command {
+    /// Run a graph offline over its finite sources, as fast as possible.
+    ///
+    /// Prints what each sink reports (metrics, files written) next to the run
+    /// time per node and in total.
+    ///
+    /// Example: evflow run graphs/highpass.toml --set cutoff=20
+    Run(cli::run::Args),
+    /// Validate a graph and print its plan: execution order, rates, buffer
+    /// block size, and which nodes were left out and why.
+    ///
+    /// Nothing is constructed, no file is read or written besides the graph.
+    ///
+    /// Example: evflow check graphs/highpass.toml
+    Check(cli::check::Args),
+    /// List node types, or describe one: ports, rates, parameters with units
+    /// and limits, and a working example.
+    ///
+    /// Example: evflow nodes butterworth
+    Nodes(cli::nodes::Args),
+    /// Print a graph in Graphviz dot syntax (pruned nodes dashed).
+    ///
+    /// Example: evflow dot graphs/highpass.toml | dot -Tpng > graph.png
+    Dot(cli::dot::Args),
+}
+
+fn main() -> ExitCode {
+    let cli = Cli::parse();
+    let result = match cli.command {
+        Command::Run(a) => cli::run::main(a),
+        Command::Check(a) => cli::check::main(a),
+        Command::Nodes(a) => cli::nodes::main(a),
+        Command::Dot(a) => cli::dot::main(a),
+    };
+    match result {
+        Ok(()) => ExitCode::SUCCESS,
+        Err(e) => {
+            eprintln!("{e:#}");
+            ExitCode::FAILURE
+        }
+    }
+}

@@ -139,7 +139,7 @@ pub(crate) fn conform(v: &Value, kind: &ParamKind) -> Result<Value, String> {
 /// Expands `multi` ports; rates are resolved later by the topology pass.
 pub(super) fn resolve_ports(decl: &NodeDecl, spec: &NodeSpec, params: &Params, sink: &mut Sink) -> Vec<ResolvedPort> {
     let mut ports = Vec::new();
-    let mut push = |ports: &mut Vec<ResolvedPort>, name: &str, ps: &PortSpec, sink: &mut Sink| {
+    let push = |ports: &mut Vec<ResolvedPort>, name: &str, ps: &PortSpec, sink: &mut Sink| {
         if ports.iter().any(|p: &ResolvedPort| p.name == name && p.dir == ps.dir) {
             sink.err(
                 decl.loc,

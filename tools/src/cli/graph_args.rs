@@ -1,0 +1,30 @@
+//! Arguments shared by the commands that load a graph.
+
+use anyhow::{anyhow, Result};
+use evflow_engine::{load_file, Checked, Override};
+use std::path::PathBuf;
+
+/// A graph file and command-line overrides.
+#[derive(clap::Args, Debug)]
+pub struct GraphArgs {
+    /// The graph file (TOML).
+    pub file: PathBuf,
+    /// Set a graph variable (`name=value`) or a node parameter
+    /// (`node.param=value`); may be repeated. Values use TOML syntax
+    /// (`85`, `2.5`, `"felt"`, `[1, 2]`); bare words are text.
+    #[arg(long = "set", value_name = "KEY=VALUE")]
+    pub set: Vec<String>,
+}
+
+impl GraphArgs {
+    /// Loads and validates the graph with the node library.
+    pub fn load(&self) -> Result<Checked> {
+        let overrides = self
+            .set
+            .iter()
+            .map(|s| Override::parse(s).map_err(|e| anyhow!("--set {e}")))
+            .collect::<Result<Vec<_>>>()?;
+        let registry = evflow_nodes::registry();
+        load_file(&self.file, &registry, &overrides).map_err(|e| anyhow!("{e}"))
+    }
+}

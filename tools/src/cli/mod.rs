@@ -1,0 +1,7 @@
+//! One module per subcommand.
+
+pub mod check;
+pub mod dot;
+pub mod graph_args;
+pub mod nodes;
+pub mod run;

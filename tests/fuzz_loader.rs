@@ -6,7 +6,6 @@
 
 use evflow_engine::{check, graph::parse_graph, Plan, PlanOptions};
 use proptest::prelude::*;
-use std::path::Path;
 
 fn seeds() -> Vec<String> {
     evflow_tests::shipped_graphs().into_iter().map(|(_, text)| text).collect()

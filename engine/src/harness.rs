@@ -144,17 +144,24 @@ impl Single<'_> {
     /// Runs the node and returns each collected output.
     pub fn run(&self) -> Result<Vec<Vec<f64>>, String> {
         let (mut plan, out_index) = self.plan()?;
+        let outs = self.collect(&mut plan, &out_index)?;
+        plan.finish().map_err(|e| e.to_string())?;
+        Ok(outs)
+    }
+
+    /// Runs `ticks` base ticks of an already built plan (from [`Single::plan`])
+    /// and returns each collected output, without finishing the plan.
+    pub fn collect(&self, plan: &mut Plan, out_index: &[usize]) -> Result<Vec<Vec<f64>>, String> {
         let mut outs = vec![Vec::new(); self.outputs.len()];
         let mut done = 0;
         while done < self.ticks {
             let n = (plan.max_block() as u64).min(self.ticks - done);
             plan.step(n as usize).map_err(|e| e.to_string())?;
-            for (o, &k) in outs.iter_mut().zip(&out_index) {
+            for (o, &k) in outs.iter_mut().zip(out_index) {
                 o.extend_from_slice(plan.output("dut", k).unwrap_or(&[]));
             }
             done += n;
         }
-        plan.finish().map_err(|e| e.to_string())?;
         Ok(outs)
     }
 }

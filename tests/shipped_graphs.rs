@@ -5,9 +5,12 @@ use evflow_engine::{load_file, run_offline, Plan, PlanOptions, RunOptions};
 use std::collections::BTreeMap;
 use std::path::Path;
 
+/// Files written by a run (name → bytes) and values reported (node, name, value).
+type RunOutput = (BTreeMap<String, Vec<u8>>, Vec<(String, String, f64)>);
+
 /// Runs a graph into `out` and returns every file written, by name, with its
 /// bytes, plus the reported values.
-fn run(graph: &Path, out: &Path) -> (BTreeMap<String, Vec<u8>>, Vec<(String, String, f64)>) {
+fn run(graph: &Path, out: &Path) -> RunOutput {
     let checked = load_file(graph, &evflow_nodes::registry(), &[]).unwrap_or_else(|e| panic!("{e}"));
     let opts = PlanOptions { out_dir: Some(out.to_path_buf()), ..Default::default() };
     let mut plan = Plan::build(&checked, &opts).unwrap_or_else(|e| panic!("{e}"));

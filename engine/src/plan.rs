@@ -93,14 +93,14 @@ pub struct Plan {
 impl Plan {
     /// Constructs the nodes that survived pruning (and only those), sizes
     /// every buffer, and prepares every node.
-    pub fn build(checked: &Checked, opts: &PlanOptions) -> Result<Plan, NodeFailure> {
+    pub fn build(checked: &Checked, opts: &PlanOptions) -> Result<Plan, Box<NodeFailure>> {
         let g = &checked.graph;
         let base_dir =
             opts.base_dir.clone().unwrap_or_else(|| g.file.parent().map(|p| p.to_path_buf()).unwrap_or_default());
         let seed = opts.seed.unwrap_or(g.seed);
         let fail = |i: usize, error: NodeError| {
             let n = &checked.nodes[i];
-            NodeFailure { file: g.file.clone(), loc: n.loc, node: n.name.clone(), kind: n.spec.name, error }
+            Box::new(NodeFailure { file: g.file.clone(), loc: n.loc, node: n.name.clone(), kind: n.spec.name, error })
         };
 
         // Block size: a multiple of every divided rate, within feedback delays.
@@ -206,7 +206,7 @@ impl Plan {
     }
 
     /// Runs `n` base ticks (`1 ≤ n ≤ max_block`). Allocation-free.
-    pub fn step(&mut self, n: usize) -> Result<(), NodeFailure> {
+    pub fn step(&mut self, n: usize) -> Result<(), Box<NodeFailure>> {
         debug_assert!(n <= self.max_block, "block larger than the plan allows");
         let n = n.min(self.max_block) as u64;
         let t0 = self.tick;
@@ -264,20 +264,20 @@ impl Plan {
     }
 
     #[cold]
-    fn failure(&self, k: usize, error: NodeError) -> NodeFailure {
+    fn failure(&self, k: usize, error: NodeError) -> Box<NodeFailure> {
         let e = &self.entries[k];
-        NodeFailure { file: self.file.clone(), loc: e.loc, node: e.name.clone(), kind: e.kind, error }
+        Box::new(NodeFailure { file: self.file.clone(), loc: e.loc, node: e.name.clone(), kind: e.kind, error })
     }
 
     /// One base tick (the live runner's step).
     #[inline]
-    pub fn tick(&mut self) -> Result<(), NodeFailure> {
+    pub fn tick(&mut self) -> Result<(), Box<NodeFailure>> {
         self.step(1)
     }
 
     /// Ends the run: every node's `finish`, in plan order (sinks rename their
     /// files here). Returns each node's summary.
-    pub fn finish(&mut self) -> Result<Vec<(String, Summary)>, NodeFailure> {
+    pub fn finish(&mut self) -> Result<Vec<(String, Summary)>, Box<NodeFailure>> {
         let mut out = Vec::new();
         for k in 0..self.entries.len() {
             match self.entries[k].node.finish() {

@@ -24,7 +24,7 @@ impl Ratio {
         }
         let close = |x: f64| {
             let r = x.round();
-            (r >= 1.0 && r <= 1e9 && (x - r).abs() <= 1e-9 * x.max(1.0)).then_some(r as u64)
+            ((1.0..=1e9).contains(&r) && (x - r).abs() <= 1e-9 * x.max(1.0)).then_some(r as u64)
         };
         if rate >= base {
             close(rate / base).map(|mul| Ratio { mul, div: 1 })

@@ -13,7 +13,7 @@ pub enum RunError {
     Endless(String),
     /// A node failed.
     #[error(transparent)]
-    Node(#[from] NodeFailure),
+    Node(#[from] Box<NodeFailure>),
     /// Stopped by the caller (e.g. Ctrl-C); sinks were not finished, so no
     /// partial output was kept.
     #[error("interrupted after {0} base ticks; no output was written")]

@@ -1,8 +1,9 @@
-//! Output stage: gain (and, later, the safety limiter and hardware outputs).
+//! Output stage: gain, summaries (and, later, the safety limiter and hardware outputs).
 
 pub mod gain;
+pub mod stats;
 
 use evflow_engine::NodeSpec;
 
 /// The node types of this family.
-pub static SPECS: &[&NodeSpec] = &[&gain::SPEC];
+pub static SPECS: &[&NodeSpec] = &[&gain::SPEC, &stats::SPEC];

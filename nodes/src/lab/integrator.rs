@@ -160,6 +160,9 @@ pub struct FrictionStep {
     pub slip: f64,
     /// True when the contact stuck.
     pub stuck: bool,
+    /// The rubbing mass's velocity at the end of the step under the applied
+    /// force, before a stick sets it to 0 (for momentum balances), m/s.
+    pub v_end: f64,
 }
 
 /// A linear system whose mass `iv` (its velocity is state `iv`) rubs on a
@@ -239,7 +242,7 @@ impl CoulombLti {
                     d[i] += bu[i] + bf[i] * f;
                 }
             });
-            return FrictionStep { force: fsum, slip: 0.5 * (x0 + x[iv]) * self.h, stuck: false };
+            return FrictionStep { force: fsum, slip: 0.5 * (x0 + x[iv]) * self.h, stuck: false, v_end: x[iv] };
         }
         let (na, ma) = (n + 1, m + 1);
         // Free motion (f = 0) of the augmented state (x, s = 0).
@@ -264,6 +267,7 @@ impl CoulombLti {
             (slide(x[iv].abs()).max(0.0).min(required.abs()) * required.signum(), false)
         };
         let slip = s_free + ds_df * force;
+        let v_end = free[iv] + self.gam[iv * ma + m] * force;
         if stuck {
             // The mass is held: its velocity is 0 and every state whose rate
             // depends on nothing but that velocity and the inputs (a position
@@ -284,7 +288,7 @@ impl CoulombLti {
                 x[i] = free[i] + self.gam[i * ma + m] * force;
             }
         }
-        FrictionStep { force, slip: if stuck { 0.0 } else { slip }, stuck }
+        FrictionStep { force, slip: if stuck { 0.0 } else { slip }, stuck, v_end }
     }
 }
 

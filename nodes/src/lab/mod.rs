@@ -8,16 +8,24 @@ pub mod display;
 pub mod display_model;
 pub mod electrical;
 pub mod expm;
+pub mod forcesensor;
 pub mod integrator;
 pub mod noise;
 pub mod profile;
 pub mod profile_load;
 pub mod rng;
+pub mod sensor_model;
+pub mod tribometer;
+pub mod tribometer_model;
 
+#[cfg(test)]
+mod chain_tests;
 #[cfg(test)]
 mod display_tests;
 #[cfg(test)]
 mod testutil;
+#[cfg(test)]
+mod tribometer_tests;
 
 pub use profile::LabProfile;
 pub use profile_load::ProfileError;
@@ -26,7 +34,7 @@ use evflow_engine::{BuildContext, NodeError, NodeSpec, ParamSpec, Params};
 use integrator::Method;
 
 /// The node types of this family.
-pub static SPECS: &[&NodeSpec] = &[&display::SPEC];
+pub static SPECS: &[&NodeSpec] = &[&display::SPEC, &tribometer::SPEC, &forcesensor::SPEC];
 
 /// The `profile` parameter shared by the lab's nodes.
 pub const PROFILE_PARAM: ParamSpec = ParamSpec::text(

@@ -1,5 +1,5 @@
 //! Coloured noise for the lab: the Ornstein–Uhlenbeck process, sampled
-//! exactly (x[n+1] = a·x[n] + σ·√(1−a²)·z, a = e^{−h/τ}), so its variance is
+//! exactly (`x[n+1] = a·x[n] + σ·√(1−a²)·z`, `a = e^{−h/τ}`), so its variance is
 //! σ² at every step size (Gillespie, "Exact numerical simulation of the
 //! Ornstein–Uhlenbeck process and its integral", Phys. Rev. E 54, 1996).
 

@@ -481,3 +481,27 @@ mod tests {
         assert!(e.contains("display.contact.stiffness_n_per_m"), "{e}");
     }
 }
+
+#[cfg(test)]
+mod doc_tests {
+    use super::KEYS;
+
+    #[test]
+    fn every_profile_key_is_documented_with_its_source() {
+        let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../docs/simulated-lab.md");
+        let doc = std::fs::read_to_string(&path).unwrap();
+        for k in KEYS {
+            let row = format!("| `{}` |", k.name);
+            assert!(doc.contains(&row), "docs/simulated-lab.md has no table row for `{}`", k.path());
+        }
+    }
+
+    #[test]
+    fn every_profile_key_is_in_the_nominal_file() {
+        let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../graphs/lab/nominal.toml");
+        let text = std::fs::read_to_string(&path).unwrap();
+        for k in KEYS {
+            assert!(text.contains(&format!("\n{} = ", k.name)), "nominal.toml lacks `{}`", k.path());
+        }
+    }
+}

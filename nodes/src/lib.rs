@@ -6,6 +6,7 @@
 #![deny(missing_docs)]
 
 pub mod filters;
+pub mod lab;
 pub mod metric;
 pub mod output;
 pub mod recording;
@@ -30,5 +31,6 @@ pub fn all_specs() -> Vec<&'static NodeSpec> {
     v.extend_from_slice(output::SPECS);
     v.extend_from_slice(recording::SPECS);
     v.extend_from_slice(metric::SPECS);
+    v.extend_from_slice(lab::SPECS);
     v
 }

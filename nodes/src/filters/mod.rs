@@ -1,6 +1,10 @@
-//! filters family (being written).
+//! Filters: `butterworth` (low-/high-pass as second-order sections) and
+//! `delay` (whole-sample delay, the node feedback cycles pass through).
+
+pub mod butterworth;
+pub mod delay;
 
 use evflow_engine::NodeSpec;
 
 /// The node types of this family.
-pub static SPECS: &[&NodeSpec] = &[];
+pub static SPECS: &[&NodeSpec] = &[&butterworth::SPEC, &delay::SPEC];

@@ -1,0 +1,72 @@
+//! The simulated lab: a virtual electrovibration display, the linear
+//! tribometer of dissertation §5.1.1 and its force sensor, standing in for
+//! the hardware so every graph runs on a fresh machine. Physics, parameter
+//! values and their sources: `docs/simulated-lab.md`. Every physical
+//! parameter lives in a lab profile (`graphs/lab/*.toml`, [`LabProfile`]).
+
+pub mod display;
+pub mod display_model;
+pub mod electrical;
+pub mod expm;
+pub mod forcesensor;
+pub mod integrator;
+pub mod noise;
+pub mod profile;
+pub mod profile_load;
+pub mod rng;
+pub mod sensor_model;
+pub mod tribometer;
+pub mod tribometer_model;
+
+#[cfg(test)]
+mod chain_tests;
+#[cfg(test)]
+mod display_tests;
+#[cfg(test)]
+mod testutil;
+#[cfg(test)]
+mod tribometer_tests;
+
+pub use profile::LabProfile;
+pub use profile_load::ProfileError;
+
+use evflow_engine::{BuildContext, NodeError, NodeSpec, ParamSpec, Params};
+use integrator::Method;
+
+/// The node types of this family.
+pub static SPECS: &[&NodeSpec] = &[&display::SPEC, &tribometer::SPEC, &forcesensor::SPEC];
+
+/// The `profile` parameter shared by the lab's nodes.
+pub const PROFILE_PARAM: ParamSpec = ParamSpec::text(
+    "profile",
+    "",
+    "lab profile file (TOML, relative to the graph file); empty = the built-in nominal lab (graphs/lab/nominal.toml)",
+);
+/// The `integrator` parameter shared by the lab's nodes.
+pub const INTEGRATOR_PARAM: ParamSpec = ParamSpec::choice(
+    "integrator",
+    Method::WORDS,
+    "exact",
+    "exact (zero-order-hold matrix exponential + implicit Coulomb), rk4 or euler (explicit, for comparison only)",
+);
+/// The `substeps` parameter shared by the lab's nodes.
+pub const SUBSTEPS_PARAM: ParamSpec = ParamSpec::int("substeps", 1, 10_000, 4, "1", "integration steps per sample");
+/// The `noise` parameter shared by the lab's nodes.
+pub const NOISE_PARAM: ParamSpec =
+    ParamSpec::float("noise", 0.0, 100.0, 1.0, "1", "scale of every random term of the profile (0 = noiseless)");
+
+/// The profile named by the `profile` parameter (nominal when empty).
+pub fn profile_of(p: &Params, ctx: &BuildContext) -> Result<LabProfile, NodeError> {
+    let name = p.str("profile");
+    if name.is_empty() {
+        return Ok(LabProfile::default());
+    }
+    let path = ctx.path(name);
+    LabProfile::load(&path).map_err(|e| NodeError::file(&path, e.issues_text()))
+}
+
+/// The method named by the `integrator` parameter.
+pub fn method_of(p: &Params) -> Result<Method, NodeError> {
+    Method::from_word(p.str("integrator"))
+        .ok_or_else(|| NodeError::param("integrator", format!("unknown integrator `{}`", p.str("integrator"))))
+}

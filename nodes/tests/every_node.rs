@@ -29,7 +29,14 @@ fn signal(len: usize, salt: u64) -> Vec<f64> {
 
 /// Files some node examples read (e.g. a recording), written into `dir`.
 fn fixtures(dir: &Path) {
-    let _ = dir;
+    use evflow_nodes::recording::format::{Channel, RecordingMeta, RecordingWriter};
+    std::fs::create_dir_all(dir.join("recordings")).expect("fixture folder");
+    let meta = RecordingMeta::new(1000.0, vec![Channel::new("force", "N")]);
+    let mut w = RecordingWriter::create(&dir.join("recordings/felt.wav"), meta).expect("fixture recording");
+    for x in signal(TICKS as usize + 100, 99) {
+        w.write_frame(&[0.2 + 0.05 * x]).expect("fixture frame");
+    }
+    w.finish().expect("fixture recording finished");
 }
 
 struct Case {

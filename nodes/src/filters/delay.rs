@@ -235,7 +235,8 @@ mod tests {
             }
             let checked = check(&accumulator(&x, a, Some(d)), &registry(), &[]).unwrap();
             for requested in [1usize, 4096] {
-                let opts = PlanOptions { max_block: requested, seed: None, base_dir: None, timing: false };
+                let opts =
+                    PlanOptions { max_block: requested, seed: None, base_dir: None, timing: false, out_dir: None };
                 let mut plan = Plan::build(&checked, &opts).unwrap();
                 // The cycle limits blocks to the delay.
                 assert_eq!(plan.max_block(), requested.min(d), "d={d}");

@@ -62,7 +62,11 @@ type = "harness.tap"
         reg.add(&source::SPEC).add(&sink::SPEC).add(&TAP);
         let g = parse_graph(&dir.path().join("copy.toml"), doc).unwrap();
         let checked = check(&g, &reg, &[]).unwrap();
-        let mut plan = Plan::build(&checked, &PlanOptions { timing: false, ..PlanOptions::default() }).unwrap();
+        let mut plan = Plan::build(
+            &checked,
+            &PlanOptions { timing: false, out_dir: Some(dir.path().to_path_buf()), ..PlanOptions::default() },
+        )
+        .unwrap();
         let report = run_offline(&mut plan, RunOptions::default()).unwrap();
         // 4321 samples at 10 kHz are 432.1 base ticks: the run covers the
         // 432 whole ticks (4320 frames).

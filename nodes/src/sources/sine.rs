@@ -170,6 +170,7 @@ mod tests {
             rate: fs,
             port_rates: vec![fs],
             base_dir: PathBuf::from("."),
+            out_dir: PathBuf::from("."),
             seed: 0,
         };
         build(&Params::from_map(m), &ctx)

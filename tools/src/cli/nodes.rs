@@ -28,13 +28,17 @@ pub fn main(a: Args) -> Result<()> {
             print!("{}", node_text(spec));
         }
         None => {
-            let mut family = "";
+            let mut families: Vec<&str> = Vec::new();
             for s in reg.specs() {
-                if s.family != family {
-                    family = s.family;
-                    println!("\n{family}:");
+                if !families.contains(&s.family) {
+                    families.push(s.family);
                 }
-                println!("  {:<16} {}", s.name, s.summary);
+            }
+            for family in families {
+                println!("\n{family}:");
+                for s in reg.specs().filter(|s| s.family == family) {
+                    println!("  {:<16} {}", s.name, s.summary);
+                }
             }
             println!("\n`evflow nodes TYPE` describes one type; docs/nodes.md has them all.");
         }

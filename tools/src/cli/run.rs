@@ -86,6 +86,18 @@ pub fn main(a: Args) -> Result<()> {
     Ok(())
 }
 
+/// A value for people: integers as integers, others with six significant digits.
+fn number(v: f64) -> String {
+    if v.fract() == 0.0 && v.abs() < 1e15 {
+        format!("{v:.0}")
+    } else if v != 0.0 && (v.abs() < 1e-3 || v.abs() >= 1e6) {
+        format!("{v:.5e}")
+    } else {
+        let digits = (5 - v.abs().log10().floor() as i32).clamp(0, 9) as usize;
+        format!("{v:.digits$}")
+    }
+}
+
 fn print_report(r: &RunReport, base_rate: f64, quiet: bool) {
     for (node, s) in &r.summaries {
         for l in &s.lines {
@@ -93,7 +105,7 @@ fn print_report(r: &RunReport, base_rate: f64, quiet: bool) {
         }
         for (k, v, unit) in &s.values {
             let unit = if unit.is_empty() || unit == "1" { String::new() } else { format!(" {unit}") };
-            println!("{node}: {k} = {v:.6}{unit}");
+            println!("{node}: {k} = {}{unit}", number(*v));
         }
     }
     if quiet {

@@ -238,6 +238,7 @@ mod tests {
             rate: 1000.0,
             port_rates: vec![1000.0, 1000.0],
             base_dir: ".".into(),
+            out_dir: ".".into(),
             seed: 0,
         };
         let params = Params::from_map(

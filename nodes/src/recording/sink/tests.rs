@@ -41,7 +41,13 @@ fn plan(dir: &Path, doc: &str, block: usize) -> Result<Plan, String> {
     reg.add(&SPEC).add(&FEED);
     let g = parse_graph(&dir.join("g.toml"), doc).map_err(|d| d.to_string())?;
     let checked = check(&g, &reg, &[]).map_err(|d| d.to_string())?;
-    let opts = PlanOptions { max_block: block, seed: None, base_dir: Some(dir.to_path_buf()), timing: false };
+    let opts = PlanOptions {
+        max_block: block,
+        seed: None,
+        base_dir: Some(dir.to_path_buf()),
+        out_dir: Some(dir.to_path_buf()),
+        timing: false,
+    };
     Plan::build(&checked, &opts).map_err(|e| e.to_string())
 }
 

@@ -23,11 +23,12 @@ pub mod registry;
 pub mod run;
 pub mod spec;
 pub mod suggest;
+pub mod sweep;
 
 pub use check::{check, Checked, Override};
 pub use diag::{Diagnostic, Diagnostics};
 pub use graph::Graph;
-pub use load::{load_file, LoadError};
+pub use load::{load_file, read_graph, LoadError};
 pub use node::{BuildContext, Io, Node, NodeError, PrepareContext, Summary};
 pub use params::{Params, Value};
 pub use plan::{Plan, PlanOptions};

@@ -2,7 +2,7 @@
 
 use crate::check::{check, Checked, Override};
 use crate::diag::{Diagnostic, Diagnostics};
-use crate::graph::parse_graph;
+use crate::graph::{parse_graph, Graph};
 use crate::registry::Registry;
 use std::path::Path;
 
@@ -24,6 +24,12 @@ pub enum LoadError {
 
 /// Reads, parses and validates a graph file.
 pub fn load_file(path: &Path, registry: &Registry, overrides: &[Override]) -> Result<Checked, LoadError> {
+    let graph = read_graph(path)?;
+    Ok(check(&graph, registry, overrides)?)
+}
+
+/// Reads and parses a graph file (syntax only; [`check`] validates it).
+pub fn read_graph(path: &Path) -> Result<Graph, LoadError> {
     let bytes = std::fs::read(path).map_err(|source| LoadError::Read { path: path.display().to_string(), source })?;
     let text = match String::from_utf8(bytes) {
         Ok(t) => t,
@@ -41,6 +47,5 @@ pub fn load_file(path: &Path, registry: &Registry, overrides: &[Override]) -> Re
             .into());
         }
     };
-    let graph = parse_graph(path, &text)?;
-    Ok(check(&graph, registry, overrides)?)
+    Ok(parse_graph(path, &text)?)
 }

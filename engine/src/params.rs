@@ -33,7 +33,9 @@ impl Value {
     /// The variable name when this value is a `$name` reference.
     pub fn var_ref(&self) -> Option<&str> {
         match self {
-            Value::Text(s) => s.strip_prefix('$').filter(|n| !n.is_empty() && !n.starts_with('$')),
+            Value::Text(s) => s
+                .strip_prefix('$')
+                .filter(|n| !n.is_empty() && n.chars().all(|c| c.is_alphanumeric() || c == '_' || c == '-')),
             _ => None,
         }
     }

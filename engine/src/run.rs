@@ -25,6 +25,8 @@ pub enum RunError {
 pub struct RunReport {
     /// Base ticks run.
     pub ticks: u64,
+    /// The base rate in Hz (ticks per second of signal).
+    pub base_rate: f64,
     /// Wall-clock time of the processing loop.
     pub elapsed: Duration,
     /// Time per node.
@@ -80,5 +82,5 @@ pub fn run_offline(plan: &mut Plan, mut opts: RunOptions<'_>) -> Result<RunRepor
     }
     let elapsed = started.elapsed();
     let summaries = plan.finish()?;
-    Ok(RunReport { ticks: done, elapsed, times: plan.times(), summaries })
+    Ok(RunReport { ticks: done, base_rate: plan.base_rate(), elapsed, times: plan.times(), summaries })
 }

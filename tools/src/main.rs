@@ -22,16 +22,22 @@ enum Command {
     /// Run a graph offline over its finite sources, as fast as possible.
     ///
     /// Prints what each sink reports (metrics, files written) next to the run
-    /// time per node and in total.
+    /// time per node and in total. With a `[sweep]` table in the graph or
+    /// `--sweep` options, runs every combination of the swept variables and
+    /// ends with a table of the reported values (`evflow sweep` is the same
+    /// command).
     ///
-    /// Example: evflow run graphs/highpass.toml --set cutoff=20
+    /// Examples:
+    ///   evflow run graphs/excitation.toml --set mass=110 --out recordings
+    ///   evflow run graphs/excitation.toml --sweep mass=60,85,110 --sweep speed=3,4,5 --csv grid.csv
+    #[command(visible_alias = "sweep")]
     Run(cli::run::Args),
     /// Validate a graph and print its plan: execution order, rates, buffer
     /// block size, and which nodes were left out and why.
     ///
     /// Nothing is constructed, no file is read or written besides the graph.
     ///
-    /// Example: evflow check graphs/highpass.toml
+    /// Example: evflow check graphs/excitation.toml
     Check(cli::check::Args),
     /// List node types, or describe one: ports, rates, parameters with units
     /// and limits, and a working example.
@@ -40,7 +46,7 @@ enum Command {
     Nodes(cli::nodes::Args),
     /// Print a graph in Graphviz dot syntax (pruned nodes dashed).
     ///
-    /// Example: evflow dot graphs/highpass.toml | dot -Tpng > graph.png
+    /// Example: evflow dot graphs/excitation.toml | dot -Tpng > graph.png
     Dot(cli::dot::Args),
 }
 

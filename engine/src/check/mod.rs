@@ -2,6 +2,7 @@
 //! constructed — names, parameters, ports, connections, safety, cycles,
 //! rates — and every problem is reported with its file, line and node.
 
+pub mod interpolate;
 mod params;
 mod topology;
 
@@ -150,6 +151,20 @@ impl Sink {
 pub fn check(graph: &Graph, registry: &Registry, overrides: &[Override]) -> Result<Checked, Diagnostics> {
     let mut sink = Sink { file: graph.file.clone(), diags: Vec::new() };
     let graph = apply_overrides(graph, overrides, &mut sink);
+
+    // Sweep axes name declared variables, once each.
+    for (i, a) in graph.sweep.iter().enumerate() {
+        if graph.sweep[..i].iter().any(|b| b.name == a.name) {
+            sink.err(a.loc, None, format!("sweep `{}` is given twice", a.name), None);
+        } else if !graph.vars.iter().any(|v| v.name == a.name) {
+            let help = if graph.vars.is_empty() {
+                format!("declare it in [vars] (e.g. `{} = …`), then sweep it", a.name)
+            } else {
+                suggest::help(&a.name, graph.vars.iter().map(|v| v.name.as_str()))
+            };
+            sink.err(a.loc, None, format!("sweep `{}`: no graph variable `{}`", a.name, a.name), Some(help));
+        }
+    }
 
     // Names.
     for (i, n) in graph.nodes.iter().enumerate() {

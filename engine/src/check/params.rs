@@ -43,6 +43,28 @@ pub(super) fn check_params(decl: &NodeDecl, spec: &NodeSpec, vars: &[Var], sink:
             },
             None => p.value.clone(),
         };
+        let value = match super::interpolate::interpolate_value(&value, vars) {
+            Ok(v) => v,
+            Err(super::interpolate::InterpolateError::Unknown(var)) => {
+                let help = suggest::help(&var, vars.iter().map(|v| v.name.as_str()));
+                sink.err(
+                    p.loc,
+                    Some(&decl.name),
+                    format!("`{}` refers to undeclared variable `${{{var}}}`", p.name),
+                    Some(help),
+                );
+                continue;
+            }
+            Err(super::interpolate::InterpolateError::Unclosed) => {
+                sink.err(
+                    p.loc,
+                    Some(&decl.name),
+                    format!("`{}`: `${{` without its closing `}}`", p.name),
+                    Some("write `${name}` to insert the graph variable `name`".into()),
+                );
+                continue;
+            }
+        };
         match conform(&value, &ps.kind) {
             Ok(v) => {
                 values.insert(p.name.clone(), v);

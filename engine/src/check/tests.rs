@@ -325,3 +325,48 @@ type = "harness.tap"
     }
     assert_eq!(seen, (1..=10).map(f64::from).collect::<Vec<_>>());
 }
+
+const SWEPT: &str = r#"
+[sweep]
+cut = [10.0, 20.0]
+"#;
+
+#[test]
+fn sweep_axes_must_name_declared_variables() {
+    let text = GOOD.replace("[nodes.src]", &format!("{SWEPT}\n[nodes.src]"));
+    assert!(errors(&text).is_empty(), "{:#?}", errors(&text));
+    let d = one_error(&text.replace("cut = [10.0", "cutt = [10.0"));
+    assert!(d.message.contains("no graph variable `cutt`"), "{}", d.message);
+    assert_eq!(d.loc.line, 15);
+    let d = one_error(&text.replace("cut = [10.0, 20.0]", "cut = 10.0"));
+    assert!(d.message.contains("must be a list"), "{}", d.message);
+    let d = one_error(&text.replace("cut = [10.0, 20.0]", "cut = []"));
+    assert!(d.message.contains("no values"), "{}", d.message);
+}
+
+#[test]
+fn sweep_round_trips() {
+    let text = GOOD.replace("[nodes.src]", &format!("{SWEPT}\n[nodes.src]"));
+    let g = parse_graph(Path::new("g.toml"), &text).unwrap();
+    assert_eq!(g.sweep.len(), 1);
+    let saved = g.to_toml();
+    let g2 = parse_graph(Path::new("g.toml"), &saved).unwrap();
+    assert_eq!(g.without_locations(), g2.without_locations());
+}
+
+#[test]
+fn text_parameters_interpolate_variables() {
+    let text = GOOD.replace("kind = ", "x = ").replace("need = 0.5", "need = 0.5\nkind = \"${mode}pass\"") + "";
+    let text = text.replace("cut = 20.0", "cut = 20.0\nmode = \"high\"");
+    let g = parse_graph(Path::new("g.toml"), &text).unwrap();
+    let c = check(&g, &registry(), &[]).unwrap();
+    assert_eq!(c.nodes[1].params.str("kind"), "highpass");
+    let c = check(&g, &registry(), &[Override::parse("mode=low").unwrap()]).unwrap();
+    assert_eq!(c.nodes[1].params.str("kind"), "lowpass");
+    let d = one_error(&text.replace("${mode}", "${mood}"));
+    assert!(d.message.contains("undeclared variable `${mood}`"), "{}", d.message);
+    assert_eq!(d.node.as_deref(), Some("f"));
+    assert!(d.help.unwrap_or_default().contains("mode"));
+    let d = one_error(&text.replace("${mode}", "${mode"));
+    assert!(d.message.contains("without its closing"), "{}", d.message);
+}

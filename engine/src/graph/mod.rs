@@ -38,6 +38,8 @@ pub struct Graph {
     pub seed: u64,
     /// Graph variables (`[vars]`), overridable from the command line.
     pub vars: Vec<Var>,
+    /// Sweep axes (`[sweep]`): a run covers every combination of their values.
+    pub sweep: Vec<Axis>,
     /// Nodes in file order.
     pub nodes: Vec<NodeDecl>,
     /// Connections in file order.
@@ -53,6 +55,18 @@ pub struct Var {
     pub name: String,
     /// Value.
     pub value: Value,
+    /// Where it is set.
+    pub loc: Loc,
+}
+
+/// One axis of a sweep: a graph variable and the values it takes in turn
+/// (`[sweep]` table, `mass = [60.0, 85.0, 110.0]`).
+#[derive(Debug, Clone, PartialEq)]
+pub struct Axis {
+    /// The variable swept (declared in `[vars]`).
+    pub name: String,
+    /// Its values, in order.
+    pub values: Vec<Value>,
     /// Where it is set.
     pub loc: Loc,
 }
@@ -121,6 +135,7 @@ impl Graph {
             duration: None,
             seed: 0,
             vars: Vec::new(),
+            sweep: Vec::new(),
             nodes: Vec::new(),
             connections: Vec::new(),
             loc: Loc::default(),
@@ -162,6 +177,9 @@ impl Graph {
         g.loc = Loc::default();
         for v in &mut g.vars {
             v.loc = Loc::default();
+        }
+        for a in &mut g.sweep {
+            a.loc = Loc::default();
         }
         for n in &mut g.nodes {
             n.loc = Loc::default();

@@ -1,6 +1,6 @@
 //! Reading a graph file: TOML with spans, so every error names its line.
 
-use super::{Connection, Endpoint, Graph, NodeDecl, ParamDecl, Var, FORMAT_VERSION};
+use super::{Axis, Connection, Endpoint, Graph, NodeDecl, ParamDecl, Var, FORMAT_VERSION};
 use crate::diag::{Diagnostic, Diagnostics, LineIndex, Loc};
 use crate::params::Value;
 use crate::suggest;
@@ -8,7 +8,7 @@ use std::path::Path;
 use toml::de::{DeTable, DeValue};
 use toml::Spanned;
 
-const TOP_KEYS: [&str; 3] = ["graph", "vars", "nodes"];
+const TOP_KEYS: [&str; 4] = ["graph", "vars", "sweep", "nodes"];
 const GRAPH_KEYS: [&str; 7] = ["format", "name", "description", "rate", "duration", "seed", "connections"];
 
 struct Ctx<'t> {
@@ -80,6 +80,9 @@ pub fn parse_graph(file: &Path, text: &str) -> Result<Graph, Diagnostics> {
                 cx.err(loc, None, "`vars` must be a table (`[vars]`)", None);
             }
         }
+    }
+    if let Some(v) = root.get_ref().get("sweep") {
+        read_sweep(&mut cx, v, &mut g);
     }
     if let Some(v) = root.get_ref().get("nodes") {
         match v.get_ref() {
@@ -221,6 +224,46 @@ fn read_node(cx: &mut Ctx<'_>, key: &Spanned<std::borrow::Cow<'_, str>>, val: &S
 /// A node name: letters, digits, `_`, `-`.
 pub(crate) fn valid_name(s: &str) -> bool {
     !s.is_empty() && s.chars().all(|c| c.is_ascii_alphanumeric() || c == '_' || c == '-')
+}
+
+/// `[sweep]`: one non-empty list of values per swept variable.
+fn read_sweep(cx: &mut Ctx<'_>, v: &Spanned<DeValue<'_>>, g: &mut Graph) {
+    let DeValue::Table(t) = v.get_ref() else {
+        let loc = cx.loc(v.span());
+        cx.err(loc, None, "`sweep` must be a table (`[sweep]`) of lists", None);
+        return;
+    };
+    for (k, val) in t.iter() {
+        let loc = cx.loc(k.span());
+        let name = k.get_ref().to_string();
+        let DeValue::Array(items) = val.get_ref() else {
+            cx.err(
+                loc,
+                None,
+                format!("sweep `{name}` must be a list of values"),
+                Some(format!("e.g. `{name} = [60.0, 85.0, 110.0]`")),
+            );
+            continue;
+        };
+        if items.is_empty() {
+            cx.err(loc, None, format!("sweep `{name}` has no values"), None);
+            continue;
+        }
+        let mut values = Vec::new();
+        for item in items.iter() {
+            if matches!(item.get_ref(), DeValue::Array(_) | DeValue::Table(_)) {
+                let at = cx.loc(item.span());
+                cx.err(at, None, format!("sweep `{name}`: each value must be a number, text or boolean"), None);
+                continue;
+            }
+            if let Some(x) = read_value(cx, item, None, &name) {
+                values.push(x);
+            }
+        }
+        if values.len() == items.len() {
+            g.sweep.push(Axis { name, values, loc });
+        }
+    }
 }
 
 fn read_value(cx: &mut Ctx<'_>, v: &Spanned<DeValue<'_>>, node: Option<&str>, key: &str) -> Option<Value> {

@@ -32,6 +32,13 @@ impl Graph {
                 let _ = writeln!(s, "{} = {}", key(&v.name), v.value);
             }
         }
+        if !self.sweep.is_empty() {
+            let _ = writeln!(s, "\n[sweep]");
+            for a in &self.sweep {
+                let values: Vec<String> = a.values.iter().map(|v| v.to_string()).collect();
+                let _ = writeln!(s, "{} = [{}]", key(&a.name), values.join(", "));
+            }
+        }
         for n in &self.nodes {
             let _ = writeln!(s, "\n[nodes.{}]", key(&n.name));
             let _ = writeln!(s, "type = {}", toml_string(&n.kind));

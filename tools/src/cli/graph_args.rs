@@ -17,13 +17,14 @@ pub struct GraphArgs {
 }
 
 impl GraphArgs {
+    /// The `--set` overrides.
+    pub fn overrides(&self) -> Result<Vec<Override>> {
+        self.set.iter().map(|s| Override::parse(s).map_err(|e| anyhow!("--set {e}"))).collect()
+    }
+
     /// Loads and validates the graph with the node library.
     pub fn load(&self) -> Result<Checked> {
-        let overrides = self
-            .set
-            .iter()
-            .map(|s| Override::parse(s).map_err(|e| anyhow!("--set {e}")))
-            .collect::<Result<Vec<_>>>()?;
+        let overrides = self.overrides()?;
         let registry = evflow_nodes::registry();
         load_file(&self.file, &registry, &overrides).map_err(|e| anyhow!("{e}"))
     }

@@ -5,3 +5,4 @@ pub mod dot;
 pub mod graph_args;
 pub mod nodes;
 pub mod run;
+pub mod run_report;

@@ -1,8 +1,11 @@
-//! `evflow run FILE`: the offline driver from the command line.
+//! `evflow run FILE`: the offline driver from the command line, for one run
+//! or a sweep over graph variables.
 
 use super::graph_args::GraphArgs;
-use anyhow::{anyhow, Result};
-use evflow_engine::{run_offline, Plan, PlanOptions, RunOptions, RunReport};
+use super::run_report::{print_report, report_json, sweep_csv, sweep_table};
+use anyhow::{anyhow, bail, Result};
+use evflow_engine::sweep::{parse_axis, points, Point};
+use evflow_engine::{check, read_graph, run_offline, Checked, Plan, PlanOptions, RunOptions, RunReport};
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::Arc;
@@ -13,6 +16,12 @@ use std::time::{Duration, Instant};
 pub struct Args {
     #[command(flatten)]
     graph: GraphArgs,
+    /// Sweep a graph variable over values (`name=v1,v2,…` or
+    /// `name=[v1, v2]`); may be repeated: every combination runs. Adds to or
+    /// replaces the graph's `[sweep]` table; `--set name=v` fixes a swept
+    /// variable instead.
+    #[arg(long = "sweep", value_name = "NAME=V1,V2,…")]
+    sweep: Vec<String>,
     /// Seed for every random stream (overrides the graph's `seed`).
     #[arg(long)]
     seed: Option<u64>,
@@ -30,28 +39,47 @@ pub struct Args {
     /// Print only what the sinks report.
     #[arg(long, short)]
     quiet: bool,
-    /// Also write the results (summaries and timings) as JSON to this file.
+    /// Also write the results (summaries and timings; one entry per run of a
+    /// sweep) as JSON to this file.
     #[arg(long, value_name = "FILE")]
     json: Option<std::path::PathBuf>,
+    /// Also write a sweep's table (one row per run, one column per reported
+    /// value) as CSV to this file.
+    #[arg(long, value_name = "FILE")]
+    csv: Option<std::path::PathBuf>,
 }
 
 /// Runs `evflow run`.
 pub fn main(a: Args) -> Result<()> {
-    let checked = a.graph.load()?;
+    let overrides = a.graph.overrides()?;
+    let axes = a.sweep.iter().map(|s| parse_axis(s).map_err(|e| anyhow!("--sweep {e}"))).collect::<Result<Vec<_>>>()?;
+    let graph = read_graph(&a.graph.file).map_err(|e| anyhow!("{e}"))?;
+    let registry = evflow_nodes::registry();
+    for ax in &axes {
+        if !graph.vars.iter().any(|v| v.name == ax.name) {
+            let help = evflow_engine::suggest::help(&ax.name, graph.vars.iter().map(|v| v.name.as_str()));
+            bail!("--sweep {}: the graph has no variable `{}`; {help}", ax.name, ax.name);
+        }
+    }
+
+    // Validate every run of the sweep before anything is built or written.
+    let runs = points(&graph.sweep, &axes, &overrides);
+    let mut checked: Vec<(Point, Checked)> = Vec::with_capacity(runs.len());
+    for p in runs {
+        let mut o = overrides.clone();
+        o.extend(p.overrides());
+        match check(&graph, &registry, &o) {
+            Ok(c) => checked.push((p, c)),
+            Err(e) if p.values.is_empty() => bail!("{e}"),
+            Err(e) => bail!("sweep run {}: {e}", p.label()),
+        }
+    }
     if !a.quiet {
-        for p in &checked.pruned {
+        for p in &checked[0].1.pruned {
             eprintln!("left out `{}`: {}", p.node, p.reason);
         }
     }
     std::fs::create_dir_all(&a.out).map_err(|e| anyhow!("{}: cannot create output folder: {e}", a.out.display()))?;
-    let opts = PlanOptions {
-        max_block: a.block.max(1),
-        seed: a.seed,
-        base_dir: None,
-        out_dir: Some(a.out.clone()),
-        timing: true,
-    };
-    let mut plan = Plan::build(&checked, &opts).map_err(|e| anyhow!("{e}"))?;
 
     let stop = Arc::new(AtomicBool::new(false));
     {
@@ -59,6 +87,48 @@ pub fn main(a: Args) -> Result<()> {
         // A second Ctrl-C (or a failure to install the handler) falls back to the default.
         let _ = ctrlc::set_handler(move || stop.store(true, Ordering::SeqCst));
     }
+    let sweep = checked.len() > 1;
+    let mut reports: Vec<(Point, RunReport)> = Vec::new();
+    let n = checked.len();
+    for (k, (point, c)) in checked.into_iter().enumerate() {
+        if stop.load(Ordering::Relaxed) {
+            bail!("interrupted after {k} of {n} runs");
+        }
+        if sweep && !a.quiet {
+            println!("── run {}/{n}: {} ──", k + 1, point.label());
+        }
+        let report =
+            run_one(&c, &a, &stop).map_err(|e| if sweep { anyhow!("sweep run {}: {e}", point.label()) } else { e })?;
+        print_report(&report, a.quiet);
+        if sweep && !a.quiet {
+            println!();
+        }
+        reports.push((point, report));
+    }
+    if sweep {
+        print!("{}", sweep_table(&reports));
+    }
+    if let Some(path) = &a.json {
+        std::fs::write(path, report_json(&reports, sweep))
+            .map_err(|e| anyhow!("{}: cannot write results: {e}", path.display()))?;
+    }
+    if let Some(path) = &a.csv {
+        std::fs::write(path, sweep_csv(&reports))
+            .map_err(|e| anyhow!("{}: cannot write table: {e}", path.display()))?;
+    }
+    Ok(())
+}
+
+/// Builds and runs one checked graph; returns its report.
+fn run_one(checked: &Checked, a: &Args, stop: &AtomicBool) -> Result<RunReport> {
+    let opts = PlanOptions {
+        max_block: a.block.max(1),
+        seed: a.seed,
+        base_dir: None,
+        out_dir: Some(a.out.clone()),
+        timing: true,
+    };
+    let mut plan = Plan::build(checked, &opts).map_err(|e| anyhow!("{e}"))?;
     let bar = ProgressBar::with_draw_target(None, ProgressDrawTarget::hidden());
     bar.set_style(
         ProgressStyle::with_template("{spinner} {bar:40} {percent:>3}% {pos}/{len} ticks, {elapsed} (eta {eta})")
@@ -78,77 +148,5 @@ pub fn main(a: Args) -> Result<()> {
     let result = run_offline(&mut plan, RunOptions { duration: a.duration, progress: Some(&mut progress) });
     bar.finish_and_clear();
     let report = result.map_err(|e| anyhow!("{e}"))?;
-    print_report(&report, plan.base_rate(), a.quiet);
-    if let Some(path) = &a.json {
-        std::fs::write(path, report_json(&report, plan.base_rate()))
-            .map_err(|e| anyhow!("{}: cannot write results: {e}", path.display()))?;
-    }
-    Ok(())
-}
-
-/// A value for people: integers as integers, others with six significant digits.
-fn number(v: f64) -> String {
-    if v.fract() == 0.0 && v.abs() < 1e15 {
-        format!("{v:.0}")
-    } else if v != 0.0 && (v.abs() < 1e-3 || v.abs() >= 1e6) {
-        format!("{v:.5e}")
-    } else {
-        let digits = (5 - v.abs().log10().floor() as i32).clamp(0, 9) as usize;
-        format!("{v:.digits$}")
-    }
-}
-
-fn print_report(r: &RunReport, base_rate: f64, quiet: bool) {
-    for (node, s) in &r.summaries {
-        for l in &s.lines {
-            println!("{node}: {l}");
-        }
-        for (k, v, unit) in &s.values {
-            let unit = if unit.is_empty() || unit == "1" { String::new() } else { format!(" {unit}") };
-            println!("{node}: {k} = {}{unit}", number(*v));
-        }
-    }
-    if quiet {
-        return;
-    }
-    let secs = r.elapsed.as_secs_f64();
-    let simulated = r.ticks as f64 / base_rate;
-    println!(
-        "\nran {} ticks ({simulated:.3} s of signal) in {:.3} s: {:.0} ticks/s, {:.0}× real time",
-        r.ticks,
-        secs,
-        r.ticks_per_second(),
-        simulated / secs.max(1e-12)
-    );
-    let total: f64 = r.times.iter().map(|t| t.elapsed.as_secs_f64()).sum::<f64>().max(1e-12);
-    println!("{:<16} {:<16} {:>10} {:>6}", "node", "type", "time", "share");
-    for t in &r.times {
-        let s = t.elapsed.as_secs_f64();
-        println!("{:<16} {:<16} {:>8.3}ms {:>5.1}%", t.node, t.kind, s * 1e3, 100.0 * s / total);
-    }
-}
-
-fn report_json(r: &RunReport, base_rate: f64) -> String {
-    let summaries: serde_json::Map<String, serde_json::Value> = r
-        .summaries
-        .iter()
-        .map(|(node, s)| {
-            let values: serde_json::Map<String, serde_json::Value> =
-                s.values.iter().map(|(k, v, _)| (k.clone(), serde_json::json!(v))).collect();
-            (node.clone(), serde_json::json!({ "values": values, "lines": s.lines }))
-        })
-        .collect();
-    let times: Vec<serde_json::Value> = r
-        .times
-        .iter()
-        .map(|t| serde_json::json!({ "node": t.node, "type": t.kind, "seconds": t.elapsed.as_secs_f64() }))
-        .collect();
-    serde_json::to_string_pretty(&serde_json::json!({
-        "ticks": r.ticks,
-        "base_rate": base_rate,
-        "seconds": r.elapsed.as_secs_f64(),
-        "summaries": summaries,
-        "times": times,
-    }))
-    .unwrap_or_default()
+    Ok(report)
 }

@@ -1,0 +1,161 @@
+//! The `evflow` program end to end: exit codes, what it prints, what it
+//! writes — and that it writes nothing when a graph is wrong.
+
+use std::path::{Path, PathBuf};
+use std::process::{Command, Output};
+
+fn root() -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR")).parent().expect("workspace root").to_path_buf()
+}
+
+fn evflow(args: &[&str]) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_evflow")).args(args).current_dir(root()).output().expect("evflow runs")
+}
+
+fn text(o: &Output) -> (String, String) {
+    (String::from_utf8_lossy(&o.stdout).into_owned(), String::from_utf8_lossy(&o.stderr).into_owned())
+}
+
+fn files_in(dir: &Path) -> Vec<String> {
+    let mut v: Vec<String> = std::fs::read_dir(dir)
+        .map(|r| r.filter_map(|e| e.ok()).map(|e| e.file_name().to_string_lossy().into_owned()).collect())
+        .unwrap_or_default();
+    v.sort();
+    v
+}
+
+#[test]
+fn help_explains_each_command_with_an_example() {
+    for cmd in ["run", "check", "nodes", "dot"] {
+        let o = evflow(&[cmd, "--help"]);
+        let (out, _) = text(&o);
+        assert!(o.status.success(), "{cmd} --help");
+        assert!(out.contains("Example"), "`evflow {cmd} --help` shows no example:\n{out}");
+    }
+    let (out, _) = text(&evflow(&["--help"]));
+    for cmd in ["run", "check", "nodes", "dot"] {
+        assert!(out.contains(cmd), "{out}");
+    }
+}
+
+#[test]
+fn run_writes_its_recording_into_the_output_folder() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().to_str().unwrap();
+    let o = evflow(&["run", "graphs/excitation.toml", "--out", out, "--set", "mass=60"]);
+    let (stdout, stderr) = text(&o);
+    assert!(o.status.success(), "{stderr}");
+    assert!(stdout.contains("wrote excitation-60g-5cms.wav (3066 frames"), "{stdout}");
+    assert!(stdout.contains("ticks/s"), "{stdout}");
+    assert_eq!(files_in(dir.path()), ["excitation-60g-5cms.json", "excitation-60g-5cms.wav"]);
+}
+
+#[test]
+fn a_wrong_graph_names_file_line_and_node_and_writes_nothing() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("out");
+    let o = evflow(&["run", "graphs/excitation.toml", "--out", out.to_str().unwrap(), "--set", "mass=5000"]);
+    let (_, stderr) = text(&o);
+    assert!(!o.status.success());
+    assert!(stderr.contains("graphs/excitation.toml:"), "{stderr}");
+    assert!(stderr.contains("node `tribometer`"), "{stderr}");
+    assert!(stderr.contains("outside its limits"), "{stderr}");
+    assert!(!out.exists(), "an invalid graph created its output folder");
+
+    let bad = dir.path().join("bad.toml");
+    std::fs::write(
+        &bad,
+        "[graph]\nformat = 1\nname = \"bad\"\nrate = 1000\nconnections = [\"s.out -> k.in\"]\n\
+         [nodes.s]\ntype = \"sinus\"\n[nodes.k]\ntype = \"stats\"\n",
+    )
+    .unwrap();
+    let o = evflow(&["check", bad.to_str().unwrap()]);
+    let (_, stderr) = text(&o);
+    assert!(!o.status.success());
+    assert!(stderr.contains("bad.toml:7"), "{stderr}");
+    assert!(stderr.contains("unknown node type `sinus`"), "{stderr}");
+    assert!(stderr.contains("did you mean `sine`?"), "{stderr}");
+}
+
+#[test]
+fn a_sweep_runs_every_combination_and_tabulates_it() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().to_str().unwrap();
+    let csv = dir.path().join("grid.csv");
+    let o = evflow(&[
+        "sweep",
+        "graphs/excitation.toml",
+        "--out",
+        out,
+        "--sweep",
+        "mass=60,110",
+        "--sweep",
+        "speed=3,5",
+        "--csv",
+        csv.to_str().unwrap(),
+        "--quiet",
+    ]);
+    let (stdout, stderr) = text(&o);
+    assert!(o.status.success(), "{stderr}");
+    for name in ["60g-3cms", "60g-5cms", "110g-3cms", "110g-5cms"] {
+        assert!(dir.path().join(format!("excitation-{name}.wav")).exists(), "{name}: {stdout}");
+    }
+    let table = std::fs::read_to_string(&csv).unwrap();
+    let lines: Vec<&str> = table.lines().collect();
+    assert_eq!(lines.len(), 5, "{table}");
+    assert!(lines[0].starts_with("mass,speed,"), "{table}");
+    assert!(lines[1].starts_with("60,3,") && lines[4].starts_with("110,5,"), "{table}");
+
+    // A bad value anywhere in the sweep stops it before anything is written.
+    let dir2 = tempfile::tempdir().unwrap();
+    let o =
+        evflow(&["run", "graphs/excitation.toml", "--out", dir2.path().to_str().unwrap(), "--sweep", "mass=60,5000"]);
+    let (_, stderr) = text(&o);
+    assert!(!o.status.success());
+    assert!(stderr.contains("sweep run mass=5000"), "{stderr}");
+    assert!(files_in(dir2.path()).is_empty());
+}
+
+#[test]
+fn check_prints_the_plan_and_what_was_left_out() {
+    let dir = tempfile::tempdir().unwrap();
+    let g = dir.path().join("g.toml");
+    std::fs::write(
+        &g,
+        "[graph]\nformat = 1\nname = \"g\"\nrate = 1000\n\
+         connections = [\"s.out -> k.in\", \"s.out -> unused.in\"]\n\
+         [nodes.s]\ntype = \"sine\"\nfrequency = 10.0\n[nodes.k]\ntype = \"stats\"\n\
+         [nodes.unused]\ntype = \"gain\"\n",
+    )
+    .unwrap();
+    let o = evflow(&["check", g.to_str().unwrap()]);
+    let (stdout, stderr) = text(&o);
+    assert!(o.status.success(), "{stderr}");
+    assert!(stdout.contains("unused"), "{stdout}");
+    assert!(stdout.contains("1000"), "{stdout}");
+}
+
+#[test]
+fn nodes_lists_and_describes_node_types() {
+    let (out, _) = text(&evflow(&["nodes"]));
+    for t in ["prbs", "butterworth", "sim.display", "recording.out", "metric"] {
+        assert!(out.contains(t), "{out}");
+    }
+    let o = evflow(&["nodes", "butterworth"]);
+    let (out, _) = text(&o);
+    assert!(o.status.success());
+    assert!(out.contains("cutoff") && out.contains("Hz"), "{out}");
+    let o = evflow(&["nodes", "buterworth"]);
+    let (_, err) = text(&o);
+    assert!(!o.status.success());
+    assert!(err.contains("did you mean `butterworth`?"), "{err}");
+}
+
+#[test]
+fn dot_prints_graphviz() {
+    let o = evflow(&["dot", "graphs/excitation.toml"]);
+    let (out, _) = text(&o);
+    assert!(o.status.success());
+    assert!(out.starts_with("digraph"), "{out}");
+    assert!(out.contains("tribometer") && out.contains("->"), "{out}");
+}

@@ -1,0 +1,5 @@
+//! The library half of the `evflow` program: what its commands share with
+//! tests and benchmarks — plots for reports.
+#![deny(missing_docs)]
+
+pub mod plot;

@@ -1,0 +1,305 @@
+//! PNG line and scatter plots for reports (work-precision diagrams, spectra,
+//! fits), drawn with plotters.
+//!
+//! Text needs a TrueType font. evflow ships none: it uses the first of
+//! `$EVFLOW_FONT` and the usual system paths of DejaVu Sans, Liberation Sans
+//! and Noto Sans (Debian: `apt install fonts-dejavu-core`). Without one the
+//! plot is still drawn — axes, grid and series — without its text, and
+//! [`Written::labelled`] says so.
+
+use plotters::prelude::*;
+use std::path::{Path, PathBuf};
+use std::sync::OnceLock;
+
+/// How a series is drawn.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Style {
+    /// Points joined by a line.
+    Line,
+    /// Points only.
+    Points,
+    /// Points joined by a line, each marked.
+    LinePoints,
+}
+
+/// One named series of (x, y) points.
+#[derive(Debug, Clone)]
+pub struct Series {
+    /// Legend entry.
+    pub name: String,
+    /// The points; non-finite ones (and non-positive ones on a log axis) are
+    /// left out.
+    pub points: Vec<(f64, f64)>,
+    /// How it is drawn.
+    pub style: Style,
+}
+
+impl Series {
+    /// A series drawn with a line.
+    pub fn line(name: impl Into<String>, points: Vec<(f64, f64)>) -> Self {
+        Self { name: name.into(), points, style: Style::Line }
+    }
+    /// A series drawn as marked points joined by a line.
+    pub fn line_points(name: impl Into<String>, points: Vec<(f64, f64)>) -> Self {
+        Self { name: name.into(), points, style: Style::LinePoints }
+    }
+    /// A series drawn as points.
+    pub fn points(name: impl Into<String>, points: Vec<(f64, f64)>) -> Self {
+        Self { name: name.into(), points, style: Style::Points }
+    }
+}
+
+/// A plot: title, axis labels and scales, series.
+#[derive(Debug, Clone, Default)]
+pub struct Plot {
+    /// Title above the plot.
+    pub title: String,
+    /// Label of the x axis, with its unit.
+    pub x_label: String,
+    /// Label of the y axis, with its unit.
+    pub y_label: String,
+    /// Logarithmic x axis.
+    pub log_x: bool,
+    /// Logarithmic y axis.
+    pub log_y: bool,
+    /// The series.
+    pub series: Vec<Series>,
+}
+
+/// What was written.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Written {
+    /// The PNG file.
+    pub path: PathBuf,
+    /// Whether a font was found for the text.
+    pub labelled: bool,
+}
+
+/// Why a plot could not be written.
+#[derive(Debug, thiserror::Error)]
+pub enum PlotError {
+    /// No series holds a point that can be drawn.
+    #[error("{path}: nothing to plot (no finite point{log})", log = if *.log { " above 0 on a log axis" } else { "" })]
+    Empty {
+        /// The file that was to be written.
+        path: String,
+        /// Whether an axis was logarithmic.
+        log: bool,
+    },
+    /// Drawing or writing failed.
+    #[error("{path}: cannot draw the plot: {message}")]
+    Draw {
+        /// The file.
+        path: String,
+        /// What went wrong.
+        message: String,
+    },
+}
+
+const SIZE: (u32, u32) = (960, 640);
+const FONT: &str = "evflow-sans";
+
+/// Registers a system font once; whether one was found.
+fn font() -> bool {
+    static FOUND: OnceLock<bool> = OnceLock::new();
+    *FOUND.get_or_init(|| {
+        let mut candidates: Vec<PathBuf> = std::env::var_os("EVFLOW_FONT").map(PathBuf::from).into_iter().collect();
+        candidates.extend(
+            [
+                "/usr/share/fonts/truetype/dejavu/DejaVuSans.ttf",
+                "/usr/share/fonts/TTF/DejaVuSans.ttf",
+                "/usr/share/fonts/dejavu/DejaVuSans.ttf",
+                "/usr/share/fonts/truetype/liberation/LiberationSans-Regular.ttf",
+                "/usr/share/fonts/truetype/noto/NotoSans-Regular.ttf",
+                "/Library/Fonts/Arial.ttf",
+                "/System/Library/Fonts/Supplemental/Arial.ttf",
+                "C:\\Windows\\Fonts\\arial.ttf",
+            ]
+            .iter()
+            .map(PathBuf::from),
+        );
+        candidates.into_iter().any(|p| match std::fs::read(&p) {
+            // Fonts live for the whole program: plotters keeps a reference.
+            Ok(bytes) => {
+                plotters::style::register_font(FONT, FontStyle::Normal, Box::leak(bytes.into_boxed_slice())).is_ok()
+            }
+            Err(_) => false,
+        })
+    })
+}
+
+/// The drawable points of a series.
+fn drawable(s: &Series, log_x: bool, log_y: bool) -> Vec<(f64, f64)> {
+    s.points
+        .iter()
+        .copied()
+        .filter(|(x, y)| x.is_finite() && y.is_finite() && (!log_x || *x > 0.0) && (!log_y || *y > 0.0))
+        .collect()
+}
+
+/// The axis range covering `v`, padded, never empty.
+fn range(v: impl Iterator<Item = f64>, log: bool) -> (f64, f64) {
+    let (lo, hi) = v.fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), x| (a.min(x), b.max(x)));
+    if log {
+        let (lo, hi) = (lo.log10(), hi.log10());
+        let pad = ((hi - lo) * 0.05).max(0.05);
+        (10f64.powf(lo - pad), 10f64.powf(hi + pad))
+    } else {
+        let pad = ((hi - lo) * 0.05).max(hi.abs().max(lo.abs()) * 0.05).max(1e-12);
+        (lo - pad, hi + pad)
+    }
+}
+
+/// A colour per series, distinct for the first ten.
+fn colour(i: usize) -> RGBColor {
+    const C: [(u8, u8, u8); 10] = [
+        (31, 119, 180),
+        (255, 127, 14),
+        (44, 160, 44),
+        (214, 39, 40),
+        (148, 103, 189),
+        (140, 86, 75),
+        (227, 119, 194),
+        (127, 127, 127),
+        (188, 189, 34),
+        (23, 190, 207),
+    ];
+    let (r, g, b) = C[i % C.len()];
+    RGBColor(r, g, b)
+}
+
+/// Draws `plot` into `path` (PNG, 960×640). Written to a temporary file and
+/// renamed, so a failure leaves no half-written image.
+pub fn write_png(plot: &Plot, path: &Path) -> Result<Written, PlotError> {
+    let shown = path.display().to_string();
+    let series: Vec<(usize, &Series, Vec<(f64, f64)>)> =
+        plot.series.iter().enumerate().map(|(i, s)| (i, s, drawable(s, plot.log_x, plot.log_y))).collect();
+    if series.iter().all(|(_, _, p)| p.is_empty()) {
+        return Err(PlotError::Empty { path: shown, log: plot.log_x || plot.log_y });
+    }
+    let all = || series.iter().flat_map(|(_, _, p)| p.iter().copied());
+    let xr = range(all().map(|p| p.0), plot.log_x);
+    let yr = range(all().map(|p| p.1), plot.log_y);
+    let labelled = font();
+    let tmp = path.with_extension("tmp.png");
+    if let Some(dir) = path.parent().filter(|d| !d.as_os_str().is_empty()) {
+        std::fs::create_dir_all(dir)
+            .map_err(|e| PlotError::Draw { path: shown.clone(), message: format!("cannot create its folder: {e}") })?;
+    }
+    let drawn = draw(plot, &series, xr, yr, labelled, &tmp);
+    let result = drawn.and_then(|()| std::fs::rename(&tmp, path).map_err(|e| e.to_string()));
+    if let Err(message) = result {
+        let _ = std::fs::remove_file(&tmp);
+        return Err(PlotError::Draw { path: shown, message });
+    }
+    Ok(Written { path: path.to_path_buf(), labelled })
+}
+
+type Pts<'a> = [(usize, &'a Series, Vec<(f64, f64)>)];
+
+fn draw(plot: &Plot, series: &Pts<'_>, xr: (f64, f64), yr: (f64, f64), text: bool, tmp: &Path) -> Result<(), String> {
+    let root = BitMapBackend::new(tmp, SIZE).into_drawing_area();
+    root.fill(&WHITE).map_err(|e| e.to_string())?;
+    match (plot.log_x, plot.log_y) {
+        (false, false) => body(&root, plot, series, (xr.0..xr.1, yr.0..yr.1), text),
+        (true, false) => body(&root, plot, series, ((xr.0..xr.1).log_scale(), yr.0..yr.1), text),
+        (false, true) => body(&root, plot, series, (xr.0..xr.1, (yr.0..yr.1).log_scale()), text),
+        (true, true) => body(&root, plot, series, ((xr.0..xr.1).log_scale(), (yr.0..yr.1).log_scale()), text),
+    }?;
+    root.present().map_err(|e| e.to_string())
+}
+
+fn body<X, Y>(
+    root: &DrawingArea<BitMapBackend<'_>, plotters::coord::Shift>,
+    plot: &Plot,
+    series: &Pts<'_>,
+    (x, y): (X, Y),
+    text: bool,
+) -> Result<(), String>
+where
+    X: plotters::coord::ranged1d::AsRangedCoord<Value = f64>,
+    Y: plotters::coord::ranged1d::AsRangedCoord<Value = f64>,
+    X::CoordDescType: plotters::coord::ranged1d::ValueFormatter<f64>,
+    Y::CoordDescType: plotters::coord::ranged1d::ValueFormatter<f64>,
+{
+    let mut b = ChartBuilder::on(root);
+    b.margin(20);
+    if text {
+        b.caption(&plot.title, (FONT, 24)).x_label_area_size(50).y_label_area_size(80);
+    } else {
+        b.x_label_area_size(10).y_label_area_size(10);
+    }
+    let mut chart = b.build_cartesian_2d(x, y).map_err(|e| e.to_string())?;
+    let mut mesh = chart.configure_mesh();
+    if text {
+        mesh.x_desc(&plot.x_label).y_desc(&plot.y_label).label_style((FONT, 16));
+    } else {
+        mesh.x_labels(0).y_labels(0);
+    }
+    mesh.draw().map_err(|e| e.to_string())?;
+    for (i, s, pts) in series {
+        let c = colour(*i);
+        if matches!(s.style, Style::Line | Style::LinePoints) {
+            let a = chart
+                .draw_series(LineSeries::new(pts.iter().copied(), c.stroke_width(2)))
+                .map_err(|e| e.to_string())?;
+            if text {
+                a.label(&s.name).legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], c.stroke_width(2)));
+            }
+        }
+        if matches!(s.style, Style::Points | Style::LinePoints) {
+            let a = chart.draw_series(pts.iter().map(|&p| Circle::new(p, 4, c.filled()))).map_err(|e| e.to_string())?;
+            if text && s.style == Style::Points {
+                a.label(&s.name).legend(move |(x, y)| Circle::new((x + 10, y), 4, c.filled()));
+            }
+        }
+    }
+    if text && series.len() > 1 {
+        chart
+            .configure_series_labels()
+            .label_font((FONT, 16))
+            .background_style(WHITE.mix(0.85))
+            .border_style(BLACK)
+            .draw()
+            .map_err(|e| e.to_string())?;
+    }
+    Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn writes_a_png_and_nothing_else() {
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("wp.png");
+        let plot = Plot {
+            title: "work-precision".into(),
+            x_label: "run time (s)".into(),
+            y_label: "error".into(),
+            log_x: true,
+            log_y: true,
+            series: vec![
+                Series::line_points("exact", (1..8).map(|k| (k as f64 * 1e-3, 10f64.powi(-k))).collect()),
+                Series::points("rk4", vec![(1e-3, 1e-2), (f64::NAN, 1.0), (0.0, 1.0)]),
+            ],
+        };
+        let w = write_png(&plot, &path).unwrap();
+        let bytes = std::fs::read(&w.path).unwrap();
+        assert_eq!(&bytes[..8], b"\x89PNG\r\n\x1a\n");
+        let names: Vec<_> = std::fs::read_dir(dir.path()).unwrap().map(|e| e.unwrap().file_name()).collect();
+        assert_eq!(names, vec![std::ffi::OsString::from("wp.png")]);
+    }
+
+    #[test]
+    fn nothing_to_plot_is_an_error_and_writes_nothing() {
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("e.png");
+        let plot =
+            Plot { log_y: true, series: vec![Series::line("s", vec![(1.0, 0.0), (2.0, -1.0)])], ..Plot::default() };
+        let e = write_png(&plot, &path).unwrap_err();
+        assert!(e.to_string().contains("nothing to plot"), "{e}");
+        assert!(!path.exists());
+    }
+}

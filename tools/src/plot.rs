@@ -172,7 +172,7 @@ fn colour(i: usize) -> RGBColor {
 /// renamed, so a failure leaves no half-written image.
 pub fn write_png(plot: &Plot, path: &Path) -> Result<Written, PlotError> {
     let shown = path.display().to_string();
-    let series: Vec<(usize, &Series, Vec<(f64, f64)>)> =
+    let series: Vec<Drawable<'_>> =
         plot.series.iter().enumerate().map(|(i, s)| (i, s, drawable(s, plot.log_x, plot.log_y))).collect();
     if series.iter().all(|(_, _, p)| p.is_empty()) {
         return Err(PlotError::Empty { path: shown, log: plot.log_x || plot.log_y });
@@ -195,7 +195,9 @@ pub fn write_png(plot: &Plot, path: &Path) -> Result<Written, PlotError> {
     Ok(Written { path: path.to_path_buf(), labelled })
 }
 
-type Pts<'a> = [(usize, &'a Series, Vec<(f64, f64)>)];
+/// A series with its index (for its colour) and its drawable points.
+type Drawable<'a> = (usize, &'a Series, Vec<(f64, f64)>);
+type Pts<'a> = [Drawable<'a>];
 
 fn draw(plot: &Plot, series: &Pts<'_>, xr: (f64, f64), yr: (f64, f64), text: bool, tmp: &Path) -> Result<(), String> {
     let root = BitMapBackend::new(tmp, SIZE).into_drawing_area();

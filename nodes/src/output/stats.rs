@@ -21,7 +21,8 @@ pub static SPEC: NodeSpec = NodeSpec::new(
 .ports(&[PortSpec::input("in", "1", "the stream to summarize").at(evflow_engine::RateSpec::Any)])
 .example("");
 
-/// Compensated sum (Neumaier's variant of Kahan summation).
+/// Compensated sum (Kahan–Babuška–Neumaier: the error of every addition is
+/// kept and added at the end).
 #[derive(Default, Clone, Copy)]
 struct Sum {
     s: f64,
@@ -29,14 +30,14 @@ struct Sum {
 }
 
 impl Sum {
+    /// Adds `x`, keeping the rounding error of the addition exactly
+    /// (Knuth's branch-free TwoSum, the same error term as Neumaier's test on
+    /// |s| ≥ |x| without its branch, which random data would mispredict).
     #[inline]
     fn add(&mut self, x: f64) {
         let t = self.s + x;
-        if self.s.abs() >= x.abs() {
-            self.c += (self.s - t) + x;
-        } else {
-            self.c += (x - t) + self.s;
-        }
+        let bp = t - self.s;
+        self.c += (self.s - (t - bp)) + (x - bp);
         self.s = t;
     }
     fn value(&self) -> f64 {

@@ -90,7 +90,9 @@ steps and after no proper divisor, by GF(2) matrix powers).",
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 struct Lfsr {
     reg: u32,
-    feedback: u32,
+    /// Bit positions of the taps (lag − 1); rows with two taps repeat one
+    /// position twice in the last two slots, where the two cancel in the XOR.
+    shifts: [u32; 4],
     top: u32,
     full: u32,
 }
@@ -99,14 +101,21 @@ impl Lfsr {
     /// A register of the row's order, started at all −1 (all ones), as `idinput`.
     fn new(taps: &Taps) -> Self {
         let full = (1u32 << taps.order) - 1;
-        Self { reg: full, feedback: taps.mask(), top: 1 << (taps.order - 1), full }
+        let mut shifts = [0; 4];
+        for (s, &t) in shifts.iter_mut().zip(taps.lags) {
+            *s = t - 1;
+        }
+        Self { reg: full, shifts, top: 1 << (taps.order - 1), full }
     }
 
     /// Shifts once; returns the value that leaves the register (`true` = −1).
     #[inline]
     fn next(&mut self) -> bool {
         let out = self.reg & self.top != 0;
-        let fb = (self.reg & self.feedback).count_ones() & 1;
+        let r = self.reg;
+        let [a, b, c, d] = self.shifts;
+        // The parity of the tapped bits: the product of ±1 values in GF(2).
+        let fb = ((r >> a) ^ (r >> b) ^ (r >> c) ^ (r >> d)) & 1;
         self.reg = ((self.reg << 1) | fb) & self.full;
         out
     }
@@ -150,11 +159,22 @@ fn build(p: &Params, _: &BuildContext) -> Result<Box<dyn Node>, NodeError> {
 
 impl Node for Prbs {
     fn process(&mut self, io: &mut Io<'_>) -> Result<(), NodeError> {
-        for y in io.output(0).iter_mut() {
-            if self.pos >= self.total {
-                *y = 0.0;
-                continue;
+        let out = io.output(0);
+        let live = (out.len() as u64).min(self.total - self.pos.min(self.total)) as usize;
+        let (out, past_end) = out.split_at_mut(live);
+        past_end.fill(0.0);
+        if self.clock == 1 {
+            // One chip per sample: no hold bookkeeping.
+            // The sign bit is flipped without a branch: the chips are random,
+            // so a branch would be mispredicted half of the time.
+            let level = self.level.to_bits();
+            for y in out.iter_mut() {
+                *y = f64::from_bits(level ^ (u64::from(self.lfsr.next()) << 63));
             }
+            self.pos += live as u64;
+            return Ok(());
+        }
+        for y in out.iter_mut() {
             if self.held == 0 {
                 self.value = if self.lfsr.next() { -self.level } else { self.level };
             }

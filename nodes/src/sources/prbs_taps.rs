@@ -140,6 +140,8 @@ mod tests {
             assert!(t.lags.windows(2).all(|w| w[0] < w[1]), "order {}: lags not ascending", t.order);
             assert_eq!(*t.lags.last().unwrap(), t.order, "order {}: the last lag must be n", t.order);
             assert!(t.lags.len() % 2 == 0, "order {}: an odd number of taps cannot be maximal", t.order);
+            // The generator XORs exactly four shifted copies (two cancelling for two taps).
+            assert!(t.lags.len() == 2 || t.lags.len() == 4, "order {}: the generator takes two or four taps", t.order);
             assert_eq!(t.mask().count_ones() as usize, t.lags.len());
         }
         assert_eq!(taps(9).unwrap().lags, &[4, 9]);

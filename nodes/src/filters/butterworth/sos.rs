@@ -10,9 +10,12 @@
 //! s2 = b2·x − a2·y
 //! ```
 //!
-//! A block is run section by section over the whole block; each sample goes
-//! through exactly the same operations as when the cascade is run one sample
-//! at a time, so block and per-sample processing give identical bits.
+//! A block is run two sections at a time over the whole block (the second
+//! section of sample n overlaps the first of sample n + 1 in the processor's
+//! pipeline, which hides the latency of each section's recursion); each
+//! sample goes through exactly the same operations as when the cascade is
+//! run one sample at a time, so block and per-sample processing give
+//! identical bits.
 
 use super::design::Section;
 
@@ -65,7 +68,14 @@ impl Cascade {
         let n = x.len().min(y.len());
         let y = &mut y[..n];
         y.copy_from_slice(&x[..n]);
-        for s in &mut self.stages {
+        let mut pairs = self.stages.chunks_exact_mut(2);
+        for pair in &mut pairs {
+            let [a, b] = pair else { unreachable!("chunks of two") };
+            for v in y.iter_mut() {
+                *v = b.tick(a.tick(*v));
+            }
+        }
+        for s in pairs.into_remainder() {
             for v in y.iter_mut() {
                 *v = s.tick(*v);
             }

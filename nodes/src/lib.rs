@@ -5,8 +5,10 @@
 //! gathers them for the loader, the validator, `evflow nodes` and the docs.
 #![deny(missing_docs)]
 
+pub mod analysis;
 pub mod filters;
 pub mod lab;
+pub mod math;
 pub mod metric;
 pub mod output;
 pub mod recording;
@@ -31,6 +33,8 @@ pub fn all_specs() -> Vec<&'static NodeSpec> {
     v.extend_from_slice(output::SPECS);
     v.extend_from_slice(recording::SPECS);
     v.extend_from_slice(metric::SPECS);
+    v.extend_from_slice(math::SPECS);
+    v.extend_from_slice(analysis::SPECS);
     v.extend_from_slice(lab::SPECS);
     v
 }

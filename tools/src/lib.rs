@@ -2,4 +2,5 @@
 //! tests and benchmarks — plots for reports.
 #![deny(missing_docs)]
 
+pub mod fit;
 pub mod plot;

@@ -166,6 +166,35 @@ pub fn check(graph: &Graph, registry: &Registry, overrides: &[Override]) -> Resu
         }
     }
 
+    // Plots name variables, nodes' reported values or run times.
+    for p in &graph.plots {
+        let known = |q: &str| -> bool {
+            q == "seconds"
+                || graph.vars.iter().any(|v| v.name == q)
+                || q.split_once('.').is_some_and(|(n, v)| !v.is_empty() && graph.nodes.iter().any(|d| d.name == n))
+        };
+        for q in std::iter::once(&p.x).chain(&p.y) {
+            if !known(q) {
+                let names =
+                    graph.vars.iter().map(|v| v.name.as_str()).chain(graph.nodes.iter().map(|n| n.name.as_str()));
+                let help = format!(
+                    "a quantity is a graph variable, `NODE.VALUE` (a value the node reports), `NODE.time` or `seconds`; {}",
+                    suggest::help(q.split('.').next().unwrap_or(q), names)
+                );
+                sink.err(p.loc, None, format!("plot `{}`: unknown quantity `{q}`", p.file), Some(help));
+            }
+        }
+        if !p.series.is_empty() && !graph.vars.iter().any(|v| v.name == p.series) {
+            let help = suggest::help(&p.series, graph.vars.iter().map(|v| v.name.as_str()));
+            sink.err(
+                p.loc,
+                None,
+                format!("plot `{}`: `series` names no graph variable `{}`", p.file, p.series),
+                Some(help),
+            );
+        }
+    }
+
     // Names.
     for (i, n) in graph.nodes.iter().enumerate() {
         if graph.nodes[..i].iter().any(|m| m.name == n.name) {

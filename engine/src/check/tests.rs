@@ -370,3 +370,39 @@ fn text_parameters_interpolate_variables() {
     let d = one_error(&text.replace("${mode}", "${mode"));
     assert!(d.message.contains("without its closing"), "{}", d.message);
 }
+
+const PLOTTED: &str = r#"
+[[plot]]
+file = "cut.png"
+x = "cut"
+y = ["sink.rms", "f.time"]
+fit = "quadratic"
+log_y = true
+"#;
+
+#[test]
+fn plots_parse_check_and_round_trip() {
+    let text = GOOD.replace("[nodes.src]", &format!("{PLOTTED}\n[nodes.src]"));
+    let g = parse_graph(Path::new("g.toml"), &text).unwrap();
+    assert_eq!(g.plots.len(), 1);
+    assert_eq!(g.plots[0].y, ["sink.rms", "f.time"]);
+    assert_eq!(g.plots[0].fit, crate::graph::Fit::Quadratic);
+    assert!(check(&g, &registry(), &[]).is_ok());
+    let saved = g.to_toml();
+    let g2 = parse_graph(Path::new("g.toml"), &saved).unwrap();
+    assert_eq!(g.without_locations(), g2.without_locations());
+
+    let d = one_error(&text.replace("\"sink.rms\"", "\"snk.rms\""));
+    assert!(d.message.contains("unknown quantity `snk.rms`"), "{}", d.message);
+    assert!(d.help.unwrap_or_default().contains("sink"));
+    let d = one_error(&text.replace("fit = \"quadratic\"", "fit = \"cubic\""));
+    assert!(d.message.contains("not a known fit"), "{}", d.message);
+    let d = one_error(&text.replace("cut.png", "cut.svg"));
+    assert!(d.message.contains("must end in .png"), "{}", d.message);
+    let d = one_error(&text.replace("x = \"cut\"\n", ""));
+    assert!(d.message.contains("plot without `x`"), "{}", d.message);
+    let d = one_error(&text.replace("log_y = true", "log_y = true\nseries = \"kind\""));
+    assert!(d.message.contains("`series` names no graph variable"), "{}", d.message);
+    let d = one_error(&text.replace("log_y = true", "logy = true"));
+    assert!(d.message.contains("unknown plot key `logy`"), "{}", d.message);
+}

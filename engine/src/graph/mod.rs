@@ -7,7 +7,9 @@ mod parse;
 
 pub use parse::parse_cli_value;
 pub(crate) use parse::valid_name as valid_port_name;
+pub mod plot;
 mod save;
+pub use plot::{Fit, PlotDecl};
 
 pub use parse::parse_graph;
 
@@ -40,6 +42,8 @@ pub struct Graph {
     pub vars: Vec<Var>,
     /// Sweep axes (`[sweep]`): a run covers every combination of their values.
     pub sweep: Vec<Axis>,
+    /// Figures drawn from the results (`[[plot]]`).
+    pub plots: Vec<PlotDecl>,
     /// Nodes in file order.
     pub nodes: Vec<NodeDecl>,
     /// Connections in file order.
@@ -136,6 +140,7 @@ impl Graph {
             seed: 0,
             vars: Vec::new(),
             sweep: Vec::new(),
+            plots: Vec::new(),
             nodes: Vec::new(),
             connections: Vec::new(),
             loc: Loc::default(),
@@ -180,6 +185,9 @@ impl Graph {
         }
         for a in &mut g.sweep {
             a.loc = Loc::default();
+        }
+        for p in &mut g.plots {
+            p.loc = Loc::default();
         }
         for n in &mut g.nodes {
             n.loc = Loc::default();

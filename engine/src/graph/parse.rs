@@ -8,7 +8,9 @@ use std::path::Path;
 use toml::de::{DeTable, DeValue};
 use toml::Spanned;
 
-const TOP_KEYS: [&str; 4] = ["graph", "vars", "sweep", "nodes"];
+const TOP_KEYS: [&str; 5] = ["graph", "vars", "sweep", "plot", "nodes"];
+
+mod plot;
 const GRAPH_KEYS: [&str; 7] = ["format", "name", "description", "rate", "duration", "seed", "connections"];
 
 struct Ctx<'t> {
@@ -83,6 +85,9 @@ pub fn parse_graph(file: &Path, text: &str) -> Result<Graph, Diagnostics> {
     }
     if let Some(v) = root.get_ref().get("sweep") {
         read_sweep(&mut cx, v, &mut g);
+    }
+    if let Some(v) = root.get_ref().get("plot") {
+        plot::read_plots(&mut cx, v, &mut g);
     }
     if let Some(v) = root.get_ref().get("nodes") {
         match v.get_ref() {

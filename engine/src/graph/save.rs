@@ -39,6 +39,28 @@ impl Graph {
                 let _ = writeln!(s, "{} = [{}]", key(&a.name), values.join(", "));
             }
         }
+        for p in &self.plots {
+            let _ = writeln!(s, "\n[[plot]]");
+            let _ = writeln!(s, "file = {}", toml_string(&p.file));
+            if !p.title.is_empty() {
+                let _ = writeln!(s, "title = {}", toml_string(&p.title));
+            }
+            let _ = writeln!(s, "x = {}", toml_string(&p.x));
+            let ys: Vec<String> = p.y.iter().map(|y| toml_string(y)).collect();
+            let _ = writeln!(s, "y = [{}]", ys.join(", "));
+            if !p.series.is_empty() {
+                let _ = writeln!(s, "series = {}", toml_string(&p.series));
+            }
+            if p.log_x {
+                let _ = writeln!(s, "log_x = true");
+            }
+            if p.log_y {
+                let _ = writeln!(s, "log_y = true");
+            }
+            if p.fit != super::plot::Fit::None {
+                let _ = writeln!(s, "fit = {}", toml_string(p.fit.name()));
+            }
+        }
         for n in &self.nodes {
             let _ = writeln!(s, "\n[nodes.{}]", key(&n.name));
             let _ = writeln!(s, "type = {}", toml_string(&n.kind));

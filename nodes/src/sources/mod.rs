@@ -4,9 +4,10 @@
 
 pub mod prbs;
 pub mod prbs_taps;
+pub mod pulse;
 pub mod sine;
 
 use evflow_engine::NodeSpec;
 
 /// The node types of this family.
-pub static SPECS: &[&NodeSpec] = &[&prbs::SPEC, &sine::SPEC];
+pub static SPECS: &[&NodeSpec] = &[&prbs::SPEC, &sine::SPEC, &pulse::SPEC];

@@ -5,4 +5,5 @@ pub mod dot;
 pub mod graph_args;
 pub mod nodes;
 pub mod run;
+pub mod run_plots;
 pub mod run_report;

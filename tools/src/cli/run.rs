@@ -112,6 +112,13 @@ pub fn main(a: Args) -> Result<()> {
         std::fs::write(path, report_json(&reports, sweep))
             .map_err(|e| anyhow!("{}: cannot write results: {e}", path.display()))?;
     }
+    let (lines, errors) = super::run_plots::draw_plots(&graph, &reports, &overrides, &a.out);
+    for l in lines {
+        println!("{l}");
+    }
+    if let Some(e) = errors.first() {
+        bail!("{e}");
+    }
     if let Some(path) = &a.csv {
         std::fs::write(path, sweep_csv(&reports))
             .map_err(|e| anyhow!("{}: cannot write table: {e}", path.display()))?;

@@ -116,8 +116,9 @@ pub fn main(a: Args) -> Result<()> {
     for l in lines {
         println!("{l}");
     }
-    if let Some(e) = errors.first() {
-        bail!("{e}");
+    // A figure that cannot be drawn does not undo the runs: say why and go on.
+    for e in errors {
+        eprintln!("warning: {e}");
     }
     if let Some(path) = &a.csv {
         std::fs::write(path, sweep_csv(&reports))

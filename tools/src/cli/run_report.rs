@@ -136,7 +136,8 @@ pub fn sweep_table(runs: &[(Point, RunReport)]) -> String {
     s
 }
 
-/// A sweep as CSV (full precision).
+/// A sweep as CSV (full precision), with every node's run time in seconds
+/// (`NODE.time` columns) after the reported values.
 pub fn sweep_csv(runs: &[(Point, RunReport)]) -> String {
     let cols = columns(runs);
     let quote =
@@ -145,11 +146,19 @@ pub fn sweep_csv(runs: &[(Point, RunReport)]) -> String {
         runs.first().map(|(p, _)| p.values.iter().map(|(k, _)| quote(k)).collect()).unwrap_or_default();
     head.extend(cols.iter().map(|(n, c)| quote(&format!("{n}.{c}"))));
     head.push("seconds".into());
+    // Run time of every node, for work-precision tables.
+    let nodes: Vec<String> =
+        runs.first().map(|(_, r)| r.times.iter().map(|t| t.node.clone()).collect()).unwrap_or_default();
+    head.extend(nodes.iter().map(|n| quote(&format!("{n}.time"))));
     let mut s = head.join(",") + "\n";
     for (p, r) in runs {
         let mut row: Vec<String> = p.values.iter().map(|(_, v)| quote(&text_of(v))).collect();
         row.extend(cols.iter().map(|(n, c)| r.value(n, c).map(|v| format!("{v}")).unwrap_or_default()));
         row.push(format!("{}", r.elapsed.as_secs_f64()));
+        for n in &nodes {
+            let t = r.times.iter().find(|t| &t.node == n).map(|t| t.elapsed.as_secs_f64());
+            row.push(t.map(|t| format!("{t}")).unwrap_or_default());
+        }
         s.push_str(&row.join(","));
         s.push('\n');
     }

@@ -149,6 +149,19 @@ impl Single<'_> {
         Ok(outs)
     }
 
+    /// Runs the node for `ticks` base ticks, finishes the run and returns
+    /// what the node reported (for sinks).
+    pub fn summary(&self) -> Result<crate::node::Summary, String> {
+        let (mut plan, out_index) = self.plan()?;
+        self.collect(&mut plan, &out_index)?;
+        let summaries = plan.finish().map_err(|e| e.to_string())?;
+        summaries
+            .into_iter()
+            .find(|(n, _)| n == "dut")
+            .map(|(_, s)| s)
+            .ok_or_else(|| "the node reported nothing".into())
+    }
+
     /// Runs `ticks` base ticks of an already built plan (from [`Single::plan`])
     /// and returns each collected output, without finishing the plan.
     pub fn collect(&self, plan: &mut Plan, out_index: &[usize]) -> Result<Vec<Vec<f64>>, String> {

@@ -122,6 +122,10 @@ impl Summary {
         self.values.push((name.to_string(), v, unit.to_string()));
         self
     }
+    /// A value by name.
+    pub fn get(&self, name: &str) -> Option<f64> {
+        self.values.iter().find(|(k, _, _)| k == name).map(|(_, v, _)| *v)
+    }
     /// Adds a line.
     pub fn line(mut self, l: impl Into<String>) -> Self {
         self.lines.push(l.into());

@@ -13,6 +13,7 @@ pub mod metric;
 pub mod output;
 pub mod recording;
 pub mod sources;
+pub mod sum;
 
 use evflow_engine::{NodeSpec, Registry};
 

@@ -1,5 +1,6 @@
 //! `error`: how far a stream is from a reference stream.
 
+use crate::sum::Sum;
 use evflow_engine::{BuildContext, Io, Node, NodeError, NodeSpec, Params, PortSpec, Role, Summary};
 
 /// Declaration of `error`.
@@ -28,25 +29,6 @@ difference), identical streams (zero), and a reference of zeros (error).",
     PortSpec::input("reference", "1", "the reference (same unit)"),
 ])
 .example("");
-
-/// Kahan–Babuška–Neumaier sum (branch-free TwoSum error term).
-#[derive(Default, Clone, Copy)]
-struct Sum {
-    s: f64,
-    c: f64,
-}
-
-impl Sum {
-    fn add(&mut self, x: f64) {
-        let t = self.s + x;
-        let bp = t - self.s;
-        self.c += (self.s - (t - bp)) + (x - bp);
-        self.s = t;
-    }
-    fn value(&self) -> f64 {
-        self.s + self.c
-    }
-}
 
 #[derive(Default)]
 struct ErrorSink {
@@ -127,14 +109,11 @@ mod tests {
             block: 128,
             base_dir: Path::new("."),
         };
-        let (mut plan, _) = s.plan()?;
-        let r =
-            evflow_engine::run_offline(&mut plan, evflow_engine::RunOptions::default()).map_err(|e| e.to_string())?;
-        Ok(r.summaries.into_iter().find(|(n, _)| n == "dut").ok_or("no summary")?.1)
+        s.summary()
     }
 
     fn get(s: &Summary, k: &str) -> f64 {
-        s.values.iter().find(|(n, _, _)| n == k).unwrap().1
+        s.get(k).unwrap_or_else(|| panic!("no value `{k}`"))
     }
 
     #[test]

@@ -177,14 +177,11 @@ mod tests {
             block: 100,
             base_dir: Path::new("."),
         };
-        let (mut plan, _) = s.plan()?;
-        let r =
-            evflow_engine::run_offline(&mut plan, evflow_engine::RunOptions::default()).map_err(|e| e.to_string())?;
-        Ok(r.summaries.into_iter().find(|(n, _)| n == "dut").ok_or("no summary")?.1)
+        s.summary()
     }
 
     fn get(s: &Summary, k: &str) -> f64 {
-        s.values.iter().find(|(n, _, _)| n == k).unwrap().1
+        s.get(k).unwrap_or_else(|| panic!("no value `{k}`"))
     }
 
     #[test]

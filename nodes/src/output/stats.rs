@@ -1,5 +1,6 @@
 //! `stats`: a sink that reports count, mean, RMS, min, max and peak-to-peak.
 
+use crate::sum::Sum;
 use evflow_engine::{BuildContext, Io, Node, NodeError, NodeSpec, PortSpec, Role, Summary};
 
 /// Declaration of `stats`.
@@ -20,30 +21,6 @@ pub static SPEC: NodeSpec = NodeSpec::new(
 )
 .ports(&[PortSpec::input("in", "1", "the stream to summarize").at(evflow_engine::RateSpec::Any)])
 .example("");
-
-/// Compensated sum (Kahan–Babuška–Neumaier: the error of every addition is
-/// kept and added at the end).
-#[derive(Default, Clone, Copy)]
-struct Sum {
-    s: f64,
-    c: f64,
-}
-
-impl Sum {
-    /// Adds `x`, keeping the rounding error of the addition exactly
-    /// (Knuth's branch-free TwoSum, the same error term as Neumaier's test on
-    /// |s| ≥ |x| without its branch, which random data would mispredict).
-    #[inline]
-    fn add(&mut self, x: f64) {
-        let t = self.s + x;
-        let bp = t - self.s;
-        self.c += (self.s - (t - bp)) + (x - bp);
-        self.s = t;
-    }
-    fn value(&self) -> f64 {
-        self.s + self.c
-    }
-}
 
 struct Stats {
     n: u64,

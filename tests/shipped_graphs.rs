@@ -60,3 +60,16 @@ fn every_shipped_graph_round_trips_through_save() {
         assert_eq!(g.without_locations(), g2.without_locations(), "{}", path.display());
     }
 }
+
+#[test]
+fn every_run_of_every_shipped_sweep_validates() {
+    use evflow_engine::sweep::points;
+    for (path, text) in evflow_tests::shipped_graphs() {
+        let g = evflow_engine::graph::parse_graph(&path, &text).unwrap_or_else(|e| panic!("{e}"));
+        for p in points(&g.sweep, &[], &[]) {
+            if let Err(e) = evflow_engine::check(&g, &evflow_nodes::registry(), &p.overrides()) {
+                panic!("{}: sweep run {}: {e}", path.display(), p.label());
+            }
+        }
+    }
+}

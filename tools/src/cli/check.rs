@@ -61,6 +61,20 @@ pub fn main(a: Args) -> Result<()> {
         let names: Vec<&str> = c.in_cycle.iter().map(|&i| c.nodes[i].name.as_str()).collect();
         println!("\nfeedback cycles broken by: {}", names.join(", "));
     }
+    if !g.sweep.is_empty() {
+        let axes: Vec<String> = g.sweep.iter().map(|ax| format!("{} ({} values)", ax.name, ax.values.len())).collect();
+        let runs = evflow_engine::sweep::points(&g.sweep, &[], &a.graph.overrides()?).len();
+        println!(
+            "
+sweep: {} → {runs} runs (`evflow run` runs them all)",
+            axes.join(" × ")
+        );
+    }
+    for p in &g.plots {
+        let fit =
+            if p.fit == evflow_engine::graph::Fit::None { String::new() } else { format!(", {} fit", p.fit.name()) };
+        println!("plot {}: {} against {}{fit}", p.file, p.y.join(", "), p.x);
+    }
     if a.build {
         let plan = Plan::build(&c, &PlanOptions::default()).map_err(|e| anyhow!("{e}"))?;
         println!("\nbuilt: {} nodes, block {} base ticks", plan.schedule().len(), plan.max_block());

@@ -10,6 +10,7 @@ pub mod lab;
 pub mod metric;
 pub mod output;
 pub mod recording;
+pub mod safety;
 pub mod sources;
 
 use evflow_engine::{NodeSpec, Registry};
@@ -29,6 +30,7 @@ pub fn all_specs() -> Vec<&'static NodeSpec> {
     v.extend_from_slice(sources::SPECS);
     v.extend_from_slice(filters::SPECS);
     v.extend_from_slice(output::SPECS);
+    v.extend_from_slice(safety::SPECS);
     v.extend_from_slice(recording::SPECS);
     v.extend_from_slice(metric::SPECS);
     v.extend_from_slice(lab::SPECS);

@@ -50,12 +50,12 @@ pub fn sleep_until(deadline: u64) {
 /// How the real-time thread waits for its next deadline.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum Wait {
-    /// Sleep until the deadline (under SCHED_FIFO, whose wake-up latency is
-    /// short and which must never busy-wait: the kernel throttles a FIFO
-    /// thread that keeps the CPU).
+    /// Sleep until the deadline.
     Sleep,
     /// Sleep until `spin_ns` before the deadline, then spin on the clock
-    /// (normal scheduling, where a sleep alone wakes late).
+    /// (a sleep alone wakes late by the timer's latency). The runner bounds
+    /// the spin to a quarter period, so the thread never keeps the CPU
+    /// (under SCHED_FIFO the kernel would throttle it).
     SleepThenSpin {
         /// How long before the deadline the sleep ends.
         spin_ns: u64,

@@ -13,7 +13,7 @@
 //!   moved to it; a replacement goes through a ring, and the replaced plan
 //!   comes back through another to be dropped by the control side.
 //! * Each tick: wait for the deadline (sleep until shortly before it, then
-//!   spin; under SCHED_FIFO sleep only), apply the commands due, run
+//!   spin for at most a quarter period), apply the commands due, run
 //!   [`crate::plan::Plan::tick`] — the same code the offline runner calls —
 //!   copy the tapped ports into their rings, and push the tick's timing.
 //! * A full ring never blocks the real-time thread: the samples of that
@@ -34,6 +34,9 @@ mod message;
 mod metrics;
 mod rt;
 mod system;
+
+/// The ring buffer crate the runner's rings come from.
+pub use rtrb;
 
 pub use clock::{now_ns, wait_until, Wait};
 pub use control::{parse_value, Control};
@@ -56,8 +59,8 @@ pub struct LiveConfig {
     pub duration: Option<f64>,
     /// What to ask of the system for the real-time thread.
     pub realtime: RealtimeRequest,
-    /// Without SCHED_FIFO: how long before each deadline the sleep ends and
-    /// the spin begins.
+    /// How long before each deadline the sleep ends and the spin begins (at
+    /// most a quarter period; zero sleeps to the deadline).
     pub spin: Duration,
     /// Consecutive deadline misses that stop the session (0: never).
     pub miss_streak: u64,

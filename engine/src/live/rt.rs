@@ -125,7 +125,11 @@ impl RtState {
     /// The loop. Returns when the stop sequence has run out, or a node failed.
     pub fn run(mut self) -> RtExit {
         let realtime = system::apply(&self.request);
-        let wait = if realtime.is_fifo() { Wait::Sleep } else { Wait::SleepThenSpin { spin_ns: self.spin_ns } };
+        // Sleep to shortly before each deadline, then spin. The spin is
+        // bounded to a quarter period, so even under SCHED_FIFO the thread
+        // never keeps the CPU (the kernel would throttle it).
+        let spin_ns = self.spin_ns.min(self.period_ns / 4);
+        let wait = if spin_ns == 0 { Wait::Sleep } else { Wait::SleepThenSpin { spin_ns } };
         prefault_stack();
         if let Some(h) = self.hook {
             h(true);

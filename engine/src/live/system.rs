@@ -53,9 +53,9 @@ impl fmt::Display for RealtimeReport {
             None => {}
         }
         match &self.fifo {
-            Some(Ok(p)) => parts.push(format!("SCHED_FIFO priority {p} (sleeps to each deadline, no spinning)")),
-            Some(Err(e)) => parts.push(format!("SCHED_FIFO refused ({e}): normal priority, sleep then spin")),
-            None => parts.push("normal priority (not asked for SCHED_FIFO): sleep then spin".into()),
+            Some(Ok(p)) => parts.push(format!("SCHED_FIFO priority {p}")),
+            Some(Err(e)) => parts.push(format!("SCHED_FIFO refused ({e}): normal priority")),
+            None => parts.push("normal priority (SCHED_FIFO not asked for)".into()),
         }
         match &self.memory_locked {
             Some(Ok(())) => parts.push("memory locked".into()),

@@ -3,5 +3,7 @@
 pub mod check;
 pub mod dot;
 pub mod graph_args;
+pub mod live;
 pub mod nodes;
+pub mod replay;
 pub mod run;

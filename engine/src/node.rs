@@ -41,6 +41,11 @@ impl NodeError {
     }
 }
 
+/// A live parameter change a node does not take (see [`Node::set`]).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, thiserror::Error)]
+#[error("this node does not take `{0}` while it runs")]
+pub struct Refused(pub &'static str);
+
 /// What a constructor knows besides its parameters.
 #[derive(Debug, Clone)]
 pub struct BuildContext {
@@ -266,5 +271,16 @@ pub trait Node: Send {
     /// largest block a cycle through them allows).
     fn cycle_delay(&self) -> usize {
         0
+    }
+
+    /// Changes a parameter declared [`crate::spec::ParamSpec::live`] between
+    /// two calls of `process` (a live session's parameter queue, or a replay
+    /// applying the session's recorded changes at the same tick). `param` is
+    /// the declared name; `value` is already checked against the declared
+    /// limits (flags as 0/1, choices as the index of the word). Like
+    /// `process`, it must not allocate, lock or block; the node moves to the
+    /// new value without a click (e.g. a ramp). The default refuses.
+    fn set(&mut self, param: &'static str, _value: f64) -> Result<(), Refused> {
+        Err(Refused(param))
     }
 }

@@ -4,8 +4,9 @@
 
 use crate::check::{Checked, Pruned};
 use crate::diag::Loc;
-use crate::node::{BuildContext, Io, Node, NodeError, PrepareContext, Summary};
+use crate::node::{BuildContext, Io, Node, NodeError, PrepareContext, Refused, Summary};
 use crate::rate::{lcm, Ratio};
+use crate::spec::NodeSpec;
 use std::path::PathBuf;
 use std::time::{Duration, Instant};
 
@@ -50,6 +51,8 @@ impl Default for PlanOptions {
 struct Entry {
     name: String,
     kind: &'static str,
+    spec: &'static NodeSpec,
+    out_names: Vec<String>,
     loc: Loc,
     node: Box<dyn Node>,
     ratio: Ratio,
@@ -162,6 +165,8 @@ impl Plan {
             entries.push(Entry {
                 name: n.name.clone(),
                 kind: n.spec.name,
+                spec: n.spec,
+                out_names: n.outputs().map(|p| n.ports[p].name.clone()).collect(),
                 loc: n.loc,
                 node,
                 ratio: n.ratio,
@@ -321,6 +326,49 @@ impl Plan {
     /// Nodes in execution order: (name, type, rate in Hz).
     pub fn schedule(&self) -> Vec<(String, &'static str, f64)> {
         self.entries.iter().map(|e| (e.name.clone(), e.kind, e.ratio.hz(self.base_rate))).collect()
+    }
+
+    /// Number of nodes in the plan; node indices run over `0..len()` in
+    /// execution order.
+    pub fn len(&self) -> usize {
+        self.entries.len()
+    }
+    /// True when the plan holds no node.
+    pub fn is_empty(&self) -> bool {
+        self.entries.is_empty()
+    }
+    /// Index of the node of that name.
+    pub fn index(&self, node: &str) -> Option<usize> {
+        self.entries.iter().position(|e| e.name == node)
+    }
+    /// The name of node `k`.
+    pub fn node_name(&self, k: usize) -> &str {
+        &self.entries[k].name
+    }
+    /// The declaration of node `k`.
+    pub fn spec(&self, k: usize) -> &'static NodeSpec {
+        self.entries[k].spec
+    }
+    /// Names of node `k`'s output ports, in order (`multi` ports expanded).
+    pub fn output_names(&self, k: usize) -> &[String] {
+        &self.entries[k].out_names
+    }
+    /// Rate of output `j` of node `k` relative to the base rate.
+    pub fn output_ratio(&self, k: usize, j: usize) -> Ratio {
+        self.entries[k].out_ratios[j]
+    }
+    /// The samples output `j` of node `k` produced in the last step
+    /// (allocation-free; for the live runner's taps).
+    #[inline]
+    pub fn output_at(&self, k: usize, j: usize) -> &[f64] {
+        let e = &self.entries[k];
+        &self.pool[e.out_slots[j]][..e.out_lens[j]]
+    }
+    /// Applies a live parameter change to node `k` before the next step
+    /// ([`Node::set`]); `param` is the declared name. Allocation-free.
+    #[inline]
+    pub fn set(&mut self, k: usize, param: &'static str, value: f64) -> Result<(), Refused> {
+        self.entries[k].node.set(param, value)
     }
 
     /// Nodes left out, and why.

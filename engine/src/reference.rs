@@ -17,6 +17,12 @@ pub fn node_markdown(spec: &NodeSpec) -> String {
     if spec.hardware {
         flags.push("drives hardware (must be fed by `limit`)".into());
     }
+    if spec.safety_guard {
+        flags.push("safety guard (may feed hardware)".into());
+    }
+    if let Some(why) = spec.offline_only {
+        flags.push(format!("offline only ({why})"));
+    }
     if spec.breaks_cycles {
         flags.push("may close a feedback cycle".into());
     }
@@ -59,7 +65,7 @@ pub fn node_markdown(spec: &NodeSpec) -> String {
                 p.kind.type_name(),
                 p.kind.limits(),
                 p.unit,
-                p.doc
+                if p.live { format!("{} *(changeable live)*", p.doc) } else { p.doc.to_string() }
             );
         }
         s.push('\n');

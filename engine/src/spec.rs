@@ -170,6 +170,9 @@ pub struct ParamSpec {
     pub unit: &'static str,
     /// One-line description.
     pub doc: &'static str,
+    /// True when the node takes changes of this parameter while it runs
+    /// ([`crate::node::Node::set`], the live runner's parameter queue).
+    pub live: bool,
 }
 
 impl ParamSpec {
@@ -182,7 +185,14 @@ impl ParamSpec {
         unit: &'static str,
         doc: &'static str,
     ) -> Self {
-        Self { name, kind: ParamKind::Float { min, max }, default: ParamDefault::Float(default), unit, doc }
+        Self {
+            name,
+            kind: ParamKind::Float { min, max },
+            default: ParamDefault::Float(default),
+            unit,
+            doc,
+            live: false,
+        }
     }
     /// An integer parameter.
     pub const fn int(
@@ -193,11 +203,11 @@ impl ParamSpec {
         unit: &'static str,
         doc: &'static str,
     ) -> Self {
-        Self { name, kind: ParamKind::Int { min, max }, default: ParamDefault::Int(default), unit, doc }
+        Self { name, kind: ParamKind::Int { min, max }, default: ParamDefault::Int(default), unit, doc, live: false }
     }
     /// A boolean parameter.
     pub const fn flag(name: &'static str, default: bool, doc: &'static str) -> Self {
-        Self { name, kind: ParamKind::Bool, default: ParamDefault::Bool(default), unit: "", doc }
+        Self { name, kind: ParamKind::Bool, default: ParamDefault::Bool(default), unit: "", doc, live: false }
     }
     /// A choice among fixed words.
     pub const fn choice(
@@ -206,23 +216,30 @@ impl ParamSpec {
         default: &'static str,
         doc: &'static str,
     ) -> Self {
-        Self { name, kind: ParamKind::Choice(words), default: ParamDefault::Text(default), unit: "", doc }
+        Self { name, kind: ParamKind::Choice(words), default: ParamDefault::Text(default), unit: "", doc, live: false }
     }
     /// A text parameter with a default.
     pub const fn text(name: &'static str, default: &'static str, doc: &'static str) -> Self {
-        Self { name, kind: ParamKind::Text, default: ParamDefault::Text(default), unit: "", doc }
+        Self { name, kind: ParamKind::Text, default: ParamDefault::Text(default), unit: "", doc, live: false }
     }
     /// A list of words, empty by default.
     pub const fn text_list(name: &'static str, doc: &'static str) -> Self {
-        Self { name, kind: ParamKind::TextList, default: ParamDefault::EmptyList, unit: "", doc }
+        Self { name, kind: ParamKind::TextList, default: ParamDefault::EmptyList, unit: "", doc, live: false }
     }
     /// A list of real numbers, empty by default.
     pub const fn float_list(name: &'static str, min: f64, max: f64, unit: &'static str, doc: &'static str) -> Self {
-        Self { name, kind: ParamKind::FloatList { min, max }, default: ParamDefault::EmptyList, unit, doc }
+        Self { name, kind: ParamKind::FloatList { min, max }, default: ParamDefault::EmptyList, unit, doc, live: false }
     }
     /// The same parameter without a default: the graph file must set it.
     pub const fn required(mut self) -> Self {
         self.default = ParamDefault::Required;
+        self
+    }
+    /// The same parameter, changeable while the graph runs live: the node's
+    /// [`crate::node::Node::set`] takes it (numbers, flags as 0/1, choices
+    /// as the index of the word) and applies it without a click.
+    pub const fn live(mut self) -> Self {
+        self.live = true;
         self
     }
 }
@@ -271,6 +288,9 @@ pub struct NodeSpec {
     pub hardware: bool,
     /// True for the safety limiter, the only node allowed to feed hardware.
     pub safety_guard: bool,
+    /// Why the node cannot run in a live session (e.g. it does blocking file
+    /// I/O while processing); `None` for nodes that can.
+    pub offline_only: Option<&'static str>,
     /// A node table that works as-is (TOML body without the header), used by
     /// the docs and by the generic tests that run every node type.
     pub example: &'static str,
@@ -299,6 +319,7 @@ impl NodeSpec {
             breaks_cycles: false,
             hardware: false,
             safety_guard: false,
+            offline_only: None,
             example: "",
             build,
         }
@@ -336,6 +357,12 @@ impl NodeSpec {
     /// Marks the safety limiter.
     pub const fn safety_guard(mut self) -> Self {
         self.safety_guard = true;
+        self
+    }
+    /// Marks a node that cannot run live, saying why (the live runner
+    /// refuses a graph that contains it).
+    pub const fn offline_only(mut self, reason: &'static str) -> Self {
+        self.offline_only = Some(reason);
         self
     }
     /// Sets the working example node table.

@@ -12,6 +12,7 @@ pub mod math;
 pub mod metric;
 pub mod output;
 pub mod recording;
+pub mod safety;
 pub mod sources;
 pub mod sum;
 
@@ -32,6 +33,7 @@ pub fn all_specs() -> Vec<&'static NodeSpec> {
     v.extend_from_slice(sources::SPECS);
     v.extend_from_slice(filters::SPECS);
     v.extend_from_slice(output::SPECS);
+    v.extend_from_slice(safety::SPECS);
     v.extend_from_slice(recording::SPECS);
     v.extend_from_slice(metric::SPECS);
     v.extend_from_slice(math::SPECS);

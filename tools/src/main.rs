@@ -44,6 +44,16 @@ enum Command {
     ///
     /// Example: evflow nodes butterworth
     Nodes(cli::nodes::Args),
+    /// Run a graph live, in real time (1 tick per base-rate period), and
+    /// record the session (inputs, outputs, parameter changes) for replay.
+    ///
+    /// Example: evflow live graphs/display-live.toml --duration 60
+    Live(cli::live::Args),
+    /// Run a graph offline over a recorded session and compare its outputs
+    /// with the live ones (bit for bit with the session's own graph).
+    ///
+    /// Example: evflow replay sessions/display-live-20250101-120000 --check
+    Replay(cli::replay::Args),
     /// Print a graph in Graphviz dot syntax (pruned nodes dashed).
     ///
     /// Example: evflow dot graphs/excitation.toml | dot -Tpng > graph.png
@@ -57,6 +67,8 @@ fn main() -> ExitCode {
         Command::Check(a) => cli::check::main(a),
         Command::Nodes(a) => cli::nodes::main(a),
         Command::Dot(a) => cli::dot::main(a),
+        Command::Live(a) => cli::live::main(a),
+        Command::Replay(a) => cli::replay::main(a),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

@@ -1,6 +1,6 @@
 //! `gain`: multiplies a stream by a constant.
 
-use evflow_engine::{BuildContext, Io, Node, NodeError, NodeSpec, ParamSpec, Params, PortSpec, Role};
+use evflow_engine::{BuildContext, Io, Node, NodeError, NodeSpec, ParamSpec, Params, PortSpec, Refused, Role};
 
 /// Declaration of `gain`.
 pub static SPEC: NodeSpec =
@@ -8,30 +8,71 @@ pub static SPEC: NodeSpec =
         .doc(
             "y[n] = g · x[n]. Used to scale synthesized actuation signals before the display \
          (the gain sweep 0.6–1.4 of dissertation §5.3.1, Table 5.1; 1.0 corresponds to 100 Vpp \
-         through the amplifier). Runs at the rate of its input.",
+         through the amplifier). Runs at the rate of its input.\n\n\
+         `gain` changes live (a session's parameter queue): the multiplier then moves linearly \
+         from its current value to the new one over `ramp` seconds (round(ramp·rate) samples, at \
+         least one), so a change never clicks; a change during a ramp starts a new ramp from where \
+         the gain is. Checked by the exact ramp values in its unit tests and the generic \
+         block ≡ per-sample test.",
         )
         .ports(&[PortSpec::input("in", "1", "signal"), PortSpec::output("out", "1", "signal × gain")])
-        .params(&[ParamSpec::float("gain", -1e6, 1e6, 1.0, "1", "multiplier")])
+        .params(&[
+            ParamSpec::float("gain", -1e6, 1e6, 1.0, "1", "multiplier").live(),
+            ParamSpec::float("ramp", 0.0, 10.0, 0.01, "s", "time a live change of `gain` takes"),
+        ])
         .example("gain = 1.2");
 
 struct Gain {
+    /// The gain at t = 0.
+    initial: f64,
     gain: f64,
+    /// Where a ramp ends, its step per sample and the samples it has left.
+    target: f64,
+    delta: f64,
+    left: u64,
+    ramp_samples: u64,
 }
 
-fn build(p: &Params, _: &BuildContext) -> Result<Box<dyn Node>, NodeError> {
-    Ok(Box::new(Gain { gain: p.f64("gain") }))
+fn build(p: &Params, ctx: &BuildContext) -> Result<Box<dyn Node>, NodeError> {
+    let g = p.f64("gain");
+    let ramp_samples = (p.f64("ramp") * ctx.rate).round().max(1.0) as u64;
+    Ok(Box::new(Gain { initial: g, gain: g, target: g, delta: 0.0, left: 0, ramp_samples }))
 }
 
 impl Node for Gain {
     fn process(&mut self, io: &mut Io<'_>) -> Result<(), NodeError> {
         let (x, y) = io.io(0, 0);
+        if self.left == 0 {
+            for (y, x) in y.iter_mut().zip(x) {
+                *y = self.gain * x;
+            }
+            return Ok(());
+        }
         for (y, x) in y.iter_mut().zip(x) {
+            if self.left > 0 {
+                self.left -= 1;
+                self.gain = if self.left == 0 { self.target } else { self.gain + self.delta };
+            }
             *y = self.gain * x;
         }
         Ok(())
     }
 
-    fn reset(&mut self) {}
+    fn reset(&mut self) {
+        self.gain = self.initial;
+        self.target = self.initial;
+        self.left = 0;
+    }
+
+    fn set(&mut self, param: &'static str, value: f64) -> Result<(), Refused> {
+        if param != "gain" {
+            return Err(Refused(param));
+        }
+        self.target = value;
+        self.left = self.ramp_samples;
+        self.delta = (value - self.gain) / self.ramp_samples as f64;
+        Ok(())
+    }
 }
 
 #[cfg(test)]
@@ -58,5 +99,30 @@ mod tests {
         for (y, x) in out[0].iter().zip(&x) {
             assert_eq!(*y, -2.5 * x);
         }
+    }
+
+    #[test]
+    fn a_live_change_ramps_linearly_and_lands_exactly() {
+        let mut g = Gain { initial: 1.0, gain: 1.0, target: 1.0, delta: 0.0, left: 0, ramp_samples: 4 };
+        let x = [2.0; 8];
+        let mut y = [0.0; 8];
+        let pool = vec![x.to_vec()];
+        let run = |g: &mut Gain, y: &mut [f64; 8]| {
+            let mut outs = vec![vec![0.0; 8]];
+            let mut io = Io::new(&pool, &[0], &[8], &mut outs, &[8], 0);
+            g.process(&mut io).unwrap();
+            y.copy_from_slice(&outs[0]);
+        };
+        g.set("gain", 0.2).unwrap();
+        run(&mut g, &mut y);
+        for (a, b) in y[..3].iter().zip([1.6, 1.2, 0.8]) {
+            assert!((a - b).abs() < 1e-15);
+        }
+        assert_eq!(y[3], 0.4);
+        assert!(y[4..].iter().all(|&v| v == 0.4));
+        assert!(g.set("ramp", 1.0).is_err());
+        g.reset();
+        run(&mut g, &mut y);
+        assert!(y.iter().all(|&v| v == 2.0));
     }
 }

@@ -46,6 +46,9 @@ pub static SPEC: NodeSpec = NodeSpec::new(
     ParamSpec::float("gain", 0.0, 1e6, 0.0, "1", "condition: display gain, 1 = 100 Vpp (0 = not recorded)"),
     ParamSpec::text("source", "", "what wrote it, kept in the sidecar (empty: the node's type and name)"),
 ])
+.offline_only(
+    "it writes its file from the processing thread; a live session records its inputs and outputs itself (docs/live.md)",
+)
 .example(
     "path = \"out.wav\"\nchannels = [\"force\"]\nunits = [\"N\"]\nload_g = 85.0\nvelocity_cm_s = 4.0\nmaterial = \"felt\"",
 );

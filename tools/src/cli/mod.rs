@@ -3,7 +3,9 @@
 pub mod check;
 pub mod dot;
 pub mod graph_args;
+pub mod live;
 pub mod nodes;
+pub mod replay;
 pub mod run;
 pub mod run_plots;
 pub mod run_report;

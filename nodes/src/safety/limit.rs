@@ -1,0 +1,216 @@
+//! `limit`: the safety limiter in front of every hardware output.
+
+use super::envelope::Envelope;
+use evflow_engine::{BuildContext, Io, Node, NodeError, NodeSpec, ParamSpec, Params, PortSpec, Refused, Role, Summary};
+
+/// The longest fade the limiter may take: the live runner's stop sequence
+/// runs this long (plus one tick) before it ends a session.
+pub const MAX_RAMP_S: f64 = 0.010;
+
+/// Declaration of `limit`.
+pub static SPEC: NodeSpec = NodeSpec::new(
+    "limit",
+    "safety",
+    Role::Filter,
+    "Safety limiter: amplitude clamp, slew-rate limit, ramp to zero on NaN, fault or stop.",
+    build,
+)
+.doc(
+    "The last node before hardware: the loader refuses a graph in which a hardware output is fed by \
+anything else (`docs/safety.md`). An actuation signal reaches a finger through a high-voltage \
+amplifier (1.0 = 50 V at the amplifier output, ±1.0 = 100 Vpp; dissertation §5.2.3, Table 5.1's \
+gain sweep), so the limiter guarantees, whatever arrives at `in`:\n\
+\n\
+* **Amplitude clamp**: |out| ≤ `amplitude` at every sample.\n\
+* **Slew-rate limit**: the clamped signal moves at most `slew`/rate per sample (the default, \
+4000 /s, leaves 1 kHz actuation untouched — a full ±1 swing in one 1 ms sample is 2000 /s — and \
+limits faster rates and runaway signals).\n\
+* **Gate**: the output is the slewed signal times a gate that moves linearly between 0 and 1 in \
+`ramp` seconds (round(ramp·rate) samples, at least one). The gate opens at t = 0 (a session never \
+starts with a step) and closes — reaching exactly 0 within `ramp` ≤ 10 ms — on: a NaN or infinite \
+input sample (the signal is held at its last finite value while it fades); a nonzero (or NaN) \
+sample on any fault input (one input per `faults` entry, e.g. a link or contact flag); or \
+`enable` set to false (the live runner does this on stop, Ctrl-C, the end of the duration, a \
+streak of deadline misses and device disconnects). NaN and fault-input faults latch: the output \
+stays at zero until `enable` is set to true again (re-arming), after which it fades back in.\n\
+\n\
+Outputs are always finite. `enable` is the one parameter that changes live. The summary reports \
+how many samples were clamped and slew-limited, and every fault with its sample index.\n\
+\n\
+**Checked against:** the clamp and slew bounds on random and extreme inputs (±1e300, steps, NaN \
+bursts); the fade reaching exactly zero within round(ramp·rate) samples after a NaN, a fault \
+input and a disable; the latch and re-arm; block ≡ per-sample processing (generic node test).",
+)
+.ports(&[
+    PortSpec::input("in", "1", "actuation signal"),
+    PortSpec::input("fault", "1", "fault flag: nonzero (or NaN) closes the gate and latches").per("faults"),
+    PortSpec::output("out", "1", "limited actuation signal"),
+])
+.params(&[
+    ParamSpec::float("amplitude", 0.0, 10.0, 1.0, "1", "largest |out| (1.0 = 50 V peak, 100 Vpp)"),
+    ParamSpec::float("slew", 1e-3, 1e12, 4000.0, "1/s", "largest rate of change of the clamped signal"),
+    ParamSpec::float("ramp", 0.0, MAX_RAMP_S, MAX_RAMP_S, "s", "fade time of the gate (at most 10 ms)"),
+    ParamSpec::text_list("faults", "names of fault-flag inputs (e.g. [\"link\"]); none by default"),
+    ParamSpec::flag("enable", true, "gate open; false fades to zero, true re-arms after a fault").live(),
+])
+.safety_guard()
+.example("amplitude = 1.0\nslew = 4000.0\nramp = 0.01");
+
+/// What closed the gate first.
+#[derive(Debug, Clone, Copy, PartialEq)]
+enum Fault {
+    NotFinite { sample: u64 },
+    Input { port: usize, sample: u64 },
+}
+
+struct Limit {
+    amplitude: f64,
+    /// Largest change per sample.
+    step: f64,
+    ramp_steps: u32,
+    fault_names: Vec<String>,
+    enabled: bool,
+    latched: bool,
+    /// The clamped, slew-limited signal.
+    held: f64,
+    gate: Envelope,
+    clamped: u64,
+    slewed: u64,
+    faults: Vec<Fault>,
+    /// Index at the node's rate of the next sample.
+    next: u64,
+}
+
+/// Faults kept for the summary (more are counted, not listed).
+const FAULTS_LISTED: usize = 16;
+
+fn build(p: &Params, ctx: &BuildContext) -> Result<Box<dyn Node>, NodeError> {
+    let ramp_steps = (p.f64("ramp") * ctx.rate).round().max(1.0);
+    if ramp_steps > u32::MAX as f64 {
+        return Err(NodeError::param("ramp", "too many samples at this rate"));
+    }
+    let fault_names = p.text_list("faults").to_vec();
+    for reserved in ["in", "out"] {
+        if fault_names.iter().any(|n| n == reserved) {
+            return Err(NodeError::param("faults", format!("`{reserved}` is taken by the signal port; rename it")));
+        }
+    }
+    let mut node = Limit {
+        amplitude: p.f64("amplitude"),
+        step: p.f64("slew") / ctx.rate,
+        ramp_steps: ramp_steps as u32,
+        fault_names,
+        enabled: p.bool("enable"),
+        latched: false,
+        held: 0.0,
+        gate: Envelope::closed(1),
+        clamped: 0,
+        slewed: 0,
+        faults: Vec::new(),
+        next: 0,
+    };
+    node.reset();
+    node.enabled = p.bool("enable");
+    Ok(Box::new(node))
+}
+
+impl Limit {
+    fn record(&mut self, f: Fault) {
+        if self.faults.len() < FAULTS_LISTED {
+            self.faults.push(f);
+        }
+    }
+}
+
+impl Node for Limit {
+    fn prepare(&mut self, _: &evflow_engine::PrepareContext) -> Result<(), NodeError> {
+        self.faults.reserve_exact(FAULTS_LISTED);
+        Ok(())
+    }
+
+    fn process(&mut self, io: &mut Io<'_>) -> Result<(), NodeError> {
+        let n = io.len();
+        let n_faults = io.n_inputs() - 1;
+        for i in 0..n {
+            let x = io.input(0)[i];
+            let sample = self.next + i as u64;
+            if !self.latched {
+                if !x.is_finite() {
+                    self.latched = true;
+                    self.record(Fault::NotFinite { sample });
+                } else if let Some(port) = (1..=n_faults).find(|&k| io.input(k)[i] != 0.0) {
+                    self.latched = true;
+                    self.record(Fault::Input { port: port - 1, sample });
+                }
+            }
+            if x.is_finite() {
+                let c = x.clamp(-self.amplitude, self.amplitude);
+                if c != x {
+                    self.clamped += 1;
+                }
+                let d = c - self.held;
+                if d > self.step {
+                    self.held += self.step;
+                    self.slewed += 1;
+                } else if d < -self.step {
+                    self.held -= self.step;
+                    self.slewed += 1;
+                } else {
+                    self.held = c;
+                }
+                // Rounding in `held ± step` cannot leave the clamp range.
+                self.held = self.held.clamp(-self.amplitude, self.amplitude);
+            }
+            let g = self.gate.advance(self.enabled && !self.latched);
+            io.output(0)[i] = g * self.held;
+        }
+        self.next += n as u64;
+        Ok(())
+    }
+
+    fn reset(&mut self) {
+        self.latched = false;
+        self.held = 0.0;
+        self.gate = Envelope::closed(self.ramp_steps);
+        self.clamped = 0;
+        self.slewed = 0;
+        self.faults.clear();
+        self.next = 0;
+    }
+
+    fn set(&mut self, param: &'static str, value: f64) -> Result<(), Refused> {
+        match param {
+            "enable" => {
+                self.enabled = value != 0.0;
+                if self.enabled {
+                    self.latched = false;
+                }
+                Ok(())
+            }
+            _ => Err(Refused(param)),
+        }
+    }
+
+    fn finish(&mut self) -> Result<Summary, NodeError> {
+        let mut s = Summary::default().value("clamped", self.clamped as f64, "samples").value(
+            "slew_limited",
+            self.slewed as f64,
+            "samples",
+        );
+        for f in &self.faults {
+            s = s.line(match *f {
+                Fault::NotFinite { sample } => format!("fault: non-finite input at sample {sample}; faded to zero"),
+                Fault::Input { port, sample } => {
+                    format!("fault: input `{}` raised at sample {sample}; faded to zero", self.fault_names[port])
+                }
+            });
+        }
+        if self.latched {
+            s = s.line("ended with the gate latched closed (re-arm with enable = true)");
+        }
+        Ok(s)
+    }
+}
+
+#[cfg(test)]
+mod tests;

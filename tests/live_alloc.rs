@@ -1,0 +1,206 @@
+//! Real-time hygiene: every live-capable shipped graph (and a few built
+//! here to cover more node types) runs on the live runner with an
+//! allocation-counting allocator armed on the real-time thread for its whole
+//! loop — every tick, every parameter change, the stop sequence. Any
+//! allocation or free there fails the test.
+//!
+//! Graphs added to `graphs/` later join automatically; a graph that cannot
+//! run live (an offline-only node) is listed and skipped.
+
+use evflow_engine::live::{self, LiveConfig, LivePlan};
+use evflow_engine::{load_file, Plan, PlanOptions};
+use std::alloc::{GlobalAlloc, Layout, System};
+use std::cell::Cell;
+use std::sync::atomic::{AtomicU64, Ordering};
+
+struct Counting;
+
+thread_local! {
+    static ARMED: Cell<bool> = const { Cell::new(false) };
+}
+static ALLOCS: AtomicU64 = AtomicU64::new(0);
+static ARMINGS: AtomicU64 = AtomicU64::new(0);
+
+fn armed() -> bool {
+    ARMED.try_with(|a| a.get()).unwrap_or(false)
+}
+
+// SAFETY: forwards to the system allocator; counting has no effect on memory.
+unsafe impl GlobalAlloc for Counting {
+    unsafe fn alloc(&self, l: Layout) -> *mut u8 {
+        if armed() {
+            ALLOCS.fetch_add(1, Ordering::SeqCst);
+        }
+        unsafe { System.alloc(l) }
+    }
+    unsafe fn dealloc(&self, p: *mut u8, l: Layout) {
+        if armed() {
+            ALLOCS.fetch_add(1, Ordering::SeqCst);
+        }
+        unsafe { System.dealloc(p, l) }
+    }
+    unsafe fn alloc_zeroed(&self, l: Layout) -> *mut u8 {
+        if armed() {
+            ALLOCS.fetch_add(1, Ordering::SeqCst);
+        }
+        unsafe { System.alloc_zeroed(l) }
+    }
+    unsafe fn realloc(&self, p: *mut u8, l: Layout, n: usize) -> *mut u8 {
+        if armed() {
+            ALLOCS.fetch_add(1, Ordering::SeqCst);
+        }
+        unsafe { System.realloc(p, l, n) }
+    }
+}
+
+#[global_allocator]
+static GLOBAL: Counting = Counting;
+
+fn hook(on: bool) {
+    if on {
+        ARMINGS.fetch_add(1, Ordering::SeqCst);
+    }
+    ARMED.with(|a| a.set(on));
+}
+
+/// Runs `plan` live for `seconds`, changing every live parameter of every
+/// node (to its default) halfway, and returns the allocations counted.
+fn allocations(plan: Plan, seconds: f64) -> Result<u64, String> {
+    let mut taps = LivePlan::source_taps(&plan);
+    taps.extend(LivePlan::guard_taps(&plan));
+    let mut changes = Vec::new();
+    for k in 0..plan.len() {
+        for p in plan.spec(k).params.iter().filter(|p| p.live) {
+            changes.push((plan.node_name(k).to_string(), p));
+        }
+    }
+    let lp = LivePlan::new(plan, &taps).map_err(|e| e.to_string())?;
+    let cfg = LiveConfig { duration: Some(seconds), miss_streak: 0, hook: Some(hook), ..LiveConfig::default() };
+    let before = ALLOCS.load(Ordering::SeqCst);
+    let armings = ARMINGS.load(Ordering::SeqCst);
+    let mut session = live::start(lp, &cfg).map_err(|e| e.to_string())?;
+    let half = session.control.tick_at(seconds / 2.0);
+    for (node, p) in &changes {
+        let v = match p.default {
+            evflow_engine::spec::ParamDefault::Float(x) => x.to_string(),
+            evflow_engine::spec::ParamDefault::Int(i) => i.to_string(),
+            evflow_engine::spec::ParamDefault::Bool(b) => b.to_string(),
+            evflow_engine::spec::ParamDefault::Text(t) => t.to_string(),
+            _ => continue,
+        };
+        session.control.set(node, p.name, &v, Some(half)).map_err(|e| e.to_string())?;
+    }
+    let exit = session.join();
+    if let Some(f) = exit.failure {
+        return Err(f.to_string());
+    }
+    assert_eq!(ARMINGS.load(Ordering::SeqCst), armings + 1, "the hook armed the guard");
+    Ok(ALLOCS.load(Ordering::SeqCst) - before)
+}
+
+fn build(path: &std::path::Path, text: Option<&str>) -> Plan {
+    let reg = evflow_nodes::registry();
+    let checked = match text {
+        Some(t) => {
+            let g = evflow_engine::graph::parse_graph(path, t).unwrap_or_else(|e| panic!("{e}"));
+            evflow_engine::check(&g, &reg, &[]).unwrap_or_else(|e| panic!("{e}"))
+        }
+        None => load_file(path, &reg, &[]).unwrap_or_else(|e| panic!("{e}")),
+    };
+    let dir = tempfile::tempdir().unwrap();
+    let opts =
+        PlanOptions { max_block: 1, timing: false, out_dir: Some(dir.path().to_path_buf()), ..Default::default() };
+    Plan::build(&checked, &opts).unwrap_or_else(|e| panic!("{e}"))
+}
+
+/// Graphs covering node types no shipped live graph uses yet.
+const EXTRA: &[(&str, &str)] = &[(
+    "filters-and-metric",
+    r#"
+[graph]
+format = 1
+name = "filters-and-metric"
+rate = 1000.0
+connections = [
+    "excite.out -> low.in", "low.out -> mix.in", "mix.out -> limit.in",
+    "limit.out -> back.in", "back.out -> met.virtual", "excite.out -> met.real",
+    "limit.out -> st.in",
+]
+[nodes.excite]
+type = "prbs"
+order = 9
+periods = 1000
+[nodes.low]
+type = "butterworth"
+kind = "lowpass"
+order = 4
+cutoff = 100.0
+[nodes.mix]
+type = "gain"
+gain = 0.5
+[nodes.limit]
+type = "limit"
+[nodes.back]
+type = "delay"
+samples = 3
+[nodes.met]
+type = "metric"
+nfft = 256
+[nodes.st]
+type = "stats"
+"#,
+)];
+
+/// A node that allocates in `process`: the guard must see it.
+mod allocating {
+    use evflow_engine::{BuildContext, Io, Node, NodeError, NodeSpec, Params, PortSpec, Role};
+    pub static SPEC: NodeSpec = NodeSpec::new("test.alloc", "test", Role::Sink, "allocates (test only)", build)
+        .ports(&[PortSpec::input("in", "1", "x")]);
+    struct A(Vec<Vec<f64>>);
+    fn build(_: &Params, _: &BuildContext) -> Result<Box<dyn Node>, NodeError> {
+        Ok(Box::new(A(Vec::new())))
+    }
+    impl Node for A {
+        fn process(&mut self, io: &mut Io<'_>) -> Result<(), NodeError> {
+            self.0.push(io.input(0).to_vec());
+            Ok(())
+        }
+        fn reset(&mut self) {}
+    }
+}
+
+#[test]
+fn no_allocation_on_the_real_time_thread() {
+    // The guard works: a node that allocates is caught.
+    {
+        let mut reg = evflow_nodes::registry();
+        reg.add(&allocating::SPEC);
+        let doc = "[graph]\nformat = 1\nname = \"a\"\nrate = 1000.0\nconnections = [\"s.out -> a.in\"]\n\
+                   [nodes.s]\ntype = \"sine\"\n[nodes.a]\ntype = \"test.alloc\"\n";
+        let g = evflow_engine::graph::parse_graph(std::path::Path::new("a.toml"), doc).unwrap();
+        let checked = evflow_engine::check(&g, &reg, &[]).unwrap();
+        let plan = Plan::build(&checked, &PlanOptions { max_block: 1, ..Default::default() }).unwrap();
+        let n = allocations(plan, 0.05).unwrap();
+        assert!(n >= 50, "the guard must count the allocating node's allocations (counted {n})");
+    }
+
+    let mut ran = Vec::new();
+    let mut skipped = Vec::new();
+    for (path, _) in evflow_tests::shipped_graphs() {
+        match allocations(build(&path, None), 0.4) {
+            Ok(n) => {
+                assert_eq!(n, 0, "{}: {n} allocations or frees on the real-time thread", path.display());
+                ran.push(path.display().to_string());
+            }
+            Err(why) if why.contains("cannot run live") => skipped.push(format!("{}: {why}", path.display())),
+            Err(why) => panic!("{}: {why}", path.display()),
+        }
+    }
+    for (name, text) in EXTRA {
+        let n = allocations(build(std::path::Path::new(name), Some(text)), 0.4).unwrap();
+        assert_eq!(n, 0, "{name}: {n} allocations or frees on the real-time thread");
+        ran.push(name.to_string());
+    }
+    eprintln!("ran live without allocating: {ran:?}\nnot live-capable: {skipped:?}");
+    assert!(ran.iter().any(|g| g.ends_with("display-live.toml")), "the shipped live graph ran");
+}

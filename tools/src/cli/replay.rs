@@ -1,0 +1,260 @@
+//! `evflow replay SESSION [GRAPH]`: a recorded live session, offline.
+//!
+//! The session's recorded inputs take the place of the source nodes of the
+//! same names (as `recording.in` nodes with the same ports), its logged
+//! parameter changes are applied before the same ticks, and the graph —
+//! the session's own, or another one — runs offline in large blocks. The
+//! outputs are compared with the recorded ones: with the session's own
+//! graph they are identical bit for bit, because the live tick and the
+//! offline step are the same code.
+
+use super::live::session::{read_events, FileSpec, LoggedEvent, Manifest};
+use anyhow::{anyhow, Context, Result};
+use evflow_engine::graph::{parse_graph, ParamDecl};
+use evflow_engine::{check, Override, Plan, PlanOptions, Value};
+use evflow_nodes::recording::format::Recording;
+use std::path::{Path, PathBuf};
+
+/// Arguments of `evflow replay`.
+#[derive(clap::Args, Debug)]
+pub struct Args {
+    /// The session folder written by `evflow live`.
+    session: PathBuf,
+    /// A graph to run over the session instead of its own (its sources of
+    /// the same names take the recorded inputs).
+    graph: Option<PathBuf>,
+    /// Set a graph variable or node parameter (`name=value`,
+    /// `node.param=value`); the session's own overrides apply when GRAPH is
+    /// not given.
+    #[arg(long = "set", value_name = "KEY=VALUE")]
+    set: Vec<String>,
+    /// Block size in base ticks (results do not depend on it).
+    #[arg(long, default_value_t = 4096)]
+    block: usize,
+    /// Folder for files the graph writes.
+    #[arg(long, value_name = "DIR", default_value = ".")]
+    out: PathBuf,
+    /// Fail unless every recorded output is reproduced bit for bit.
+    #[arg(long)]
+    check: bool,
+    /// Print only the comparison.
+    #[arg(long, short)]
+    quiet: bool,
+}
+
+/// How one recorded output compares with its replay.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Comparison {
+    /// `node.port`.
+    pub name: String,
+    /// Samples compared.
+    pub samples: usize,
+    /// Index of the first differing sample, with the two values.
+    pub first_difference: Option<(usize, f64, f64)>,
+    /// Largest absolute difference.
+    pub max_abs: f64,
+}
+
+/// Runs `evflow replay`.
+pub fn main(a: Args) -> Result<()> {
+    let m = Manifest::read(&a.session)?;
+    let own = a.graph.is_none();
+    let (graph_file, base_dir) = match &a.graph {
+        Some(g) => (g.clone(), g.parent().map(Path::to_path_buf).unwrap_or_default()),
+        None => (a.session.join("graph.toml"), m.base_dir.clone()),
+    };
+    let text =
+        std::fs::read_to_string(&graph_file).with_context(|| format!("{}: cannot read", graph_file.display()))?;
+    let mut graph = parse_graph(&graph_file, &text).map_err(|e| anyhow!("{e}"))?;
+
+    // Recorded inputs replace the sources of the same names.
+    let session_dir = std::fs::canonicalize(&a.session).unwrap_or_else(|_| a.session.clone());
+    let mut ticks = u64::MAX;
+    let mut replaced = Vec::new();
+    for f in &m.inputs {
+        let rec = open(&session_dir, f)?;
+        ticks = ticks.min(f.ratio.ticks_for(rec.frames() as u64));
+        if let Some(decl) = graph.nodes.iter_mut().find(|n| n.name == f.node) {
+            let path = session_dir.join(&f.file).to_string_lossy().into_owned();
+            decl.kind = "recording.in".into();
+            decl.params = vec![
+                param("path", Value::Text(path)),
+                param("channels", Value::TextList(f.ports.clone())),
+                param("rate", Value::Float(f.rate)),
+            ];
+            replaced.push(f.node.clone());
+        }
+    }
+    let recorded: Vec<(FileSpec, Vec<f64>)> = m
+        .outputs
+        .iter()
+        .map(|f| {
+            let rec = open(&session_dir, f)?;
+            let samples = rec.channel(&f.ports[0]).map(<[f64]>::to_vec).unwrap_or_default();
+            Ok((f.clone(), samples))
+        })
+        .collect::<Result<_>>()?;
+    for (f, s) in &recorded {
+        ticks = ticks.min(f.ratio.ticks_for(s.len() as u64));
+    }
+    if ticks == u64::MAX {
+        return Err(anyhow!("{}: the session recorded nothing to replay", a.session.display()));
+    }
+
+    // Overrides: the session's (for its own graph) and the command line's;
+    // none may address a replaced source.
+    let mut overrides = Vec::new();
+    for s in if own { m.overrides.iter().chain(&a.set).collect::<Vec<_>>() } else { a.set.iter().collect() } {
+        let o = Override::parse(s).map_err(|e| anyhow!("--set {e}"))?;
+        if o.key.split_once('.').is_some_and(|(n, _)| replaced.iter().any(|r| r == n)) {
+            continue;
+        }
+        overrides.push(o);
+    }
+    let checked = check(&graph, &evflow_nodes::registry(), &overrides).map_err(|e| anyhow!("{e}"))?;
+    std::fs::create_dir_all(&a.out).map_err(|e| anyhow!("{}: cannot create output folder: {e}", a.out.display()))?;
+    let opts = PlanOptions {
+        max_block: a.block.max(1),
+        seed: Some(m.seed),
+        base_dir: Some(base_dir),
+        out_dir: Some(a.out.clone()),
+        timing: true,
+    };
+    let mut plan = Plan::build(&checked, &opts).map_err(|e| anyhow!("{e}"))?;
+    if (plan.base_rate() - m.base_rate).abs() > 1e-9 * m.base_rate {
+        return Err(anyhow!("the graph runs at {} Hz but the session at {} Hz", plan.base_rate(), m.base_rate));
+    }
+
+    // Events: changes to apply; gaps and plan replacements end the exact part.
+    let mut exact_until = ticks;
+    let mut sets = Vec::new();
+    for e in read_events(&a.session.join("events.jsonl"))? {
+        match e {
+            LoggedEvent::Set { tick, node, param, value } if tick < ticks => {
+                if replaced.contains(&node) {
+                    continue;
+                }
+                let Some(k) = plan.index(&node) else {
+                    eprintln!("replay: the graph has no node `{node}`; its change at tick {tick} is skipped");
+                    continue;
+                };
+                let Some(p) = plan.spec(k).param(&param) else {
+                    eprintln!("replay: `{node}` has no parameter `{param}`; its change at tick {tick} is skipped");
+                    continue;
+                };
+                sets.push((tick, k, p.name, value));
+            }
+            LoggedEvent::Gap { tick, .. } | LoggedEvent::Replaced { tick } => exact_until = exact_until.min(tick),
+            _ => {}
+        }
+    }
+    let (replayed, report_ticks) = run(&mut plan, &recorded, &sets, ticks)?;
+    let summaries = plan.finish().map_err(|e| anyhow!("{e}"))?;
+
+    if !a.quiet {
+        println!(
+            "replayed {} ticks ({:.3} s) of session `{}`{}",
+            report_ticks,
+            report_ticks as f64 / m.base_rate,
+            m.name,
+            if replaced.is_empty() { String::new() } else { format!("; recorded inputs: {}", replaced.join(", ")) }
+        );
+        for (node, s) in &summaries {
+            for l in &s.lines {
+                println!("{node}: {l}");
+            }
+            for (k, v, unit) in &s.values {
+                println!("{node}: {k} = {v}{}", super::live::unit_suffix(unit));
+            }
+        }
+    }
+    let mut all_same = true;
+    for ((f, rec), out) in recorded.iter().zip(&replayed) {
+        let name = format!("{}.{}", f.node, f.ports[0]);
+        let Some(out) = out else {
+            println!("{name}: not in the replayed graph");
+            all_same = false;
+            continue;
+        };
+        let n = (f.ratio.count(0, exact_until) as usize).min(rec.len()).min(out.len());
+        let c = compare(&name, &rec[..n], &out[..n]);
+        match c.first_difference {
+            None => println!("{name}: identical to the live session, bit for bit ({} samples)", c.samples),
+            Some((i, r, o)) => {
+                all_same = false;
+                println!(
+                    "{name}: differs from sample {i} (live {r:e}, replay {o:e}); largest difference {:e} over {} samples",
+                    c.max_abs, c.samples
+                );
+            }
+        }
+    }
+    if exact_until < ticks {
+        println!("compared up to tick {exact_until} (the session lost samples or replaced its plan there)");
+    }
+    if a.check && !all_same {
+        return Err(anyhow!("the replay does not reproduce the live outputs"));
+    }
+    Ok(())
+}
+
+fn param(name: &str, value: Value) -> ParamDecl {
+    ParamDecl { name: name.into(), value, loc: Default::default() }
+}
+
+fn open(dir: &Path, f: &FileSpec) -> Result<Recording> {
+    Recording::open(&dir.join(&f.file)).map_err(|e| anyhow!("{e}"))
+}
+
+/// Runs `ticks` ticks in blocks, applying each change before its tick and
+/// collecting the outputs the session recorded.
+fn run(
+    plan: &mut Plan,
+    recorded: &[(FileSpec, Vec<f64>)],
+    sets: &[(u64, usize, &'static str, f64)],
+    ticks: u64,
+) -> Result<(Vec<Option<Vec<f64>>>, u64)> {
+    let taps: Vec<Option<(usize, usize)>> = recorded
+        .iter()
+        .map(|(f, _)| {
+            let k = plan.index(&f.node)?;
+            let j = plan.output_names(k).iter().position(|p| *p == f.ports[0])?;
+            Some((k, j))
+        })
+        .collect();
+    let mut out: Vec<Option<Vec<f64>>> = taps.iter().map(|t| t.map(|_| Vec::new())).collect();
+    let ticks = plan.remaining_ticks().map_or(ticks, |r| r.min(ticks));
+    let block = plan.max_block() as u64;
+    let mut t = 0;
+    let mut next = 0;
+    while t < ticks {
+        while next < sets.len() && sets[next].0 <= t {
+            let (tick, k, p, v) = sets[next];
+            plan.set(k, p, v).map_err(|e| anyhow!("tick {tick}: `{}`: {e}", plan.node_name(k)))?;
+            next += 1;
+        }
+        let until = sets.get(next).map_or(ticks, |s| s.0.min(ticks));
+        let n = block.min(until - t).max(1);
+        plan.step(n as usize).map_err(|e| anyhow!("{e}"))?;
+        for (tap, o) in taps.iter().zip(&mut out) {
+            if let (Some((k, j)), Some(o)) = (tap, o) {
+                o.extend_from_slice(plan.output_at(*k, *j));
+            }
+        }
+        t += n;
+    }
+    Ok((out, ticks))
+}
+
+/// Compares two equally long signals bit for bit.
+pub fn compare(name: &str, recorded: &[f64], replayed: &[f64]) -> Comparison {
+    let mut first = None;
+    let mut max_abs: f64 = 0.0;
+    for (i, (r, o)) in recorded.iter().zip(replayed).enumerate() {
+        if r.to_bits() != o.to_bits() {
+            first.get_or_insert((i, *r, *o));
+            max_abs = max_abs.max((r - o).abs());
+        }
+    }
+    Comparison { name: name.to_string(), samples: recorded.len().min(replayed.len()), first_difference: first, max_abs }
+}

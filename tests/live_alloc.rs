@@ -109,7 +109,7 @@ mod syscalls {
         // SAFETY: a plain sigaction with a handler that only touches atomics.
         unsafe {
             let mut sa: libc::sigaction = std::mem::zeroed();
-            sa.sa_sigaction = on_sigsys as usize;
+            sa.sa_sigaction = on_sigsys as *const () as usize;
             sa.sa_flags = libc::SA_SIGINFO;
             assert_eq!(libc::sigaction(libc::SIGSYS, &sa, std::ptr::null_mut()), 0);
         }

@@ -4,6 +4,12 @@
 //! loop — every tick, every parameter change, the stop sequence. Any
 //! allocation or free there fails the test.
 //!
+//! On x86-64 Linux a seccomp filter is also installed on the real-time
+//! thread when the loop starts: it allows only the clock (sleep, read) and
+//! the memory and exit calls a thread makes when it ends; any other system
+//! call — a write (printing, file I/O), a read, a futex wait (a contended
+//! lock), an open — traps, is counted, and fails the test.
+//!
 //! Graphs added to `graphs/` later join automatically; a graph that cannot
 //! run live (an offline-only node) is listed and skipped.
 
@@ -59,13 +65,112 @@ static GLOBAL: Counting = Counting;
 fn hook(on: bool) {
     if on {
         ARMINGS.fetch_add(1, Ordering::SeqCst);
+        syscalls::forbid_on_this_thread();
     }
     ARMED.with(|a| a.set(on));
 }
 
+/// The seccomp filter and the SIGSYS handler that counts trapped calls.
+#[cfg(all(target_os = "linux", target_arch = "x86_64"))]
+mod syscalls {
+    use std::sync::atomic::{AtomicI64, AtomicU64, Ordering};
+
+    pub static TRAPPED: AtomicU64 = AtomicU64::new(0);
+    pub static FIRST: AtomicI64 = AtomicI64::new(-1);
+
+    /// System calls the real-time thread may make: the clock, and what a
+    /// thread's exit needs (memory, signal stack, exit).
+    const ALLOWED: &[i64] = &[
+        libc::SYS_clock_nanosleep,
+        libc::SYS_clock_gettime,
+        libc::SYS_rt_sigreturn,
+        libc::SYS_mmap,
+        libc::SYS_munmap,
+        libc::SYS_madvise,
+        libc::SYS_mprotect,
+        libc::SYS_brk,
+        libc::SYS_sigaltstack,
+        libc::SYS_rt_sigprocmask,
+        libc::SYS_exit,
+        libc::SYS_exit_group,
+    ];
+    const AUDIT_ARCH_X86_64: u32 = 0xC000_003E;
+
+    extern "C" fn on_sigsys(_: libc::c_int, info: *mut libc::siginfo_t, _: *mut libc::c_void) {
+        // SAFETY: for SIGSYS the kernel fills `si_syscall` at offset 24 of
+        // siginfo_t on x86-64 (after signo, errno, code and the call address).
+        let nr = unsafe { *(info as *const u8).add(24).cast::<libc::c_int>() };
+        TRAPPED.fetch_add(1, Ordering::SeqCst);
+        let _ = FIRST.compare_exchange(-1, nr as i64, Ordering::SeqCst, Ordering::SeqCst);
+    }
+
+    /// Installs the process-wide SIGSYS handler (once).
+    pub fn install_handler() {
+        // SAFETY: a plain sigaction with a handler that only touches atomics.
+        unsafe {
+            let mut sa: libc::sigaction = std::mem::zeroed();
+            sa.sa_sigaction = on_sigsys as *const () as usize;
+            sa.sa_flags = libc::SA_SIGINFO;
+            assert_eq!(libc::sigaction(libc::SIGSYS, &sa, std::ptr::null_mut()), 0);
+        }
+    }
+
+    fn stmt(code: u16, k: u32) -> libc::sock_filter {
+        libc::sock_filter { code, jt: 0, jf: 0, k }
+    }
+
+    /// Installs the filter on the calling thread only.
+    pub fn forbid_on_this_thread() {
+        const LD: u16 = (libc::BPF_LD | libc::BPF_W | libc::BPF_ABS) as u16;
+        const JEQ: u16 = (libc::BPF_JMP | libc::BPF_JEQ | libc::BPF_K) as u16;
+        const RET: u16 = (libc::BPF_RET | libc::BPF_K) as u16;
+        let mut prog = vec![
+            stmt(LD, 4), // arch
+            libc::sock_filter { code: JEQ, jt: 1, jf: 0, k: AUDIT_ARCH_X86_64 },
+            stmt(RET, libc::SECCOMP_RET_ALLOW),
+            stmt(LD, 0), // syscall number
+        ];
+        let n = ALLOWED.len();
+        for (i, &nr) in ALLOWED.iter().enumerate() {
+            // Jump over the remaining tests and the trap to the allow.
+            prog.push(libc::sock_filter { code: JEQ, jt: (n - i) as u8, jf: 0, k: nr as u32 });
+        }
+        prog.push(stmt(RET, libc::SECCOMP_RET_TRAP));
+        prog.push(stmt(RET, libc::SECCOMP_RET_ALLOW));
+        let fprog = libc::sock_fprog { len: prog.len() as u16, filter: prog.as_mut_ptr() };
+        // SAFETY: valid filter program; no_new_privs is required to install
+        // a filter without CAP_SYS_ADMIN and affects only this thread.
+        unsafe {
+            assert_eq!(libc::prctl(libc::PR_SET_NO_NEW_PRIVS, 1, 0, 0, 0), 0);
+            assert_eq!(libc::prctl(libc::PR_SET_SECCOMP, libc::SECCOMP_MODE_FILTER, &fprog as *const _), 0);
+        }
+        drop(prog);
+    }
+}
+
+#[cfg(not(all(target_os = "linux", target_arch = "x86_64")))]
+mod syscalls {
+    use std::sync::atomic::{AtomicI64, AtomicU64};
+    pub static TRAPPED: AtomicU64 = AtomicU64::new(0);
+    pub static FIRST: AtomicI64 = AtomicI64::new(-1);
+    pub fn install_handler() {}
+    pub fn forbid_on_this_thread() {}
+}
+
+/// Allocations and frees, and forbidden system calls, counted on the
+/// real-time thread.
+#[derive(Debug, PartialEq)]
+struct Counts {
+    allocations: u64,
+    syscalls: u64,
+    first_syscall: i64,
+}
+
 /// Runs `plan` live for `seconds`, changing every live parameter of every
-/// node (to its default) halfway, and returns the allocations counted.
-fn allocations(plan: Plan, seconds: f64) -> Result<u64, String> {
+/// node (to its default) halfway, and counts what the real-time thread did.
+fn allocations(plan: Plan, seconds: f64) -> Result<Counts, String> {
+    syscalls::TRAPPED.store(0, Ordering::SeqCst);
+    syscalls::FIRST.store(-1, Ordering::SeqCst);
     let mut taps = LivePlan::source_taps(&plan);
     taps.extend(LivePlan::guard_taps(&plan));
     let mut changes = Vec::new();
@@ -95,8 +200,14 @@ fn allocations(plan: Plan, seconds: f64) -> Result<u64, String> {
         return Err(f.to_string());
     }
     assert_eq!(ARMINGS.load(Ordering::SeqCst), armings + 1, "the hook armed the guard");
-    Ok(ALLOCS.load(Ordering::SeqCst) - before)
+    Ok(Counts {
+        allocations: ALLOCS.load(Ordering::SeqCst) - before,
+        syscalls: syscalls::TRAPPED.load(Ordering::SeqCst),
+        first_syscall: syscalls::FIRST.load(Ordering::SeqCst),
+    })
 }
+
+const CLEAN: Counts = Counts { allocations: 0, syscalls: 0, first_syscall: -1 };
 
 fn build(path: &std::path::Path, text: Option<&str>) -> Plan {
     let reg = evflow_nodes::registry();
@@ -163,6 +274,8 @@ mod allocating {
     impl Node for A {
         fn process(&mut self, io: &mut Io<'_>) -> Result<(), NodeError> {
             self.0.push(io.input(0).to_vec());
+            // File I/O: a system call the filter traps.
+            let _ = std::fs::metadata("/");
             Ok(())
         }
         fn reset(&mut self) {}
@@ -171,6 +284,7 @@ mod allocating {
 
 #[test]
 fn no_allocation_on_the_real_time_thread() {
+    syscalls::install_handler();
     // The guard works: a node that allocates is caught.
     {
         let mut reg = evflow_nodes::registry();
@@ -181,7 +295,10 @@ fn no_allocation_on_the_real_time_thread() {
         let checked = evflow_engine::check(&g, &reg, &[]).unwrap();
         let plan = Plan::build(&checked, &PlanOptions { max_block: 1, ..Default::default() }).unwrap();
         let n = allocations(plan, 0.05).unwrap();
-        assert!(n >= 50, "the guard must count the allocating node's allocations (counted {n})");
+        assert!(n.allocations >= 50, "the guard must count the allocating node's allocations ({n:?})");
+        if cfg!(all(target_os = "linux", target_arch = "x86_64")) {
+            assert!(n.syscalls >= 50, "the filter must trap the node's file I/O ({n:?})");
+        }
     }
 
     let mut ran = Vec::new();
@@ -189,7 +306,7 @@ fn no_allocation_on_the_real_time_thread() {
     for (path, _) in evflow_tests::shipped_graphs() {
         match allocations(build(&path, None), 0.4) {
             Ok(n) => {
-                assert_eq!(n, 0, "{}: {n} allocations or frees on the real-time thread", path.display());
+                assert_eq!(n, CLEAN, "{}: allocations/frees or system calls on the real-time thread", path.display());
                 ran.push(path.display().to_string());
             }
             Err(why) if why.contains("cannot run live") => skipped.push(format!("{}: {why}", path.display())),
@@ -198,7 +315,7 @@ fn no_allocation_on_the_real_time_thread() {
     }
     for (name, text) in EXTRA {
         let n = allocations(build(std::path::Path::new(name), Some(text)), 0.4).unwrap();
-        assert_eq!(n, 0, "{name}: {n} allocations or frees on the real-time thread");
+        assert_eq!(n, CLEAN, "{name}: allocations/frees or system calls on the real-time thread");
         ran.push(name.to_string());
     }
     eprintln!("ran live without allocating: {ran:?}\nnot live-capable: {skipped:?}");

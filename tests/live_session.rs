@@ -147,5 +147,6 @@ fn ctrl_c_ends_the_session_with_the_actuation_at_zero() {
     let y = Recording::open(&s.join("outputs/limit.out")).unwrap().channel("out").unwrap().to_vec();
     assert_eq!(manifest["end"]["ticks"].as_u64().unwrap() as usize, y.len());
     assert_eq!(*y.last().unwrap(), 0.0);
-    assert!(y[y.len() - 12] != 0.0, "running until the stop");
+    let before_stop = &y[y.len() - 40..y.len() - 11];
+    assert!(before_stop.iter().any(|&v| v != 0.0), "running until the stop");
 }

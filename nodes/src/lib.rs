@@ -9,6 +9,7 @@ pub mod analysis;
 pub mod filters;
 pub mod lab;
 pub mod math;
+pub mod mesh;
 pub mod metric;
 pub mod output;
 pub mod recording;

@@ -1,0 +1,410 @@
+//! Edge emphasis (dissertation §4.1.2): the dihedral angle θ between the
+//! triangle hit in the previous tick and the one hit now, convex edges
+//! only, sharpness S = −(θ − 180°)/(180° − θ_min) (Eq. 4.8) relative to the
+//! mesh's sharpest convex edge θ_min, and the EDGE-TICK intensity
+//! I_e = 0.7·S + 0.3 (Eq. 4.9).
+//!
+//! **Sign convention.** Normals face the ray (n_z ≥ 0, [`Mesh::normals`]).
+//! θ is the angle inside the solid under the surface: for two faces a → b
+//! with hit points p_a, p_b, the bend is convex when each point lies below
+//! the other face's plane, (n_a − n_b)·(p_b − p_a) < 0, and then
+//! θ = 180° − ∠(n_a, n_b); otherwise θ ≥ 180° (concave or flat) and the
+//! edge is not emphasized. A ridge of two faces tilted ±45° (the top edge
+//! of a cube standing on an edge) has θ = 90°.
+//!
+//! **Walls.** A vertical face is never hit by a vertical ray, so stepping
+//! over a wall (the top of a cube to the floor) joins two parallel faces:
+//! the normals alone see no edge. The profile in the vertical plane of the
+//! motion does: the slope angles of face a, of the chord p_a → p_b and of
+//! face b along the motion, α_a, α_c, α_b, turn convexly by
+//! max(0, α_a − α_c) + max(0, α_c − α_b), and θ is the smaller of the
+//! normals' angle and 180° minus that turn. For adjacent faces crossed
+//! head-on both agree; for an oblique crossing the normals give the sharper
+//! (true) angle; over a wall the profile gives about 90°.
+//!
+//! **θ_min** is computed once over every edge of the welded mesh a finger
+//! can cross: pairs of non-vertical faces (every pair around a
+//! non-manifold edge — the finger can cross from any of them to any other),
+//! a non-vertical face meeting a vertical one that goes down from the edge
+//! (a wall: θ = 180° − ∠(n_a, w), w the horizontal outward direction), and
+//! boundary edges of open meshes: wholly above the floor a boundary is a
+//! cliff (the same wall rule); touching or below the floor it meets the
+//! floor plane from below or level and is not convex. A mesh without a
+//! convex edge has θ_min = 180° and never ticks (S = 0).
+//!
+//! Convex bends flatter than `max_angle` (default 160°) are the facets of a
+//! smooth surface, not edges: they are neither emphasized nor counted in
+//! θ_min (Fig. 4.4 marks θ < 135° as relatively sharp).
+
+use super::raycast::vertical_hit;
+use super::trimesh::{dot, sub, Mesh};
+use std::collections::HashMap;
+
+/// Faces with n_z at or below this are vertical walls.
+const VERTICAL: f64 = 1e-12;
+
+/// What the mesh's edges are made of.
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub struct EdgeCensus {
+    /// Distinct edges.
+    pub edges: usize,
+    /// Edges with one face (open mesh).
+    pub boundary: usize,
+    /// Edges with three or more faces.
+    pub non_manifold: usize,
+    /// Convex edges (or face pairs) sharper than `max_angle`.
+    pub convex: usize,
+    /// The sharpest convex angle θ_min, degrees (180 when none).
+    pub theta_min: f64,
+}
+
+/// Angle between unit vectors, degrees.
+fn angle(a: [f64; 3], b: [f64; 3]) -> f64 {
+    dot(a, b).clamp(-1.0, 1.0).acos().to_degrees()
+}
+
+/// θ of a convex wall or cliff at edge (v0, v1) of a face with normal `n`
+/// and opposite vertex `o`: 180° − ∠(n, w), w horizontal, away from the face.
+fn wall_angle(n: [f64; 3], v0: [f64; 3], v1: [f64; 3], o: [f64; 3]) -> Option<f64> {
+    let e = sub(v1, v0);
+    let len = e[0].hypot(e[1]);
+    if len == 0.0 {
+        return None; // a vertical edge: no wall along it
+    }
+    let mut w = [e[1] / len, -e[0] / len, 0.0];
+    if dot(w, sub(o, v0)) > 0.0 {
+        w = w.map(|x| -x);
+    }
+    Some(180.0 - angle(n, w))
+}
+
+/// The convex angle of faces a and b sharing edge (v0, v1), if convex.
+fn pair_angle(m: &Mesh, a: u32, b: u32, v0: u32, v1: u32) -> Option<f64> {
+    let opp = |t: u32| m.triangles[t as usize].into_iter().find(|&k| k != v0 && k != v1);
+    let (oa, ob) = (opp(a)?, opp(b)?);
+    let (na, nb) = (m.normals[a as usize], m.normals[b as usize]);
+    let (p0, p1) = (m.vertices[v0 as usize], m.vertices[v1 as usize]);
+    let (va, vb) = (m.vertices[oa as usize], m.vertices[ob as usize]);
+    let (vert_a, vert_b) = (na[2] <= VERTICAL, nb[2] <= VERTICAL);
+    match (vert_a, vert_b) {
+        (true, true) => None,
+        (false, true) | (true, false) => {
+            let (n, o, wall_o) = if vert_b { (na, va, vb) } else { (nb, vb, va) };
+            // Convex only when the wall goes down from the edge.
+            (wall_o[2] < p0[2].min(p1[2])).then(|| wall_angle(n, p0, p1, o)).flatten()
+        }
+        (false, false) => {
+            let scale = dot(sub(p1, p0), sub(p1, p0)).sqrt().max(1e-300);
+            let s = dot(na, sub(vb, p0)) + dot(nb, sub(va, p0));
+            (s < -1e-12 * scale).then(|| 180.0 - angle(na, nb))
+        }
+    }
+}
+
+/// The census and θ_min of a mesh whose floor (screen plane) is at `floor`.
+pub fn census(m: &Mesh, floor: f64, max_angle: f64) -> EdgeCensus {
+    let mut map: HashMap<(u32, u32), Vec<u32>> = HashMap::with_capacity(m.triangles.len() * 3 / 2);
+    for (t, tri) in m.triangles.iter().enumerate() {
+        for k in 0..3 {
+            let (a, b) = (tri[k], tri[(k + 1) % 3]);
+            map.entry((a.min(b), a.max(b))).or_default().push(t as u32);
+        }
+    }
+    let ext = m.bounds().extent().max(1e-300);
+    let mut c = EdgeCensus { edges: map.len(), theta_min: 180.0, ..Default::default() };
+    let take = |th: f64, c: &mut EdgeCensus| {
+        if th < max_angle {
+            c.convex += 1;
+            c.theta_min = c.theta_min.min(th);
+        }
+    };
+    for (&(v0, v1), faces) in &map {
+        match faces.len() {
+            1 => {
+                c.boundary += 1;
+                let t = faces[0];
+                let n = m.normals[t as usize];
+                let (p0, p1) = (m.vertices[v0 as usize], m.vertices[v1 as usize]);
+                let above = p0[2].min(p1[2]) > floor + 1e-9 * ext;
+                if n[2] > VERTICAL && above {
+                    let o = m.triangles[t as usize].into_iter().find(|&k| k != v0 && k != v1);
+                    if let Some(th) = o.and_then(|o| wall_angle(n, p0, p1, m.vertices[o as usize])) {
+                        take(th, &mut c);
+                    }
+                }
+            }
+            k => {
+                if k > 2 {
+                    c.non_manifold += 1;
+                }
+                for i in 0..k {
+                    for j in i + 1..k {
+                        if let Some(th) = pair_angle(m, faces[i], faces[j], v0, v1) {
+                            take(th, &mut c);
+                        }
+                    }
+                }
+            }
+        }
+    }
+    c
+}
+
+/// Eq. 4.8, clamped to [0, 1]; 0 when the mesh has no convex edge.
+pub fn sharpness(theta: f64, theta_min: f64) -> f64 {
+    if theta_min >= 180.0 || theta >= 180.0 {
+        return 0.0;
+    }
+    (-(theta - 180.0) / (180.0 - theta_min)).clamp(0.0, 1.0)
+}
+
+/// Eq. 4.9.
+pub fn edge_intensity(s: f64) -> f64 {
+    0.7 * s + 0.3
+}
+
+/// One tick's edge result.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct EdgeEvent {
+    /// θ of the bend crossed this tick, degrees (180 when none).
+    pub theta: f64,
+    /// Eq. 4.8 (0 when none).
+    pub sharpness: f64,
+    /// Eq. 4.9 when an edge is emphasized this tick, else 0.
+    pub intensity: f64,
+}
+
+/// No edge this tick.
+pub const NO_EDGE: EdgeEvent = EdgeEvent { theta: 180.0, sharpness: 0.0, intensity: 0.0 };
+
+/// Tracks the triangle under the finger from tick to tick.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct EdgeTracker {
+    theta_min: f64,
+    max_angle: f64,
+    max_step: f64,
+    floor: f64,
+    prev: Option<([f64; 3], Option<u32>)>,
+}
+
+/// Slope angle (degrees) of a face with normal `n` along horizontal unit `d`.
+fn slope_angle(n: [f64; 3], d: [f64; 2]) -> f64 {
+    (-(n[0] * d[0] + n[1] * d[1])).atan2(n[2]).to_degrees()
+}
+
+impl EdgeTracker {
+    /// A tracker for a mesh with the given θ_min.
+    pub fn new(theta_min: f64, max_angle: f64, max_step: f64, floor: f64) -> Self {
+        EdgeTracker { theta_min, max_angle, max_step, floor, prev: None }
+    }
+
+    /// Back to t = 0.
+    pub fn reset(&mut self) {
+        self.prev = None;
+    }
+
+    /// The surface point and triangle under (x, y), given the triangle the
+    /// ray cast reported (`None`, or an index that does not hold the point,
+    /// means the floor).
+    pub fn locate(&self, m: &Mesh, x: f64, y: f64, tri: Option<u32>) -> ([f64; 3], Option<u32>) {
+        if let Some(t) = tri.filter(|&t| (t as usize) < m.triangles.len()) {
+            let [a, b, c] = m.corners(t as usize);
+            if let Some(z) = vertical_hit(&a, &b, &c, x, y) {
+                return ([x, y, z], Some(t));
+            }
+        }
+        ([x, y, self.floor], None)
+    }
+
+    /// One tick: the finger at `p` on triangle `tri` (`None`: the floor).
+    pub fn step(&mut self, m: &Mesh, p: [f64; 3], tri: Option<u32>) -> EdgeEvent {
+        if !p.iter().all(|v| v.is_finite()) {
+            return NO_EDGE;
+        }
+        let prev = self.prev.replace((p, tri));
+        let Some((q, qt)) = prev else { return NO_EDGE };
+        if qt == tri {
+            return NO_EDGE;
+        }
+        let up = [0.0, 0.0, 1.0];
+        let normal = |t: Option<u32>| t.map_or(up, |t| m.normals[t as usize]);
+        let (na, nb) = (normal(qt), normal(tri));
+        let d3 = sub(p, q);
+        let dr = d3[0].hypot(d3[1]);
+        if dr > self.max_step {
+            return NO_EDGE; // a jump, not a crossing
+        }
+        let mut theta = 180.0;
+        if dot(sub(na, nb), d3) < 0.0 {
+            theta = 180.0 - angle(na, nb);
+        }
+        if dr > 0.0 {
+            let d = [d3[0] / dr, d3[1] / dr];
+            let (aa, ab) = (slope_angle(na, d), slope_angle(nb, d));
+            let ac = d3[2].atan2(dr).to_degrees();
+            let turn = (aa - ac).max(0.0) + (ac - ab).max(0.0);
+            theta = f64::min(theta, 180.0 - turn);
+        }
+        let theta = theta.max(0.0);
+        if theta >= self.max_angle {
+            return EdgeEvent { theta, ..NO_EDGE };
+        }
+        let s = sharpness(theta, self.theta_min);
+        if s <= 0.0 {
+            return EdgeEvent { theta, ..NO_EDGE };
+        }
+        EdgeEvent { theta, sharpness: s, intensity: edge_intensity(s) }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::mesh::raycast::RayCaster;
+    use crate::mesh::scenes::{grid, scene, Shape};
+
+    /// A unit cube rotated by `rx` about x then `ry` about y, 12 triangles
+    /// in the given winding (true = outward).
+    fn cube(rx: f64, ry: f64, outward: bool) -> Mesh {
+        let mut v = Vec::new();
+        for k in 0..8 {
+            let p = [(k & 1) as f64 - 0.5, ((k >> 1) & 1) as f64 - 0.5, ((k >> 2) & 1) as f64 - 0.5];
+            let (c, s) = (rx.cos(), rx.sin());
+            let p = [p[0], c * p[1] - s * p[2], s * p[1] + c * p[2]];
+            let (c, s) = (ry.cos(), ry.sin());
+            v.push([c * p[0] + s * p[2], p[1], -s * p[0] + c * p[2]]);
+        }
+        let quads = [[0, 2, 3, 1], [4, 5, 7, 6], [0, 1, 5, 4], [2, 6, 7, 3], [0, 4, 6, 2], [1, 3, 7, 5]];
+        let mut t = Vec::new();
+        for q in quads {
+            let (a, b) = if outward {
+                ([q[0], q[1], q[2]], [q[0], q[2], q[3]])
+            } else {
+                ([q[0], q[2], q[1]], [q[0], q[3], q[2]])
+            };
+            t.push(a);
+            t.push(b);
+        }
+        Mesh::new(v, t, 0.0)
+    }
+
+    #[test]
+    fn cube_edges_are_90_degrees_and_convex_whatever_the_winding() {
+        let q = std::f64::consts::FRAC_PI_4;
+        for outward in [true, false] {
+            // Standing on an edge: the top ridge is a 90° convex edge between two faces at ±45°.
+            let m = cube(q, 0.0, outward);
+            let c = census(&m, m.bounds().min[2], 160.0);
+            assert!((c.theta_min - 90.0).abs() < 1e-9, "{c:?}");
+            assert_eq!((c.edges, c.boundary, c.non_manifold), (18, 0, 0));
+            // Scan across the ridge (along y) at 1 kHz-like steps.
+            let rc = RayCaster::new(&m);
+            let mut tr = EdgeTracker::new(c.theta_min, 160.0, 1.0, m.bounds().min[2]);
+            let mut events = Vec::new();
+            for k in 0..200 {
+                let y = -0.5 + k as f64 * 0.005;
+                let h = rc.cast(0.1, y).unwrap();
+                let e = tr.step(&m, [0.1, y, h.z], Some(h.tri));
+                if e.intensity > 0.0 {
+                    events.push((y, e));
+                }
+            }
+            assert_eq!(events.len(), 1, "{events:?}");
+            let (y, e) = events[0];
+            assert!(y.abs() < 0.01);
+            assert!((e.theta - 90.0).abs() < 1e-9, "{e:?}");
+            assert!((e.sharpness - 1.0).abs() < 1e-9 && (e.intensity - 1.0).abs() < 1e-9);
+        }
+        // Axis-aligned: the top edges are walls going down, 90° and convex;
+        // stepping off the top onto the floor is caught by the profile.
+        let m = cube(0.0, 0.0, true);
+        let floor = m.bounds().min[2];
+        let c = census(&m, floor, 160.0);
+        assert!((c.theta_min - 90.0).abs() < 1e-9 && c.convex == 4, "{c:?}");
+        let rc = RayCaster::new(&m);
+        let mut tr = EdgeTracker::new(c.theta_min, 160.0, 1.0, floor);
+        let mut hits = 0;
+        for k in 0..100 {
+            let x = k as f64 * 0.01;
+            let h = rc.cast(x, 0.0);
+            let (p, t) = tr.locate(&m, x, 0.0, h.map(|h| h.tri));
+            let e = tr.step(&m, p, t);
+            if e.intensity > 0.0 {
+                hits += 1;
+                assert!(e.theta < 91.0 && e.sharpness > 0.98, "{e:?}");
+            }
+        }
+        assert_eq!(hits, 1);
+    }
+
+    #[test]
+    fn concave_edges_are_ignored_and_a_valley_has_no_convex_edge() {
+        // V-shaped valley z = |x| − 1 with its rim on the floor: one concave edge.
+        let m = grid(2, 2, [-1.0, 1.0], [-1.0, 1.0], |x, _| x.abs() - 1.0);
+        let c = census(&m, 0.0, 160.0);
+        assert_eq!(c.theta_min, 180.0);
+        assert_eq!(sharpness(120.0, c.theta_min), 0.0);
+        let rc = RayCaster::new(&m);
+        let mut tr = EdgeTracker::new(c.theta_min, 160.0, 1.0, 0.0);
+        assert_eq!(c.boundary, 8);
+        for k in 0..100 {
+            let x = -0.5 + k as f64 * 0.01;
+            let h = rc.cast(x, 0.3).unwrap();
+            assert_eq!(tr.step(&m, [x, 0.3, h.z], Some(h.tri)).intensity, 0.0);
+        }
+        // Ridge z = −|x|: convex with θ = 180 − 90 = 90°.
+        let m = grid(2, 2, [-1.0, 1.0], [-1.0, 1.0], |x, _| -x.abs());
+        assert!((census(&m, -1.0, 160.0).theta_min - 90.0).abs() < 1e-9);
+    }
+
+    #[test]
+    fn frustum_angles_match_their_geometry() {
+        // Top–side: 180° − atan 2; side–side (hip): 180° − acos(1/5).
+        let top_side = 180.0 - 2f64.atan().to_degrees();
+        let hip = 180.0 - (0.2f64).acos().to_degrees();
+        // Scenes stand on the screen plane z = 0 (their floor).
+        let m = scene(Shape::Frustum, "bump", 0).unwrap();
+        let c = census(&m, 0.0, 160.0);
+        assert!((c.theta_min - hip).abs() < 1e-9, "{c:?} vs {hip}");
+        assert_eq!(c.convex, 4 + 4);
+        // A hole: the rim (ground–side) is the only convex edge; the open
+        // border of the ground lies on the floor and is not an edge.
+        let m = scene(Shape::Frustum, "hole", 0).unwrap();
+        let c = census(&m, 0.0, 160.0);
+        assert!((c.theta_min - top_side).abs() < 1e-9, "{c:?} vs {top_side}");
+        assert_eq!((c.boundary, c.convex), (4, 4));
+    }
+
+    #[test]
+    fn boundary_and_non_manifold_edges_are_handled() {
+        // A square floating at z = 1 over a floor at 0: its border is a 90° cliff.
+        let sq = grid(1, 1, [0.0, 1.0], [0.0, 1.0], |_, _| 1.0);
+        let c = census(&sq, 0.0, 160.0);
+        assert_eq!((c.boundary, c.convex), (4, 4));
+        assert!((c.theta_min - 90.0).abs() < 1e-9);
+        // The same square lying on the floor: no edge.
+        assert_eq!(census(&sq, 1.0, 160.0).theta_min, 180.0);
+        // A fin: three faces on the edge (0,0,0)-(1,0,0): two roof halves and
+        // a third face going up. Pairs: roof halves 90°, ...
+        let v = vec![[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.5, -1.0, -1.0], [0.5, 1.0, -1.0], [0.5, 0.0, 1.0]];
+        let m = Mesh::new(v, vec![[0, 1, 2], [0, 1, 3], [0, 1, 4]], 0.0);
+        let c = census(&m, -1.0, 160.0);
+        assert_eq!(c.non_manifold, 1);
+        // Roof halves: normals (0,−1,1)/√2 and (0,1,1)/√2 → 90°; the fin is
+        // vertical and goes up (not convex); the roof's open borders reach
+        // down to the floor (not cliffs).
+        assert!((c.theta_min - 90.0).abs() < 1e-9, "{c:?}");
+        assert_eq!((c.convex, c.boundary), (1, 6));
+    }
+
+    #[test]
+    fn eq_4_8_and_4_9() {
+        assert_eq!(sharpness(180.0, 90.0), 0.0);
+        assert_eq!(sharpness(90.0, 90.0), 1.0);
+        assert!((sharpness(135.0, 90.0) - 0.5).abs() < 1e-15);
+        assert_eq!(sharpness(60.0, 90.0), 1.0);
+        assert_eq!(edge_intensity(0.0), 0.3);
+        assert_eq!(edge_intensity(1.0), 1.0);
+        assert!((edge_intensity(0.5) - 0.65).abs() < 1e-15);
+    }
+}

@@ -1,0 +1,18 @@
+//! The mesh family: live mesh-gradient rendering (dissertation §3.2.1 and
+//! chapter 4). A touch point becomes a vertical ray on a 3D mesh; the
+//! surface gradient between consecutive hits becomes a friction intensity
+//! (Eq. 4.1–4.7), sharp convex edges an EDGE-TICK intensity (Eq. 4.8–4.9),
+//! and `grain` turns both into an actuation waveform. Design and figures:
+//! `docs/mesh.md`.
+
+pub mod calibrate;
+pub mod edges;
+pub mod error;
+pub mod gradient;
+pub mod obj;
+pub mod raycast;
+pub mod scenes;
+pub mod trimesh;
+
+pub use error::MeshError;
+pub use trimesh::Mesh;

@@ -1,0 +1,262 @@
+//! The triangle mesh every mesh node works on: f64 vertices welded so that
+//! neighbouring triangles share edges, triangles as vertex-index triples,
+//! per-triangle unit normals oriented toward the ray (n_z ≥ 0, so the OBJ's
+//! winding does not matter), bounds and a content hash.
+
+use std::collections::HashMap;
+
+/// A triangle mesh in mesh units (the scenes of §4.2 are in cm).
+#[derive(Debug, Clone, PartialEq)]
+pub struct Mesh {
+    /// Vertex positions.
+    pub vertices: Vec<[f64; 3]>,
+    /// Triangles as indices into `vertices`.
+    pub triangles: Vec<[u32; 3]>,
+    /// Unit normal of each triangle, flipped to point up (n_z ≥ 0; a
+    /// vertical triangle keeps n_z = 0 with its file orientation). Zero for
+    /// degenerate (zero-area) triangles.
+    pub normals: Vec<[f64; 3]>,
+}
+
+/// Axis-aligned bounds.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Bounds {
+    /// Smallest coordinates.
+    pub min: [f64; 3],
+    /// Largest coordinates.
+    pub max: [f64; 3],
+}
+
+impl Bounds {
+    /// The centre.
+    pub fn center(&self) -> [f64; 3] {
+        [0, 1, 2].map(|i| 0.5 * (self.min[i] + self.max[i]))
+    }
+    /// The largest side length.
+    pub fn extent(&self) -> f64 {
+        (0..3).map(|i| self.max[i] - self.min[i]).fold(0.0, f64::max)
+    }
+}
+
+/// The unit normal of a triangle (right-hand rule over its vertex order),
+/// or zero when its area is zero.
+pub fn raw_normal(a: [f64; 3], b: [f64; 3], c: [f64; 3]) -> [f64; 3] {
+    let u = sub(b, a);
+    let v = sub(c, a);
+    let n = cross(u, v);
+    let len = dot(n, n).sqrt();
+    if len > 0.0 && len.is_finite() {
+        n.map(|x| x / len)
+    } else {
+        [0.0; 3]
+    }
+}
+
+/// a − b.
+pub fn sub(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
+    [a[0] - b[0], a[1] - b[1], a[2] - b[2]]
+}
+/// a · b.
+pub fn dot(a: [f64; 3], b: [f64; 3]) -> f64 {
+    a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
+}
+/// a × b.
+pub fn cross(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
+    [a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]]
+}
+
+impl Mesh {
+    /// A mesh from vertices and triangles: vertices at the same position
+    /// (within `weld` mesh units; 0 = bit-identical coordinates) are merged,
+    /// triangles whose corners merged into fewer than three are dropped,
+    /// and normals are computed from the geometry (never taken from a file)
+    /// and oriented up.
+    pub fn new(vertices: Vec<[f64; 3]>, triangles: Vec<[u32; 3]>, weld: f64) -> Self {
+        let (vertices, remap) = weld_vertices(&vertices, weld);
+        let mut tris = Vec::with_capacity(triangles.len());
+        for t in triangles {
+            let t = t.map(|i| remap[i as usize]);
+            if t[0] != t[1] && t[1] != t[2] && t[0] != t[2] {
+                tris.push(t);
+            }
+        }
+        let normals = tris
+            .iter()
+            .map(|t| {
+                let n = raw_normal(vertices[t[0] as usize], vertices[t[1] as usize], vertices[t[2] as usize]);
+                if n[2] < 0.0 {
+                    n.map(|x| -x)
+                } else {
+                    n
+                }
+            })
+            .collect();
+        Mesh { vertices, triangles: tris, normals }
+    }
+
+    /// The three corners of triangle `t`.
+    #[inline]
+    pub fn corners(&self, t: usize) -> [[f64; 3]; 3] {
+        self.triangles[t].map(|i| self.vertices[i as usize])
+    }
+
+    /// Bounds of all vertices used by a triangle (all vertices if none).
+    pub fn bounds(&self) -> Bounds {
+        let mut b = Bounds { min: [f64::INFINITY; 3], max: [f64::NEG_INFINITY; 3] };
+        for v in &self.vertices {
+            for (i, x) in v.iter().enumerate() {
+                b.min[i] = b.min[i].min(*x);
+                b.max[i] = b.max[i].max(*x);
+            }
+        }
+        if self.vertices.is_empty() {
+            b = Bounds { min: [0.0; 3], max: [0.0; 3] };
+        }
+        b
+    }
+
+    /// A 64-bit FNV-1a hash of the welded vertices and triangles (bit
+    /// patterns), which keys the calibration cache.
+    pub fn content_hash(&self) -> u64 {
+        let mut h = Fnv::new();
+        h.u64(self.vertices.len() as u64);
+        for v in &self.vertices {
+            for x in v {
+                h.u64(x.to_bits());
+            }
+        }
+        h.u64(self.triangles.len() as u64);
+        for t in &self.triangles {
+            for i in t {
+                h.u64(*i as u64);
+            }
+        }
+        h.finish()
+    }
+}
+
+/// FNV-1a, 64 bits.
+#[derive(Debug, Clone, Copy)]
+pub struct Fnv(u64);
+
+impl Fnv {
+    /// The offset basis.
+    pub fn new() -> Self {
+        Fnv(0xcbf2_9ce4_8422_2325)
+    }
+    /// Hashes the 8 bytes of `x` (little-endian).
+    pub fn u64(&mut self, x: u64) {
+        for b in x.to_le_bytes() {
+            self.0 ^= b as u64;
+            self.0 = self.0.wrapping_mul(0x0100_0000_01b3);
+        }
+    }
+    /// The hash.
+    pub fn finish(&self) -> u64 {
+        self.0
+    }
+}
+
+impl Default for Fnv {
+    fn default() -> Self {
+        Self::new()
+    }
+}
+
+/// Merges vertices closer than `tol` (exactly equal when `tol` = 0): the
+/// merged list and, for each input vertex, its index in it. With a
+/// tolerance the vertices are hashed on a grid of cell `tol` and compared
+/// with the 27 neighbouring cells, so no pair closer than `tol` is missed.
+fn weld_vertices(v: &[[f64; 3]], tol: f64) -> (Vec<[f64; 3]>, Vec<u32>) {
+    let mut out = Vec::with_capacity(v.len());
+    let mut remap = Vec::with_capacity(v.len());
+    if tol <= 0.0 {
+        let mut seen: HashMap<[u64; 3], u32> = HashMap::with_capacity(v.len());
+        for p in v {
+            // +0.0 and −0.0 are the same point.
+            let key = p.map(|x| (x + 0.0).to_bits());
+            let id = *seen.entry(key).or_insert_with(|| {
+                out.push(*p);
+                (out.len() - 1) as u32
+            });
+            remap.push(id);
+        }
+        return (out, remap);
+    }
+    let mut grid: HashMap<[i64; 3], Vec<u32>> = HashMap::with_capacity(v.len());
+    let cell = |p: &[f64; 3]| p.map(|x| (x / tol).floor() as i64);
+    for p in v {
+        let c = cell(p);
+        let mut found = None;
+        'search: for dx in -1..=1 {
+            for dy in -1..=1 {
+                for dz in -1..=1 {
+                    if let Some(list) = grid.get(&[c[0] + dx, c[1] + dy, c[2] + dz]) {
+                        for &j in list {
+                            let q = out[j as usize];
+                            let d = sub(*p, q);
+                            if dot(d, d) <= tol * tol {
+                                found = Some(j);
+                                break 'search;
+                            }
+                        }
+                    }
+                }
+            }
+        }
+        let id = match found {
+            Some(j) => j,
+            None => {
+                out.push(*p);
+                let j = (out.len() - 1) as u32;
+                grid.entry(c).or_default().push(j);
+                j
+            }
+        };
+        remap.push(id);
+    }
+    (out, remap)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn seams_are_welded_and_collapsed_triangles_dropped() {
+        // Two triangles of a square, the diagonal's vertices duplicated (a UV seam).
+        let v =
+            vec![[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [1.0, 1.0, 0.0], [1.0, 1.0, 0.0], [0.0, 1.0, 0.0], [-0.0, 0.0, 0.0]];
+        let m = Mesh::new(v.clone(), vec![[0, 1, 2], [3, 4, 5]], 0.0);
+        assert_eq!(m.vertices.len(), 4);
+        assert_eq!(m.triangles[0][0], m.triangles[1][2]);
+        assert_eq!(m.triangles[0][2], m.triangles[1][0]);
+        // A tolerance merges near points; a triangle collapsing to a segment goes.
+        let v2 = vec![[0.0, 0.0, 0.0], [1e-9, 0.0, 0.0], [0.0, 1.0, 0.0]];
+        assert_eq!(Mesh::new(v2.clone(), vec![[0, 1, 2]], 1e-6).triangles.len(), 0);
+        assert_eq!(Mesh::new(v2, vec![[0, 1, 2]], 0.0).triangles.len(), 1);
+    }
+
+    #[test]
+    fn normals_face_the_ray_whatever_the_winding() {
+        let v = vec![[0.0, 0.0, 0.0], [1.0, 0.0, 0.5], [0.0, 1.0, 0.0]];
+        let a = Mesh::new(v.clone(), vec![[0, 1, 2]], 0.0);
+        let b = Mesh::new(v, vec![[0, 2, 1]], 0.0);
+        assert_eq!(a.normals, b.normals);
+        assert!(a.normals[0][2] > 0.0);
+        let n = a.normals[0];
+        assert!((dot(n, n) - 1.0).abs() < 1e-15);
+        assert!((n[0] + 0.5 / 1.25f64.sqrt()).abs() < 1e-15);
+    }
+
+    #[test]
+    fn hash_changes_with_content() {
+        let v = vec![[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0]];
+        let a = Mesh::new(v.clone(), vec![[0, 1, 2]], 0.0);
+        let mut v2 = v;
+        v2[1][2] = 1e-12;
+        let b = Mesh::new(v2, vec![[0, 1, 2]], 0.0);
+        assert_ne!(a.content_hash(), b.content_hash());
+        assert_eq!(a.content_hash(), a.clone().content_hash());
+    }
+}

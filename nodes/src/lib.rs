@@ -38,6 +38,7 @@ pub fn all_specs() -> Vec<&'static NodeSpec> {
     v.extend_from_slice(recording::SPECS);
     v.extend_from_slice(metric::SPECS);
     v.extend_from_slice(math::SPECS);
+    v.extend_from_slice(mesh::SPECS);
     v.extend_from_slice(analysis::SPECS);
     v.extend_from_slice(lab::SPECS);
     v

@@ -16,3 +16,15 @@ pub mod trimesh;
 
 pub use error::MeshError;
 pub use trimesh::Mesh;
+pub mod edges_node;
+pub mod gradient_node;
+pub mod grain;
+pub mod path;
+pub mod profile1d;
+pub mod source;
+
+use evflow_engine::NodeSpec;
+
+/// The node types of this family.
+pub static SPECS: &[&NodeSpec] =
+    &[&profile1d::SPEC, &gradient_node::SPEC, &edges_node::SPEC, &grain::SPEC, &path::SPEC];

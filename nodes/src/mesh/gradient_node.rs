@@ -1,0 +1,213 @@
+//! `mesh.gradient`: touch point → vertical ray on a mesh → surface
+//! gradient → friction intensity (dissertation §4.1, Eq. 4.1–4.7).
+
+use super::calibrate::{calibrate, CacheStatus, Range, ScanSettings};
+use super::gradient::{intensity, Gradient, GradientSettings, SlopeMode};
+use super::raycast::RayCaster;
+use super::source::{self, Placed};
+use evflow_engine::{BuildContext, Io, Node, NodeError, NodeSpec, ParamSpec, Params, PortSpec, Role, Summary};
+
+/// Declaration of `mesh.gradient`.
+pub static SPEC: NodeSpec = NodeSpec::new(
+    "mesh.gradient",
+    "mesh",
+    Role::Filter,
+    "Touch point → vertical ray cast on a 3D mesh → surface gradient → friction intensity (§4.1).",
+    build,
+)
+.doc(
+    "The generalized gradient algorithm of dissertation §4.1. Each tick the touch point (x, y) — metres \
+on the screen, mapped to mesh units by `unit` and `offset_x/y` — casts a vertical ray from above the \
+mesh; the highest hit is the hit point. A ray that misses lands on the screen plane (`floor`: z = 0 \
+for generated scenes, the lowest vertex for a file).\n\n\
+**Slope.** `slope = \"secant\"` (the dissertation's): tan α = Δz/Δr between the hit point and the \
+previous one (Eq. 4.1–4.3), where \"previous\" is the last hit point at least `min_step` away — the \
+output holds while the finger moves less (a stationary finger never divides by zero) and a move longer \
+than `max_step` in one tick (a lift or jump) restarts without a slope. `slope = \"normal\"`: the slope of \
+the hit triangle along the last direction of motion, −(n_x d_x + n_y d_y)/n_z, defined every tick even \
+when the finger nearly stops. `docs/mesh.md` compares their fidelity.\n\n\
+**Intensity.** F = −F_pz·tan α (Eq. 4.4–4.5, F_pz = `normal_force`), F^sq = sgn(F)√|F| (Eq. 4.6), \
+I = linear map of [F_min, F_max] onto [`i_max`, `i_min`] = [1.0, 0.3] (Eq. 4.7), clamped outside. \
+With `range = \"auto\"` (F_min, F_max) = (μ − 2σ, μ + 2σ) of F^sq over a simulated scan of the mesh \
+(§4.1.1: `calib_directions` directions × `calib_lines` lines at the `calib_speeds`, at this node's rate), \
+cached in the folder `cache` (relative to the output folder; empty: no cache) under a hash of the mesh \
+and the settings, so the next session starts at once; `range = \"fixed\"` takes `f_min`/`f_max` \
+(the formative study's ±1). A flat mesh has F_min = F_max = 0 and renders I = `i_max`.\n\n\
+**Mesh.** `file` (OBJ via tobj; quads and n-gons triangulated; normals recomputed; vertices welded \
+so neighbouring triangles share edges, within `weld`), or a generated §4.2 scene (`shape`, `config`, \
+`resolution`; cm). The BVH (obvhs CWBVH) is built when the node is constructed — never for a pruned \
+node. The hit test is f64 and watertight: rays through vertices and edges hit whatever the winding.\n\n\
+**Ports** (all at the node's rate): inputs `x`, `y` (m); outputs `intensity`, `fsq` (√N), `slope`, `z` \
+(height under the finger, m), `tri` (index of the triangle hit, −1 off the mesh; feeds `mesh.edges`).\n\n\
+**Checked against:** planes and ramps scanned in many directions (exact slope), the Eq. 4.7 closed form, \
+a brute-force loop over all triangles on grid meshes hit exactly at vertices and edges, the analytic \
+gradient of the Gaussian scene (fidelity report), and the robustness cases of `docs/mesh.md`.",
+)
+.ports(&[
+    PortSpec::input("x", "m", "touch x on the screen"),
+    PortSpec::input("y", "m", "touch y on the screen"),
+    PortSpec::output("intensity", "1", "AREA-EVEN intensity I (Eq. 4.7), 0.3 … 1.0"),
+    PortSpec::output("fsq", "sqrt(N)", "signed square root of the lateral force, F^sq (Eq. 4.6)"),
+    PortSpec::output("slope", "1", "tan α, the surface slope along the motion"),
+    PortSpec::output("z", "m", "height of the surface under the finger"),
+    PortSpec::output("tri", "1", "index of the triangle hit, −1 off the mesh"),
+])
+.params(&[
+    source::FILE,
+    source::SHAPE,
+    source::CONFIG,
+    source::RESOLUTION,
+    source::UNIT,
+    source::OFFSET_X,
+    source::OFFSET_Y,
+    source::WELD,
+    ParamSpec::choice("slope", &["secant", "normal"], "secant", "slope estimate: Eq. 4.1 secant or triangle normal"),
+    ParamSpec::float("min_step", 0.0, 1.0, 0.0005, "m", "smallest move that updates the previous hit point"),
+    ParamSpec::float("max_step", 1e-6, 1e3, 0.01, "m", "largest move per tick taken as motion (longer: a jump)"),
+    ParamSpec::float("normal_force", 0.0, 100.0, 1.0, "N", "F_pz of Eq. 4.4"),
+    ParamSpec::choice("range", &["auto", "fixed"], "auto", "F_min/F_max: simulated scan (§4.1.1) or fixed"),
+    ParamSpec::float("f_min", -1e3, 1e3, -1.0, "sqrt(N)", "F_min when range = fixed"),
+    ParamSpec::float("f_max", -1e3, 1e3, 1.0, "sqrt(N)", "F_max when range = fixed"),
+    ParamSpec::float("i_max", 0.0, 1.0, 1.0, "1", "intensity at F_min (most friction)"),
+    ParamSpec::float("i_min", 0.0, 1.0, 0.3, "1", "intensity at F_max (least perceivable friction)"),
+    ParamSpec::float_list(
+        "calib_speeds",
+        1e-6,
+        100.0,
+        "m/s",
+        "finger speeds of the calibration scan; empty: 0.02, 0.05, 0.1",
+    ),
+    ParamSpec::int("calib_directions", 1, 360, 12, "1", "directions of the calibration scan (over 360°)"),
+    ParamSpec::int("calib_lines", 1, 1000, 24, "1", "parallel lines per direction in the calibration scan"),
+    ParamSpec::text("cache", ".evflow-cache", "calibration cache folder (relative to the output folder); empty: none"),
+])
+.example("shape = \"gaussian\"\nconfig = \"bump\"\nresolution = 12\ncalib_directions = 4\ncalib_lines = 8");
+
+/// Default calibration speeds, m/s (3–7 cm/s is the study's range; slower and faster included).
+pub const DEFAULT_SPEEDS: [f64; 3] = [0.02, 0.05, 0.1];
+
+/// The node, also used by the fidelity report and the benchmark.
+pub struct MeshGradient {
+    /// The mesh and its placement.
+    pub placed: Placed,
+    /// The ray caster (BVH).
+    pub rc: RayCaster,
+    /// The estimator.
+    pub est: Gradient,
+    /// The F^sq range.
+    pub range: Range,
+    /// Intensity at F_min and at F_max.
+    pub i_hi: f64,
+    /// Intensity at F_max.
+    pub i_lo: f64,
+    cache: CacheStatus,
+    /// Ticks on the mesh and off it.
+    hits: u64,
+    misses: u64,
+}
+
+/// Builds the node's state from its parameters.
+pub fn build_state(p: &Params, ctx: &BuildContext) -> Result<MeshGradient, NodeError> {
+    let placed = source::load(p, ctx)?;
+    let rc = RayCaster::new(&placed.mesh);
+    let unit = placed.unit;
+    let gs = GradientSettings {
+        mode: if p.str("slope") == "normal" { SlopeMode::Normal } else { SlopeMode::Secant },
+        min_step: p.f64("min_step") / unit,
+        max_step: p.f64("max_step") / unit,
+        normal_force: p.f64("normal_force"),
+        floor: placed.floor,
+    };
+    if gs.max_step < gs.min_step {
+        return Err(NodeError::param("max_step", "must not be smaller than min_step"));
+    }
+    let (range, cache) = if p.str("range") == "fixed" {
+        let (f_min, f_max) = (p.f64("f_min"), p.f64("f_max"));
+        if f_min > f_max {
+            return Err(NodeError::param("f_min", format!("{f_min} exceeds f_max = {f_max}")));
+        }
+        (
+            Range { f_min, f_max, mean: 0.5 * (f_min + f_max), std: 0.25 * (f_max - f_min), samples: 0 },
+            CacheStatus::Disabled,
+        )
+    } else {
+        let speeds = p.float_list("calib_speeds");
+        let speeds = if speeds.is_empty() { DEFAULT_SPEEDS.to_vec() } else { speeds.to_vec() };
+        let ss = ScanSettings {
+            speeds: speeds.iter().map(|v| v / unit).collect(),
+            rate: ctx.rate,
+            directions: p.usize("calib_directions"),
+            lines: p.usize("calib_lines"),
+        };
+        let dir = p.str("cache");
+        let dir = (!dir.is_empty()).then(|| ctx.out_path(dir));
+        calibrate(&placed.mesh, &rc, gs, &ss, dir.as_deref())
+    };
+    Ok(MeshGradient {
+        placed,
+        rc,
+        est: Gradient::new(gs),
+        range,
+        i_hi: p.f64("i_max"),
+        i_lo: p.f64("i_min"),
+        cache,
+        hits: 0,
+        misses: 0,
+    })
+}
+
+fn build(p: &Params, ctx: &BuildContext) -> Result<Box<dyn Node>, NodeError> {
+    Ok(Box::new(build_state(p, ctx)?))
+}
+
+/// One tick's outputs: intensity, F^sq, slope, z (m), triangle (−1: none).
+pub type TickOut = [f64; 5];
+
+impl MeshGradient {
+    /// One tick at the touch point (m).
+    #[inline]
+    pub fn tick(&mut self, x: f64, y: f64) -> TickOut {
+        let (mx, my) = self.placed.to_mesh(x, y);
+        let e = self.est.step(&self.placed.mesh, &self.rc, mx, my);
+        match e.hit {
+            Some(_) => self.hits += 1,
+            None => self.misses += 1,
+        }
+        let i = intensity(e.fsq, self.range.f_min, self.range.f_max, self.i_hi, self.i_lo);
+        let z = e.z * self.placed.unit;
+        [i, e.fsq, e.slope, if z.is_finite() { z } else { 0.0 }, e.hit.map_or(-1.0, |h| h.tri as f64)]
+    }
+}
+
+impl Node for MeshGradient {
+    fn process(&mut self, io: &mut Io<'_>) -> Result<(), NodeError> {
+        for i in 0..io.len() {
+            let out = self.tick(io.input(0)[i], io.input(1)[i]);
+            for (k, v) in out.into_iter().enumerate() {
+                io.output(k)[i] = v;
+            }
+        }
+        Ok(())
+    }
+
+    fn reset(&mut self) {
+        self.est.reset();
+        self.hits = 0;
+        self.misses = 0;
+    }
+
+    fn finish(&mut self) -> Result<Summary, NodeError> {
+        let mut s = Summary::default()
+            .value("f_min", self.range.f_min, "sqrt(N)")
+            .value("f_max", self.range.f_max, "sqrt(N)")
+            .value("triangles", self.placed.mesh.triangles.len() as f64, "1")
+            .value("on_mesh", self.hits as f64 / (self.hits + self.misses).max(1) as f64, "1");
+        s = match &self.cache {
+            CacheStatus::Hit(p) => s.line(format!("F^sq range from the cache {}", p.display())),
+            CacheStatus::Written(p) => s.line(format!("F^sq range calibrated, cached in {}", p.display())),
+            CacheStatus::Failed(e) => s.line(format!("F^sq range calibrated; not cached: {e}")),
+            CacheStatus::Disabled => s,
+        };
+        Ok(s)
+    }
+}

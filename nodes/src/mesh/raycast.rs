@@ -144,7 +144,9 @@ impl RayCaster {
     pub fn cast(&self, x: f64, y: f64) -> Option<Hit> {
         let bvh = self.bvh.as_ref()?;
         let (px, py) = (x - self.origin[0], y - self.origin[1]);
-        if !(px.is_finite() && py.is_finite()) {
+        // Off the bounds (or not finite): no hit, and nothing unrepresentable reaches the f32 BVH.
+        let inside = |v: f64, k: usize| v >= self.bounds.min[k] && v <= self.bounds.max[k];
+        if !(inside(x, 0) && inside(y, 1)) {
             return None;
         }
         let ray =
@@ -256,5 +258,6 @@ mod tests {
         assert_eq!(rc.cast(2.0, 2.0).unwrap().z, 2.0);
         assert!(rc.cast(3.0, 3.0).is_none());
         assert!(rc.cast(f64::NAN, 0.0).is_none());
+        assert!(rc.cast(1e300, -1e300).is_none() && rc.cast(f64::INFINITY, 1.0).is_none());
     }
 }

@@ -30,8 +30,9 @@ when the finger nearly stops. `docs/mesh.md` compares their fidelity.\n\n\
 I = linear map of [F_min, F_max] onto [`i_max`, `i_min`] = [1.0, 0.3] (Eq. 4.7), clamped outside. \
 With `range = \"auto\"` (F_min, F_max) = (μ − 2σ, μ + 2σ) of F^sq over a simulated scan of the mesh \
 (§4.1.1: `calib_directions` directions × `calib_lines` lines at the `calib_speeds`, at this node's rate), \
-cached in the folder `cache` (relative to the output folder; empty: no cache) under a hash of the mesh \
-and the settings, so the next session starts at once; `range = \"fixed\"` takes `f_min`/`f_max` \
+cached under a hash of the mesh and the settings, so the next session starts at once — in the folder \
+`cache` (relative to the output folder), by default the user's cache folder ($EVFLOW_CACHE, else \
+$XDG_CACHE_HOME/evflow, else ~/.cache/evflow), or nowhere with `cache = \"none\"`; `range = \"fixed\"` takes `f_min`/`f_max` \
 (the formative study's ±1). A flat mesh has F_min = F_max = 0 and renders I = `i_max`.\n\n\
 **Mesh.** `file` (OBJ via tobj; quads and n-gons triangulated; normals recomputed; vertices welded \
 so neighbouring triangles share edges, within `weld`), or a generated §4.2 scene (`shape`, `config`, \
@@ -79,7 +80,11 @@ gradient of the Gaussian scene (fidelity report), and the robustness cases of `d
     ),
     ParamSpec::int("calib_directions", 1, 360, 12, "1", "directions of the calibration scan (over 360°)"),
     ParamSpec::int("calib_lines", 1, 1000, 24, "1", "parallel lines per direction in the calibration scan"),
-    ParamSpec::text("cache", ".evflow-cache", "calibration cache folder (relative to the output folder); empty: none"),
+    ParamSpec::text(
+        "cache",
+        "",
+        "calibration cache folder (relative to the output folder); empty: the user's cache folder; \"none\": no cache",
+    ),
 ])
 .example("shape = \"gaussian\"\nconfig = \"bump\"\nresolution = 12\ncalib_directions = 4\ncalib_lines = 8");
 
@@ -139,8 +144,11 @@ pub fn build_state(p: &Params, ctx: &BuildContext) -> Result<MeshGradient, NodeE
             directions: p.usize("calib_directions"),
             lines: p.usize("calib_lines"),
         };
-        let dir = p.str("cache");
-        let dir = (!dir.is_empty()).then(|| ctx.out_path(dir));
+        let dir = match p.str("cache") {
+            "none" => None,
+            "" => user_cache_dir(),
+            d => Some(ctx.out_path(d)),
+        };
         calibrate(&placed.mesh, &rc, gs, &ss, dir.as_deref())
     };
     Ok(MeshGradient {
@@ -154,6 +162,15 @@ pub fn build_state(p: &Params, ctx: &BuildContext) -> Result<MeshGradient, NodeE
         hits: 0,
         misses: 0,
     })
+}
+
+/// The user's cache folder for evflow: `$EVFLOW_CACHE`, else
+/// `$XDG_CACHE_HOME/evflow`, else `$HOME/.cache/evflow`.
+pub fn user_cache_dir() -> Option<std::path::PathBuf> {
+    let var = |k: &str| std::env::var_os(k).filter(|v| !v.is_empty()).map(std::path::PathBuf::from);
+    var("EVFLOW_CACHE")
+        .or_else(|| var("XDG_CACHE_HOME").map(|d| d.join("evflow")))
+        .or_else(|| var("HOME").map(|d| d.join(".cache").join("evflow")))
 }
 
 fn build(p: &Params, ctx: &BuildContext) -> Result<Box<dyn Node>, NodeError> {

@@ -15,12 +15,14 @@
 //! **Walls.** A vertical face is never hit by a vertical ray, so stepping
 //! over a wall (the top of a cube to the floor) joins two parallel faces:
 //! the normals alone see no edge. The profile in the vertical plane of the
-//! motion does: the slope angles of face a, of the chord p_a → p_b and of
-//! face b along the motion, α_a, α_c, α_b, turn convexly by
-//! max(0, α_a − α_c) + max(0, α_c − α_b), and θ is the smaller of the
-//! normals' angle and 180° minus that turn. For adjacent faces crossed
-//! head-on both agree; for an oblique crossing the normals give the sharper
-//! (true) angle; over a wall the profile gives about 90°.
+//! motion does: with the slope angles of face a, of the chord p_a → p_b and
+//! of face b along the motion, α_a, α_c, α_b, crossing an ordinary edge
+//! keeps α_c between α_a and α_b, while a wall makes the chord steeper than
+//! both — a drop (α_c < min) turns convexly by α_a − α_c at its top, a step
+//! up (α_c > max) by α_c − α_b — and θ is then the smaller of the normals'
+//! angle and 180° minus that turn (about 90° over a wall). The profile is
+//! not used otherwise: a vertical section across a sloping edge (a hip) is
+//! not its normal section and can look sharper than the edge is.
 //!
 //! **θ_min** is computed once over every edge of the welded mesh a finger
 //! can cross: pairs of non-vertical faces (every pair around a
@@ -242,8 +244,14 @@ impl EdgeTracker {
             let d = [d3[0] / dr, d3[1] / dr];
             let (aa, ab) = (slope_angle(na, d), slope_angle(nb, d));
             let ac = d3[2].atan2(dr).to_degrees();
-            let turn = (aa - ac).max(0.0) + (ac - ab).max(0.0);
-            theta = f64::min(theta, 180.0 - turn);
+            let cliff = if ac < aa.min(ab) {
+                aa - ac
+            } else if ac > aa.max(ab) {
+                ac - ab
+            } else {
+                0.0
+            };
+            theta = f64::min(theta, 180.0 - cliff);
         }
         let theta = theta.max(0.0);
         if theta >= self.max_angle {

@@ -17,8 +17,9 @@ pub static SPEC: NodeSpec = NodeSpec::new(
     "Dissertation §4.1.2. Takes the touch point and the triangle `mesh.gradient` hit (`tri`, −1 off the \
 mesh) and, when the triangle changes, the dihedral angle θ between the previous and the current one: \
 convex only (normals face the ray; convex when each hit point lies below the other face's plane), \
-θ = 180° − ∠(n_a, n_b), or less when the motion's vertical profile bends more — stepping over a \
-vertical wall, which a vertical ray never hits. Convex bends flatter than `max_angle` are the facets \
+θ = 180° − ∠(n_a, n_b); when the chord between the two hit points is steeper than both faces (a \
+vertical wall, which a vertical ray never hits, lies between them) the convex turn at the wall's \
+top gives θ instead, if sharper. Convex bends flatter than `max_angle` are the facets \
 of a smooth surface and are ignored. Sharpness S = −(θ − 180°)/(180° − θ_min) (Eq. 4.8), θ_min the \
 sharpest convex edge of the whole mesh, computed once when the node is built over every edge of the \
 welded mesh (pairs of faces around non-manifold edges, walls, and open boundaries above the screen \

@@ -28,3 +28,4 @@ use evflow_engine::NodeSpec;
 /// The node types of this family.
 pub static SPECS: &[&NodeSpec] =
     &[&profile1d::SPEC, &gradient_node::SPEC, &edges_node::SPEC, &grain::SPEC, &path::SPEC];
+pub mod fidelity;

@@ -54,6 +54,11 @@ enum Command {
     ///
     /// Example: evflow replay sessions/display-live-20250101-120000 --check
     Replay(cli::replay::Args),
+    /// Measure how well a method renders against ground truth, next to its
+    /// run time, with tables and PNG figures.
+    ///
+    /// Example: evflow report mesh --out report
+    Report(cli::report_mesh::ReportArgs),
     /// Print a graph in Graphviz dot syntax (pruned nodes dashed).
     ///
     /// Example: evflow dot graphs/excitation.toml | dot -Tpng > graph.png
@@ -69,6 +74,7 @@ fn main() -> ExitCode {
         Command::Dot(a) => cli::dot::main(a),
         Command::Live(a) => cli::live::main(a),
         Command::Replay(a) => cli::replay::main(a),
+        Command::Report(a) => cli::report_mesh::main(a),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

@@ -4,13 +4,15 @@
 //! mesh's sharpest convex edge θ_min, and the EDGE-TICK intensity
 //! I_e = 0.7·S + 0.3 (Eq. 4.9).
 //!
-//! **Sign convention.** Normals face the ray (n_z ≥ 0, [`Mesh::normals`]).
-//! θ is the angle inside the solid under the surface: for two faces a → b
-//! with hit points p_a, p_b, the bend is convex when each point lies below
-//! the other face's plane, (n_a − n_b)·(p_b − p_a) < 0, and then
-//! θ = 180° − ∠(n_a, n_b); otherwise θ ≥ 180° (concave or flat) and the
-//! edge is not emphasized. A ridge of two faces tilted ±45° (the top edge
-//! of a cube standing on an edge) has θ = 90°.
+//! **Sign convention.** Normals are [`Mesh::normals`]: consistent over
+//! each connected piece whatever the file's winding, the faces a ray from
+//! above hits first facing it (up), a closed solid's pointing out. θ is the
+//! angle inside the solid: for two faces a → b with hit points p_a, p_b,
+//! the bend is convex when each point lies behind the other face's plane,
+//! (n_a − n_b)·(p_b − p_a) < 0, and then θ = 180° − ∠(n_a, n_b); otherwise
+//! θ ≥ 180° (concave or flat) and the edge is not emphasized. A ridge of
+//! two faces tilted ±45° (the top edge of a cube standing on an edge) has
+//! θ = 90°, and so has every edge of an axis-aligned cube.
 //!
 //! **Walls.** A vertical face is never hit by a vertical ray, so stepping
 //! over a wall (the top of a cube to the floor) joins two parallel faces:
@@ -24,11 +26,11 @@
 //! not used otherwise: a vertical section across a sloping edge (a hip) is
 //! not its normal section and can look sharper than the edge is.
 //!
-//! **θ_min** is computed once over every edge of the welded mesh a finger
-//! can cross: pairs of non-vertical faces (every pair around a
-//! non-manifold edge — the finger can cross from any of them to any other),
-//! a non-vertical face meeting a vertical one that goes down from the edge
-//! (a wall: θ = 180° − ∠(n_a, w), w the horizontal outward direction), and
+//! **θ_min** is computed once over every edge of the welded mesh: pairs of
+//! faces (every pair around a non-manifold edge — the finger can cross
+//! from any of them to any other; walls included, by the general rule when
+//! the pair is consistently oriented, else as a wall going down from the
+//! edge, θ = 180° − ∠(n_a, w), w the horizontal outward direction), and
 //! boundary edges of open meshes: wholly above the floor a boundary is a
 //! cliff (the same wall rule); touching or below the floor it meets the
 //! floor plane from below or level and is not convex. A mesh without a
@@ -80,26 +82,47 @@ fn wall_angle(n: [f64; 3], v0: [f64; 3], v1: [f64; 3], o: [f64; 3]) -> Option<f6
     Some(180.0 - angle(n, w))
 }
 
+/// A normal turned to face up (the slope along a direction does not depend
+/// on the normal's sign; the angle formulas below do).
+fn up(n: [f64; 3]) -> [f64; 3] {
+    if n[2] < 0.0 {
+        n.map(|x| -x)
+    } else {
+        n
+    }
+}
+
 /// The convex angle of faces a and b sharing edge (v0, v1), if convex.
+/// When the two run the edge in opposite directions (consistently
+/// oriented, [`Mesh`]'s normals then point out of the solid) the general
+/// rule holds for any faces, walls included: convex when each opposite
+/// vertex lies behind the other face's plane, θ = 180° − ∠(n_a, n_b).
+/// Otherwise (around a non-manifold edge, or on a non-orientable piece)
+/// the faces are taken as seen from above: normals turned up, and a
+/// vertical face is a wall, convex when it goes down from the edge.
 fn pair_angle(m: &Mesh, a: u32, b: u32, v0: u32, v1: u32) -> Option<f64> {
+    let runs = |t: u32| {
+        let tri = m.triangles[t as usize];
+        (0..3).any(|k| tri[k] == v0 && tri[(k + 1) % 3] == v1)
+    };
     let opp = |t: u32| m.triangles[t as usize].into_iter().find(|&k| k != v0 && k != v1);
     let (oa, ob) = (opp(a)?, opp(b)?);
     let (na, nb) = (m.normals[a as usize], m.normals[b as usize]);
     let (p0, p1) = (m.vertices[v0 as usize], m.vertices[v1 as usize]);
     let (va, vb) = (m.vertices[oa as usize], m.vertices[ob as usize]);
-    let (vert_a, vert_b) = (na[2] <= VERTICAL, nb[2] <= VERTICAL);
-    match (vert_a, vert_b) {
+    let scale = dot(sub(p1, p0), sub(p1, p0)).sqrt().max(1e-300);
+    let convex = |na: [f64; 3], nb: [f64; 3]| dot(na, sub(vb, p0)) + dot(nb, sub(va, p0)) < -1e-12 * scale;
+    if runs(a) != runs(b) {
+        return convex(na, nb).then(|| 180.0 - angle(na, nb));
+    }
+    let (na, nb) = (up(na), up(nb));
+    match (na[2] <= VERTICAL, nb[2] <= VERTICAL) {
         (true, true) => None,
         (false, true) | (true, false) => {
-            let (n, o, wall_o) = if vert_b { (na, va, vb) } else { (nb, vb, va) };
-            // Convex only when the wall goes down from the edge.
+            let (n, o, wall_o) = if nb[2] <= VERTICAL { (na, va, vb) } else { (nb, vb, va) };
             (wall_o[2] < p0[2].min(p1[2])).then(|| wall_angle(n, p0, p1, o)).flatten()
         }
-        (false, false) => {
-            let scale = dot(sub(p1, p0), sub(p1, p0)).sqrt().max(1e-300);
-            let s = dot(na, sub(vb, p0)) + dot(nb, sub(va, p0));
-            (s < -1e-12 * scale).then(|| 180.0 - angle(na, nb))
-        }
+        (false, false) => convex(na, nb).then(|| 180.0 - angle(na, nb)),
     }
 }
 
@@ -125,7 +148,7 @@ pub fn census(m: &Mesh, floor: f64, max_angle: f64) -> EdgeCensus {
             1 => {
                 c.boundary += 1;
                 let t = faces[0];
-                let n = m.normals[t as usize];
+                let n = up(m.normals[t as usize]);
                 let (p0, p1) = (m.vertices[v0 as usize], m.vertices[v1 as usize]);
                 let above = p0[2].min(p1[2]) > floor + 1e-9 * ext;
                 if n[2] > VERTICAL && above {
@@ -191,6 +214,7 @@ pub struct EdgeTracker {
 
 /// Slope angle (degrees) of a face with normal `n` along horizontal unit `d`.
 fn slope_angle(n: [f64; 3], d: [f64; 2]) -> f64 {
+    let n = up(n);
     (-(n[0] * d[0] + n[1] * d[1])).atan2(n[2]).to_degrees()
 }
 
@@ -323,12 +347,13 @@ mod tests {
             assert!((e.theta - 90.0).abs() < 1e-9, "{e:?}");
             assert!((e.sharpness - 1.0).abs() < 1e-9 && (e.intensity - 1.0).abs() < 1e-9);
         }
-        // Axis-aligned: the top edges are walls going down, 90° and convex;
-        // stepping off the top onto the floor is caught by the profile.
+        // Axis-aligned: all twelve edges are convex 90° (the walls' outward
+        // normals are known from the orientation); stepping off the top onto
+        // the floor is caught by the profile.
         let m = cube(0.0, 0.0, true);
         let floor = m.bounds().min[2];
         let c = census(&m, floor, 160.0);
-        assert!((c.theta_min - 90.0).abs() < 1e-9 && c.convex == 4, "{c:?}");
+        assert!((c.theta_min - 90.0).abs() < 1e-9 && c.convex == 12, "{c:?}");
         let rc = RayCaster::new(&m);
         let mut tr = EdgeTracker::new(c.theta_min, 160.0, 1.0, floor);
         let mut hits = 0;

@@ -135,7 +135,8 @@ impl Gradient {
                     self.slope = match hit {
                         Some(h) => {
                             let n = mesh.normals[h.tri as usize];
-                            if n[2] > 0.0 {
+                            // The slope does not depend on the normal's sign.
+                            if n[2] != 0.0 {
                                 -(n[0] * d[0] + n[1] * d[1]) / n[2]
                             } else {
                                 0.0

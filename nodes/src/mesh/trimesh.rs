@@ -1,7 +1,16 @@
 //! The triangle mesh every mesh node works on: f64 vertices welded so that
 //! neighbouring triangles share edges, triangles as vertex-index triples,
-//! per-triangle unit normals oriented toward the ray (n_z ≥ 0, so the OBJ's
-//! winding does not matter), bounds and a content hash.
+//! per-triangle unit normals, bounds and a content hash.
+//!
+//! **Orientation.** The file's winding is not trusted: each connected
+//! piece (triangles joined across edges with exactly two faces) is
+//! re-oriented consistently from one seed — among the faces at the piece's
+//! highest vertex the least steep one, turned to face up (toward the ray).
+//! A neighbour that runs the shared edge in the same direction as its
+//! oriented neighbour is flipped. Triangles are stored in the oriented
+//! winding (right-hand rule gives the normal), so a closed solid ends up
+//! with outward normals and a terrain with upward ones, whatever the
+//! file's winding was — even mixed.
 
 use std::collections::HashMap;
 
@@ -12,8 +21,8 @@ pub struct Mesh {
     pub vertices: Vec<[f64; 3]>,
     /// Triangles as indices into `vertices`.
     pub triangles: Vec<[u32; 3]>,
-    /// Unit normal of each triangle, flipped to point up (n_z ≥ 0; a
-    /// vertical triangle keeps n_z = 0 with its file orientation). Zero for
+    /// Unit normal of each triangle in the oriented winding (see the module
+    /// doc); the faces a ray from above hits first face up. Zero for
     /// degenerate (zero-area) triangles.
     pub normals: Vec<[f64; 3]>,
 }
@@ -69,8 +78,8 @@ impl Mesh {
     /// A mesh from vertices and triangles: vertices at the same position
     /// (within `weld` mesh units; 0 = bit-identical coordinates) are merged,
     /// triangles whose corners merged into fewer than three are dropped,
-    /// and normals are computed from the geometry (never taken from a file)
-    /// and oriented up.
+    /// the triangles are oriented consistently (module doc) and normals are
+    /// computed from the geometry (never taken from a file).
     pub fn new(vertices: Vec<[f64; 3]>, triangles: Vec<[u32; 3]>, weld: f64) -> Self {
         let (vertices, remap) = weld_vertices(&vertices, weld);
         let mut tris = Vec::with_capacity(triangles.len());
@@ -80,17 +89,16 @@ impl Mesh {
                 tris.push(t);
             }
         }
-        let normals = tris
+        let mut normals: Vec<[f64; 3]> = tris
             .iter()
-            .map(|t| {
-                let n = raw_normal(vertices[t[0] as usize], vertices[t[1] as usize], vertices[t[2] as usize]);
-                if n[2] < 0.0 {
-                    n.map(|x| -x)
-                } else {
-                    n
-                }
-            })
+            .map(|t| raw_normal(vertices[t[0] as usize], vertices[t[1] as usize], vertices[t[2] as usize]))
             .collect();
+        for (t, flip) in orientation(&vertices, &tris, &normals).into_iter().enumerate() {
+            if flip {
+                tris[t].swap(1, 2);
+                normals[t] = normals[t].map(|x| -x);
+            }
+        }
         Mesh { vertices, triangles: tris, normals }
     }
 
@@ -133,6 +141,79 @@ impl Mesh {
         }
         h.finish()
     }
+}
+
+/// Which triangles to flip so each connected piece is consistently
+/// oriented with its seed facing up (see the module doc).
+fn orientation(v: &[[f64; 3]], tris: &[[u32; 3]], normals: &[[f64; 3]]) -> Vec<bool> {
+    // Edge → (triangle, runs low→high) for every triangle on it.
+    let mut edges: HashMap<(u32, u32), Vec<(u32, bool)>> = HashMap::with_capacity(tris.len() * 3 / 2);
+    for (t, tri) in tris.iter().enumerate() {
+        for k in 0..3 {
+            let (a, b) = (tri[k], tri[(k + 1) % 3]);
+            edges.entry((a.min(b), a.max(b))).or_default().push((t as u32, a < b));
+        }
+    }
+    let neighbours = |t: usize, out: &mut Vec<(usize, bool)>| {
+        out.clear();
+        let tri = tris[t];
+        for k in 0..3 {
+            let (a, b) = (tri[k], tri[(k + 1) % 3]);
+            if let Some(f) = edges.get(&(a.min(b), a.max(b))) {
+                if f.len() == 2 {
+                    let (me, other) = if f[0].0 as usize == t { (f[0], f[1]) } else { (f[1], f[0]) };
+                    // Same direction on the shared edge: inconsistent winding.
+                    out.push((other.0 as usize, me.1 == other.1));
+                }
+            }
+        }
+    };
+    let mut flip = vec![false; tris.len()];
+    let mut component = vec![usize::MAX; tris.len()];
+    let mut done = vec![false; tris.len()];
+    let mut buf = Vec::new();
+    let mut stack = Vec::new();
+    for start in 0..tris.len() {
+        if component[start] != usize::MAX {
+            continue;
+        }
+        // Collect the piece.
+        let mut piece = vec![start];
+        component[start] = start;
+        stack.push(start);
+        while let Some(t) = stack.pop() {
+            neighbours(t, &mut buf);
+            for &(n, _) in &buf {
+                if component[n] == usize::MAX {
+                    component[n] = start;
+                    piece.push(n);
+                    stack.push(n);
+                }
+            }
+        }
+        // Seed: the least steep face at the piece's highest vertex, facing up.
+        let top = piece.iter().flat_map(|&t| tris[t]).max_by(|&a, &b| v[a as usize][2].total_cmp(&v[b as usize][2]));
+        let seed = piece
+            .iter()
+            .copied()
+            .filter(|&t| top.is_some_and(|tv| tris[t].contains(&tv)))
+            .max_by(|&a, &b| normals[a][2].abs().total_cmp(&normals[b][2].abs()))
+            .unwrap_or(start);
+        flip[seed] = normals[seed][2] < 0.0;
+        done[seed] = true;
+        stack.push(seed);
+        while let Some(t) = stack.pop() {
+            neighbours(t, &mut buf);
+            for &(n, inconsistent) in &buf {
+                if !done[n] {
+                    done[n] = true;
+                    flip[n] = flip[t] ^ inconsistent;
+                    stack.push(n);
+                }
+            }
+        }
+    }
+    flip
 }
 
 /// FNV-1a, 64 bits.
@@ -235,6 +316,18 @@ mod tests {
         let v2 = vec![[0.0, 0.0, 0.0], [1e-9, 0.0, 0.0], [0.0, 1.0, 0.0]];
         assert_eq!(Mesh::new(v2.clone(), vec![[0, 1, 2]], 1e-6).triangles.len(), 0);
         assert_eq!(Mesh::new(v2, vec![[0, 1, 2]], 0.0).triangles.len(), 1);
+    }
+
+    #[test]
+    fn mixed_windings_are_made_consistent_with_the_top_facing_up() {
+        // A ridge of four triangles, two of them written clockwise.
+        let v =
+            vec![[0.0, 0.0, 0.0], [1.0, 0.0, 1.0], [2.0, 0.0, 0.0], [0.0, 1.0, 0.0], [1.0, 1.0, 1.0], [2.0, 1.0, 0.0]];
+        let m = Mesh::new(v, vec![[0, 1, 4], [0, 4, 3], [1, 5, 4], [1, 2, 5]], 0.0);
+        assert!(m.normals.iter().all(|n| n[2] > 0.0), "{:?}", m.normals);
+        for (t, n) in m.triangles.iter().zip(&m.normals) {
+            assert_eq!(raw_normal(m.vertices[t[0] as usize], m.vertices[t[1] as usize], m.vertices[t[2] as usize]), *n);
+        }
     }
 
     #[test]

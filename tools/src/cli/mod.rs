@@ -6,6 +6,7 @@ pub mod graph_args;
 pub mod live;
 pub mod nodes;
 pub mod replay;
+pub mod report_mesh;
 pub mod run;
 pub mod run_plots;
 pub mod run_report;

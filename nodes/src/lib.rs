@@ -12,10 +12,12 @@ pub mod math;
 pub mod mesh;
 pub mod metric;
 pub mod output;
+pub mod rate;
 pub mod recording;
 pub mod safety;
 pub mod sources;
 pub mod sum;
+pub mod texture;
 
 use evflow_engine::{NodeSpec, Registry};
 
@@ -41,5 +43,7 @@ pub fn all_specs() -> Vec<&'static NodeSpec> {
     v.extend_from_slice(mesh::SPECS);
     v.extend_from_slice(analysis::SPECS);
     v.extend_from_slice(lab::SPECS);
+    v.extend_from_slice(rate::SPECS);
+    v.extend_from_slice(texture::SPECS);
     v
 }

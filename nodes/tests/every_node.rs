@@ -37,6 +37,19 @@ fn fixtures(dir: &Path) {
         w.write_frame(&[0.2 + 0.05 * x]).expect("fixture frame");
     }
     w.finish().expect("fixture recording finished");
+    // A 2 × 2 grid of actuation signals for `interp` (loads 60/110 g, velocities 3/7 cm/s).
+    std::fs::create_dir_all(dir.join("recordings/grid")).expect("grid folder");
+    for (k, (load, velocity)) in [(60.0, 3.0), (60.0, 7.0), (110.0, 3.0), (110.0, 7.0)].into_iter().enumerate() {
+        let mut meta = RecordingMeta::new(1000.0, vec![Channel::new("u", "1")]);
+        meta.condition.load_g = Some(load);
+        meta.condition.velocity_cm_s = Some(velocity);
+        let mut w =
+            RecordingWriter::create(&dir.join(format!("recordings/grid/cell{k}.wav")), meta).expect("grid cell");
+        for x in signal(4000, 7 + k as u64) {
+            w.write_frame(&[x]).expect("grid frame");
+        }
+        w.finish().expect("grid cell finished");
+    }
 }
 
 struct Case {

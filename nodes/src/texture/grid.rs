@@ -1,0 +1,370 @@
+//! The (load, velocity) grid of actuation signals U_ij (dissertation
+//! Fig. 5.6, Fig. 6.7), loaded from recordings.
+//!
+//! Each cell is one recording (`docs/recording-format.md`) whose sidecar
+//! names its condition: `condition.load_g` (m_i) and
+//! `condition.velocity_cm_s` (v_j). The grid's axes are the distinct loads
+//! and velocities found. Only the sidecars of every candidate are read at
+//! first; the samples are loaded only for the cells a session can reach —
+//! the cells that bracket the declared load and velocity ranges after the
+//! clamping of §6.4 — so a session confined to 60–85 g never opens the
+//! 110 g recordings.
+//!
+//! Every reachable cell must exist: a missing one is an error naming the
+//! condition and what was found, as are duplicates, a condition without load
+//! or velocity, a non-positive velocity, and cells at different rates.
+
+use crate::recording::format::{Recording, RecordingPaths};
+use std::path::{Path, PathBuf};
+
+/// What can be wrong with a grid. Every message names the file or folder.
+#[derive(Debug, thiserror::Error)]
+pub enum GridError {
+    /// The folder cannot be listed.
+    #[error("{}: cannot list the grid folder: {message}", path.display())]
+    Folder {
+        /// The folder.
+        path: PathBuf,
+        /// The system's message.
+        message: String,
+    },
+    /// No recording was found.
+    #[error("{where_}: no recording with a load and velocity condition{filter}; a grid cell is a recording whose sidecar sets condition.load_g and condition.velocity_cm_s")]
+    Empty {
+        /// Folder or list.
+        where_: String,
+        /// The material filter, if any.
+        filter: String,
+    },
+    /// A sidecar cannot be read or lacks a condition.
+    #[error("{}: {message}", path.display())]
+    Sidecar {
+        /// The sidecar.
+        path: PathBuf,
+        /// What is wrong.
+        message: String,
+    },
+    /// Two recordings claim one cell.
+    #[error("{} and {} both hold the cell load {load} g, velocity {velocity} cm/s; keep one", a.display(), b.display())]
+    Duplicate {
+        /// First recording.
+        a: PathBuf,
+        /// Second recording.
+        b: PathBuf,
+        /// Load in g.
+        load: f64,
+        /// Velocity in cm/s.
+        velocity: f64,
+    },
+    /// A cell the session can reach has no recording.
+    #[error("{where_}: the grid cell load {load} g, velocity {velocity} cm/s is missing (loads {loads:?} g × velocities {velocities:?} cm/s were found, {found} of {total} reachable cells present); record or synthesize it, or narrow load_range/velocity_range")]
+    MissingCell {
+        /// Folder or list.
+        where_: String,
+        /// Missing load in g.
+        load: f64,
+        /// Missing velocity in cm/s.
+        velocity: f64,
+        /// The load axis.
+        loads: Vec<f64>,
+        /// The velocity axis.
+        velocities: Vec<f64>,
+        /// Reachable cells present.
+        found: usize,
+        /// Reachable cells in all.
+        total: usize,
+    },
+    /// Cells at different sample rates.
+    #[error("{}: recorded at {rate} Hz but {} at {first} Hz; every grid cell must have one rate", path.display(), first_path.display())]
+    Rate {
+        /// The odd one.
+        path: PathBuf,
+        /// Its rate.
+        rate: f64,
+        /// The first cell.
+        first_path: PathBuf,
+        /// The first cell's rate.
+        first: f64,
+    },
+    /// The recording itself is unreadable.
+    #[error("{0}")]
+    Recording(String),
+}
+
+/// One candidate cell: its condition and files, samples not yet loaded.
+#[derive(Debug, Clone)]
+pub struct CellInfo {
+    /// The recording (as named by the user or found in the folder).
+    pub path: PathBuf,
+    /// m_i in g.
+    pub load: f64,
+    /// v_j in cm/s.
+    pub velocity: f64,
+    /// Sample rate in Hz.
+    pub rate: f64,
+    /// Channel names.
+    pub channels: Vec<String>,
+    /// Display gain of the condition (1 when absent).
+    pub gain: f64,
+}
+
+/// Where to find the cells and which to use.
+#[derive(Debug, Clone, Default)]
+pub struct GridSource {
+    /// A folder: every `*.json` sidecar in it is a candidate.
+    pub folder: Option<PathBuf>,
+    /// Or explicit recordings.
+    pub paths: Vec<PathBuf>,
+    /// Keep only this material (`condition.material`); empty keeps all.
+    pub material: String,
+    /// The channel holding U_ij; empty means the recording's only channel.
+    pub channel: String,
+    /// Loads a session can reach, g (`[lo, hi]`); `None` = all.
+    pub load_range: Option<(f64, f64)>,
+    /// Velocities a session can reach, cm/s; `None` = all.
+    pub velocity_range: Option<(f64, f64)>,
+    /// Multiply each cell by its condition's display gain.
+    pub apply_gain: bool,
+}
+
+/// The loaded grid: axes ascending, cells row-major (load, then velocity).
+#[derive(Debug, Clone)]
+pub struct Grid {
+    /// m_i, g, ascending (only the reachable ones).
+    pub loads: Vec<f64>,
+    /// v_j, cm/s, ascending (only the reachable ones).
+    pub velocities: Vec<f64>,
+    /// Sample rate of every cell, Hz.
+    pub rate: f64,
+    /// U_ij, `cells[i * velocities.len() + j]`.
+    pub cells: Vec<Vec<f64>>,
+    /// The recordings, in the order of `cells`.
+    pub paths: Vec<PathBuf>,
+}
+
+impl Grid {
+    /// U_ij.
+    pub fn cell(&self, i: usize, j: usize) -> &[f64] {
+        &self.cells[i * self.velocities.len() + j]
+    }
+
+    /// Builds a grid from signals in memory (tests, tools): `cells[i][j]`
+    /// is U_ij at `rate`.
+    pub fn from_signals(loads: Vec<f64>, velocities: Vec<f64>, rate: f64, cells: Vec<Vec<Vec<f64>>>) -> Self {
+        let paths = vec![PathBuf::new(); loads.len() * velocities.len()];
+        Self { loads, velocities, rate, cells: cells.into_iter().flatten().collect(), paths }
+    }
+
+    /// Loads the reachable part of the grid described by `src`.
+    pub fn load(src: &GridSource) -> Result<Self, GridError> {
+        let (where_, candidates) = list_candidates(src)?;
+        let mut cells: Vec<CellInfo> = Vec::new();
+        for path in candidates {
+            if let Some(c) = read_cell(&path, src.folder.is_some())? {
+                if !src.material.is_empty() && c.material.as_deref() != Some(src.material.as_str()) {
+                    continue;
+                }
+                cells.push(c.info);
+            }
+        }
+        if cells.is_empty() {
+            let filter =
+                if src.material.is_empty() { String::new() } else { format!(" of material `{}`", src.material) };
+            return Err(GridError::Empty { where_, filter });
+        }
+        let loads = axis(cells.iter().map(|c| c.load));
+        let velocities = axis(cells.iter().map(|c| c.velocity));
+        let index = |axis: &[f64], x: f64| axis.iter().position(|a| same(*a, x)).unwrap_or(0);
+        let mut at: Vec<Option<usize>> = vec![None; loads.len() * velocities.len()];
+        for (k, c) in cells.iter().enumerate() {
+            let slot = index(&loads, c.load) * velocities.len() + index(&velocities, c.velocity);
+            if let Some(prev) = at[slot] {
+                return Err(GridError::Duplicate {
+                    a: cells[prev].path.clone(),
+                    b: c.path.clone(),
+                    load: c.load,
+                    velocity: c.velocity,
+                });
+            }
+            at[slot] = Some(k);
+        }
+        let (i0, i1) = reachable(&loads, src.load_range);
+        let (j0, j1) = reachable(&velocities, src.velocity_range);
+        let total = (i1 - i0 + 1) * (j1 - j0 + 1);
+        let found = (i0..=i1)
+            .flat_map(|i| (j0..=j1).map(move |j| (i, j)))
+            .filter(|(i, j)| at[i * velocities.len() + j].is_some())
+            .count();
+        for i in i0..=i1 {
+            for j in j0..=j1 {
+                if at[i * velocities.len() + j].is_none() {
+                    return Err(GridError::MissingCell {
+                        where_,
+                        load: loads[i],
+                        velocity: velocities[j],
+                        loads: loads.clone(),
+                        velocities: velocities.clone(),
+                        found,
+                        total,
+                    });
+                }
+            }
+        }
+        let mut grid = Grid {
+            loads: loads[i0..=i1].to_vec(),
+            velocities: velocities[j0..=j1].to_vec(),
+            rate: 0.0,
+            cells: Vec::new(),
+            paths: Vec::new(),
+        };
+        let mut first: Option<&CellInfo> = None;
+        for i in i0..=i1 {
+            for j in j0..=j1 {
+                let Some(k) = at[i * velocities.len() + j] else { continue };
+                let c = &cells[k];
+                match first {
+                    None => first = Some(c),
+                    Some(f) if !same(f.rate, c.rate) => {
+                        return Err(GridError::Rate {
+                            path: c.path.clone(),
+                            rate: c.rate,
+                            first_path: f.path.clone(),
+                            first: f.rate,
+                        })
+                    }
+                    Some(_) => {}
+                }
+                let channel = pick_channel(c, &src.channel)?;
+                let rec = Recording::open_channels(&c.path, &[channel.as_str()])
+                    .map_err(|e| GridError::Recording(e.to_string()))?;
+                rec.require_complete().map_err(|e| GridError::Recording(e.to_string()))?;
+                let mut samples = rec.into_channels().remove(0);
+                if src.apply_gain {
+                    samples.iter_mut().for_each(|x| *x *= c.gain);
+                }
+                grid.cells.push(samples);
+                grid.paths.push(c.path.clone());
+            }
+        }
+        grid.rate = first.map(|c| c.rate).unwrap_or(0.0);
+        Ok(grid)
+    }
+}
+
+/// Equal within 1e-9 relative (conditions written by different tools).
+fn same(a: f64, b: f64) -> bool {
+    (a - b).abs() <= 1e-9 * a.abs().max(b.abs()).max(1.0)
+}
+
+/// Distinct values, ascending.
+fn axis(values: impl Iterator<Item = f64>) -> Vec<f64> {
+    let mut v: Vec<f64> = values.collect();
+    v.sort_by(f64::total_cmp);
+    v.dedup_by(|a, b| same(*a, *b));
+    v
+}
+
+/// The index range of `axis` a session confined to `range` can touch:
+/// from the lower bracket of the clamped low end to the upper bracket of
+/// the clamped high end.
+pub fn reachable(axis: &[f64], range: Option<(f64, f64)>) -> (usize, usize) {
+    let last = axis.len() - 1;
+    let Some((lo, hi)) = range else { return (0, last) };
+    let (lo, hi) = (lo.min(hi), lo.max(hi));
+    let i0 = axis.iter().rposition(|a| *a <= lo).unwrap_or(0);
+    let i1 = axis.iter().position(|a| *a >= hi).unwrap_or(last);
+    (i0.min(i1), i1.max(i0))
+}
+
+fn list_candidates(src: &GridSource) -> Result<(String, Vec<PathBuf>), GridError> {
+    if let Some(folder) = &src.folder {
+        let rd = std::fs::read_dir(folder)
+            .map_err(|e| GridError::Folder { path: folder.clone(), message: e.to_string() })?;
+        let mut v: Vec<PathBuf> = rd
+            .filter_map(|e| e.ok().map(|e| e.path()))
+            .filter(|p| p.extension().and_then(|e| e.to_str()) == Some("json"))
+            .collect();
+        v.sort();
+        Ok((folder.display().to_string(), v))
+    } else {
+        let where_ = match src.paths.first() {
+            Some(p) => format!("the grid list ({} recordings, first {})", src.paths.len(), p.display()),
+            None => "the grid list (empty)".into(),
+        };
+        Ok((where_, src.paths.clone()))
+    }
+}
+
+struct Candidate {
+    info: CellInfo,
+    material: Option<String>,
+}
+
+/// Reads a sidecar. In a folder a sidecar without a condition is skipped
+/// (it is not a grid cell); in an explicit list it is an error.
+fn read_cell(path: &Path, lenient: bool) -> Result<Option<Candidate>, GridError> {
+    let paths = RecordingPaths::new(path);
+    let bad = |message: String| GridError::Sidecar { path: paths.json.clone(), message };
+    let text = std::fs::read_to_string(&paths.json).map_err(|e| {
+        bad(if e.kind() == std::io::ErrorKind::NotFound { "no such recording sidecar".into() } else { e.to_string() })
+    })?;
+    let v: serde_json::Value = serde_json::from_str(&text).map_err(|e| bad(format!("not valid JSON: {e}")))?;
+    if v.get("format").and_then(|f| f.as_str()) != Some(crate::recording::format::FORMAT_NAME) {
+        if lenient {
+            return Ok(None);
+        }
+        return Err(bad("not an evflow recording sidecar".into()));
+    }
+    let cond = v.get("condition");
+    let num = |k: &str| cond.and_then(|c| c.get(k)).and_then(|x| x.as_f64());
+    let (load, velocity) = match (num("load_g"), num("velocity_cm_s")) {
+        (Some(l), Some(v)) => (l, v),
+        _ if lenient => return Ok(None),
+        _ => return Err(bad("the condition lacks load_g or velocity_cm_s, so it is no grid cell".into())),
+    };
+    if !(load.is_finite() && velocity.is_finite() && velocity > 0.0) {
+        return Err(bad(format!("condition load {load} g, velocity {velocity} cm/s: a grid cell needs a finite load and a positive velocity")));
+    }
+    let rate = v.get("rate").and_then(|r| r.as_f64()).unwrap_or(0.0);
+    let channels = v
+        .get("channels")
+        .and_then(|c| c.as_array())
+        .map(|a| a.iter().filter_map(|c| c.get("name").and_then(|n| n.as_str()).map(String::from)).collect())
+        .unwrap_or_default();
+    let gain = num("gain").unwrap_or(1.0);
+    let material = cond.and_then(|c| c.get("material")).and_then(|m| m.as_str()).map(String::from);
+    Ok(Some(Candidate { info: CellInfo { path: paths.wav, load, velocity, rate, channels, gain }, material }))
+}
+
+fn pick_channel(c: &CellInfo, wanted: &str) -> Result<String, GridError> {
+    if !wanted.is_empty() {
+        return Ok(wanted.to_string());
+    }
+    match c.channels.as_slice() {
+        [one] => Ok(one.clone()),
+        many => Err(GridError::Sidecar {
+            path: RecordingPaths::new(&c.path).json,
+            message: format!(
+                "has {} channels ({}); set `channel` to the one holding the actuation signal",
+                many.len(),
+                many.join(", ")
+            ),
+        }),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn reachable_cells_bracket_the_clamped_range() {
+        let v = [3.0, 4.0, 5.0, 6.0, 7.0];
+        assert_eq!(reachable(&v, None), (0, 4));
+        assert_eq!(reachable(&v, Some((3.5, 4.5))), (0, 2));
+        assert_eq!(reachable(&v, Some((4.0, 5.0))), (1, 2));
+        assert_eq!(reachable(&v, Some((0.0, 1.0))), (0, 0));
+        assert_eq!(reachable(&v, Some((9.0, 20.0))), (4, 4));
+        assert_eq!(reachable(&[85.0], Some((60.0, 110.0))), (0, 0));
+    }
+}

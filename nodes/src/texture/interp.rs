@@ -1,0 +1,249 @@
+//! `interp`: the interpolated actuation signal for the user's load and
+//! velocity, recomputed at the update rate and sent to `playback` as frames.
+
+use super::frame::{at, HEADER, MAGIC};
+use super::grid::{Grid, GridSource};
+use super::kernel::SincKernel;
+use super::scheme::{Geometry, Mix, Scheme};
+use crate::rate::clock::Clock;
+use evflow_engine::{
+    BuildContext, Io, Node, NodeError, NodeSpec, ParamSpec, Params, PortSpec, PrepareContext, RateSpec, Role, Summary,
+};
+use std::path::PathBuf;
+
+/// Declaration of `interp`.
+pub static SPEC: NodeSpec = NodeSpec::new(
+    "interp",
+    "texture",
+    Role::Filter,
+    "Interpolates an actuation signal over the (load, velocity) grid (§5.3.3 basic, Eq. 6.4 improved) at the update rate.",
+    build,
+)
+.doc(
+    "Loads a grid of actuation signals U_ij — recordings whose sidecars set `condition.load_g` = m_i and \
+`condition.velocity_cm_s` = v_j (`docs/recording-format.md`) — and, at every update (10 Hz in the user \
+study, §6.5.1), computes the signal for the user's current load m_u and speed |v_u| from the four \
+neighbouring cells:\n\n\
+* `scheme = \"improved\"` (dissertation Eq. 6.4): weighted average over mass (Eq. 6.1), re-sampling of \
+each velocity column by v_j/v_u (𝓡𝓢, §6.2–6.3: its main component moves to the frequency of v_u), \
+weighted average over velocity;\n\
+* `scheme = \"basic\"` (§5.3.3): the bilinear weighted average without re-sampling.\n\n\
+Loads and velocities outside the grid are clamped to its extremes (§6.4); a grid with one load or one \
+velocity drops that step; a speed of 0 is clamped to v_min (no division by zero; `playback` makes rest \
+silent).\n\n\
+**Ports.** `load` (g) and `velocity` (cm/s, sign ignored) at any one rate (e.g. 40 Hz IR-frame rate or \
+1 kHz); `table` at `stream_rate`: one frame of F = stream_rate/update_rate samples per update, holding a \
+10-sample header and the table (layout in `nodes/src/texture/frame.rs`, `docs/texture.md`). Connect it \
+to `playback.table`. The condition is latched at the first sample of each frame (the latest input at or \
+before it), so a table is heard one update period after its condition was read.\n\n\
+**Real time.** The table is computed sample by sample as the frame is sent, stream_rate/base-rate \
+samples per tick (20 per 1 ms tick by default): the 10 Hz update costs the same small amount every tick \
+instead of one large burst. Each sample costs two kernel evaluations of 2·W/c taps (W = `half_width`, c \
+the anti-alias cutoff, smaller for larger velocity steps); nothing is allocated after `prepare`.\n\n\
+**Grid.** `folder` (every recording in it) or `paths`; `material` filters; `channel` picks the channel \
+(default: the recording's only one). Only the cells that `load_range` × `velocity_range` can reach are \
+loaded (the rest are never opened). A reachable cell without a recording, two recordings for one cell, \
+a cell without a condition, or cells at different rates is an error at load naming the file or cell.\n\n\
+**Loop.** Every table covers the same stretch of texture, from a margin x₀ to x₀ + L: L = `loop` cm, or \
+by default the longest the recordings allow (at most `stream_rate/update_rate − 10 − overlap` samples at \
+v_min); a loop of a whole number of texture periods has no seam at all. Each table holds `overlap` ms \
+more, which `playback` crossfades into the loop's start so the loop has no seam click.\n\n\
+**Checked against:** the sine examples of §6.1–6.2 (10 and 20 Hz → 15 Hz: one full-power peak; basic: \
+two half-amplitude peaks; 19 Hz with weights 0.1/0.9 and 12 Hz with 0.8/0.2), clamping, single-row and \
+single-column grids, a velocity ratio of 10, missing and duplicate cells (`nodes/tests/texture_*.rs`).",
+)
+.ports(&[
+    PortSpec::input("load", "g", "user's normal load m_u"),
+    PortSpec::input("velocity", "cm/s", "user's scanning velocity v_u (its magnitude is used)"),
+    PortSpec::output("table", "frame", "table frames for `playback` (header + U_uu)").at(RateSpec::Param("stream_rate")),
+])
+.params(&[
+    ParamSpec::text("folder", "", "folder of grid recordings (relative to the graph file); or use `paths`"),
+    ParamSpec::text_list("paths", "grid recordings, one per cell (instead of `folder`)"),
+    ParamSpec::text("material", "", "use only recordings of this condition.material (empty: all)"),
+    ParamSpec::text("channel", "", "channel holding U_ij (empty: the recording's only channel)"),
+    ParamSpec::choice("scheme", &["improved", "basic"], "improved", "Eq. 6.4 two-part scheme or §5.3.3 basic average"),
+    ParamSpec::float_list("load_range", 0.0, 1e6, "g", "[lo, hi] loads a session can reach (empty: whole grid)"),
+    ParamSpec::float_list("velocity_range", 0.0, 1e6, "cm/s", "[lo, hi] velocities a session can reach (empty: whole grid)"),
+    ParamSpec::float("update_rate", 0.01, 1000.0, 10.0, "Hz", "table updates per second (§6.5.1: 10 Hz)"),
+    ParamSpec::float("stream_rate", 1.0, 1e7, 20_000.0, "Hz", "rate of the `table` port; frame length = stream_rate/update_rate"),
+    ParamSpec::float("loop", 0.0, 1e4, 0.0, "cm", "length of texture each table covers (0: the longest the recordings allow)"),
+    ParamSpec::float("overlap", 0.0, 1000.0, 10.0, "ms", "seam overlap read past the loop's end"),
+    ParamSpec::int("half_width", 2, 64, 16, "1", "re-sampling kernel half-width W (zero crossings)"),
+    ParamSpec::flag("apply_gain", false, "multiply each cell by its condition.gain (Table 5.1)"),
+])
+.example("folder = \"recordings/grid\"\nscheme = \"improved\"\nupdate_rate = 10.0\nstream_rate = 20000.0");
+
+/// The state of `interp`.
+struct Interp {
+    grid: Grid,
+    kernel: SincKernel,
+    geo: Geometry,
+    scheme: Scheme,
+    frame: usize,
+    in_clock: Clock,
+    out_clock: Clock,
+    /// Table samples sent since t = 0.
+    sent: u64,
+    /// Input samples received since t = 0, and consumed (latched) so far.
+    received: u64,
+    consumed: u64,
+    latest: (f64, f64),
+    mix: Option<Mix>,
+    generation: u64,
+    scratch: [Vec<f64>; 2],
+    shown: String,
+}
+
+fn build(p: &Params, ctx: &BuildContext) -> Result<Box<dyn Node>, NodeError> {
+    let folder = p.str("folder");
+    let paths = p.text_list("paths");
+    if folder.is_empty() == paths.is_empty() {
+        return Err(NodeError::param(
+            "folder",
+            "give either `folder` (a folder of grid recordings) or `paths` (a list), not both or neither",
+        ));
+    }
+    let range = |name: &str| -> Result<Option<(f64, f64)>, NodeError> {
+        match p.float_list(name) {
+            [] => Ok(None),
+            [lo, hi] => Ok(Some((*lo, *hi))),
+            other => Err(NodeError::param(name, format!("give two numbers [lo, hi], not {} values", other.len()))),
+        }
+    };
+    let src = GridSource {
+        folder: (!folder.is_empty()).then(|| ctx.path(folder)),
+        paths: paths.iter().map(|s| ctx.path(s)).collect::<Vec<PathBuf>>(),
+        material: p.str("material").to_string(),
+        channel: p.str("channel").to_string(),
+        load_range: range("load_range")?,
+        velocity_range: range("velocity_range")?,
+        apply_gain: p.bool("apply_gain"),
+    };
+    let shown = if folder.is_empty() { format!("{} recordings", paths.len()) } else { folder.to_string() };
+    let grid = Grid::load(&src).map_err(|e| NodeError::Data(format!("grid: {e}")))?;
+    let update = p.f64("update_rate");
+    let stream = ctx.port_rates[2];
+    let frame_f = stream / update;
+    let frame = frame_f.round() as usize;
+    if (frame_f - frame as f64).abs() > 1e-9 * frame_f || frame < HEADER + 32 {
+        return Err(NodeError::param(
+            "stream_rate",
+            format!("stream_rate/update_rate = {stream}/{update} = {frame_f} must be a whole number of samples ≥ {} (the frame length)", HEADER + 32),
+        ));
+    }
+    let overlap = (p.f64("overlap") * 1e-3 * grid.rate).round() as usize;
+    let kernel = SincKernel::new(p.usize("half_width"), 0.9, 8.6);
+    let geo = Geometry::new(&grid, &kernel, frame - HEADER, overlap, p.f64("loop"))
+        .map_err(|e| NodeError::Data(format!("grid {shown}: {e}")))?;
+    let scheme = if p.str("scheme") == "basic" { Scheme::Basic } else { Scheme::Improved };
+    Ok(Box::new(Interp {
+        in_clock: Clock::new(ctx.port_rates[0], ctx.base_rate, "load")?,
+        out_clock: Clock::new(stream, ctx.base_rate, "table")?,
+        grid,
+        kernel,
+        geo,
+        scheme,
+        frame,
+        sent: 0,
+        received: 0,
+        consumed: 0,
+        latest: (0.0, 0.0),
+        mix: None,
+        generation: 0,
+        scratch: [Vec::new(), Vec::new()],
+        shown,
+    }))
+}
+
+impl Interp {
+    /// Latches the inputs at or before table sample `s` from this call's
+    /// inputs (`load`, `vel`, starting at global input index `first`).
+    fn latch(&mut self, s: u64, first: u64, n: usize) {
+        while self.consumed < first + n as u64 && self.in_clock.at_or_before(self.consumed, &self.out_clock, s) {
+            let k = (self.consumed - first) as usize;
+            self.latest = (self.scratch[0][k], self.scratch[1][k]);
+            self.consumed += 1;
+        }
+    }
+
+    /// Sample `pos` of the current frame.
+    #[inline]
+    fn value(&self, pos: usize) -> f64 {
+        let Some(mix) = &self.mix else { return 0.0 };
+        if pos >= HEADER {
+            let k = pos - HEADER;
+            return if k < mix.len + mix.overlap { mix.sample(&self.grid, &self.kernel, k) } else { 0.0 };
+        }
+        match pos {
+            at::MAGIC => MAGIC,
+            at::FRAME => self.frame as f64,
+            at::LEN => mix.len as f64,
+            at::OVERLAP => mix.overlap as f64,
+            at::LOOP_CM => mix.loop_cm,
+            at::RATE => self.grid.rate,
+            at::LOAD => mix.load,
+            at::VELOCITY => mix.velocity,
+            at::GENERATION => self.generation as f64,
+            _ => match mix.scheme {
+                Scheme::Basic => 0.0,
+                Scheme::Improved => 1.0,
+            },
+        }
+    }
+}
+
+impl Node for Interp {
+    fn prepare(&mut self, ctx: &PrepareContext) -> Result<(), NodeError> {
+        self.scratch = [vec![0.0; ctx.max_block], vec![0.0; ctx.max_block]];
+        Ok(())
+    }
+
+    fn process(&mut self, io: &mut Io<'_>) -> Result<(), NodeError> {
+        let n_in = io.input_len(0).min(io.input_len(1));
+        self.scratch[0][..n_in].copy_from_slice(&io.input(0)[..n_in]);
+        self.scratch[1][..n_in].copy_from_slice(&io.input(1)[..n_in]);
+        let first = self.received;
+        let out = io.output(0);
+        for (q, y) in out.iter_mut().enumerate() {
+            let s = self.sent + q as u64;
+            let pos = (s % self.frame as u64) as usize;
+            if pos == 0 {
+                self.latch(s, first, n_in);
+                let (m, v) = self.latest;
+                self.mix = Some(Mix::new(&self.grid, &self.geo, &self.kernel, self.scheme, m, v));
+                self.generation = s / self.frame as u64;
+            }
+            *y = self.value(pos);
+        }
+        self.sent += out.len() as u64;
+        // Inputs after the last frame start of this call precede every later table sample.
+        self.latch(u64::MAX / 4, first, n_in);
+        self.received += n_in as u64;
+        Ok(())
+    }
+
+    fn reset(&mut self) {
+        self.sent = 0;
+        self.received = 0;
+        self.consumed = 0;
+        self.latest = (0.0, 0.0);
+        self.mix = None;
+        self.generation = 0;
+    }
+
+    fn finish(&mut self) -> Result<Summary, NodeError> {
+        let g = &self.grid;
+        Ok(Summary::default().line(format!(
+            "grid {}: {} load(s) {:?} g × {} velocit(ies) {:?} cm/s loaded at {} Hz; loop {:.3} cm, {} frames sent",
+            self.shown,
+            g.loads.len(),
+            g.loads,
+            g.velocities.len(),
+            g.velocities,
+            g.rate,
+            self.geo.loop_cm,
+            self.sent / self.frame as u64
+        )))
+    }
+}

@@ -1,0 +1,21 @@
+//! Texture rendering over the (load, velocity) grid (dissertation §5.3.3,
+//! chapter 6): the operators 𝒲𝒜 ([`wa`], Eq. 6.1) and 𝓡𝓢 ([`rs`], §6.2),
+//! the basic and improved schemes ([`scheme`], Eq. 6.4), the grid of
+//! recordings ([`grid`]), the frequency–velocity relation of §6.3
+//! ([`freqvel`]), and the nodes `interp` and `playback` (design and figures
+//! in `docs/texture.md`).
+
+pub mod frame;
+pub mod freqvel;
+pub mod grid;
+pub mod interp;
+pub mod kernel;
+pub mod playback;
+pub mod rs;
+pub mod scheme;
+pub mod wa;
+
+use evflow_engine::NodeSpec;
+
+/// The node types of this family.
+pub static SPECS: &[&NodeSpec] = &[&interp::SPEC, &playback::SPEC];

@@ -1,0 +1,107 @@
+//! `interp` → `playback` end to end: the played signal's spectrum, block ≡
+//! tick, time and position modes, and switching tables without a click.
+
+mod texture_util;
+
+use texture_util::{amplitudes, peak, run_chain, write_sine_grid};
+
+/// A loop of 6 cm: six periods of the one-cycle-per-cm texture, so the
+/// loop itself has no seam and the spectra are those of pure sines.
+const INTERP: &str = "folder = \"grid\"\nloop = 6.0";
+const TIME: &str = "mode = \"time\"";
+
+fn sine_grid(dir: &std::path::Path) {
+    // One load, velocities 10 and 20 cm/s, a texture of one cycle per cm.
+    write_sine_grid(&dir.join("grid"), &[85.0], &[10.0, 20.0], 1.0, |_, _| 1.0);
+}
+
+#[test]
+fn the_played_signal_has_the_interpolated_frequency() {
+    let dir = tempfile::tempdir().unwrap();
+    sine_grid(dir.path());
+    let n = 3000;
+    let out = run_chain(dir.path(), INTERP, TIME, &vec![85.0; n], &vec![15.0; n], n as u64, 4096).unwrap();
+    // The first table is complete after one update period (100 ms), then fades in over 20 ms.
+    assert!(out[..100].iter().all(|y| *y == 0.0));
+    let a = amplitudes(&out[200..]);
+    assert_eq!(peak(&a), 15);
+    assert!((a[15] - 1.0).abs() < 0.02, "{}", a[15]);
+    assert!(a[10] < 0.01 && a[20] < 0.01, "{} {}", a[10], a[20]);
+
+    // The basic scheme plays both grid frequencies at half amplitude.
+    let basic = format!("{INTERP}\nscheme = \"basic\"");
+    let out = run_chain(dir.path(), &basic, TIME, &vec![85.0; n], &vec![15.0; n], n as u64, 4096).unwrap();
+    let a = amplitudes(&out[200..]);
+    assert!((a[10] - 0.5).abs() < 0.02 && (a[20] - 0.5).abs() < 0.02, "{} {}", a[10], a[20]);
+    assert!(a[15] < 0.01);
+}
+
+#[test]
+fn block_and_tick_processing_are_identical() {
+    let dir = tempfile::tempdir().unwrap();
+    sine_grid(dir.path());
+    let n = 1500;
+    let v: Vec<f64> = (0..n).map(|i| 25.0 * (i as f64 / 300.0).sin()).collect();
+    let m: Vec<f64> = (0..n).map(|i| 60.0 + i as f64 / 10.0).collect();
+    for pb in [TIME, "mode = \"position\"\ncrossfade = 35.0"] {
+        let tick = run_chain(dir.path(), INTERP, pb, &m, &v, n as u64, 1).unwrap();
+        for block in [7, 100, 4096] {
+            let blk = run_chain(dir.path(), INTERP, pb, &m, &v, n as u64, block).unwrap();
+            assert!(tick.iter().zip(&blk).all(|(a, b)| a.to_bits() == b.to_bits()), "{pb}, block {block}");
+        }
+        assert!(tick.iter().all(|y| y.is_finite() && y.abs() <= 1.5));
+    }
+}
+
+#[test]
+fn position_mode_at_the_tables_velocity_plays_like_time_mode() {
+    let dir = tempfile::tempdir().unwrap();
+    sine_grid(dir.path());
+    let n = 2000;
+    let t = run_chain(dir.path(), INTERP, TIME, &vec![85.0; n], &vec![13.0; n], n as u64, 512).unwrap();
+    let p =
+        run_chain(dir.path(), INTERP, "mode = \"position\"", &vec![85.0; n], &vec![13.0; n], n as u64, 512).unwrap();
+    let worst = t.iter().zip(&p).map(|(a, b)| (a - b).abs()).fold(0.0, f64::max);
+    assert!(worst < 1e-6, "{worst}");
+}
+
+#[test]
+fn switching_tables_does_not_click() {
+    let dir = tempfile::tempdir().unwrap();
+    sine_grid(dir.path());
+    let n = 3000;
+    // The finger jumps from 11 to 19 cm/s and back: the tables change from
+    // 11 Hz to 19 Hz sines. The largest step between samples of a unit sine
+    // at 19 Hz is 2π·19/1000 ≈ 0.12; a click would be a step of up to 2.
+    let v: Vec<f64> = (0..n).map(|i| if (i / 700) % 2 == 0 { 11.0 } else { 19.0 }).collect();
+    for pb in [TIME, "mode = \"position\""] {
+        let out = run_chain(dir.path(), INTERP, pb, &vec![85.0; n], &v, n as u64, 64).unwrap();
+        let jump = out.windows(2).map(|w| (w[1] - w[0]).abs()).fold(0.0, f64::max);
+        assert!(jump < 0.13, "{pb}: largest step {jump}");
+        // Without the crossfade the same switches do click.
+        let hard = format!("{pb}\ncrossfade = 0.0");
+        let out = run_chain(dir.path(), INTERP, &hard, &vec![85.0; n], &v, n as u64, 64).unwrap();
+        let jump_hard = out.windows(2).map(|w| (w[1] - w[0]).abs()).fold(0.0, f64::max);
+        assert!(jump_hard > 2.0 * jump, "{pb}: {jump_hard} vs {jump}");
+    }
+}
+
+#[test]
+fn playback_ignores_what_is_not_a_table() {
+    use evflow_engine::harness::Single;
+    let noise: Vec<f64> = (0..4000).map(|i| ((i * 7919) % 101) as f64 / 50.0 - 1.0).collect();
+    let single = Single {
+        spec: &evflow_nodes::texture::playback::SPEC,
+        params: "mode = \"time\"",
+        inputs: vec![("table", noise.clone(), 1000.0), ("velocity", vec![5.0; 4000], 1000.0)],
+        outputs: vec!["out"],
+        base_rate: 1000.0,
+        ticks: 4000,
+        block: 256,
+        base_dir: std::path::Path::new("."),
+    };
+    assert!(single.run().unwrap()[0].iter().all(|y| *y == 0.0));
+    let s = single.summary().unwrap();
+    assert_eq!(s.get("tables"), Some(0.0));
+    assert_eq!(s.get("rejected_frames"), Some(40.0));
+}

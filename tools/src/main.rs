@@ -58,7 +58,12 @@ enum Command {
     /// run time, with tables and PNG figures.
     ///
     /// Example: evflow report mesh --out report
-    Report(cli::report_mesh::ReportArgs),
+    Report(cli::report::ReportArgs),
+    /// Benchmarks with distributions and baselines (the figures of
+    /// docs/benchmarks.md). Build with --release.
+    ///
+    /// Example: cargo run --release -p evflow -- bench mesh
+    Bench(cli::bench::BenchArgs),
     /// Print a graph in Graphviz dot syntax (pruned nodes dashed).
     ///
     /// Example: evflow dot graphs/excitation.toml | dot -Tpng > graph.png
@@ -74,7 +79,8 @@ fn main() -> ExitCode {
         Command::Dot(a) => cli::dot::main(a),
         Command::Live(a) => cli::live::main(a),
         Command::Replay(a) => cli::replay::main(a),
-        Command::Report(a) => cli::report_mesh::main(a),
+        Command::Report(a) => cli::report::main(a),
+        Command::Bench(a) => cli::bench::main(a),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

@@ -1,10 +1,12 @@
 //! Filters: `butterworth` (low-/high-pass as second-order sections) and
-//! `delay` (whole-sample delay, the node feedback cycles pass through).
+//! `delay` (whole-sample delay, the node feedback cycles pass through),
+//! `foaw` (velocity from sampled positions by adaptive windowing).
 
 pub mod butterworth;
 pub mod delay;
+pub mod foaw;
 
 use evflow_engine::NodeSpec;
 
 /// The node types of this family.
-pub static SPECS: &[&NodeSpec] = &[&butterworth::SPEC, &delay::SPEC];
+pub static SPECS: &[&NodeSpec] = &[&butterworth::SPEC, &delay::SPEC, &foaw::SPEC];

@@ -1,12 +1,13 @@
 //! One module per subcommand.
 
+pub mod bench;
 pub mod check;
 pub mod dot;
 pub mod graph_args;
 pub mod live;
 pub mod nodes;
 pub mod replay;
-pub mod report_mesh;
+pub mod report;
 pub mod run;
 pub mod run_plots;
 pub mod run_report;

@@ -10,23 +10,6 @@ use evflow_nodes::mesh::obj::load_obj;
 use evflow_tools::plot::{write_png, Plot, Series};
 use std::path::PathBuf;
 
-/// Arguments of `evflow report`.
-#[derive(clap::Args, Debug)]
-pub struct ReportArgs {
-    #[command(subcommand)]
-    which: Which,
-}
-
-#[derive(clap::Subcommand, Debug)]
-enum Which {
-    /// Mesh-gradient rendering (dissertation chapter 4): gradient error
-    /// against mesh resolution and run time; edge detection against
-    /// dihedral ground truth.
-    ///
-    /// Example: evflow report mesh --out report
-    Mesh(Args),
-}
-
 /// Arguments of `evflow report mesh`.
 #[derive(clap::Args, Debug)]
 pub struct Args {
@@ -61,14 +44,8 @@ fn turn(p: [f64; 3], up: &str) -> Result<[f64; 3]> {
     })
 }
 
-/// Runs `evflow report`.
-pub fn main(a: ReportArgs) -> Result<()> {
-    match a.which {
-        Which::Mesh(a) => mesh(a),
-    }
-}
-
-fn mesh(a: Args) -> Result<()> {
+/// Runs `evflow report mesh`.
+pub fn main(a: Args) -> Result<()> {
     std::fs::create_dir_all(&a.out).with_context(|| format!("{}: cannot create", a.out.display()))?;
     let plan = ScanPlan::standard();
     println!(

@@ -1,0 +1,176 @@
+//! The first-order adaptive windowing (FOAW) velocity estimator of
+//! Janabi-Sharifi, Hayward & Chen, "Discrete-time adaptive windowing for
+//! velocity estimation", IEEE Trans. Control Systems Technology 8(6),
+//! 1003–1009, 2000.
+//!
+//! At sample k the window grows, n = 1, 2, …, N, while a straight line
+//! through the newest position y_k with slope b_n passes within the noise
+//! bound d of every position inside the window,
+//! |y_{k−j} − (y_k − b_n·j·T)| ≤ d for j = 1 … n−1; the estimate is the
+//! slope of the largest window that passed (n = 1, the finite difference,
+//! always passes). The slope is
+//!
+//! * **end-fit**: b_n = (y_k − y_{k−n}) / (n·T), the line through the
+//!   window's two ends;
+//! * **best-fit**: b_n = (n·Σᵢ y_{k−i} − 2·Σᵢ i·y_{k−i}) / (T·n(n+1)(n+2)/6),
+//!   i = 0 … n, the least-squares slope over the window's n + 1 samples
+//!   (the paper's Eq. for the best-fit variant; for n = 1 it is the finite
+//!   difference).
+//!
+//! Slow, steady motion gets a long window (little noise); a change of
+//! velocity breaks the fit and shrinks the window (little lag).
+
+/// Which slope a window gets.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Fit {
+    /// Through the window's two ends.
+    End,
+    /// Least squares over the window.
+    Best,
+}
+
+/// A FOAW estimator with its window of past positions. Allocates only in
+/// [`Foaw::new`].
+#[derive(Debug, Clone)]
+pub struct Foaw {
+    fit: Fit,
+    /// Noise bound d, position units.
+    noise: f64,
+    /// Sample period T, s.
+    period: f64,
+    /// Ring of the last N + 1 positions; `head` is the newest.
+    ring: Vec<f64>,
+    head: usize,
+    len: usize,
+    velocity: f64,
+}
+
+impl Foaw {
+    /// An estimator with noise bound `noise` (position units), sample
+    /// period `period` (s) and windows of at most `max_window` ≥ 1 samples.
+    pub fn new(fit: Fit, noise: f64, period: f64, max_window: usize) -> Self {
+        let cap = max_window.max(1) + 1;
+        Foaw { fit, noise, period, ring: vec![0.0; cap], head: 0, len: 0, velocity: 0.0 }
+    }
+
+    /// Forgets every position (velocity 0).
+    pub fn reset(&mut self) {
+        self.len = 0;
+        self.head = 0;
+        self.velocity = 0.0;
+    }
+
+    /// The position `j` samples before the newest.
+    #[inline]
+    fn back(&self, j: usize) -> f64 {
+        let cap = self.ring.len();
+        self.ring[(self.head + cap - j) % cap]
+    }
+
+    /// Takes the next position and returns the velocity estimate (position
+    /// units per second). A non-finite position is skipped and the last
+    /// estimate held.
+    pub fn push(&mut self, y: f64) -> f64 {
+        if !y.is_finite() {
+            return self.velocity;
+        }
+        let cap = self.ring.len();
+        self.head = (self.head + 1) % cap;
+        self.ring[self.head] = y;
+        self.len = (self.len + 1).min(cap);
+        if self.len < 2 {
+            self.velocity = 0.0;
+            return 0.0;
+        }
+        let t = self.period;
+        let mut accepted = (y - self.back(1)) / t;
+        // Running sums over i = 0 … n for the best fit, of positions
+        // relative to y_k (the slope is shift-invariant; this way a resting
+        // finger gives exactly 0 and large coordinates lose no precision).
+        let (mut s0, mut s1) = (self.back(1) - y, self.back(1) - y);
+        for n in 2..self.len {
+            let yn = self.back(n);
+            s0 += yn - y;
+            s1 += n as f64 * (yn - y);
+            let nf = n as f64;
+            let b = match self.fit {
+                Fit::End => (y - yn) / (nf * t),
+                Fit::Best => (nf * s0 - 2.0 * s1) / (t * nf * (nf + 1.0) * (nf + 2.0) / 6.0),
+            };
+            let fits = (1..n).all(|j| (self.back(j) - (y - b * j as f64 * t)).abs() <= self.noise);
+            if !fits {
+                break;
+            }
+            accepted = b;
+        }
+        self.velocity = if accepted.is_finite() { accepted } else { 0.0 };
+        self.velocity
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn exact_on_a_noiseless_ramp_and_zero_at_rest() {
+        for fit in [Fit::End, Fit::Best] {
+            let mut f = Foaw::new(fit, 1e-9, 0.025, 16);
+            let mut v = 0.0;
+            for k in 0..40 {
+                v = f.push(0.1 + 0.05 * 0.025 * k as f64);
+            }
+            assert!((v - 0.05).abs() < 1e-9, "{fit:?}: {v}");
+            let mut rest = Foaw::new(fit, 1e-4, 0.025, 16);
+            for _ in 0..40 {
+                assert_eq!(rest.push(0.3), 0.0);
+            }
+        }
+    }
+
+    #[test]
+    fn best_fit_slope_is_least_squares() {
+        // Against a direct least-squares fit over the whole window when
+        // every point fits (noise bound large).
+        let ys = [0.0, 0.9, 2.2, 2.8, 4.1, 5.0];
+        let mut f = Foaw::new(Fit::Best, 10.0, 1.0, 5);
+        let mut v = 0.0;
+        for &y in &ys {
+            v = f.push(y);
+        }
+        let n = ys.len() as f64;
+        let mt = (n - 1.0) / 2.0;
+        let my = ys.iter().sum::<f64>() / n;
+        let sxy: f64 = ys.iter().enumerate().map(|(i, y)| (i as f64 - mt) * (y - my)).sum();
+        let sxx: f64 = (0..ys.len()).map(|i| (i as f64 - mt).powi(2)).sum();
+        assert!((v - sxy / sxx).abs() < 1e-12, "{v} vs {}", sxy / sxx);
+    }
+
+    #[test]
+    fn a_velocity_step_shrinks_the_window() {
+        // 1 unit/s, then −1 unit/s: within two samples of the reversal the
+        // window holds only post-reversal samples and the estimate is exact.
+        let mut f = Foaw::new(Fit::End, 1e-6, 1.0, 16);
+        let mut y = 0.0;
+        for _ in 0..20 {
+            f.push(y);
+            y += 1.0;
+        }
+        y -= 2.0;
+        f.push(y);
+        y -= 1.0;
+        assert_eq!(f.push(y), -1.0);
+    }
+
+    #[test]
+    fn non_finite_positions_hold_the_estimate() {
+        let mut f = Foaw::new(Fit::Best, 1e-3, 0.025, 8);
+        for k in 0..10 {
+            f.push(0.01 * k as f64);
+        }
+        let v = f.push(0.1);
+        assert_eq!(f.push(f64::NAN), v);
+        assert_eq!(f.push(f64::INFINITY), v);
+        assert!(f.push(0.11).is_finite());
+    }
+}

@@ -1,0 +1,32 @@
+//! `evflow bench`: benchmarks that report distributions (per-tick p50, p99,
+//! max) and ratios against a baseline measured in the same run — the
+//! figures of `docs/benchmarks.md`. Throughput of whole graphs is
+//! `evflow run`'s timing; micro-benchmarks are criterion benches.
+
+pub mod mesh;
+pub mod stats;
+
+/// Arguments of `evflow bench`.
+#[derive(clap::Args, Debug)]
+pub struct BenchArgs {
+    #[command(subcommand)]
+    which: Which,
+}
+
+#[derive(clap::Subcommand, Debug)]
+enum Which {
+    /// The mesh-gradient chain (chapter 4): BVH build time, ray casts
+    /// through the BVH against a brute-force loop over all triangles, and
+    /// the live chain's per-tick compute time, for meshes of 1 k, 100 k and
+    /// 1 M triangles. Build with --release.
+    ///
+    /// Example: cargo run --release -p evflow -- bench mesh
+    Mesh(mesh::Args),
+}
+
+/// Runs the chosen benchmark.
+pub fn main(a: BenchArgs) -> anyhow::Result<()> {
+    match a.which {
+        Which::Mesh(m) => mesh::main(m),
+    }
+}

@@ -1,0 +1,51 @@
+//! `evflow bench` and `evflow report` end to end on small sizes: they run,
+//! print complete tables and write their figures (the figures themselves
+//! are checked by the library tests they print).
+
+use std::path::{Path, PathBuf};
+use std::process::Command;
+
+fn root() -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR")).parent().expect("workspace root").to_path_buf()
+}
+
+fn evflow(args: &[&str]) -> (bool, String, String) {
+    let o = Command::new(env!("CARGO_BIN_EXE_evflow")).args(args).current_dir(root()).output().expect("evflow runs");
+    (
+        o.status.success(),
+        String::from_utf8_lossy(&o.stdout).into_owned(),
+        String::from_utf8_lossy(&o.stderr).into_owned(),
+    )
+}
+
+#[test]
+fn bench_mesh_prints_a_row_per_size_with_no_hit_mismatch() {
+    let (ok, out, err) = evflow(&["bench", "mesh", "--sizes", "300,2000", "--ticks", "200", "--queries", "300"]);
+    assert!(ok, "{err}");
+    let rows: Vec<&str> = out.lines().filter(|l| l.starts_with("| ") && !l.starts_with("| triangles")).collect();
+    assert_eq!(rows.len(), 2, "{out}");
+    for r in rows {
+        let cells: Vec<&str> = r.split('|').map(str::trim).collect();
+        assert_eq!(cells[7], "0", "the BVH and brute force disagree: {r}");
+    }
+}
+
+#[test]
+fn report_foaw_writes_its_table_and_figures() {
+    let dir = tempfile::tempdir().unwrap();
+    let out_dir = dir.path().to_str().unwrap();
+    let (ok, out, err) = evflow(&["report", "foaw", "--out", out_dir, "--seconds", "3"]);
+    assert!(ok, "{err}");
+    assert!(out.contains("| finite difference |") && out.contains("FOAW best-fit"), "{out}");
+    for f in ["foaw-tradeoff.png", "foaw-steps.png"] {
+        assert!(dir.path().join(f).is_file() || err.contains("warning"), "{f} missing: {out}{err}");
+    }
+}
+
+#[test]
+fn bad_arguments_are_named() {
+    let (ok, _, err) = evflow(&["report", "foaw", "--rate", "0"]);
+    assert!(!ok && err.contains("--rate"), "{err}");
+    let (ok, _, err) = evflow(&["bench", "mesh", "--config", "9B9H", "--sizes", "300"]);
+    assert!(!ok && err.contains("9B9H"), "{err}");
+}

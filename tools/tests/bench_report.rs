@@ -43,6 +43,17 @@ fn report_foaw_writes_its_table_and_figures() {
 }
 
 #[test]
+fn report_resample_scores_every_method() {
+    let dir = tempfile::tempdir().unwrap();
+    let (ok, out, err) =
+        evflow(&["report", "resample", "--out", dir.path().to_str().unwrap(), "--samples", "2000", "--repeats", "1"]);
+    assert!(ok, "{err}");
+    let rows = out.lines().filter(|l| l.starts_with("| ") && !l.starts_with("| method")).count();
+    assert_eq!(rows, 14, "{out}");
+    assert!(out.contains("rubato fft") && out.contains("kaiser sinc W=16"), "{out}");
+}
+
+#[test]
 fn bad_arguments_are_named() {
     let (ok, _, err) = evflow(&["report", "foaw", "--rate", "0"]);
     assert!(!ok && err.contains("--rate"), "{err}");

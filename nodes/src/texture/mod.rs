@@ -12,6 +12,7 @@ pub mod interp;
 pub mod kernel;
 pub mod playback;
 pub mod rs;
+pub mod rs_precision;
 pub mod scheme;
 pub mod wa;
 

@@ -43,6 +43,7 @@ struct Row {
     brute_ns: f64,
     mismatches: usize,
     tick_us: [f64; 3],
+    on_mesh: f64,
 }
 
 /// Runs the benchmark and prints a Markdown table.
@@ -58,11 +59,11 @@ pub fn main(a: Args) -> Result<()> {
         eprintln!("mesh of ~{size} triangles (resolution {resolution}) …");
         rows.push(measure(&a, resolution)?);
     }
-    println!("| triangles | resolution | BVH build | ray cast (BVH) | ray cast (brute force) | brute / BVH | hit mismatches | tick p50 | tick p99 | tick max |");
-    println!("|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|");
+    println!("| triangles | resolution | BVH build | ray cast (BVH) | ray cast (brute force) | brute / BVH | hit mismatches | tick p50 | tick p99 | tick max | ticks on the mesh |");
+    println!("|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|");
     for r in &rows {
         println!(
-            "| {} | {} | {:.1} ms | {:.0} ns | {:.0} ns | {:.0}× | {} | {:.2} µs | {:.2} µs | {:.1} µs |",
+            "| {} | {} | {:.1} ms | {:.0} ns | {:.0} ns | {:.0}× | {} | {:.2} µs | {:.2} µs | {:.1} µs | {:.0} % |",
             r.triangles,
             r.resolution,
             r.build_ms,
@@ -72,7 +73,8 @@ pub fn main(a: Args) -> Result<()> {
             r.mismatches,
             r.tick_us[0],
             r.tick_us[1],
-            r.tick_us[2]
+            r.tick_us[2],
+            r.on_mesh * 100.0
         );
     }
     Ok(())
@@ -104,8 +106,8 @@ fn measure(a: &Args, resolution: usize) -> Result<Row> {
         .filter(|&&(x, y)| rc.cast(x, y).map(|h| h.tri) != rc.cast_brute(x, y).map(|h| h.tri))
         .count();
 
-    let tick_us = time_chain(a, resolution)?;
-    Ok(Row { resolution, triangles, build_ms, cast_ns, brute_ns, mismatches, tick_us })
+    let (tick_us, on_mesh) = time_chain(a, resolution)?;
+    Ok(Row { resolution, triangles, build_ms, cast_ns, brute_ns, mismatches, tick_us, on_mesh })
 }
 
 /// Seeded touch points spread over the mesh's footprint.
@@ -135,8 +137,9 @@ fn time_casts(points: &[(f64, f64)], cast: impl Fn(f64, f64) -> Option<u32>) -> 
     ns
 }
 
-/// p50, p99 and max per-tick compute time of the live chain, µs.
-fn time_chain(a: &Args, resolution: usize) -> Result<[f64; 3]> {
+/// p50, p99 and max per-tick compute time of the live chain, µs, and the
+/// fraction of ticks whose touch point was on the mesh (`surface.tri` ≥ 0).
+fn time_chain(a: &Args, resolution: usize) -> Result<([f64; 3], f64)> {
     let sets = [format!("surface.resolution={resolution}"), format!("edges.resolution={resolution}")];
     let overrides = sets
         .iter()
@@ -149,11 +152,20 @@ fn time_chain(a: &Args, resolution: usize) -> Result<[f64; 3]> {
     for _ in 0..1000 {
         plan.tick().map_err(|e| anyhow!("{e}"))?;
     }
+    let surface = plan.index("surface").ok_or_else(|| anyhow!("{}: no node `surface`", a.graph.display()))?;
+    let tri = plan
+        .output_names(surface)
+        .iter()
+        .position(|n| n == "tri")
+        .ok_or_else(|| anyhow!("{}: node `surface` has no output `tri`", a.graph.display()))?;
     let mut us = Vec::with_capacity(a.ticks);
+    let mut hits = 0usize;
     for _ in 0..a.ticks.max(1) {
         let t = Instant::now();
         plan.tick().map_err(|e| anyhow!("{e}"))?;
         us.push(t.elapsed().as_secs_f64() * 1e6);
+        hits += usize::from(plan.output_at(surface, tri).first().is_some_and(|&t| t >= 0.0));
     }
-    Ok([percentile(&mut us, 0.5), percentile(&mut us, 0.99), percentile(&mut us, 1.0)])
+    let on_mesh = hits as f64 / us.len() as f64;
+    Ok(([percentile(&mut us, 0.5), percentile(&mut us, 0.99), percentile(&mut us, 1.0)], on_mesh))
 }

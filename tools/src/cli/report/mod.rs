@@ -3,6 +3,7 @@
 
 pub mod foaw;
 pub mod mesh;
+pub mod resample;
 
 /// Arguments of `evflow report`.
 #[derive(clap::Args, Debug)]
@@ -25,6 +26,12 @@ enum Which {
     ///
     /// Example: evflow report foaw --out report
     Foaw(foaw::Args),
+    /// Re-sampling for the texture chain (§6.2): error against run time
+    /// of rubato's sinc, polynomial and FFT resamplers and the live
+    /// kernel of `interp`, a table and a work-precision PNG.
+    ///
+    /// Example: cargo run --release -p evflow -- report resample --out report
+    Resample(resample::Args),
 }
 
 /// Runs the chosen report.
@@ -32,5 +39,6 @@ pub fn main(a: ReportArgs) -> anyhow::Result<()> {
     match a.which {
         Which::Mesh(m) => mesh::main(m),
         Which::Foaw(f) => foaw::main(f),
+        Which::Resample(r) => resample::main(r),
     }
 }

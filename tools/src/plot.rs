@@ -150,6 +150,50 @@ fn range(v: impl Iterator<Item = f64>, log: bool) -> (f64, f64) {
     }
 }
 
+/// An axis label: at most four significant digits, no float noise
+/// (0.30000000000000004 → 0.3), exponent form for very small or large values.
+fn tick_label(v: f64) -> String {
+    if v == 0.0 || !v.is_finite() {
+        return format!("{v}");
+    }
+    let mag = v.abs().log10().floor();
+    if !(-3.0..6.0).contains(&mag) {
+        return format!("{v:.1e}");
+    }
+    let decimals = (3.0 - mag).max(0.0) as usize;
+    let s = format!("{v:.decimals$}");
+    if s.contains('.') {
+        s.trim_end_matches('0').trim_end_matches('.').to_string()
+    } else {
+        s
+    }
+}
+
+/// Key points of a log axis: multiples of the powers of ten inside the
+/// range — 1, 2, 5 per decade, denser under one decade, only the powers
+/// over more than four (values parsed from text so labels carry no float
+/// noise).
+fn log_keys((lo, hi): (f64, f64)) -> Vec<f64> {
+    let decades = (hi / lo).log10();
+    let mults: &[f64] = if decades < 1.0 {
+        &[1.0, 1.5, 2.0, 3.0, 4.0, 5.0, 6.0, 8.0]
+    } else if decades > 4.0 {
+        &[1.0]
+    } else {
+        &[1.0, 2.0, 5.0]
+    };
+    let mut v = Vec::new();
+    for e in (lo.log10().floor() as i32)..=(hi.log10().ceil() as i32) {
+        for &m in mults {
+            let k: f64 = format!("{m}e{e}").parse().unwrap_or(f64::NAN);
+            if k >= lo && k <= hi {
+                v.push(k);
+            }
+        }
+    }
+    v
+}
+
 /// A colour per series, distinct for the first ten.
 fn colour(i: usize) -> RGBColor {
     const C: [(u8, u8, u8); 10] = [
@@ -202,11 +246,13 @@ type Pts<'a> = [Drawable<'a>];
 fn draw(plot: &Plot, series: &Pts<'_>, xr: (f64, f64), yr: (f64, f64), text: bool, tmp: &Path) -> Result<(), String> {
     let root = BitMapBackend::new(tmp, SIZE).into_drawing_area();
     root.fill(&WHITE).map_err(|e| e.to_string())?;
+    let lx = || (xr.0..xr.1).log_scale().with_key_points(log_keys(xr));
+    let ly = || (yr.0..yr.1).log_scale().with_key_points(log_keys(yr));
     match (plot.log_x, plot.log_y) {
         (false, false) => body(&root, plot, series, (xr.0..xr.1, yr.0..yr.1), text),
-        (true, false) => body(&root, plot, series, ((xr.0..xr.1).log_scale(), yr.0..yr.1), text),
-        (false, true) => body(&root, plot, series, (xr.0..xr.1, (yr.0..yr.1).log_scale()), text),
-        (true, true) => body(&root, plot, series, ((xr.0..xr.1).log_scale(), (yr.0..yr.1).log_scale()), text),
+        (true, false) => body(&root, plot, series, (lx(), yr.0..yr.1), text),
+        (false, true) => body(&root, plot, series, (xr.0..xr.1, ly()), text),
+        (true, true) => body(&root, plot, series, (lx(), ly()), text),
     }?;
     root.present().map_err(|e| e.to_string())
 }
@@ -234,7 +280,11 @@ where
     let mut chart = b.build_cartesian_2d(x, y).map_err(|e| e.to_string())?;
     let mut mesh = chart.configure_mesh();
     if text {
-        mesh.x_desc(&plot.x_label).y_desc(&plot.y_label).label_style((FONT, 16));
+        mesh.x_desc(&plot.x_label)
+            .y_desc(&plot.y_label)
+            .label_style((FONT, 16))
+            .x_label_formatter(&|v| tick_label(*v))
+            .y_label_formatter(&|v| tick_label(*v));
     } else {
         mesh.x_labels(0).y_labels(0);
     }
@@ -271,6 +321,24 @@ where
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn tick_labels_are_short() {
+        assert_eq!(tick_label(0.30000000000000004), "0.3");
+        assert_eq!(tick_label(0.0125), "0.0125");
+        assert_eq!(tick_label(1234.6), "1235");
+        assert_eq!(tick_label(20.0), "20");
+        assert_eq!(tick_label(2e-5), "2.0e-5");
+        assert_eq!(tick_label(-0.5), "-0.5");
+    }
+
+    #[test]
+    fn log_key_points_suit_the_span_and_stay_within_the_range() {
+        assert_eq!(log_keys((0.11, 0.9)), vec![0.15, 0.2, 0.3, 0.4, 0.5, 0.6, 0.8]);
+        assert_eq!(log_keys((1e-3, 1e3)), vec![1e-3, 1e-2, 0.1, 1.0, 10.0, 100.0, 1e3]);
+        let k = log_keys((0.004, 0.3));
+        assert_eq!(k, vec![0.005, 0.01, 0.02, 0.05, 0.1, 0.2]);
+    }
 
     #[test]
     fn writes_a_png_and_nothing_else() {

@@ -23,7 +23,7 @@ pub struct Args {
     #[arg(long, value_delimiter = ',', default_value = "4,8,16,32,64,128,256,512")]
     resolutions: Vec<usize>,
     /// A mesh with sharp edges for the edge report (units taken as cm).
-    #[arg(long, default_value = "/work/shared/data/meshes/fandisk.obj")]
+    #[arg(long, default_value = "../shared/data/meshes/fandisk.obj")]
     edges_mesh: PathBuf,
     /// The edge mesh's axis that points up, toward the viewer (x, y, z, -x, -y, -z).
     #[arg(long, default_value = "z", allow_hyphen_values = true)]

@@ -17,6 +17,7 @@ pub mod rng;
 pub mod sensor_model;
 pub mod tribometer;
 pub mod tribometer_model;
+pub mod user;
 
 #[cfg(test)]
 mod chain_tests;
@@ -34,7 +35,7 @@ use evflow_engine::{BuildContext, NodeError, NodeSpec, ParamSpec, Params};
 use integrator::Method;
 
 /// The node types of this family.
-pub static SPECS: &[&NodeSpec] = &[&display::SPEC, &tribometer::SPEC, &forcesensor::SPEC];
+pub static SPECS: &[&NodeSpec] = &[&display::SPEC, &tribometer::SPEC, &forcesensor::SPEC, &user::SPEC];
 
 /// The `profile` parameter shared by the lab's nodes.
 pub const PROFILE_PARAM: ParamSpec = ParamSpec::text(

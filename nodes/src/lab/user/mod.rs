@@ -1,0 +1,218 @@
+//! `sim.user`: the virtual user of the simulated lab — a finger scanning
+//! side to side ([`finger`]) as the rig's sensors report it: an IR touch
+//! frame (40 Hz, quantized) and a load cell (40 Hz, noisy).
+
+pub mod finger;
+
+use crate::lab::rng::Rng;
+use crate::rate::clock::Clock;
+use evflow_engine::{
+    BuildContext, Io, Node, NodeError, NodeSpec, ParamSpec, Params, PortSpec, RateSpec, Role, Summary,
+};
+use finger::{Finger, FingerSettings};
+
+/// Declaration of `sim.user`.
+pub static SPEC: NodeSpec = NodeSpec::new(
+    "sim.user",
+    "lab",
+    Role::Source,
+    "Virtual user: a finger scanning side to side with a person's varying speed and pressure, as an IR frame and a load cell report it.",
+    build,
+)
+.doc(
+    "Stands in for a person at the display (dissertation §6.5: the user study's finger, tracked by an \
+IR frame and a load cell). The finger strokes left and right over `travel` along the direction \
+`direction` from (`origin_x`, `origin_y`) on the screen. Each stroke picks a cruising speed in \
+[`speed_min`, `speed_max`] and a pressure (as a mass) in [`mass_min`, `mass_max`] uniformly; within \
+the stroke both drift (Ornstein–Uhlenbeck, correlation time `wander`, rms 15 % of the range, kept in \
+range) — 3–7 cm/s and 60–110 g by default, like the dissertation's conditions, and the limits allow \
+the extremes (0–50 cm/s, 1–1000 g). Reversals are smooth: a raised-cosine stop and restart taking \
+`reversal` seconds, braking so as to stop exactly at the end of the travel. Seeded (the graph's seed \
+and the node name, or `seed`).\n\n\
+**Outputs at the node's rate** (`rate`, 1 kHz): the truth — `position` along the stroke (m, from \
+its start), signed `velocity` (m/s, mean over the sample: + away from the origin), `load` (N = \
+mass·g), and the touch point `x`, `y` on the screen (m) for the mesh chain. **Outputs at `ir_rate`** \
+(40 Hz, an IR touch frame's report rate): `ir_x`, `ir_y` — the touch point sampled at each frame and \
+quantized to `ir_resolution` (0.5 mm by default; IR frames resolve about 0.3–1 mm) — and \
+`load_cell`, the load sampled at each frame plus Gaussian noise of rms `load_noise` (N).\n\n\
+Feed `load` and `velocity` to `sim.display` or `sim.texture`, `x`/`y` to `mesh.gradient`, and the \
+sensor outputs to `foaw` and `interp` as a rig's would be. Checked against: the stroke stays on the \
+travel, speed and load stay in their ranges, the velocity is the derivative of the position, \
+reversals at both ends, bounded acceleration, frames exactly every 1/`ir_rate`, quantization to the \
+resolution, determinism per seed, and finite bounded outputs at the extremes.",
+)
+.ports(&[
+    PortSpec::output("position", "m", "finger position along the stroke, from its start"),
+    PortSpec::output("velocity", "m/s", "signed finger velocity along the stroke"),
+    PortSpec::output("load", "N", "normal load of the finger"),
+    PortSpec::output("x", "m", "touch point x on the screen"),
+    PortSpec::output("y", "m", "touch point y on the screen"),
+    PortSpec::output("ir_x", "m", "touch x as the IR frame reports it (quantized)").at(RateSpec::Param("ir_rate")),
+    PortSpec::output("ir_y", "m", "touch y as the IR frame reports it (quantized)").at(RateSpec::Param("ir_rate")),
+    PortSpec::output("load_cell", "N", "load as the load cell reports it (noisy)").at(RateSpec::Param("ir_rate")),
+])
+.params(&[
+    ParamSpec::float("speed_min", 0.0, 50.0, 3.0, "cm/s", "slowest cruising speed"),
+    ParamSpec::float("speed_max", 0.0, 50.0, 7.0, "cm/s", "fastest cruising speed"),
+    ParamSpec::float("mass_min", 1.0, 1000.0, 60.0, "g", "lightest pressure, as a mass (load = mass·g)"),
+    ParamSpec::float("mass_max", 1.0, 1000.0, 110.0, "g", "heaviest pressure, as a mass"),
+    ParamSpec::float("travel", 0.001, 1.0, 0.08, "m", "length of a stroke"),
+    ParamSpec::float("direction", -360.0, 360.0, 0.0, "deg", "direction of the strokes on the screen (0 = +x)"),
+    ParamSpec::float("origin_x", -1e6, 1e6, 0.0, "m", "screen x of the strokes' start"),
+    ParamSpec::float("origin_y", -1e6, 1e6, 0.0, "m", "screen y of the strokes' start"),
+    ParamSpec::float("reversal", 0.002, 10.0, 0.1, "s", "time to stop and restart at a reversal"),
+    ParamSpec::float("wander", 0.01, 100.0, 1.0, "s", "correlation time of the speed and pressure drift"),
+    ParamSpec::float("ir_rate", 1.0, 1000.0, 40.0, "Hz", "report rate of the IR frame and load cell"),
+    ParamSpec::float("ir_resolution", 0.0, 0.1, 0.0005, "m", "IR frame resolution (0: exact)"),
+    ParamSpec::float("load_noise", 0.0, 10.0, 0.005, "N", "rms noise of the load cell"),
+    ParamSpec::int("seed", -1, i64::MAX, -1, "1", "random seed (−1: from the graph's seed and the node name)"),
+    ParamSpec::float("rate", 1.0, 1e6, 1000.0, "Hz", "sample rate of the true outputs"),
+])
+.rate_param("rate")
+.example("speed_min = 3.0\nspeed_max = 7.0\nmass_min = 60.0\nmass_max = 110.0\nir_rate = 40.0");
+
+struct SimUser {
+    settings: FingerSettings,
+    seed: u64,
+    finger: Finger,
+    dir: (f64, f64),
+    origin: (f64, f64),
+    resolution: f64,
+    load_noise: f64,
+    noise: Rng,
+    node_clock: Clock,
+    ir_clock: Clock,
+    /// Samples produced so far: at the node's rate and at the IR rate.
+    sent: u64,
+    ir_sent: u64,
+    /// The last IR report (held if the engine asks for more reports than were due).
+    last_ir: [f64; 3],
+}
+
+fn build(p: &Params, ctx: &BuildContext) -> Result<Box<dyn Node>, NodeError> {
+    let range = |lo: &str, hi: &str| -> Result<(f64, f64), NodeError> {
+        let (a, b) = (p.f64(lo), p.f64(hi));
+        if a > b {
+            return Err(NodeError::param(lo, format!("{lo} = {a} is above {hi} = {b}")));
+        }
+        Ok((a, b))
+    };
+    let (s0, s1) = range("speed_min", "speed_max")?;
+    let (m0, m1) = range("mass_min", "mass_max")?;
+    let rate = ctx.rate;
+    let ir_rate = p.f64("ir_rate");
+    let ir_clock = Clock::new(ir_rate, ctx.base_rate, "ir_x")?;
+    let node_clock = Clock::new(rate, ctx.base_rate, "position")?;
+    if ir_rate > rate {
+        return Err(NodeError::param("ir_rate", format!("ir_rate = {ir_rate} Hz is above the node's rate {rate} Hz")));
+    }
+    let settings = FingerSettings {
+        travel: p.f64("travel"),
+        speed: (s0 * 0.01, s1 * 0.01),
+        mass: (m0 * 1e-3, m1 * 1e-3),
+        reversal: p.f64("reversal"),
+        wander: p.f64("wander"),
+        h: 1.0 / rate,
+    };
+    let seed = match p.i64("seed") {
+        s if s >= 0 => s as u64,
+        _ => ctx.node_seed(),
+    };
+    let a = p.f64("direction").to_radians();
+    let mut node = SimUser {
+        settings,
+        seed,
+        finger: Finger::new(settings, seed),
+        dir: (a.cos(), a.sin()),
+        origin: (p.f64("origin_x"), p.f64("origin_y")),
+        resolution: p.f64("ir_resolution"),
+        load_noise: p.f64("load_noise"),
+        noise: Rng::substream(seed, 4),
+        node_clock,
+        ir_clock,
+        sent: 0,
+        ir_sent: 0,
+        last_ir: [0.0; 3],
+    };
+    node.reset();
+    Ok(Box::new(node))
+}
+
+impl SimUser {
+    fn touch(&self) -> (f64, f64) {
+        let p = self.finger.position;
+        (self.origin.0 + p * self.dir.0, self.origin.1 + p * self.dir.1)
+    }
+
+    fn quantize(&self, v: f64) -> f64 {
+        if self.resolution > 0.0 {
+            (v / self.resolution).round() * self.resolution
+        } else {
+            v
+        }
+    }
+
+    /// The IR frame and load cell report of the finger's current state.
+    fn report(&mut self) -> [f64; 3] {
+        let (x, y) = self.touch();
+        let noise = if self.load_noise > 0.0 { self.load_noise * self.noise.gaussian() } else { 0.0 };
+        [self.quantize(x), self.quantize(y), self.finger.load() + noise]
+    }
+}
+
+impl Node for SimUser {
+    fn process(&mut self, io: &mut Io<'_>) -> Result<(), NodeError> {
+        let n = io.len();
+        let n_ir = io.output_len(5).min(io.output_len(6)).min(io.output_len(7));
+        let mut k_ir = 0;
+        for q in 0..n {
+            // Sample `sent` of the node's clock is the state after this step.
+            self.finger.step();
+            let (x, y) = self.touch();
+            let outs = io.outputs();
+            outs[0][q] = self.finger.position;
+            outs[1][q] = self.finger.velocity;
+            outs[2][q] = self.finger.load();
+            outs[3][q] = x;
+            outs[4][q] = y;
+            // IR reports due at or before this sample take this state.
+            while k_ir < n_ir && self.ir_clock.at_or_before(self.ir_sent, &self.node_clock, self.sent) {
+                let r = self.report();
+                self.last_ir = r;
+                let outs = io.outputs();
+                for (j, v) in r.iter().enumerate() {
+                    outs[5 + j][k_ir] = *v;
+                }
+                k_ir += 1;
+                self.ir_sent += 1;
+            }
+            self.sent += 1;
+        }
+        // Reports the engine counts in this call beyond those due (never expected): hold the last.
+        while k_ir < n_ir {
+            let r = self.last_ir;
+            let outs = io.outputs();
+            for (j, v) in r.iter().enumerate() {
+                outs[5 + j][k_ir] = *v;
+            }
+            k_ir += 1;
+            self.ir_sent += 1;
+        }
+        Ok(())
+    }
+
+    fn reset(&mut self) {
+        self.finger = Finger::new(self.settings, self.seed);
+        self.noise = Rng::substream(self.seed, 4);
+        self.sent = 0;
+        self.ir_sent = 0;
+        self.last_ir = [0.0; 3];
+    }
+
+    fn finish(&mut self) -> Result<Summary, NodeError> {
+        Ok(Summary::default().value("ir_reports", self.ir_sent as f64, "1"))
+    }
+}
+
+#[cfg(test)]
+mod tests;

@@ -15,6 +15,7 @@ pub mod profile;
 pub mod profile_load;
 pub mod rng;
 pub mod sensor_model;
+pub mod texture;
 pub mod tribometer;
 pub mod tribometer_model;
 pub mod user;
@@ -35,7 +36,7 @@ use evflow_engine::{BuildContext, NodeError, NodeSpec, ParamSpec, Params};
 use integrator::Method;
 
 /// The node types of this family.
-pub static SPECS: &[&NodeSpec] = &[&display::SPEC, &tribometer::SPEC, &forcesensor::SPEC, &user::SPEC];
+pub static SPECS: &[&NodeSpec] = &[&display::SPEC, &tribometer::SPEC, &forcesensor::SPEC, &texture::SPEC, &user::SPEC];
 
 /// The `profile` parameter shared by the lab's nodes.
 pub const PROFILE_PARAM: ParamSpec = ParamSpec::text(

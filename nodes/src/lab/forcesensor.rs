@@ -2,7 +2,7 @@
 
 use super::sensor_model::SensorModel;
 use super::{method_of, profile_of, INTEGRATOR_PARAM, NOISE_PARAM, PROFILE_PARAM, SUBSTEPS_PARAM};
-use evflow_engine::{BuildContext, Io, Node, NodeError, NodeSpec, Params, PortSpec, Role, Summary};
+use evflow_engine::{BuildContext, Io, Node, NodeError, NodeSpec, ParamSpec, Params, PortSpec, Role, Summary};
 
 /// Declaration of `sim.forcesensor`.
 pub static SPEC: NodeSpec = NodeSpec::new(
@@ -30,7 +30,20 @@ pub static SPEC: NodeSpec = NodeSpec::new(
     PortSpec::input("velocity", "m/s", "carriage velocity (its sign selects the bias)"),
     PortSpec::output("force", "N", "acquired lateral force"),
 ])
-.params(&[PROFILE_PARAM, INTEGRATOR_PARAM, SUBSTEPS_PARAM, NOISE_PARAM])
+.params(&[
+    PROFILE_PARAM,
+    INTEGRATOR_PARAM,
+    SUBSTEPS_PARAM,
+    NOISE_PARAM,
+    ParamSpec::int(
+        "seed",
+        -1,
+        i64::MAX,
+        -1,
+        "1",
+        "noise and drift seed (−1: from the graph's seed and the node name; set it per repetition)",
+    ),
+])
 .example("profile = \"\"\nnoise = 1.0");
 
 struct SimForceSensor {
@@ -40,7 +53,11 @@ struct SimForceSensor {
 fn build(p: &Params, ctx: &BuildContext) -> Result<Box<dyn Node>, NodeError> {
     let profile = profile_of(p, ctx)?;
     let method = method_of(p)?;
-    let model = SensorModel::new(&profile, ctx.rate, method, p.usize("substeps"), p.f64("noise"), ctx.node_seed())
+    let seed = match p.i64("seed") {
+        s if s >= 0 => s as u64,
+        _ => ctx.node_seed(),
+    };
+    let model = SensorModel::new(&profile, ctx.rate, method, p.usize("substeps"), p.f64("noise"), seed)
         .map_err(|m| NodeError::param("profile", m))?;
     Ok(Box::new(SimForceSensor { model }))
 }

@@ -11,6 +11,7 @@ pub mod lab;
 pub mod math;
 pub mod mesh;
 pub mod metric;
+pub mod narx;
 pub mod output;
 pub mod rate;
 pub mod recording;

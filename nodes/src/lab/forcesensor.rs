@@ -53,10 +53,7 @@ struct SimForceSensor {
 fn build(p: &Params, ctx: &BuildContext) -> Result<Box<dyn Node>, NodeError> {
     let profile = profile_of(p, ctx)?;
     let method = method_of(p)?;
-    let seed = match p.i64("seed") {
-        s if s >= 0 => s as u64,
-        _ => ctx.node_seed(),
-    };
+    let seed = crate::lab::seed_of(p, ctx);
     let model = SensorModel::new(&profile, ctx.rate, method, p.usize("substeps"), p.f64("noise"), seed)
         .map_err(|m| NodeError::param("profile", m))?;
     Ok(Box::new(SimForceSensor { model }))

@@ -38,6 +38,15 @@ use integrator::Method;
 /// The node types of this family.
 pub static SPECS: &[&NodeSpec] = &[&display::SPEC, &tribometer::SPEC, &forcesensor::SPEC, &texture::SPEC, &user::SPEC];
 
+/// The seed a node's `seed` parameter asks for: its value when ≥ 0, else
+/// the graph's seed mixed with the node's name.
+pub fn seed_of(p: &Params, ctx: &BuildContext) -> u64 {
+    match p.i64("seed") {
+        s if s >= 0 => s as u64,
+        _ => ctx.node_seed(),
+    }
+}
+
 /// The `profile` parameter shared by the lab's nodes.
 pub const PROFILE_PARAM: ParamSpec = ParamSpec::text(
     "profile",

@@ -114,10 +114,7 @@ fn build(p: &Params, ctx: &BuildContext) -> Result<Box<dyn Node>, NodeError> {
         wander: p.f64("wander"),
         h: 1.0 / rate,
     };
-    let seed = match p.i64("seed") {
-        s if s >= 0 => s as u64,
-        _ => ctx.node_seed(),
-    };
+    let seed = crate::lab::seed_of(p, ctx);
     let a = p.f64("direction").to_radians();
     let mut node = SimUser {
         settings,

@@ -4,7 +4,7 @@
 //! over the training rows; early stopping on the validation block as in
 //! [`super::lm`] (with `max_fail` counted in epochs).
 
-use super::{interrupted, mse, Data, Epoch, Settings, Stop, Trained, Watch};
+use super::{finish, interrupted, mse, Data, Epoch, Settings, Stop, Trained, Watch};
 use crate::lab::rng::Rng;
 use crate::narx::net::Net;
 use std::sync::atomic::AtomicBool;
@@ -97,10 +97,7 @@ pub fn train(
             break;
         }
     }
-    let net = if validation.is_empty() { net } else { watch.best(net) };
-    let train_mse = mse(&net, train, &mut work);
-    let validation_mse = if validation.is_empty() { f64::NAN } else { mse(&net, validation, &mut work) };
-    Trained { net, epochs, stop: reason, train_mse, validation_mse }
+    finish(net, watch, train, validation, epochs, reason)
 }
 
 #[cfg(test)]

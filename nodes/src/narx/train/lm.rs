@@ -6,7 +6,7 @@
 //! damped normal matrix; a matrix that is not positive definite counts as
 //! a failed step (μ grows).
 
-use super::{interrupted, mse, Data, Epoch, Settings, Stop, Trained, Watch};
+use super::{finish, interrupted, mse, Data, Epoch, Settings, Stop, Trained, Watch};
 use crate::narx::net::Net;
 use faer::prelude::*;
 use faer::Mat;
@@ -115,10 +115,7 @@ pub fn train(
             break;
         }
     }
-    let net = if validation.is_empty() { net } else { watch.best(net) };
-    let train_mse = mse(&net, train, &mut work);
-    let validation_mse = if validation.is_empty() { f64::NAN } else { mse(&net, validation, &mut work) };
-    Trained { net, epochs, stop: reason, train_mse, validation_mse }
+    finish(net, watch, train, validation, epochs, reason)
 }
 
 #[cfg(test)]

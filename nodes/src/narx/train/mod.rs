@@ -131,6 +131,16 @@ impl Watch {
     }
 }
 
+/// The trained network — the best on validation, or the last without
+/// validation data — with its errors.
+pub(crate) fn finish(net: Net, watch: Watch, train: &Data, validation: &Data, epochs: usize, stop: Stop) -> Trained {
+    let net = if validation.is_empty() { net } else { watch.best(net) };
+    let mut work = net.work();
+    let train_mse = mse(&net, train, &mut work);
+    let validation_mse = if validation.is_empty() { f64::NAN } else { mse(&net, validation, &mut work) };
+    Trained { net, epochs, stop, train_mse, validation_mse }
+}
+
 /// True when `flag` is set.
 pub(crate) fn interrupted(flag: Option<&AtomicBool>) -> bool {
     flag.is_some_and(|f| f.load(Ordering::Relaxed))

@@ -1,11 +1,11 @@
-//! Rate nodes: `hold` (raise a rate by an integer factor), `decimate`
-//! (lower it, with an anti-alias filter) and `resample` (rubato), and the
-//! exact cross-rate sample ordering they and multi-rate nodes share
+//! Rate nodes: `hold` (zero-order hold to another rate), and the exact
+//! cross-rate sample ordering it and the multi-rate nodes share
 //! ([`clock`]).
 
 pub mod clock;
+pub mod hold;
 
 use evflow_engine::NodeSpec;
 
 /// The node types of this family.
-pub static SPECS: &[&NodeSpec] = &[];
+pub static SPECS: &[&NodeSpec] = &[&hold::SPEC];

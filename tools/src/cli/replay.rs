@@ -74,14 +74,29 @@ pub fn main(a: Args) -> Result<()> {
     for f in &m.inputs {
         let rec = open(&session_dir, f)?;
         ticks = ticks.min(f.ratio.ticks_for(rec.frames() as u64));
-        if let Some(decl) = graph.nodes.iter_mut().find(|n| n.name == f.node) {
-            let path = session_dir.join(&f.file).to_string_lossy().into_owned();
+        let path = session_dir.join(&f.file).to_string_lossy().into_owned();
+        let params = vec![
+            param("path", Value::Text(path)),
+            param("channels", Value::TextList(f.ports.clone())),
+            param("rate", Value::Float(f.rate)),
+        ];
+        if replaced.contains(&f.node) {
+            // A further rate of a multi-rate source: its own recording node,
+            // and the connections from those ports move to it.
+            let name = format!("{}__{}", f.node, f.file.rsplit('-').next().unwrap_or("rate"));
+            let Some(decl) = graph.nodes.iter().find(|n| n.name == f.node).cloned() else { continue };
+            graph.nodes.push(evflow_engine::graph::NodeDecl {
+                name: name.clone(),
+                kind: "recording.in".into(),
+                params,
+                ..decl
+            });
+            for c in graph.connections.iter_mut().filter(|c| c.from.node == f.node && f.ports.contains(&c.from.port)) {
+                c.from.node = name.clone();
+            }
+        } else if let Some(decl) = graph.nodes.iter_mut().find(|n| n.name == f.node) {
             decl.kind = "recording.in".into();
-            decl.params = vec![
-                param("path", Value::Text(path)),
-                param("channels", Value::TextList(f.ports.clone())),
-                param("rate", Value::Float(f.rate)),
-            ];
+            decl.params = params;
             replaced.push(f.node.clone());
         }
     }

@@ -45,26 +45,26 @@ impl FileSpec {
     }
 }
 
-/// Groups taps into files: sources by node (`inputs/NODE`), the rest one
-/// port each (`outputs/NODE.PORT`). `n_inputs` taps at the front are inputs.
+/// Groups taps into files: sources by node and rate (`inputs/NODE`, and
+/// `inputs/NODE-RATEHz` for each further rate of a multi-rate source such
+/// as `sim.user`), the rest one port each (`outputs/NODE.PORT`). `n_inputs`
+/// taps at the front are inputs.
 pub fn files(taps: &[TapInfo], n_inputs: usize) -> Result<(Vec<FileSpec>, Vec<FileSpec>)> {
     let mut inputs: Vec<FileSpec> = Vec::new();
     for t in &taps[..n_inputs] {
-        match inputs.iter_mut().find(|f| f.node == t.node) {
-            Some(f) if f.ratio == t.ratio => f.ports.push(t.port.clone()),
-            Some(_) => {
-                return Err(anyhow!(
-                    "source `{}` has outputs at different rates; a session cannot record it as one input",
-                    t.node
-                ))
+        match inputs.iter_mut().find(|f| f.node == t.node && f.ratio == t.ratio) {
+            Some(f) => f.ports.push(t.port.clone()),
+            None => {
+                let first = !inputs.iter().any(|f| f.node == t.node);
+                let file = if first { format!("inputs/{}", t.node) } else { format!("inputs/{}-{}Hz", t.node, t.rate) };
+                inputs.push(FileSpec {
+                    file,
+                    node: t.node.clone(),
+                    ports: vec![t.port.clone()],
+                    ratio: t.ratio,
+                    rate: t.rate,
+                })
             }
-            None => inputs.push(FileSpec {
-                file: format!("inputs/{}", t.node),
-                node: t.node.clone(),
-                ports: vec![t.port.clone()],
-                ratio: t.ratio,
-                rate: t.rate,
-            }),
         }
     }
     let outputs = taps[n_inputs..]

@@ -31,6 +31,13 @@ fn bench_mesh_prints_a_row_per_size_with_no_hit_mismatch() {
 }
 
 #[test]
+fn bench_texture_splits_table_starts_from_other_ticks() {
+    let (ok, out, err) = evflow(&["bench", "texture", "--ticks", "500"]);
+    assert!(ok, "{err}");
+    assert!(out.contains("| table starts (10 Hz) | 5 |") && out.contains("| others | 495 |"), "{out}");
+}
+
+#[test]
 fn report_foaw_writes_its_table_and_figures() {
     let dir = tempfile::tempdir().unwrap();
     let out_dir = dir.path().to_str().unwrap();

@@ -5,6 +5,7 @@
 
 pub mod mesh;
 pub mod stats;
+pub mod texture;
 
 /// Arguments of `evflow bench`.
 #[derive(clap::Args, Debug)]
@@ -22,11 +23,18 @@ enum Which {
     ///
     /// Example: cargo run --release -p evflow -- bench mesh
     Mesh(mesh::Args),
+    /// The texture chain (chapter 6): per-tick compute time of
+    /// graphs/texture-live.toml, the ticks that start a 10 Hz table update
+    /// apart from the others. Build with --release.
+    ///
+    /// Example: cargo run --release -p evflow -- bench texture
+    Texture(texture::Args),
 }
 
 /// Runs the chosen benchmark.
 pub fn main(a: BenchArgs) -> anyhow::Result<()> {
     match a.which {
         Which::Mesh(m) => mesh::main(m),
+        Which::Texture(t) => texture::main(t),
     }
 }

@@ -61,6 +61,30 @@ fn report_resample_scores_every_method() {
 }
 
 #[test]
+fn report_freqvel_finds_the_linear_relation_of_the_rippled_paper() {
+    let dir = tempfile::tempdir().unwrap();
+    let (ok, out, err) = evflow(&[
+        "report",
+        "freqvel",
+        "--out",
+        dir.path().to_str().unwrap(),
+        "--samples",
+        "rippled-paper",
+        "--speeds",
+        "3,5,7",
+        "--passes",
+        "2",
+    ]);
+    assert!(ok, "{err}");
+    let row = out.lines().find(|l| l.starts_with("| rippled-paper")).unwrap_or_else(|| panic!("{out}"));
+    let cells: Vec<&str> = row.split('|').map(str::trim).collect();
+    // 5 mm ripples: 2 Hz per cm/s, R² near 1.
+    let slope: f64 = cells[5].parse().unwrap();
+    let r2: f64 = cells[7].parse().unwrap();
+    assert!((slope - 2.0).abs() < 0.1 && r2 > 0.99, "{row}");
+}
+
+#[test]
 fn bad_arguments_are_named() {
     let (ok, _, err) = evflow(&["report", "foaw", "--rate", "0"]);
     assert!(!ok && err.contains("--rate"), "{err}");

@@ -55,15 +55,13 @@ pub fn sample(name: &str) -> Option<Surface> {
             rough(0.03, 0.3, 5.0, 0.5, 24, 11),
             0.08 * MM,
         ),
-        // Woven 1.6 mm threads in a 4.8 mm pattern, some fuzz; soft: a wide contact.
-        "chair-fabric" => Surface::new(
-            0.22,
-            &periodic(&[(1.6, 0.18, 0.0), (4.8, 0.10, 1.1)]),
-            rough(0.08, 0.5, 8.0, 1.0, 32, 12),
-            0.45 * MM,
-        ),
-        // No pattern: random fibres 0.5–10 mm; thick and soft: the widest contact.
-        "felt-fabric" => Surface::new(0.24, &[], rough(0.20, 0.5, 10.0, 1.0, 64, 13), 0.9 * MM),
+        // Woven 1.6 mm threads, some fuzz; soft: a wide contact.
+        "chair-fabric" => {
+            Surface::new(0.22, &periodic(&[(1.6, 0.45, 0.0)]), rough(0.05, 0.5, 4.0, 0.5, 32, 12), 0.3 * MM)
+        }
+        // No pattern: random fibre clumps of 1.5–3.5 mm; thick and soft:
+        // the widest contact, which leaves mostly the larger clumps.
+        "felt-fabric" => Surface::new(0.24, &[], rough(0.20, 1.5, 3.5, 0.0, 48, 13), 0.6 * MM),
         // Linen nodes at 0.9 mm (and their harmonic), irregular threads; sturdy.
         "painting-canvas" => Surface::new(
             0.19,
@@ -71,10 +69,10 @@ pub fn sample(name: &str) -> Option<Surface> {
             rough(0.10, 0.3, 6.0, 0.5, 32, 14),
             0.06 * MM,
         ),
-        // Ridges 3 mm apart at 45° to the scan: 4.24 mm along it, square-wave
-        // harmonics 1, 3, 5; rigid and smooth between ridges.
+        // Ridges 1.5 mm apart at 45° to the scan: 2.12 mm along it,
+        // square-wave harmonics 1, 3, 5; rigid and smooth between ridges.
         "plastic-sheet" => {
-            let l = 3.0 * std::f64::consts::SQRT_2;
+            let l = 1.5 * std::f64::consts::SQRT_2;
             Surface::new(
                 0.13,
                 &periodic(&[(l, 0.40, 0.0), (l / 3.0, 0.13, 0.0), (l / 5.0, 0.08, 0.0)]),
@@ -82,8 +80,9 @@ pub fn sample(name: &str) -> Option<Surface> {
                 0.04 * MM,
             )
         }
-        // Random folds 0.8–25 mm, large; thick paper, fairly stiff.
-        "scrunched-paper" => Surface::new(0.18, &[], rough(0.30, 0.8, 25.0, 0.7, 64, 16), 0.1 * MM),
+        // Random folds of 3–5 mm (a characteristic fold size), large; thick
+        // paper, fairly stiff.
+        "scrunched-paper" => Surface::new(0.18, &[], rough(0.30, 3.0, 5.0, 0.0, 48, 16), 0.1 * MM),
         // An almost perfect 5 mm sinusoid (§6.3, Fig. 6.5), a faint harmonic.
         "rippled-paper" => Surface::new(
             0.17,

@@ -98,11 +98,11 @@ fn soft_samples_lose_their_detail_under_the_contact_and_rough_ones_keep_it() {
             assert!(*k > 0.8, "{n} keeps {k} ({kept:?})");
         }
     }
-    let soft_hf = kept.iter().filter(|p| is_soft(p.0)).map(|p| p.2).fold(0.0, f64::max);
-    for (n, _, hf) in &kept {
-        if ["painting-canvas", "dotted-sheet"].contains(n) {
-            assert!(*hf > 5.0 * soft_hf, "{n}: {hf} vs soft {soft_hf}");
-        }
+    // Felt, soft and without a pattern, keeps almost nothing above 25 Hz
+    // at 5 cm/s; the canvas and the dotted sheet keep most of their power there.
+    let hf = |name: &str| kept.iter().find(|p| p.0 == name).map(|p| p.2).unwrap();
+    for n in ["painting-canvas", "dotted-sheet"] {
+        assert!(hf(n) > 5.0 * hf("felt-fabric"), "{n}: {} vs felt {}", hf(n), hf("felt-fabric"));
     }
 }
 

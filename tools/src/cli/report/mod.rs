@@ -2,6 +2,7 @@
 //! to its run time, as tables and PNG figures.
 
 pub mod foaw;
+pub mod freqvel;
 pub mod mesh;
 pub mod resample;
 
@@ -26,6 +27,12 @@ enum Which {
     ///
     /// Example: evflow report foaw --out report
     Foaw(foaw::Args),
+    /// Frequency–velocity relation (§6.3, Fig. 6.6): each texture sample
+    /// recorded on the simulated tribometer at several speeds, main
+    /// spectral component against speed with a linear fit and R².
+    ///
+    /// Example: cargo run --release -p evflow -- report freqvel --out report
+    Freqvel(freqvel::Args),
     /// Re-sampling for the texture chain (§6.2): error against run time
     /// of rubato's sinc, polynomial and FFT resamplers and the live
     /// kernel of `interp`, a table and a work-precision PNG.
@@ -39,6 +46,7 @@ pub fn main(a: ReportArgs) -> anyhow::Result<()> {
     match a.which {
         Which::Mesh(m) => mesh::main(m),
         Which::Foaw(f) => foaw::main(f),
+        Which::Freqvel(f) => freqvel::main(f),
         Which::Resample(r) => resample::main(r),
     }
 }

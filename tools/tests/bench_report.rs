@@ -85,6 +85,26 @@ fn report_freqvel_finds_the_linear_relation_of_the_rippled_paper() {
 }
 
 #[test]
+fn report_interp_improved_beats_basic_on_the_rippled_paper() {
+    let dir = tempfile::tempdir().unwrap();
+    let (ok, out, err) = evflow(&[
+        "report",
+        "interp",
+        "--out",
+        dir.path().to_str().unwrap(),
+        "--samples",
+        "rippled-paper",
+        "--passes",
+        "2",
+    ]);
+    assert!(ok, "{err}");
+    let rows: Vec<&str> = out.lines().filter(|l| l.starts_with("| rippled-paper")).collect();
+    assert_eq!(rows.len(), 4, "{out}");
+    assert!(rows.iter().all(|r| r.ends_with("| yes |")), "{out}");
+    assert!(out.contains("better on 4 of 4 velocity-interpolated conditions"), "{out}");
+}
+
+#[test]
 fn bad_arguments_are_named() {
     let (ok, _, err) = evflow(&["report", "foaw", "--rate", "0"]);
     assert!(!ok && err.contains("--rate"), "{err}");

@@ -5,13 +5,12 @@
 //! main spectral component is fitted against the speed (slope, intercept,
 //! R²). A table and a PNG.
 
-use anyhow::{anyhow, Context, Result};
-use evflow_engine::{run_offline, Plan, PlanOptions, RunOptions};
+use super::lab_recording::{record, Condition};
+use anyhow::{Context, Result};
 use evflow_nodes::lab::texture::samples::NAMES;
-use evflow_nodes::recording::format::Recording;
 use evflow_nodes::texture::freqvel::relation;
 use evflow_tools::plot::{write_png, Plot, Series};
-use std::path::{Path, PathBuf};
+use std::path::PathBuf;
 
 /// Arguments of `evflow report freqvel`.
 #[derive(clap::Args, Debug)]
@@ -39,74 +38,6 @@ pub struct Args {
     graph: PathBuf,
 }
 
-/// Records one sample at one speed and returns its constant-speed force.
-fn record(a: &Args, sample: &str, speed: f64, dir: &Path) -> Result<(f64, Vec<f64>)> {
-    let sets = [
-        format!("sample=\"{sample}\""),
-        format!("speed={speed}"),
-        format!("mass={}", a.mass),
-        format!("passes={}", a.passes),
-        "rep=1".to_string(),
-    ];
-    let overrides = sets
-        .iter()
-        .map(|s| evflow_engine::Override::parse(s).map_err(|e| anyhow!("{e}")))
-        .collect::<Result<Vec<_>>>()?;
-    let registry = evflow_nodes::registry();
-    let mut checked = evflow_engine::load_file(&a.graph, &registry, &overrides).map_err(|e| anyhow!("{e}"))?;
-    checked.graph.sweep.clear();
-    let out = dir.join(format!("{sample}-{speed}"));
-    std::fs::create_dir_all(&out).with_context(|| format!("{}: cannot create", out.display()))?;
-    let opts = PlanOptions { max_block: 1024, seed: None, base_dir: None, out_dir: Some(out.clone()), timing: false };
-    let mut plan = Plan::build(&checked, &opts).map_err(|e| anyhow!("{e}"))?;
-    run_offline(&mut plan, RunOptions { duration: None, progress: None }).map_err(|e| anyhow!("{e}"))?;
-    let wav = std::fs::read_dir(&out)
-        .with_context(|| format!("{}: no recording", out.display()))?
-        .filter_map(|e| e.ok().map(|e| e.path()))
-        .find(|p| p.extension().is_some_and(|x| x == "wav"))
-        .ok_or_else(|| anyhow!("{}: the graph wrote no recording", out.display()))?;
-    let rec = Recording::open(&wav).map_err(|e| anyhow!("{e}"))?;
-    let (force, velocity) = (
-        rec.channel("force").ok_or_else(|| anyhow!("{}: no `force` channel", wav.display()))?,
-        rec.channel("velocity").ok_or_else(|| anyhow!("{}: no `velocity` channel", wav.display()))?,
-    );
-    // Constant-speed segments (§5.1.1): runs within 2 % of the set speed,
-    // less their first 100 ms (the high-pass filter's response to the
-    // reversal), each less its mean (the friction's sign flips between
-    // passes) and faded in and out over 50 ms so that the joins add no
-    // steps, concatenated.
-    let settle = (0.1 * rec.rate()) as usize;
-    let mut kept = Vec::new();
-    let mut run: Vec<f64> = Vec::new();
-    let flush = |run: &mut Vec<f64>, kept: &mut Vec<f64>| {
-        if run.len() > 2 * settle {
-            let seg = &run[settle..];
-            let mean = seg.iter().sum::<f64>() / seg.len() as f64;
-            let fade = settle / 2;
-            let n = seg.len();
-            kept.extend(seg.iter().enumerate().map(|(i, f)| {
-                let edge = i.min(n - 1 - i);
-                let w = if edge < fade {
-                    0.5 - 0.5 * (std::f64::consts::PI * edge as f64 / fade as f64).cos()
-                } else {
-                    1.0
-                };
-                w * (f - mean)
-            }));
-        }
-        run.clear();
-    };
-    for (f, v) in force.iter().zip(velocity) {
-        if (v.abs() * 100.0 - speed).abs() <= 0.02 * speed {
-            run.push(*f);
-        } else {
-            flush(&mut run, &mut kept);
-        }
-    }
-    flush(&mut run, &mut kept);
-    Ok((rec.rate(), kept))
-}
-
 /// Runs `evflow report freqvel`.
 pub fn main(a: Args) -> Result<()> {
     anyhow::ensure!(a.band.len() == 2 && a.band[0] < a.band[1], "--band needs two frequencies, low,high");
@@ -131,8 +62,14 @@ pub fn main(a: Args) -> Result<()> {
     let mut series = Vec::new();
     for s in &samples {
         eprintln!("recording {s} …");
-        let recs =
-            a.speeds.iter().map(|&v| record(&a, s, v, tmp.path()).map(|r| (v, r))).collect::<Result<Vec<_>>>()?;
+        let recs = a
+            .speeds
+            .iter()
+            .map(|&v| {
+                let c = Condition { sample: s, mass: a.mass, speed: v, passes: a.passes, rep: 1 };
+                record(&a.graph, &c, tmp.path()).map(|r| (v, r))
+            })
+            .collect::<Result<Vec<_>>>()?;
         let rate = recs[0].1 .0;
         let signals: Vec<(f64, &[f64])> = recs.iter().map(|(v, (_, x))| (*v, x.as_slice())).collect();
         match relation(&signals, rate, a.band[0], a.band[1]) {

@@ -3,6 +3,8 @@
 
 pub mod foaw;
 pub mod freqvel;
+pub mod interp;
+pub mod lab_recording;
 pub mod mesh;
 pub mod resample;
 
@@ -33,6 +35,13 @@ enum Which {
     ///
     /// Example: cargo run --release -p evflow -- report freqvel --out report
     Freqvel(freqvel::Args),
+    /// Interpolation over the (load, velocity) grid (Fig. 5.6, 5.9, 6.8):
+    /// the basic (§5.3.3) and improved (Eq. 6.4) schemes against the
+    /// recording at every untrained condition, E_s beside the repeat
+    /// baseline; a table and PNG spectra.
+    ///
+    /// Example: cargo run --release -p evflow -- report interp --out report
+    Interp(interp::Args),
     /// Re-sampling for the texture chain (§6.2): error against run time
     /// of rubato's sinc, polynomial and FFT resamplers and the live
     /// kernel of `interp`, a table and a work-precision PNG.
@@ -47,6 +56,7 @@ pub fn main(a: ReportArgs) -> anyhow::Result<()> {
         Which::Mesh(m) => mesh::main(m),
         Which::Foaw(f) => foaw::main(f),
         Which::Freqvel(f) => freqvel::main(f),
+        Which::Interp(i) => interp::main(i),
         Which::Resample(r) => resample::main(r),
     }
 }

@@ -1,0 +1,213 @@
+//! `evflow report interp`: cross-validation of the interpolation schemes
+//! (dissertation Fig. 5.6, 5.9, 6.8) on the simulated lab. Each sample is
+//! recorded over a grid; the corners (or the rows) are the trained cells;
+//! every untrained condition is interpolated from them by the basic scheme
+//! (§5.3.3) and the improved one (Eq. 6.4) and compared with the real
+//! recording at that condition by E_s (Eq. 5.2), beside the repeat baseline
+//! (a second recording of the same condition). The cells here are the
+//! recorded forces themselves (record-and-playback, §6.5.2): this isolates
+//! the interpolation from the NARX models, whose synthesized cells take
+//! their place once they exist.
+
+use super::lab_recording::{record, Condition};
+use anyhow::{anyhow, Context, Result};
+use evflow_nodes::lab::texture::samples::NAMES;
+use evflow_nodes::metric::spectral_error::{spectral_rms_error, Band};
+use evflow_nodes::metric::spectrum::{averaged_spectrum, SpectrumConfig, Window};
+use evflow_nodes::texture::grid::Grid;
+use evflow_nodes::texture::kernel::SincKernel;
+use evflow_nodes::texture::scheme::{Geometry, Mix, Scheme};
+use evflow_tools::plot::{write_png, Plot, Series};
+use std::path::{Path, PathBuf};
+
+/// Arguments of `evflow report interp`.
+#[derive(clap::Args, Debug)]
+pub struct Args {
+    /// Folder for the PNG figures.
+    #[arg(long, default_value = ".")]
+    out: PathBuf,
+    /// Texture samples (default: all seven; the rippled paper uses the grid of Fig. 6.8).
+    #[arg(long, value_delimiter = ',')]
+    samples: Vec<String>,
+    /// Tribometer passes per recording.
+    #[arg(long, default_value_t = 4)]
+    passes: u32,
+    /// Band of E_s, Hz.
+    #[arg(long, value_delimiter = ',', default_value = "2,200")]
+    band: Vec<f64>,
+    /// The recording graph.
+    #[arg(long, default_value = "graphs/record-textures.toml")]
+    graph: PathBuf,
+}
+
+/// A sample's trained grid and its validation conditions.
+struct Plan {
+    loads: Vec<f64>,
+    speeds: Vec<f64>,
+    validate: Vec<(f64, f64)>,
+}
+
+/// Fig. 5.6 (3×3 grid, corners trained, the m₂ row and v₂ column validated)
+/// or, for the rippled paper, Fig. 6.8 (60/110 g × 3–7 cm/s trained, 85 g
+/// at 3.5–6.5 cm/s validated).
+fn plan_for(sample: &str) -> Plan {
+    if sample == "rippled-paper" {
+        Plan {
+            loads: vec![60.0, 110.0],
+            speeds: vec![3.0, 4.0, 5.0, 6.0, 7.0],
+            validate: vec![(85.0, 3.5), (85.0, 4.5), (85.0, 5.5), (85.0, 6.5)],
+        }
+    } else {
+        Plan {
+            loads: vec![60.0, 110.0],
+            speeds: vec![3.0, 7.0],
+            validate: vec![(85.0, 3.0), (85.0, 5.0), (85.0, 7.0), (60.0, 5.0), (110.0, 5.0)],
+        }
+    }
+}
+
+/// Magnitude spectrum (1 Hz bins, Hann, half overlap).
+fn spectrum(x: &[f64], rate: f64) -> Result<Vec<f64>> {
+    let cfg = SpectrumConfig { rate, nfft: rate.round() as usize, window: Window::Hann, overlap: 0.5 };
+    averaged_spectrum(x, cfg)
+        .map_err(|e| anyhow!("{e}"))?
+        .map(|s| s.magnitude)
+        .ok_or_else(|| anyhow!("a signal of {} samples is too short for a spectrum", x.len()))
+}
+
+/// One row of the result.
+struct Row {
+    sample: String,
+    load: f64,
+    speed: f64,
+    repeat: f64,
+    basic: f64,
+    improved: f64,
+}
+
+fn evaluate(a: &Args, sample: &str, tmp: &Path, band: &Band, plots: &mut Vec<Plot>) -> Result<Vec<Row>> {
+    let p = plan_for(sample);
+    let rec = |mass: f64, speed: f64, rep: u32| {
+        record(&a.graph, &Condition { sample, mass, speed, passes: a.passes, rep }, tmp)
+    };
+    let mut cells = Vec::new();
+    let mut rate = 0.0;
+    for &m in &p.loads {
+        let mut row = Vec::new();
+        for &v in &p.speeds {
+            let (r, x) = rec(m, v, 1)?;
+            rate = r;
+            row.push(x);
+        }
+        cells.push(row);
+    }
+    let grid = Grid::from_signals(p.loads.clone(), p.speeds.clone(), rate, cells);
+    let kernel = SincKernel::new(16, 0.9, 8.6);
+    let geo = Geometry::new(&grid, &kernel, 1_000_000, 0, 0.0).map_err(|e| anyhow!("{sample}: {e}"))?;
+    let mut rows = Vec::new();
+    for &(m, v) in &p.validate {
+        let real = spectrum(&rec(m, v, 1)?.1, rate)?;
+        let again = spectrum(&rec(m, v, 2)?.1, rate)?;
+        let table = |scheme| Mix::new(&grid, &geo, &kernel, scheme, m, v).table(&grid, &kernel);
+        let (tb, ti) = (table(Scheme::Basic), table(Scheme::Improved));
+        let (sb, si) = (spectrum(&tb, rate)?, spectrum(&ti, rate)?);
+        let es =
+            |s: &[f64]| spectral_rms_error(s, &real, band).map_err(|e| anyhow!("{sample} at {m} g, {v} cm/s: {e}"));
+        rows.push(Row {
+            sample: sample.into(),
+            load: m,
+            speed: v,
+            repeat: es(&again)?,
+            basic: es(&sb)?,
+            improved: es(&si)?,
+        });
+        if sample == "rippled-paper" && v == 4.5 || sample == "dotted-sheet" && m == 85.0 && v == 5.0 {
+            let pts = |s: &[f64]| -> Vec<(f64, f64)> {
+                s.iter()
+                    .enumerate()
+                    .skip(2)
+                    .take(150)
+                    .map(|(k, y)| (k as f64 * rate / (2.0 * (s.len() - 1) as f64), *y))
+                    .collect()
+            };
+            plots.push(Plot {
+                title: format!("{sample}, {m} g, {v} cm/s: real vs interpolated force spectra (cf. Fig. 5.9, 6.8)"),
+                x_label: "frequency (Hz)".into(),
+                y_label: "magnitude".into(),
+                log_x: false,
+                log_y: true,
+                series: vec![
+                    Series::line("real (recorded)", pts(&real)),
+                    Series::line("basic (§5.3.3)", pts(&sb)),
+                    Series::line("improved (Eq. 6.4)", pts(&si)),
+                ],
+            });
+        }
+    }
+    Ok(rows)
+}
+
+/// Runs `evflow report interp`.
+pub fn main(a: Args) -> Result<()> {
+    anyhow::ensure!(a.band.len() == 2 && a.band[0] < a.band[1], "--band needs two frequencies, low,high");
+    let samples: Vec<String> =
+        if a.samples.is_empty() { NAMES.iter().map(|s| s.to_string()).collect() } else { a.samples.clone() };
+    for s in &samples {
+        anyhow::ensure!(NAMES.contains(&s.as_str()), "--samples: unknown sample `{s}` (one of {})", NAMES.join(", "));
+    }
+    std::fs::create_dir_all(&a.out).with_context(|| format!("{}: cannot create", a.out.display()))?;
+    let tmp = tempfile::tempdir().context("cannot create a temporary folder")?;
+    let band = Band::new(1000.0, 1000, a.band[0], a.band[1], false).map_err(|e| anyhow!("--band: {e}"))?;
+    let mut plots = Vec::new();
+    let mut rows = Vec::new();
+    for s in &samples {
+        eprintln!("recording and interpolating {s} …");
+        rows.extend(evaluate(&a, s, tmp.path(), &band, &mut plots)?);
+    }
+    println!(
+        "E_s (Eq. 5.2, {}–{} Hz) against the recording at each untrained condition; cells: recorded forces.\n",
+        a.band[0], a.band[1]
+    );
+    println!("| sample | load (g) | speed (cm/s) | repeat baseline | basic (§5.3.3) | improved (Eq. 6.4) | improved better |");
+    println!("|---|---:|---:|---:|---:|---:|---|");
+    let (mut wins, mut velocity_cases) = (0, 0);
+    for r in &rows {
+        let velocity_interpolated = if r.sample == "rippled-paper" { true } else { r.speed == 5.0 };
+        if velocity_interpolated {
+            velocity_cases += 1;
+            wins += usize::from(r.improved < r.basic);
+        }
+        println!(
+            "| {} | {} | {} | {:.3} | {:.3} | {:.3} | {} |",
+            r.sample,
+            r.load,
+            r.speed,
+            r.repeat,
+            r.basic,
+            r.improved,
+            if !velocity_interpolated {
+                "— (no velocity step)"
+            } else if r.improved < r.basic {
+                "yes"
+            } else {
+                "**no**"
+            }
+        );
+    }
+    let mean = |f: fn(&Row) -> f64| rows.iter().map(f).sum::<f64>() / rows.len().max(1) as f64;
+    println!(
+        "\nmean E_s: repeat {:.3}, basic {:.3}, improved {:.3}; the improved scheme is better on {wins} of {velocity_cases} velocity-interpolated conditions.",
+        mean(|r| r.repeat),
+        mean(|r| r.basic),
+        mean(|r| r.improved)
+    );
+    for (i, plot) in plots.iter().enumerate() {
+        match write_png(plot, &a.out.join(format!("interp-spectra-{}.png", i + 1))) {
+            Ok(w) => {
+                println!("wrote {}{}", w.path.display(), if w.labelled { "" } else { " (no font found: unlabelled)" })
+            }
+            Err(e) => eprintln!("warning: {e}"),
+        }
+    }
+    Ok(())
+}

@@ -1,0 +1,125 @@
+//! Texture recordings made on the spot for the reports: one condition of
+//! `graphs/record-textures.toml` run on the simulated lab, reduced to its
+//! constant-speed segments (§5.1.1).
+
+use anyhow::{anyhow, Context, Result};
+use evflow_engine::{run_offline, Plan, PlanOptions, RunOptions};
+use evflow_nodes::recording::format::Recording;
+use std::path::Path;
+
+/// One recording condition.
+#[derive(Debug, Clone, Copy)]
+pub struct Condition<'a> {
+    /// Texture sample.
+    pub sample: &'a str,
+    /// Stylus mass, g.
+    pub mass: f64,
+    /// Speed, cm/s.
+    pub speed: f64,
+    /// Tribometer passes.
+    pub passes: u32,
+    /// Repetition (the force sensor's seed).
+    pub rep: u32,
+}
+
+/// Records `c` with `graph` into a folder under `dir` and returns the rate
+/// and the constant-speed force: runs within 2 % of the set speed, less
+/// their first 100 ms (the high-pass filter's response to the reversal),
+/// each less its mean (the friction's sign flips between passes) and faded
+/// in and out over 50 ms so that the joins add no steps, concatenated.
+pub fn record(graph: &Path, c: &Condition<'_>, dir: &Path) -> Result<(f64, Vec<f64>)> {
+    let sets = [
+        format!("sample=\"{}\"", c.sample),
+        format!("speed={}", c.speed),
+        format!("mass={}", c.mass),
+        format!("passes={}", c.passes),
+        format!("rep={}", c.rep),
+    ];
+    let overrides = sets
+        .iter()
+        .map(|s| evflow_engine::Override::parse(s).map_err(|e| anyhow!("{e}")))
+        .collect::<Result<Vec<_>>>()?;
+    let registry = evflow_nodes::registry();
+    let checked = evflow_engine::load_file(graph, &registry, &overrides).map_err(|e| anyhow!("{e}"))?;
+    let out = dir.join(format!("{}-{}g-{}cms-r{}", c.sample, c.mass, c.speed, c.rep));
+    std::fs::create_dir_all(&out).with_context(|| format!("{}: cannot create", out.display()))?;
+    let opts = PlanOptions { max_block: 1024, seed: None, base_dir: None, out_dir: Some(out.clone()), timing: false };
+    let mut plan = Plan::build(&checked, &opts).map_err(|e| anyhow!("{e}"))?;
+    run_offline(&mut plan, RunOptions { duration: None, progress: None }).map_err(|e| anyhow!("{e}"))?;
+    let wav = std::fs::read_dir(&out)
+        .with_context(|| format!("{}: no recording", out.display()))?
+        .filter_map(|e| e.ok().map(|e| e.path()))
+        .find(|p| p.extension().is_some_and(|x| x == "wav"))
+        .ok_or_else(|| anyhow!("{}: the graph wrote no recording", out.display()))?;
+    let rec = Recording::open(&wav).map_err(|e| anyhow!("{e}"))?;
+    let (force, velocity) = (
+        rec.channel("force").ok_or_else(|| anyhow!("{}: no `force` channel", wav.display()))?,
+        rec.channel("velocity").ok_or_else(|| anyhow!("{}: no `velocity` channel", wav.display()))?,
+    );
+    Ok((rec.rate(), constant_speed(force, velocity, c.speed, rec.rate())))
+}
+
+/// The constant-speed segments of `force` (see [`record`]).
+pub fn constant_speed(force: &[f64], velocity: &[f64], speed_cm_s: f64, rate: f64) -> Vec<f64> {
+    let settle = (0.1 * rate) as usize;
+    let fade = settle / 2;
+    let mut kept = Vec::new();
+    let mut run: Vec<f64> = Vec::new();
+    let flush = |run: &mut Vec<f64>, kept: &mut Vec<f64>| {
+        if run.len() > 2 * settle {
+            let seg = &run[settle..];
+            let mean = seg.iter().sum::<f64>() / seg.len() as f64;
+            let n = seg.len();
+            kept.extend(seg.iter().enumerate().map(|(i, f)| {
+                let edge = i.min(n - 1 - i);
+                let w = if edge < fade {
+                    0.5 - 0.5 * (std::f64::consts::PI * edge as f64 / fade as f64).cos()
+                } else {
+                    1.0
+                };
+                w * (f - mean)
+            }));
+        }
+        run.clear();
+    };
+    for (f, v) in force.iter().zip(velocity) {
+        if (v.abs() * 100.0 - speed_cm_s).abs() <= 0.02 * speed_cm_s {
+            run.push(*f);
+        } else {
+            flush(&mut run, &mut kept);
+        }
+    }
+    flush(&mut run, &mut kept);
+    kept
+}
+
+#[cfg(test)]
+mod tests {
+    use super::constant_speed;
+
+    #[test]
+    fn keeps_the_constant_speed_runs_settled_centred_and_faded() {
+        // Two 1 s runs at 5 cm/s in opposite directions with offsets ±0.1 N,
+        // separated by a reversal: 2 × 900 samples kept, each with mean ~0,
+        // starting and ending at 0.
+        let rate = 1000.0;
+        let mut f = Vec::new();
+        let mut v = Vec::new();
+        for (dir, off) in [(1.0, 0.1), (-1.0, -0.1)] {
+            for k in 0..1000 {
+                f.push(off + 0.01 * (k as f64 * 0.3).sin());
+                v.push(dir * 0.05);
+            }
+            for _ in 0..50 {
+                f.push(0.0);
+                v.push(0.0);
+            }
+        }
+        let kept = constant_speed(&f, &v, 5.0, rate);
+        assert_eq!(kept.len(), 1800);
+        for seg in kept.chunks(900) {
+            assert!(seg[0].abs() < 1e-12 && seg[899].abs() < 1e-3);
+            assert!(seg.iter().sum::<f64>().abs() / 900.0 < 1e-3);
+        }
+    }
+}

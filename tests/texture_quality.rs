@@ -1,0 +1,27 @@
+//! The rendering-quality graph: under the virtual user, the improved
+//! interpolation scheme (Eq. 6.4) renders the texture closer to the real
+//! sample at the user's instantaneous condition than the basic one
+//! (§5.3.3), with either playback mode — as `docs/texture.md` states.
+
+use evflow_engine::{load_file, run_offline, Override, Plan, PlanOptions, RunOptions};
+
+fn e_s(scheme: &str, mode: &str) -> f64 {
+    let path = evflow_tests::root().join("graphs/texture-quality.toml");
+    let overrides: Vec<Override> = [format!("scheme=\"{scheme}\""), format!("mode=\"{mode}\"")]
+        .iter()
+        .map(|s| Override::parse(s).unwrap())
+        .collect();
+    let checked = load_file(&path, &evflow_nodes::registry(), &overrides).unwrap_or_else(|e| panic!("{e}"));
+    let mut plan = Plan::build(&checked, &PlanOptions::default()).unwrap_or_else(|e| panic!("{e}"));
+    let report =
+        run_offline(&mut plan, RunOptions { duration: None, progress: None }).unwrap_or_else(|e| panic!("{e}"));
+    report.value("quality", "E_s").expect("quality reports E_s")
+}
+
+#[test]
+fn the_improved_scheme_renders_closer_to_the_real_sample_in_both_playback_modes() {
+    for mode in ["time", "position"] {
+        let (basic, improved) = (e_s("basic", mode), e_s("improved", mode));
+        assert!(improved < 0.9 * basic, "{mode}: improved {improved} vs basic {basic}");
+    }
+}

@@ -14,6 +14,7 @@ pub mod metric;
 pub mod output;
 pub mod recording;
 pub mod safety;
+pub mod serial;
 pub mod sources;
 pub mod sum;
 
@@ -41,5 +42,6 @@ pub fn all_specs() -> Vec<&'static NodeSpec> {
     v.extend_from_slice(mesh::SPECS);
     v.extend_from_slice(analysis::SPECS);
     v.extend_from_slice(lab::SPECS);
+    v.extend_from_slice(serial::SPECS);
     v
 }

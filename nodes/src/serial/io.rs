@@ -133,7 +133,10 @@ impl Io {
             self.publish(&mut was_up);
         }
         if let Some(mut p) = port {
-            let mut bye = Vec::new();
+            // The last samples the graph queued, then a zero sample.
+            let mut bye = std::mem::take(&mut backlog);
+            self.drain_actuation(&mut samples);
+            self.session.transmit(Instant::now(), &samples, &mut bye);
             self.session.goodbye(&mut bye);
             let _ = p.write_all(&bye);
             let _ = p.flush();

@@ -11,6 +11,7 @@
 //! * `input`, `output`: the nodes (feature `serial`).
 
 pub mod crc;
+pub mod device;
 pub mod examples;
 pub mod frame;
 pub mod host;
@@ -36,3 +37,6 @@ pub static SPECS: &[&NodeSpec] = &[&input::SPEC, &output::SPEC];
 /// The node types of this family (none without the `serial` feature).
 #[cfg(not(feature = "serial"))]
 pub static SPECS: &[&NodeSpec] = &[];
+
+#[cfg(all(test, feature = "serial", unix))]
+mod node_tests;

@@ -120,6 +120,12 @@ impl Node for SerialOut {
         let Some(l) = &self.live else {
             return Ok(s.line(self.idle.clone().unwrap_or_default()));
         };
+        // Let the I/O thread send what is still queued before reporting.
+        let until = std::time::Instant::now() + std::time::Duration::from_millis(50);
+        while l.ring.slots() < l.ring.buffer().capacity() && std::time::Instant::now() < until {
+            std::thread::sleep(std::time::Duration::from_millis(1));
+        }
+        std::thread::sleep(std::time::Duration::from_millis(3));
         let r = l.link.state.report();
         let c = r.counters;
         s = s

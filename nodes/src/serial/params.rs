@@ -51,12 +51,21 @@ pub fn link_config(p: &Params) -> Option<LinkConfig> {
     })
 }
 
-/// True when this plan runs live (one tick per step): the one case in
-/// which a serial node opens its port. Offline runs and replays step in
-/// large blocks, as fast as the machine allows, and must not drive a
-/// device.
+/// The largest block (in the node's samples) a live plan prepares a node
+/// for: the live runner asks for blocks of one tick, which the plan rounds
+/// up to its rate unit (the least common multiple of the graph's rate
+/// divisors: 25 with a 40 Hz node at 1 kHz, 1000 with a 1 Hz one). Offline
+/// runs and replays use 4096 by default.
+pub const LIVE_MAX_BLOCK: usize = 1000;
+
+/// True when the plan runs live (blocks of one tick): the one case in which
+/// a serial node opens its port. Offline runs and replays step in large
+/// blocks, as fast as the machine allows, and must not drive a device. The
+/// engine does not say whether a plan is live; the block size is the sign
+/// (an offline run asked for blocks of at most 1000 ticks would open the
+/// port too).
 pub fn is_live(ctx: &PrepareContext) -> bool {
-    ctx.max_block == 1
+    ctx.max_block <= LIVE_MAX_BLOCK
 }
 
 /// A node rate as the u16 of a HELLO.

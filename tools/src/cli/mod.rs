@@ -1,6 +1,8 @@
 //! One module per subcommand.
 
 pub mod check;
+#[cfg(feature = "serial")]
+pub mod devsim;
 pub mod dot;
 pub mod graph_args;
 pub mod live;

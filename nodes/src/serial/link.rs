@@ -1,0 +1,253 @@
+//! One serial link per port, shared by the `serial.in` and `serial.out`
+//! nodes that name it: the port, its I/O thread, and the lock-free rings
+//! between that thread and the nodes' `process` (which runs on the live
+//! runner's real-time thread and must not do I/O, lock or allocate).
+//!
+//! ```text
+//!            ┌──────────── I/O thread (one per port) ────────────┐
+//!  port ───▶ │ read (1 ms timeout) → StreamDecoder → HostSession │ ──touch ring──▶ serial.in.process
+//!            │                                                   │ ──force ring──▶
+//!  port ◀─── │ write ◀── HostSession (HELLO, heartbeat, fade) ◀──│ ◀─actuation ring── serial.out.process
+//!            └───────────────────────────────────────────────────┘
+//!   link state (atomics): connected, device faults, samples processed
+//! ```
+//!
+//! Links are found by port path in a process-wide table, only while plans
+//! are built (never on the real-time thread). The link lives while a node
+//! holds it; dropping the last node stops the thread and closes the port.
+
+use super::host::HostCounters;
+use super::io;
+use super::message::Touch;
+use std::sync::atomic::{AtomicBool, AtomicU16, AtomicU64, Ordering};
+use std::sync::{Arc, Mutex, Weak};
+use std::thread::JoinHandle;
+use std::time::{Duration, Instant};
+
+/// Capacity of the touch ring (frames).
+pub const TOUCH_RING: usize = 64;
+/// Capacity of the force ring (samples: 4 s at 1 kHz).
+pub const FORCE_RING: usize = 4096;
+/// Capacity of the actuation ring (samples: 1 s at 1 kHz).
+pub const ACTUATION_RING: usize = 1024;
+
+/// Port settings; the nodes sharing a port must agree on them.
+#[derive(Debug, Clone, PartialEq)]
+pub struct LinkConfig {
+    /// Device path (e.g. `/dev/ttyACM0`, a pty, `COM3`).
+    pub port: String,
+    /// Baud rate (ignored by USB CDC devices and ptys).
+    pub baud: u32,
+    /// How long building the node waits for the device's HELLO.
+    pub wait: Duration,
+    /// No valid frame for this long: the link is down.
+    pub timeout: Duration,
+    /// Reopen interval after the link was lost.
+    pub retry: Duration,
+}
+
+/// Counters and events of a link, kept by its I/O thread for the nodes'
+/// summaries (locked only by that thread and by `finish`, never on the
+/// real-time thread).
+#[derive(Debug, Clone, Default)]
+pub struct LinkReport {
+    /// Protocol counters.
+    pub counters: HostCounters,
+    /// Touch frames dropped because the touch ring was full.
+    pub touch_overruns: u64,
+    /// Force samples dropped because the force ring was full.
+    pub force_overruns: u64,
+    /// Actuation samples dropped in the I/O thread because too many had
+    /// queued up (after a stall of the thread): only the newest are sent.
+    pub stale_dropped: u64,
+    /// Write backlog dropped because the port did not take it.
+    pub write_overflows: u64,
+    /// Times the link came up.
+    pub connects: u64,
+    /// Times the link went down after being up.
+    pub disconnects: u64,
+    /// What happened, in order (the first [`EVENTS_KEPT`]).
+    pub events: Vec<String>,
+    /// Events beyond those kept.
+    pub events_dropped: u64,
+    /// The last failure to open the port or to hear the device.
+    pub last_error: Option<String>,
+}
+
+/// Events kept in a [`LinkReport`].
+pub const EVENTS_KEPT: usize = 32;
+
+impl LinkReport {
+    /// Records an event.
+    pub fn event(&mut self, e: String) {
+        if self.events.len() < EVENTS_KEPT {
+            self.events.push(e);
+        } else {
+            self.events_dropped += 1;
+        }
+    }
+}
+
+/// What the I/O thread and the nodes share.
+#[derive(Debug, Default)]
+pub struct LinkState {
+    /// The link is up (handshake done, frames arriving).
+    pub connected: AtomicBool,
+    /// The device's fault bits.
+    pub faults: AtomicU16,
+    /// Samples `serial.in` has produced (stamps events).
+    pub in_samples: AtomicU64,
+    /// Samples `serial.out` has taken.
+    pub out_samples: AtomicU64,
+    /// A `serial.in` reads the inbound rings.
+    pub has_reader: AtomicBool,
+    /// The actuation rate of the `serial.out` on this link, Hz (0: none).
+    pub actuation_hz: AtomicU16,
+    /// Asks the I/O thread to end.
+    pub stop: AtomicBool,
+    /// Counters and events.
+    pub report: Mutex<LinkReport>,
+}
+
+impl LinkState {
+    /// A copy of the report.
+    pub fn report(&self) -> LinkReport {
+        self.report.lock().map(|r| r.clone()).unwrap_or_default()
+    }
+    /// The sample index events are stamped with: `serial.in`'s, else `serial.out`'s.
+    pub fn sample(&self) -> u64 {
+        if self.has_reader.load(Ordering::Relaxed) {
+            self.in_samples.load(Ordering::Relaxed)
+        } else {
+            self.out_samples.load(Ordering::Relaxed)
+        }
+    }
+}
+
+/// The ring ends `serial.in` reads.
+pub struct InEnd {
+    /// Touch frames.
+    pub touch: rtrb::Consumer<Touch>,
+    /// Force samples, N.
+    pub force: rtrb::Consumer<f32>,
+}
+
+/// A running link.
+pub struct Link {
+    /// Its settings.
+    pub config: LinkConfig,
+    /// Shared state.
+    pub state: Arc<LinkState>,
+    /// The node that opened it.
+    pub opened_by: String,
+    in_end: Mutex<Option<InEnd>>,
+    out_end: Mutex<Option<rtrb::Producer<f32>>>,
+    thread: Mutex<Option<JoinHandle<()>>>,
+}
+
+static LINKS: Mutex<Vec<(String, Weak<Link>)>> = Mutex::new(Vec::new());
+
+/// The link on `config.port`: the running one, or a new one (its I/O
+/// thread starts opening the port at once). `node` names the caller for
+/// errors.
+pub fn attach(config: &LinkConfig, node: &str) -> Result<Arc<Link>, String> {
+    let mut links = LINKS.lock().map_err(|_| "the serial link table is poisoned".to_string())?;
+    links.retain(|(_, w)| w.strong_count() > 0);
+    if let Some(l) = links.iter().find(|(p, _)| *p == config.port).and_then(|(_, w)| w.upgrade()) {
+        if l.config != *config {
+            return Err(format!(
+                "port {} is already opened by `{}` with other settings ({}); give every node on one port the same \
+                 `baud`, `wait`, `timeout` and `retry`",
+                config.port,
+                l.opened_by,
+                describe(&l.config)
+            ));
+        }
+        return Ok(l);
+    }
+    let l = Link::start(config.clone(), node)?;
+    links.push((config.port.clone(), Arc::downgrade(&l)));
+    Ok(l)
+}
+
+fn describe(c: &LinkConfig) -> String {
+    format!(
+        "baud {}, wait {} s, timeout {} s, retry {} s",
+        c.baud,
+        c.wait.as_secs_f64(),
+        c.timeout.as_secs_f64(),
+        c.retry.as_secs_f64()
+    )
+}
+
+impl Link {
+    fn start(config: LinkConfig, node: &str) -> Result<Arc<Link>, String> {
+        let state = Arc::new(LinkState::default());
+        let (touch_tx, touch_rx) = rtrb::RingBuffer::new(TOUCH_RING);
+        let (force_tx, force_rx) = rtrb::RingBuffer::new(FORCE_RING);
+        let (act_tx, act_rx) = rtrb::RingBuffer::new(ACTUATION_RING);
+        let thread = {
+            let state = state.clone();
+            let c = config.clone();
+            std::thread::Builder::new()
+                .name("evflow-serial".into())
+                .spawn(move || io::run(c, state, touch_tx, force_tx, act_rx))
+                .map_err(|e| format!("cannot start the I/O thread for {}: {e}", config.port))?
+        };
+        Ok(Arc::new(Link {
+            config,
+            state,
+            opened_by: node.to_string(),
+            in_end: Mutex::new(Some(InEnd { touch: touch_rx, force: force_rx })),
+            out_end: Mutex::new(Some(act_tx)),
+            thread: Mutex::new(Some(thread)),
+        }))
+    }
+
+    /// The inbound rings, for the one `serial.in` of this port.
+    pub fn take_in(&self) -> Option<InEnd> {
+        let end = self.in_end.lock().ok()?.take();
+        if end.is_some() {
+            self.state.has_reader.store(true, Ordering::Relaxed);
+        }
+        end
+    }
+
+    /// The actuation ring, for the one `serial.out` of this port.
+    pub fn take_out(&self, rate_hz: u16) -> Option<rtrb::Producer<f32>> {
+        let end = self.out_end.lock().ok()?.take();
+        if end.is_some() {
+            self.state.actuation_hz.store(rate_hz, Ordering::Relaxed);
+        }
+        end
+    }
+
+    /// Waits up to `config.wait` for the link to come up.
+    pub fn wait_connected(&self) -> Result<(), String> {
+        let until = Instant::now() + self.config.wait;
+        loop {
+            if self.state.connected.load(Ordering::Acquire) {
+                return Ok(());
+            }
+            if Instant::now() >= until {
+                let why = self.state.report().last_error.unwrap_or_else(|| "the device did not answer HELLO".into());
+                return Err(format!(
+                    "no link to the device on {} within {} s: {why} (set `wait` to wait longer, 0 to start without \
+                     the device)",
+                    self.config.port,
+                    self.config.wait.as_secs_f64()
+                ));
+            }
+            std::thread::sleep(Duration::from_millis(5));
+        }
+    }
+}
+
+impl Drop for Link {
+    fn drop(&mut self) {
+        self.state.stop.store(true, Ordering::Release);
+        if let Some(t) = self.thread.get_mut().ok().and_then(Option::take) {
+            let _ = t.join();
+        }
+    }
+}

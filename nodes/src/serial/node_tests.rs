@@ -1,0 +1,307 @@
+//! `serial.in` and `serial.out` in a plan stepped one tick per millisecond
+//! (as the live runner does) against a device on a pseudo-terminal: what
+//! the graph sends arrives, what the device sends comes back, a vanished
+//! device fades the output and the link comes back; errors name the port.
+
+use super::device::{DeviceConfig, DeviceSession};
+use super::message::{self, Message, Touch};
+use evflow_engine::{check, graph::parse_graph, Override, Plan, PlanOptions};
+use serialport::{SerialPort, TTYPort};
+use std::io::{ErrorKind, Read, Write};
+use std::path::Path;
+use std::sync::atomic::{AtomicBool, Ordering};
+use std::sync::Arc;
+use std::time::{Duration, Instant};
+
+/// What a test device saw.
+#[derive(Debug, Default)]
+struct Log {
+    received: Vec<i16>,
+    hellos: u64,
+}
+
+/// A device on the master side of a fresh pty: answers HELLO, sends force
+/// = its tick count (1 kHz) and a touch frame every 25 ms.
+struct TestDevice {
+    slave: String,
+    stop: Arc<AtomicBool>,
+    thread: std::thread::JoinHandle<Log>,
+}
+
+impl TestDevice {
+    fn spawn(config: DeviceConfig) -> Self {
+        let (mut master, slave) = TTYPort::pair().expect("a pty pair");
+        let path = slave.name().expect("the slave's path");
+        drop(slave);
+        master.set_timeout(Duration::from_millis(1)).unwrap();
+        let stop = Arc::new(AtomicBool::new(false));
+        let s = stop.clone();
+        let thread = std::thread::spawn(move || {
+            let t0 = Instant::now();
+            let mut dev = DeviceSession::new(config, t0);
+            let mut log = Log::default();
+            let (mut buf, mut out) = ([0u8; 1024], Vec::new());
+            let mut tick = 0u64;
+            let mut host = false;
+            while !s.load(Ordering::Acquire) {
+                match master.read(&mut buf) {
+                    Ok(n) if n > 0 => {
+                        host = true;
+                        dev.receive(Instant::now(), &buf[..n], &mut out, &mut |v| log.received.push(v));
+                    }
+                    Err(e) if e.kind() == ErrorKind::TimedOut => host = true,
+                    _ => {
+                        // No host on the slave side (POLLHUP): wait for one.
+                        if host {
+                            dev.host_gone();
+                            host = false;
+                        }
+                        std::thread::sleep(Duration::from_millis(1));
+                    }
+                }
+                let now = Instant::now();
+                while tick < now.duration_since(t0).as_millis() as u64 {
+                    tick += 1;
+                    dev.play(now, &mut out);
+                    if dev.engaged() {
+                        dev.send(Message::Force(tick as f32), &mut out);
+                        if tick.is_multiple_of(25) {
+                            let x = tick as f32 * 1e-4;
+                            dev.send(Message::Touch(Touch { x, y: 0.03, load: 0.8, flags: 1 }), &mut out);
+                        }
+                        if tick.is_multiple_of(100) {
+                            dev.heartbeat(now, &mut out);
+                        }
+                    }
+                }
+                if host && !out.is_empty() {
+                    let _ = master.write_all(&out);
+                }
+                out.clear();
+            }
+            log.hellos = dev.counters().hellos;
+            log
+        });
+        Self { slave: path, stop, thread }
+    }
+
+    fn stop(self) -> Log {
+        self.stop.store(true, Ordering::Release);
+        self.thread.join().unwrap()
+    }
+}
+
+const GRAPH: &str = r#"
+[graph]
+format = 1
+name = "t"
+rate = 1000.0
+connections = ["drive.out -> limit.in", "dev.fault -> limit.link", "limit.out -> out.u", "dev.force -> st.in"]
+[vars]
+port = ""
+wait = 2.0
+[nodes.dev]
+type = "serial.in"
+port = "$port"
+wait = "$wait"
+retry = 0.05
+timeout = 2.0
+[nodes.drive]
+type = "sine"
+frequency = 50.0
+amplitude = 0.7
+[nodes.limit]
+type = "limit"
+faults = ["link"]
+[nodes.out]
+type = "serial.out"
+port = "$port"
+wait = "$wait"
+retry = 0.05
+timeout = 2.0
+[nodes.st]
+type = "stats"
+"#;
+
+fn plan(port: &str, max_block: usize, wait: f64) -> Result<Plan, String> {
+    let g = parse_graph(Path::new("t.toml"), GRAPH).map_err(|e| e.to_string())?;
+    let o = [Override::parse(&format!("port={port}")).unwrap(), Override::parse(&format!("wait={wait}")).unwrap()];
+    let checked = check(&g, &crate::registry(), &o).map_err(|e| e.to_string())?;
+    Plan::build(&checked, &PlanOptions { max_block, ..Default::default() }).map_err(|e| e.to_string())
+}
+
+/// Per tick: serial.in's outputs (x, y, load, force, contact, connected,
+/// fault) and the limiter's output.
+type Row = ([f64; 7], f64);
+
+/// Ticks `plan` `n` times, one per millisecond.
+fn run(plan: &mut Plan, n: usize) -> Vec<Row> {
+    let dev = plan.index("dev").unwrap();
+    let lim = plan.index("limit").unwrap();
+    let t0 = Instant::now();
+    let mut rows = Vec::new();
+    for k in 0..n {
+        let due = t0 + Duration::from_millis(k as u64);
+        if let Some(d) = due.checked_duration_since(Instant::now()) {
+            std::thread::sleep(d);
+        }
+        plan.tick().unwrap();
+        let mut r = [0.0; 7];
+        for (j, v) in r.iter_mut().enumerate() {
+            *v = plan.output_at(dev, j)[0];
+        }
+        rows.push((r, plan.output_at(lim, 0)[0]));
+    }
+    rows
+}
+
+/// (values of `want` missing from `have`, values of `have` not in `want`),
+/// by the longest common subsequence.
+fn lcs_diff(want: &[i16], have: &[i16]) -> (usize, usize) {
+    let mut prev = vec![0u32; have.len() + 1];
+    let mut row = vec![0u32; have.len() + 1];
+    for w in want {
+        for (j, h) in have.iter().enumerate() {
+            row[j + 1] = if w == h { prev[j] + 1 } else { prev[j + 1].max(row[j]) };
+        }
+        std::mem::swap(&mut prev, &mut row);
+    }
+    let common = prev[have.len()] as usize;
+    (want.len() - common, have.len() - common)
+}
+
+#[test]
+fn a_live_plan_exchanges_samples_with_the_device() {
+    let dev = TestDevice::spawn(DeviceConfig::default());
+    let mut p = plan(&dev.slave, 1, 5.0).unwrap();
+    let rows = run(&mut p, 400);
+    let summaries = p.finish().unwrap();
+    drop(p); // the link closes: a zero sample goes out last
+    std::thread::sleep(Duration::from_millis(50));
+    let log = dev.stop();
+
+    assert!(rows.iter().all(|(r, _)| r[5] == 1.0 && r[6] == 0.0), "connected throughout, no fault");
+    // Touch frames: x = tick·1e-4 every 25 ms, held between frames.
+    let xs: Vec<f64> = rows.iter().map(|(r, _)| r[0]).collect();
+    assert!(xs.windows(2).all(|w| w[1] >= w[0]), "x only grows");
+    assert!(xs.last().unwrap() > &0.0);
+    assert!(rows.iter().skip(50).all(|(r, _)| r[1] == 0.03f32 as f64 && r[2] == 0.8f32 as f64 && r[4] == 1.0));
+    // Force = the device's tick count, one fresh sample on most ticks, never going back.
+    let f: Vec<f64> = rows.iter().map(|(r, _)| r[3]).collect();
+    assert!(f.windows(2).all(|w| w[1] >= w[0]));
+    let fresh = f.windows(2).filter(|w| w[1] > w[0]).count();
+    assert!(fresh > 200, "{fresh} of 400 ticks had a new force sample");
+    // Every limiter output sample reached the device, in order, quantized
+    // (the I/O thread's stall fade may add frames when this thread stalls).
+    let sent: Vec<i16> = rows.iter().map(|(_, u)| message::actuation_to_i16(*u).0).collect();
+    let o = &summaries.iter().find(|(n, _)| n == "out").unwrap().1;
+    let (missing, extra) = lcs_diff(&sent, &log.received);
+    let dropped = o.get("dropped_stale").unwrap() + o.get("ring_overruns").unwrap();
+    assert!(missing as f64 <= dropped, "{missing} samples never arrived ({dropped} dropped after stalls)");
+    assert!(extra as f64 <= 10.0 * o.get("stall_fades").unwrap() + 1.0, "{extra} extra frames: {o:?}");
+    assert!(sent.iter().any(|v| v.unsigned_abs() > 20000), "the sine got through the limiter");
+    assert_eq!(o.get("sent"), Some(400.0));
+    let s = &summaries.iter().find(|(n, _)| n == "dev").unwrap().1;
+    assert_eq!(s.get("bad_crc"), Some(0.0));
+    assert_eq!(s.get("connects"), Some(1.0));
+}
+
+#[test]
+fn a_vanished_device_fades_the_output_and_the_link_comes_back() {
+    let dir = tempfile::tempdir().unwrap();
+    let link = dir.path().join("device");
+    let dev = TestDevice::spawn(DeviceConfig::default());
+    std::os::unix::fs::symlink(&dev.slave, &link).unwrap();
+    let mut p = plan(link.to_str().unwrap(), 1, 5.0).unwrap();
+    let before = run(&mut p, 100);
+    assert!(before.iter().all(|(r, _)| r[5] == 1.0));
+    assert!(before.last().unwrap().1 != 0.0);
+
+    dev.stop(); // the pty closes: the port's reads fail
+    let mut gone = Vec::new();
+    let t = Instant::now();
+    while gone.iter().all(|(r, _): &Row| r[5] == 1.0) {
+        assert!(t.elapsed() < Duration::from_secs(5), "the disconnect was never noticed");
+        gone.extend(run(&mut p, 10));
+    }
+    gone.extend(run(&mut p, 20));
+    let k = gone.iter().position(|(r, _)| r[5] == 0.0).unwrap();
+    assert!(gone[k..].iter().all(|(r, _)| r[6] == 1.0), "fault raised with the disconnect");
+    assert!(gone[k + 10..].iter().all(|(_, u)| *u == 0.0), "the limiter reached 0 within 10 ms");
+
+    // A new device behind the same path: the node reopens it.
+    let dev2 = TestDevice::spawn(DeviceConfig::default());
+    std::fs::remove_file(&link).unwrap();
+    std::os::unix::fs::symlink(&dev2.slave, &link).unwrap();
+    let mut back = Vec::new();
+    let t = Instant::now();
+    while back.last().is_none_or(|(r, _): &Row| r[5] == 0.0) {
+        assert!(t.elapsed() < Duration::from_secs(10), "the link never came back");
+        back.extend(run(&mut p, 10));
+    }
+    assert_eq!(back.last().unwrap().0[6], 0.0, "fault cleared");
+    assert!(back.iter().all(|(_, u)| *u == 0.0), "the limiter stays latched until re-armed");
+    let k = p.index("limit").unwrap();
+    p.set(k, "enable", 1.0).unwrap();
+    let armed = run(&mut p, 100);
+    assert!(armed.iter().any(|(_, u)| u.abs() > 0.3), "re-armed, the actuation flows again");
+    let s = p.finish().unwrap();
+    drop(p);
+    let log = dev2.stop();
+    assert!(log.received.iter().any(|v| v.unsigned_abs() > 10000), "and reaches the new device");
+    let d = &s.iter().find(|(n, _)| n == "dev").unwrap().1;
+    assert_eq!((d.get("connects"), d.get("disconnects")), (Some(2.0), Some(1.0)));
+    assert!(d.lines.iter().any(|l| l.contains("link lost")), "{:?}", d.lines);
+}
+
+#[test]
+fn errors_name_the_port_and_the_reason() {
+    let e = plan("/nonexistent/evflow-tty", 1, 0.05).err().unwrap();
+    assert!(e.contains("/nonexistent/evflow-tty") && e.contains("cannot open"), "{e}");
+    assert!(e.contains("dev"), "names the node: {e}");
+
+    let dev = TestDevice::spawn(DeviceConfig { version: 2, ..DeviceConfig::default() });
+    let e = plan(&dev.slave, 1, 0.5).err().unwrap();
+    assert!(e.contains("protocol version 2"), "{e}");
+    dev.stop();
+}
+
+#[test]
+fn offline_runs_never_open_the_port() {
+    let dev = TestDevice::spawn(DeviceConfig::default());
+    let mut p = plan(&dev.slave, 4096, 2.0).unwrap();
+    p.step(4096).unwrap();
+    let s = p.finish().unwrap();
+    let d = &s.iter().find(|(n, _)| n == "dev").unwrap().1;
+    assert!(d.lines[0].contains("offline run"), "{:?}", d.lines);
+    drop(p);
+    std::thread::sleep(Duration::from_millis(50));
+    let log = dev.stop();
+    assert_eq!((log.hellos, log.received.len()), (0, 0), "the device heard nothing");
+}
+
+#[test]
+fn one_node_of_each_direction_per_port() {
+    let dev = TestDevice::spawn(DeviceConfig::default());
+    let p = plan(&dev.slave, 1, 5.0).unwrap();
+    let e = plan(&dev.slave, 1, 5.0).err().unwrap();
+    assert!(e.contains("already has a `serial.in`"), "{e}");
+    drop(p);
+    dev.stop();
+}
+
+#[test]
+fn nodes_on_one_port_must_agree_on_its_settings() {
+    let dev = TestDevice::spawn(DeviceConfig::default());
+    let text = GRAPH.replace(
+        "[nodes.out]\ntype = \"serial.out\"\nport = \"$port\"\nwait = \"$wait\"\nretry = 0.05\ntimeout = 2.0",
+        "[nodes.out]\ntype = \"serial.out\"\nport = \"$port\"\nwait = \"$wait\"\nretry = 0.05\ntimeout = 2.0\nbaud = 115200",
+    );
+    assert_ne!(text, GRAPH);
+    let g = parse_graph(Path::new("t.toml"), &text).unwrap();
+    let o = [Override::parse(&format!("port={}", dev.slave)).unwrap()];
+    let checked = check(&g, &crate::registry(), &o).unwrap();
+    let e = Plan::build(&checked, &PlanOptions { max_block: 1, ..Default::default() }).err().unwrap().to_string();
+    assert!(e.contains("other settings") && e.contains("baud 921600"), "{e}");
+    dev.stop();
+}

@@ -1,0 +1,77 @@
+//! The port parameters `serial.in` and `serial.out` share, and what a node
+//! does with them when its plan is prepared: open the link in a live run,
+//! stay off the device otherwise.
+
+use evflow_engine::{NodeError, ParamSpec, Params, PrepareContext};
+use std::time::Duration;
+
+use super::link::LinkConfig;
+
+/// The shared parameters.
+pub const PORT_PARAMS: [ParamSpec; 5] = [
+    ParamSpec::text(
+        "port",
+        "",
+        "serial device (e.g. /dev/ttyACM0, the pty `evflow devsim` prints, COM3); empty = no device: the node runs \
+         unconnected",
+    ),
+    ParamSpec::int("baud", 50, 12_000_000, 921_600, "Bd", "baud rate (ignored by USB CDC devices and ptys)"),
+    ParamSpec::float(
+        "wait",
+        0.0,
+        600.0,
+        2.0,
+        "s",
+        "how long starting a live run waits for the device's HELLO before it fails (0: start unconnected)",
+    ),
+    ParamSpec::float("timeout", 0.01, 60.0, 0.25, "s", "no valid frame for this long: the link is down"),
+    ParamSpec::float("retry", 0.01, 600.0, 0.5, "s", "after a disconnect, reopen the port this often"),
+];
+
+/// Why a node with a port does not use it.
+pub fn offline_reason(max_block: usize) -> String {
+    format!(
+        "offline run (blocks of {max_block} ticks): the port was not opened; serial nodes talk to the device only in \
+         live runs (ticks of one sample)"
+    )
+}
+
+/// The text of a node without a port.
+pub const NO_PORT: &str = "no port given (port = \"\"): ran without a device";
+
+/// The port settings of a node, `None` when `port` is empty.
+pub fn link_config(p: &Params) -> Option<LinkConfig> {
+    let port = p.str("port").trim();
+    (!port.is_empty()).then(|| LinkConfig {
+        port: port.to_string(),
+        baud: p.i64("baud").clamp(1, u32::MAX as i64) as u32,
+        wait: Duration::from_secs_f64(p.f64("wait")),
+        timeout: Duration::from_secs_f64(p.f64("timeout")),
+        retry: Duration::from_secs_f64(p.f64("retry")),
+    })
+}
+
+/// The largest block (in the node's samples) a live plan prepares a node
+/// for: the live runner asks for blocks of one tick, which the plan rounds
+/// up to its rate unit (the least common multiple of the graph's rate
+/// divisors: 25 with a 40 Hz node at 1 kHz, 1000 with a 1 Hz one). Offline
+/// runs and replays use 4096 by default.
+pub const LIVE_MAX_BLOCK: usize = 1000;
+
+/// True when the plan runs live (blocks of one tick): the one case in which
+/// a serial node opens its port. Offline runs and replays step in large
+/// blocks, as fast as the machine allows, and must not drive a device. The
+/// engine does not say whether a plan is live; the block size is the sign
+/// (an offline run asked for blocks of at most 1000 ticks would open the
+/// port too).
+pub fn is_live(ctx: &PrepareContext) -> bool {
+    ctx.max_block <= LIVE_MAX_BLOCK
+}
+
+/// A node rate as the u16 of a HELLO.
+pub fn rate_hz(node: &str, rate: f64) -> Result<u16, NodeError> {
+    if !(1.0..=65535.0).contains(&rate.round()) {
+        return Err(NodeError::Other(format!("`{node}`: rate {rate} Hz does not fit the protocol's u16 field")));
+    }
+    Ok(rate.round() as u16)
+}

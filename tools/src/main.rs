@@ -82,9 +82,14 @@ enum Command {
     /// `--corrupt` damages frames to test the host's receiver; `--log`
     /// records what it received and rendered.
     ///
-    /// Examples:
+    /// Example, in two terminals:
+    ///
     ///   evflow devsim --link /tmp/evflow-device
+    ///
     ///   evflow live graphs/display-serial.toml --set port=/tmp/evflow-device --duration 30
+    ///
+    /// Example, damaging 5 % of the frames and logging for a minute:
+    ///
     ///   evflow devsim --corrupt 0.05 --log devsim-log --duration 60
     #[cfg(feature = "serial")]
     Devsim(cli::devsim::Args),

@@ -68,11 +68,4 @@ mod tests {
         }
         assert!(doc.contains("0x29B1"), "the document gives the CRC check value");
     }
-
-    #[test]
-    fn print_examples() {
-        for (name, seq, m) in examples() {
-            println!("{name}: {}", hex(&m, seq));
-        }
-    }
 }

@@ -7,6 +7,8 @@ pub mod samples;
 pub mod surface;
 
 #[cfg(test)]
+mod chain_tests;
+#[cfg(test)]
 mod tests;
 
 use evflow_engine::{BuildContext, Io, Node, NodeError, NodeSpec, ParamSpec, Params, PortSpec, Role};
@@ -24,20 +26,27 @@ pub static SPEC: NodeSpec = NodeSpec::new(
     "A texture sample on the tribometer (dissertation §5.1.1, §5.3) or under the virtual user's finger. \
 Friction F = μ(x)·N·tanh(v/0.5 mm/s), opposing the motion (positive when moving toward +x, as \
 `sim.display`), zero at rest. μ(x) = μ₀·(1 + m(x)): the modulation m is a sum of spatial sinusoids — \
-the sample's periodic pattern and a random roughness of many sinusoids with fixed phases, so every scan \
-of a sample meets the same surface and repeated recordings differ only by the sensor's noise — each \
+the sample's periodic pattern and a random texture of many sinusoids with fixed wavelengths and phases \
+(broadband, or around a preferred scale for the patternless felt and scrunched paper), so every scan of \
+a sample meets the same surface and repeated recordings differ only by the sensor's noise — each \
 attenuated by the contact patch, exp(−2π²σ²/λ²), with σ = σ₁·(N/1 N)^{1/3} (Hertzian growth with the \
-load; σ₁ large for soft samples). At a constant speed a component of wavelength λ sounds at v/λ, the \
-linear frequency–velocity relation of §6.3; the power grows with the load (§5.3.1); soft samples (chair \
-and felt fabric) keep little power at high frequency, rough ones (canvas, scrunched paper, the sheets) \
-much. The seven samples, with their values and reasons: `docs/simulated-lab.md` (Texture samples).\n\n\
+load; σ₁ large for the soft samples). The plastic sheet's ridge harmonics grow with the load as \
+(N/N₈₅)^1.5 (at most ×2), as §5.3.1 saw minor components emphasized at heavier mass. At a constant speed \
+a component of wavelength λ sounds at v/λ, the linear frequency–velocity relation of §6.3; the main \
+wavelengths (0.9–2.5 mm) put the main component above the 10 Hz high-pass of §5.1.1 at 3 cm/s; the \
+power grows with the load (§5.3.1); the soft samples (chair and felt fabric) keep little power below \
+1 mm, the rough ones much. The seven samples, with their values and reasons: `docs/simulated-lab.md` \
+(Texture samples).\n\n\
 **Ports** (at the node's rate): `position` (m), `velocity` (m/s), `load` (N) from `sim.tribometer` or \
 `sim.user`; `force` (N) to `sim.forcesensor`. Non-finite inputs give 0 N.\n\n\
 **Parameters.** `sample`; `friction` overrides μ₀ and `contact` overrides σ₁ (0: the sample's).\n\n\
-Checked against: the closed-form patch attenuation (numerical Gaussian average), the main frequency \
-v/λ over 3–7 cm/s (linear fit, R²), power rising with load, soft versus rough high-frequency power, \
-repeated scans versus different samples, and finite bounded force at speed 0 and 50 cm/s and loads of \
-1 g and 1000 g.",
+Checked against: the closed-form patch attenuation (numerical Gaussian average); on the model and on \
+recordings through tribometer, force sensor and 10 Hz high-pass: the main frequency against 3–7 cm/s is \
+a line (R² > 0.99) of slope 1/λ of a main component; power rising with load; the plastic sheet's \
+harmonics rising with load while the dotted sheet keeps its spectral shape; soft versus rough \
+high-frequency power; mean friction 0.075–0.25 N at 60–110 g (§3.2.1); repeated recordings (sensor \
+seeds) against different samples (E_s); finite bounded force at speed 0 and 50 cm/s and loads of 1 g \
+and 1000 g.",
 )
 .ports(&[
     PortSpec::input("position", "m", "position of the contact along the scan"),

@@ -33,8 +33,11 @@ and the node name, or `seed`).\n\n\
 its start), signed `velocity` (m/s, mean over the sample: + away from the origin), `load` (N = \
 mass·g), and the touch point `x`, `y` on the screen (m) for the mesh chain. **Outputs at `ir_rate`** \
 (40 Hz, an IR touch frame's report rate): `ir_x`, `ir_y` — the touch point sampled at each frame and \
-quantized to `ir_resolution` (0.5 mm by default; IR frames resolve about 0.3–1 mm) — and \
-`load_cell`, the load sampled at each frame plus Gaussian noise of rms `load_noise` (N).\n\n\
+quantized to `ir_resolution` (0.5 mm by default, chosen: the dissertation does not give its frame's \
+resolution; a frame interpolating one virtual beam between physical beams resolves half the beam pitch, \
+Carroll Touch Touch System Programmer's Guide ch. 1) — and `load_cell`, the load sampled at each frame \
+plus Gaussian noise of rms `load_noise` (N). §6.5.1's program read both every 25 ms (40 Hz); a `hold` \
+node turns the reports into a 1 kHz sample-and-hold stream.\n\n\
 Feed `load` and `velocity` to `sim.display` or `sim.texture`, `x`/`y` to `mesh.gradient`, and the \
 sensor outputs to `foaw` and `interp` as a rig's would be. Checked against: the stroke stays on the \
 travel, speed and load stay in their ranges, the velocity is the derivative of the position, \

@@ -11,6 +11,7 @@ pub mod lab;
 pub mod math;
 pub mod mesh;
 pub mod metric;
+pub mod narx;
 pub mod output;
 pub mod recording;
 pub mod safety;
@@ -41,5 +42,6 @@ pub fn all_specs() -> Vec<&'static NodeSpec> {
     v.extend_from_slice(mesh::SPECS);
     v.extend_from_slice(analysis::SPECS);
     v.extend_from_slice(lab::SPECS);
+    v.extend_from_slice(narx::SPECS);
     v
 }

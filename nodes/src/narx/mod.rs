@@ -1,0 +1,13 @@
+//! NARX inverse models of the display (dissertation §5.2.1): a network
+//! learns the actuation u[n] from the measured lateral force, trained open
+//! loop and run closed loop.
+
+pub mod error;
+pub mod mapminmax;
+pub mod net;
+pub mod train;
+
+use evflow_engine::NodeSpec;
+
+/// The node types of this family.
+pub static SPECS: &[&NodeSpec] = &[];

@@ -1,0 +1,1 @@
+//! Adam training (placeholder until written).

@@ -2,10 +2,20 @@
 //! learns the actuation u[n] from the measured lateral force, trained open
 //! loop and run closed loop.
 
+pub mod closed_loop;
 pub mod error;
+pub mod eval;
+pub mod fit;
 pub mod mapminmax;
+pub mod model;
 pub mod net;
+pub mod taps;
 pub mod train;
+
+#[cfg(test)]
+mod explore;
+#[cfg(test)]
+mod testdata;
 
 use evflow_engine::NodeSpec;
 

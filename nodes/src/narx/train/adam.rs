@@ -1,1 +1,128 @@
-//! Adam training (placeholder until written).
+//! Adam training (Kingma & Ba 2015, "Adam: a method for stochastic
+//! optimization", Algorithm 1, with β1 = 0.9, β2 = 0.999, ε = 1e−8): an
+//! alternative to Levenberg–Marquardt for networks too large for its
+//! P × P system. Mini-batches of `batch` rows in an order reshuffled every
+//! epoch (seeded); one epoch is one pass over the training block; early
+//! stopping on the validation block as for LM.
+
+use super::{mse, Data, EarlyStop, Epoch, Options, Report, StopReason};
+use crate::lab::rng::Rng;
+use crate::narx::net::Mlp;
+use std::time::Instant;
+
+const BETA1: f64 = 0.9;
+const BETA2: f64 = 0.999;
+const EPS: f64 = 1e-8;
+
+/// Trains `net` in place on `train`, stopping early on `val`.
+pub fn train(
+    net: &mut Mlp,
+    train: &Data<'_>,
+    val: &Data<'_>,
+    opts: &Options,
+    progress: &mut dyn FnMut(&Epoch),
+) -> Report {
+    let start = Instant::now();
+    let p = net.n_params();
+    let n = train.len();
+    let mut ws = net.workspace();
+    let mut perf = mse(net, train, &mut ws);
+    let mut stop = EarlyStop::new(net.weights(), mse(net, val, &mut ws), perf, opts.max_fail);
+    let (mut m, mut v, mut g, mut row) = (vec![0.0; p], vec![0.0; p], vec![0.0; p], vec![0.0; p]);
+    let mut order: Vec<usize> = (0..n).collect();
+    let mut rng = Rng::new(opts.seed);
+    let batch = opts.batch.max(1);
+    let mut t = 0i32;
+    let mut epochs = 0;
+    let mut reason = StopReason::MaxEpochs;
+    for epoch in 1..=opts.max_epochs {
+        if n == 0 {
+            break;
+        }
+        if perf == 0.0 {
+            reason = StopReason::Goal;
+            break;
+        }
+        // Fisher–Yates shuffle.
+        for i in (1..n).rev() {
+            let j = (rng.uniform() * (i + 1) as f64) as usize;
+            order.swap(i, j.min(i));
+        }
+        let mut gnorm = 0.0;
+        for chunk in order.chunks(batch) {
+            g.fill(0.0);
+            for &i in chunk {
+                let y = net.jacobian_row(train.row(i), &mut ws, &mut row);
+                let e = y - train.target(i);
+                for (gk, rk) in g.iter_mut().zip(&row) {
+                    *gk += 2.0 * e * rk / chunk.len() as f64;
+                }
+            }
+            gnorm = g.iter().map(|x| x * x).sum::<f64>().sqrt();
+            t += 1;
+            let (c1, c2) = (1.0 - BETA1.powi(t), 1.0 - BETA2.powi(t));
+            for (k, w) in net.weights_mut().iter_mut().enumerate() {
+                m[k] = BETA1 * m[k] + (1.0 - BETA1) * g[k];
+                v[k] = BETA2 * v[k] + (1.0 - BETA2) * g[k] * g[k];
+                *w -= opts.learning_rate * (m[k] / c1) / ((v[k] / c2).sqrt() + EPS);
+            }
+        }
+        perf = mse(net, train, &mut ws);
+        let vperf = mse(net, val, &mut ws);
+        epochs = epoch;
+        progress(&Epoch {
+            epoch,
+            train_mse: perf,
+            val_mse: vperf,
+            gradient: gnorm,
+            mu: 0.0,
+            seconds: start.elapsed().as_secs_f64(),
+        });
+        if !perf.is_finite() {
+            reason = StopReason::MuMax;
+            break;
+        }
+        if gnorm < opts.min_grad {
+            reason = StopReason::MinGradient;
+            break;
+        }
+        if stop.update(epoch, net.weights(), vperf, perf) {
+            reason = StopReason::ValidationStop;
+            break;
+        }
+    }
+    let (w, best_epoch, train_mse, val_mse) = stop.best();
+    let (w, best_epoch, train_mse, val_mse) = (w.to_vec(), best_epoch, train_mse, val_mse);
+    net.weights_mut().copy_from_slice(&w);
+    Report { epochs, best_epoch, train_mse, val_mse, stop: reason, seconds: start.elapsed().as_secs_f64() }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use ndarray::{Array1, Array2};
+
+    #[test]
+    fn fits_a_smooth_function() {
+        let mut r = Rng::new(1);
+        let n = 400;
+        let mut x = Array2::zeros((n, 2));
+        let mut t = Array1::zeros(n);
+        for i in 0..n {
+            let (a, b) = (2.0 * r.uniform() - 1.0, 2.0 * r.uniform() - 1.0);
+            x[(i, 0)] = a;
+            x[(i, 1)] = b;
+            t[i] = (1.5 * a).sin() * b + 0.3 * a * a;
+        }
+        let d = Data::new(x.slice(ndarray::s![..300, ..]), t.slice(ndarray::s![..300])).unwrap();
+        let v = Data::new(x.slice(ndarray::s![300.., ..]), t.slice(ndarray::s![300..])).unwrap();
+        let mut net = Mlp::new(2, &[8]).unwrap();
+        net.init_nguyen_widrow(&mut Rng::new(5));
+        let mut ws = net.workspace();
+        let before = mse(&net, &d, &mut ws);
+        let opts = Options { max_epochs: 300, learning_rate: 0.01, batch: 16, max_fail: 1000, ..Options::default() };
+        let rep = train(&mut net, &d, &v, &opts, &mut |_| {});
+        assert!(rep.train_mse < before / 20.0 && rep.train_mse < 2e-3, "{rep:?} (before {before})");
+        assert!(rep.val_mse < 4e-3, "{rep:?}");
+    }
+}

@@ -94,6 +94,25 @@ impl ClosedLoop {
     /// Takes the force sample x[t] (N) and returns the estimate of u[t − L].
     #[inline]
     pub fn step(&mut self, x: f64) -> f64 {
+        let y = self.estimate(x);
+        self.feed_back(y);
+        self.ymap.reverse(y)
+    }
+
+    /// Like [`ClosedLoop::step`], but feeds back the known actuation
+    /// `u_known` = u[t − L] instead of the estimate (teacher forcing): how a
+    /// closed loop is started from known initial states, as MATLAB's
+    /// `preparets` does with the first k_y targets. Returns the estimate.
+    pub fn step_known(&mut self, x: f64, u_known: f64) -> f64 {
+        let y = self.estimate(x);
+        let known = self.ymap.apply(if u_known.is_finite() { u_known } else { 0.0 }).clamp(-1.0, 1.0);
+        self.feed_back(known);
+        self.ymap.reverse(y)
+    }
+
+    /// The clamped, normalized network output for the newest force sample.
+    #[inline]
+    fn estimate(&mut self, x: f64) -> f64 {
         let x = if x.is_finite() {
             x
         } else {
@@ -110,7 +129,7 @@ impl ClosedLoop {
         let ny = yh.len();
         self.taps.fill(&mut self.row, |k| yh[(ypos + ny + 1 - k) % ny], |j| xh[(xpos + 2 * nx - skip - j) % nx]);
         let raw = self.net.forward(&self.row, &mut self.ws);
-        let y = if raw.is_finite() {
+        if raw.is_finite() {
             if raw.abs() > 2.0 {
                 self.diverged += 1;
             }
@@ -121,12 +140,16 @@ impl ClosedLoop {
         } else {
             self.diverged += 1;
             self.y0
-        };
+        }
+    }
+
+    #[inline]
+    fn feed_back(&mut self, y: f64) {
         if self.taps.feedback > 0 {
+            let ny = self.yh.len();
             self.ypos = if self.ypos + 1 == ny { 0 } else { self.ypos + 1 };
             self.yh[self.ypos] = y;
         }
-        self.ymap.reverse(y)
     }
 
     /// Runs a whole force series and returns the estimates aligned with it:
@@ -139,6 +162,24 @@ impl ClosedLoop {
             let u = self.step(v);
             if t >= lat {
                 out.push(u);
+            }
+        }
+        out
+    }
+
+    /// Runs a whole force series like [`ClosedLoop::run`], with the first
+    /// `known` estimates replaced by the true actuation `u` in the feedback
+    /// (started from known states, see [`ClosedLoop::step_known`]).
+    pub fn run_known(&mut self, x: &[f64], u: &[f64], known: usize) -> Vec<f64> {
+        let lat = self.taps.latency();
+        let mut out = Vec::with_capacity(x.len());
+        for (t, &v) in x.iter().chain(std::iter::repeat_n(&0.0, lat)).enumerate() {
+            let e = match t.checked_sub(lat) {
+                Some(n) if n < known && n < u.len() => self.step_known(v, u[n]),
+                _ => self.step(v),
+            };
+            if t >= lat {
+                out.push(e);
             }
         }
         out
@@ -196,6 +237,20 @@ mod tests {
         let want = [0.8, 0.0, 0.4, 0.0, 0.2, 0.0];
         for (a, b) in y.iter().zip(want) {
             assert!((a - b).abs() < 1e-12, "{y:?}");
+        }
+    }
+
+    #[test]
+    fn known_states_are_fed_back_before_the_loop_closes() {
+        // y[n] = y[n−1]: the loop holds whatever was fed back last.
+        let taps = Taps { feedback: 1, input: 0, lookahead: 0 };
+        let net = Mlp::with_weights(2, &[], vec![1.0, 0.0, 0.0]).unwrap();
+        let mut cl = ClosedLoop::new(net, taps, map(-1.0, 1.0), map(-1.0, 1.0));
+        let u = [0.5, -0.3, 0.7, 0.1, 0.1];
+        let est = cl.run_known(&[0.0; 5], &u, 3);
+        let want = [0.0, 0.5, -0.3, 0.7, 0.7];
+        for (a, b) in est.iter().zip(want) {
+            assert!((a - b).abs() < 1e-12, "{est:?}");
         }
     }
 

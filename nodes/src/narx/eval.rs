@@ -24,6 +24,7 @@ pub fn score(est: &[f64], reference: &[f64]) -> Option<ClosedLoopScore> {
     }
     (n > 0).then(|| ClosedLoopScore {
         sign_agreement: agree as f64 / n as f64,
+        transition_agreement: transition_agreement(est, reference).unwrap_or(f64::NAN),
         rms: (sq / n as f64).sqrt(),
         samples: n,
     })

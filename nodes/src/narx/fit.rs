@@ -163,30 +163,49 @@ pub fn fit(x: &[f64], u: &[f64], cfg: &FitConfig, progress: &mut dyn FnMut(&Epoc
             train_mse: report.train_mse,
             validation_mse: finite(report.val_mse),
             closed_loop: None,
+            closed_loop_noise_force: None,
             seconds: report.seconds,
             seed: cfg.seed,
         },
         weights: net.weights().to_vec(),
     };
     if n_val > 0 {
-        let first = taps.first() + n_train;
-        model.training.closed_loop = closed_loop_score(&model, x, u, first)?;
+        let from = taps.first() + n_train;
+        model.training.closed_loop = closed_loop_score(&model, x, u, from, None)?;
+        model.training.closed_loop_noise_force = closed_loop_score(&model, x, u, from, Some(cfg.seed))?;
     }
     Ok(model)
 }
 
-/// Runs the model closed loop over `x` from a little before sample `from`
-/// (a warm-up of k_x + k_y + 50 samples fed with the model's own
-/// estimates) and scores its estimates from `from` on against `u`.
+/// Scores the model closed loop from sample `from` on against `u`. The
+/// loop is started from known states (the true u fed back up to `from`,
+/// over a warm-up of k_x + k_y + 50 samples, see
+/// [`super::closed_loop::ClosedLoop::step_known`]) and then runs on its own
+/// estimates. With `noise_seed`, the force from `from` on is replaced by
+/// Gaussian noise of the same RMS — the check that the network reads the
+/// force rather than predicting u from its own past.
 pub fn closed_loop_score(
     model: &Model,
     x: &[f64],
     u: &[f64],
     from: usize,
+    noise_seed: Option<u64>,
 ) -> Result<Option<ClosedLoopScore>, NarxError> {
+    if from >= x.len() || x.len() != u.len() {
+        return Ok(None);
+    }
     let warm = model.delays.input + model.delays.feedback + 50;
     let s = from.saturating_sub(warm);
+    let mut xs = x[s..].to_vec();
+    if let Some(seed) = noise_seed {
+        let tail = &mut xs[from - s..];
+        let rms = (tail.iter().map(|v| v * v).sum::<f64>() / tail.len() as f64).sqrt();
+        let mut r = Rng::new(seed ^ 0x006e_6f69_7365);
+        for v in tail.iter_mut() {
+            *v = rms * r.gaussian();
+        }
+    }
     let mut cl = model.closed_loop()?;
-    let est = cl.run(&x[s..]);
+    let est = cl.run_known(&xs, &u[s..], from - s);
     Ok(eval::score(&est[from - s..], &u[from..]))
 }

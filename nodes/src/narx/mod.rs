@@ -6,16 +6,12 @@ pub mod closed_loop;
 pub mod error;
 pub mod eval;
 pub mod fit;
+pub mod labdata;
 pub mod mapminmax;
 pub mod model;
 pub mod net;
 pub mod taps;
 pub mod train;
-
-#[cfg(test)]
-mod explore;
-#[cfg(test)]
-mod testdata;
 
 use evflow_engine::NodeSpec;
 

@@ -76,6 +76,10 @@ pub struct Condition {
 pub struct ClosedLoopScore {
     /// Fraction of samples where the estimate and the reference have the same sign.
     pub sign_agreement: f64,
+    /// Fraction of sample pairs (n−1, n) where the estimate changes sign
+    /// exactly when the reference does: the part of a binary actuation an
+    /// even (square-law) display makes visible whatever the global sign.
+    pub transition_agreement: f64,
     /// RMS of estimate − reference, actuation units.
     pub rms: f64,
     /// Samples compared.
@@ -105,8 +109,13 @@ pub struct Training {
     pub train_mse: f64,
     /// Open-loop MSE on the validation block (normalized units; null without one).
     pub validation_mse: Option<f64>,
-    /// Closed-loop accuracy on the validation block (null without one).
+    /// Closed-loop accuracy on the validation block, the loop started from
+    /// the true states before the block (null without a validation block).
     pub closed_loop: Option<ClosedLoopScore>,
+    /// The same with the force replaced by Gaussian noise of the same RMS:
+    /// near chance (0.5) when the network reads the force; as high as
+    /// `closed_loop` when it predicts u from its own past instead.
+    pub closed_loop_noise_force: Option<ClosedLoopScore>,
     /// Wall-clock training time, s.
     pub seconds: f64,
     /// Seed of the initial weights.

@@ -1,4 +1,5 @@
-//! Training and validation data for the tests, made on the simulated lab:
+//! Training and validation data made on the simulated lab (for tests,
+//! benchmarks and the figures of docs/narx.md):
 //! excitations (random binary, PRBS from the `prbs` node) driven through the
 //! virtual display (`sim.display`'s model) and force sensor at a constant
 //! sliding speed and load, high-passed at 10 Hz as dissertation §5.1.1.

@@ -56,6 +56,8 @@ pub struct FitConfig {
     pub seed: u64,
     /// Condition written into the model.
     pub condition: Condition,
+    /// Sample rate of the data, Hz (written into the model).
+    pub rate_hz: f64,
 }
 
 impl Default for FitConfig {
@@ -71,6 +73,7 @@ impl Default for FitConfig {
             options: Options::default(),
             seed: 1,
             condition: Condition::default(),
+            rate_hz: 1000.0,
         }
     }
 }
@@ -142,6 +145,7 @@ pub fn fit(x: &[f64], u: &[f64], cfg: &FitConfig, progress: &mut dyn FnMut(&Epoc
     let mut model = Model {
         format: model::FORMAT.into(),
         version: model::VERSION,
+        rate_hz: cfg.rate_hz,
         architecture: Architecture {
             inputs: taps.n_inputs(),
             hidden: cfg.hidden.clone(),

@@ -10,10 +10,12 @@ pub mod labdata;
 pub mod mapminmax;
 pub mod model;
 pub mod net;
+pub mod node;
 pub mod taps;
 pub mod train;
+pub mod train_node;
 
 use evflow_engine::NodeSpec;
 
 /// The node types of this family.
-pub static SPECS: &[&NodeSpec] = &[];
+pub static SPECS: &[&NodeSpec] = &[&train_node::SPEC, &node::SPEC];

@@ -6,6 +6,7 @@
 //! {
 //!   "format": "evflow-narx-model",
 //!   "version": 1,
+//!   "rate_hz": 1000,
 //!   "architecture": { "inputs": 24, "hidden": [15, 10, 5],
 //!                     "hidden_activation": "tanh", "output_activation": "linear" },
 //!   "delays": { "feedback": 2, "input": 20, "lookahead": 2 },
@@ -129,6 +130,8 @@ pub struct Model {
     pub format: String,
     /// Always [`VERSION`] when written by this code.
     pub version: u64,
+    /// Sample rate of the training data, Hz: the taps count samples at this rate.
+    pub rate_hz: f64,
     /// Network shape.
     pub architecture: Architecture,
     /// Taps and look-ahead.
@@ -178,6 +181,9 @@ impl Model {
         }
         if self.version != VERSION {
             return Err(NarxError::Version { path: path.into(), found: self.version, supported: VERSION });
+        }
+        if !(self.rate_hz.is_finite() && self.rate_hz > 0.0) {
+            return f("rate_hz", format!("{} is not a sample rate", self.rate_hz));
         }
         let a = &self.architecture;
         if a.hidden_activation != "tanh" {
@@ -283,7 +289,7 @@ fn serde_path_to_error(value: serde_json::Value, path: &Path) -> Result<Model, N
     match serde_json::from_value::<Model>(value.clone()) {
         Ok(m) => Ok(m),
         Err(e) => {
-            let sections = ["architecture", "delays", "normalization", "condition", "training", "weights"];
+            let sections = ["rate_hz", "architecture", "delays", "normalization", "condition", "training", "weights"];
             let field = sections
                 .iter()
                 .find(|s| match value.get(**s) {
@@ -300,6 +306,7 @@ fn serde_path_to_error(value: serde_json::Value, path: &Path) -> Result<Model, N
 fn section_ok(section: &str, v: &serde_json::Value) -> bool {
     let v = v.clone();
     match section {
+        "rate_hz" => serde_json::from_value::<f64>(v).is_ok(),
         "architecture" => serde_json::from_value::<Architecture>(v).is_ok(),
         "delays" => serde_json::from_value::<Taps>(v).is_ok(),
         "normalization" => serde_json::from_value::<Normalization>(v).is_ok(),
@@ -307,5 +314,146 @@ fn section_ok(section: &str, v: &serde_json::Value) -> bool {
         "training" => serde_json::from_value::<Training>(v).is_ok(),
         "weights" => serde_json::from_value::<Vec<f64>>(v).is_ok(),
         _ => true,
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A small, valid model (2 feedback, 2 input taps, look-ahead 1, one hidden layer of 3).
+    pub(crate) fn small() -> Model {
+        let delays = Taps { feedback: 2, input: 2, lookahead: 1 };
+        let inputs = delays.n_inputs();
+        let n = Mlp::new(inputs, &[3]).unwrap().n_params();
+        Model {
+            format: FORMAT.into(),
+            version: VERSION,
+            rate_hz: 1000.0,
+            architecture: Architecture {
+                inputs,
+                hidden: vec![3],
+                hidden_activation: "tanh".into(),
+                output_activation: "linear".into(),
+            },
+            delays,
+            normalization: Normalization { x: MapMinMax { min: -0.3, max: 0.7 }, y: MapMinMax { min: -1.0, max: 1.0 } },
+            condition: Condition { mass_g: Some(85.0), speed_cm_s: Some(4.0) },
+            training: Training {
+                algorithm: "lm".into(),
+                data_hash: data_hash(&[&[1.0, 2.0]]),
+                samples: 1000,
+                train_rows: 800,
+                validation_rows: 150,
+                epochs: 12,
+                best_epoch: 6,
+                stop: StopReason::ValidationStop,
+                train_mse: 0.1,
+                validation_mse: Some(0.2),
+                closed_loop: Some(ClosedLoopScore {
+                    sign_agreement: 0.5,
+                    transition_agreement: 0.9,
+                    rms: 1.3,
+                    samples: 150,
+                }),
+                closed_loop_noise_force: None,
+                seconds: 0.5,
+                seed: 3,
+            },
+            weights: (0..n).map(|i| (i as f64 * 0.731).sin() / 3.0).collect(),
+        }
+    }
+
+    fn edit(text: &str, f: impl FnOnce(&mut serde_json::Value)) -> String {
+        let mut v: serde_json::Value = serde_json::from_str(text).unwrap();
+        f(&mut v);
+        serde_json::to_string_pretty(&v).unwrap()
+    }
+
+    #[test]
+    fn saves_and_loads_bit_for_bit_through_a_temporary_file() {
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("sub/model.json");
+        let m = small();
+        m.save(&path).unwrap();
+        assert!(!dir.path().join("sub/model.json.tmp").exists());
+        let back = Model::load(&path).unwrap();
+        assert_eq!(back, m);
+        assert!(back.weights.iter().zip(&m.weights).all(|(a, b)| a.to_bits() == b.to_bits()));
+        // Overwriting replaces the file whole.
+        let mut m2 = small();
+        m2.weights[0] = 0.125;
+        m2.save(&path).unwrap();
+        assert_eq!(Model::load(&path).unwrap().weights[0], 0.125);
+        // The file is self-describing JSON.
+        let text = std::fs::read_to_string(&path).unwrap();
+        for key in [
+            "\"format\": \"evflow-narx-model\"",
+            "\"version\": 1",
+            "\"hidden\"",
+            "\"lookahead\": 1",
+            "\"mass_g\": 85.0",
+        ] {
+            assert!(text.contains(key), "{key} missing in\n{text}");
+        }
+    }
+
+    #[test]
+    fn a_write_that_fails_leaves_nothing_behind() {
+        let dir = tempfile::tempdir().unwrap();
+        // The target is a folder: the rename fails, the temporary file is removed.
+        let path = dir.path().join("taken");
+        std::fs::create_dir(&path).unwrap();
+        let e = small().save(&path).unwrap_err();
+        assert!(matches!(e, NarxError::Io { .. }), "{e}");
+        assert!(e.to_string().contains("taken"), "{e}");
+        assert!(!dir.path().join("taken.tmp").exists());
+    }
+
+    #[test]
+    fn bad_files_are_refused_naming_the_file_and_the_field() {
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("m.json");
+        let good = serde_json::to_string_pretty(&small()).unwrap();
+        let cases: Vec<(String, &str)> = vec![
+            ("{ \"format\": ".into(), "not a NARX model file"),
+            ("[1, 2]".into(), "field `format`: missing"),
+            (edit(&good, |v| v["format"] = "other".into()), "field `format`: `other`"),
+            (edit(&good, |v| v["version"] = 2.into()), "version 2 is not supported (this evflow reads version 1)"),
+            (edit(&good, |v| v["version"] = 0.into()), "version 0 is not supported"),
+            (edit(&good, |v| v["version"] = "one".into()), "field `version`"),
+            (edit(&good, |v| v.as_object_mut().unwrap().remove("delays").map(drop).unwrap()), "field `delays`"),
+            (edit(&good, |v| v["delays"]["input"] = (-3).into()), "field `delays`"),
+            (edit(&good, |v| v["training"]["stop"] = "bored".into()), "field `training`"),
+            (edit(&good, |v| v["weights"][2] = serde_json::Value::Null), "field `weights`"),
+            (
+                edit(&good, |v| v["weights"].as_array_mut().unwrap().pop().map(drop).unwrap()),
+                "field `weights`: 24 values, the architecture needs 25",
+            ),
+            (edit(&good, |v| v["architecture"]["inputs"] = 7.into()), "field `architecture.inputs`: 7 inputs"),
+            (edit(&good, |v| v["architecture"]["hidden"][0] = 0.into()), "field `architecture.hidden[0]`"),
+            (edit(&good, |v| v["architecture"]["hidden_activation"] = "relu".into()), "hidden_activation"),
+            (edit(&good, |v| v["normalization"]["x"]["min"] = 5.into()), "field `normalization.x`"),
+            (edit(&good, |v| v["delays"]["lookahead"] = (-5).into()), "field `delays.lookahead`"),
+            (edit(&good, |v| v["rate_hz"] = 0.into()), "field `rate_hz`: 0 is not a sample rate"),
+            (edit(&good, |v| v.as_object_mut().unwrap().remove("rate_hz").map(drop).unwrap()), "field `rate_hz`"),
+        ];
+        for (text, want) in cases {
+            std::fs::write(&path, &text).unwrap();
+            let e = Model::load(&path).unwrap_err().to_string();
+            assert!(e.contains("m.json"), "{e}");
+            assert!(e.contains(want), "want `{want}` in: {e}");
+        }
+        let e = Model::load(&dir.path().join("missing.json")).unwrap_err().to_string();
+        assert!(e.contains("missing.json") && e.contains("cannot read"), "{e}");
+    }
+
+    #[test]
+    fn the_data_hash_sees_every_bit() {
+        let a = data_hash(&[&[1.0, 2.0], &[3.0]]);
+        assert!(a.starts_with("fnv1a64:") && a.len() == 8 + 16);
+        assert_ne!(a, data_hash(&[&[1.0, 2.0], &[3.0 + f64::EPSILON * 2.0]]));
+        assert_ne!(data_hash(&[&[0.0]]), data_hash(&[&[-0.0]]));
+        assert_eq!(a, data_hash(&[&[1.0, 2.0], &[3.0]]));
     }
 }

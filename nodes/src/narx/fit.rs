@@ -213,3 +213,65 @@ pub fn closed_loop_score(
     let est = cl.run_known(&xs, &u[s..], from - s);
     Ok(eval::score(&est[from - s..], &u[from..]))
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn data(n: usize) -> (Vec<f64>, Vec<f64>) {
+        let u = super::super::labdata::rbs(n, 4);
+        let x: Vec<f64> = (0..n).map(|i| if i == 0 { 0.0 } else { (u[i] - u[i - 1]).powi(2) + 0.1 * u[i] }).collect();
+        (x, u)
+    }
+
+    fn small() -> FitConfig {
+        FitConfig {
+            hidden: vec![4],
+            feedback: 1,
+            input: 2,
+            options: Options { max_epochs: 5, ..Options::default() },
+            ..FitConfig::default()
+        }
+    }
+
+    #[test]
+    fn bad_data_is_refused_naming_the_sample() {
+        let (mut x, u) = data(500);
+        x[123] = f64::NAN;
+        let e = fit(&x, &u, &small(), &mut |_| {}).unwrap_err().to_string();
+        assert!(e.contains("the force x[123] is NaN"), "{e}");
+        let (x, mut u) = data(500);
+        u[7] = f64::INFINITY;
+        let e = fit(&x, &u, &small(), &mut |_| {}).unwrap_err().to_string();
+        assert!(e.contains("the actuation y[7] is inf"), "{e}");
+        let (x, u) = data(500);
+        let e = fit(&x[..10], &u, &small(), &mut |_| {}).unwrap_err().to_string();
+        assert!(e.contains("10 force samples but 500 actuation samples"), "{e}");
+        let cfg = FitConfig { validation: 0.95, ..small() };
+        assert!(fit(&x, &u, &cfg, &mut |_| {}).unwrap_err().to_string().contains("validation fraction"));
+        let cfg = FitConfig { lookahead: Some(-5), ..small() };
+        assert!(fit(&x, &u, &cfg, &mut |_| {}).unwrap_err().to_string().contains("leaves no input tap"));
+    }
+
+    #[test]
+    fn a_fit_records_how_it_was_made() {
+        let (x, u) = data(600);
+        let m = fit(&x, &u, &small(), &mut |_| {}).unwrap();
+        m.validate(std::path::Path::new("m.json")).unwrap();
+        assert_eq!(m.training.samples, 600);
+        assert_eq!(m.training.train_rows + m.training.validation_rows, m.delays.usable(600));
+        assert_eq!(m.training.validation_rows, (m.delays.usable(600) as f64 * 0.15).round() as usize);
+        assert_eq!(m.training.data_hash, model::data_hash(&[&x, &u]));
+        assert!(m.training.closed_loop.is_some() && m.training.closed_loop_noise_force.is_some());
+        // The transitions lead the force by nothing here: d from the cross-correlation is 0.
+        assert_eq!(m.delays.lookahead, 0);
+        // Same data, same seed: the same model, bit for bit (training time aside).
+        let mut again = fit(&x, &u, &small(), &mut |_| {}).unwrap();
+        again.training.seconds = m.training.seconds;
+        assert_eq!(again, m);
+        // Without validation there are no closed-loop scores.
+        let cfg = FitConfig { validation: 0.0, ..small() };
+        let m = fit(&x, &u, &cfg, &mut |_| {}).unwrap();
+        assert!(m.training.closed_loop.is_none() && m.training.validation_mse.is_none());
+    }
+}

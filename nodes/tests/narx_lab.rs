@@ -123,6 +123,7 @@ fn the_chosen_model_reads_the_force_on_excitations_it_cannot_predict() {
         "chosen model: taps {:?}, {} epochs ({:?}), trained in {seconds:.2} s, validation block {:?}",
         m.delays, m.training.epochs, m.training.stop, m.training.closed_loop
     );
+    eprintln!("chosen model record: {:?}\n  normalization {:?}", m.training, m.normalization);
     for (name, u) in excitations() {
         let real = closed_loop(m, &u, false);
         let noise = closed_loop(m, &u, true);

@@ -141,6 +141,7 @@ fn training_refuses_data_it_cannot_learn_from() {
     ];
     for (name, x, y, want) in cases {
         let e = train(dir.path(), TRAIN_PARAMS, x, y).summary().unwrap_err();
+        eprintln!("{name}: {e}");
         assert!(e.contains(want), "{name}: want `{want}` in: {e}");
         assert!(!dir.path().join("m.json").exists() && !dir.path().join("m.json.tmp").exists(), "{name}");
     }

@@ -208,8 +208,7 @@ impl Node for Train {
         };
         let model = fit(&self.x, &self.y, &self.cfg, &mut report).map_err(|e| match e {
             super::error::NarxError::Data(m) => NodeError::Data(format!(
-                "narx.train `{}`: {m}{}",
-                self.node,
+                "{m}{}",
                 if self.skip > 0 {
                     format!(" (after skipping the first {} samples)", self.skip)
                 } else {

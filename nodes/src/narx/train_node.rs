@@ -51,7 +51,9 @@ pub static SPEC: NodeSpec = NodeSpec::new(
      model file (docs/narx.md) is written through a temporary file and a rename.\n\n\
      **Summary.** `train_mse`, `validation_mse` (open loop, normalized), closed-loop `sign_agreement`, \
      `transition_agreement`, `rms` on the validation block, `noise_force_transition_agreement`, `epochs`, \
-     `seconds` (training time).\n\n\
+     `seconds` (training time; left out, and 0 in the model, with `record_time = false`, for byte-identical \
+     reruns). `skip` and `samples` cut one stretch out of the stream (e.g. the constant-speed part of a \
+     tribometer pass, where the pen slides and the force carries the actuation).\n\n\
      Checked against: finite-difference Jacobians, an exactly solvable linear least-squares problem, \
      MATLAB's `mapminmax` values, early stopping on pure noise, and the simulated lab \
      (nodes/tests/narx_lab.rs).",
@@ -78,10 +80,12 @@ pub static SPEC: NodeSpec = NodeSpec::new(
     ParamSpec::float("learning_rate", 1e-9, 1.0, 1e-3, "1", "Adam: step size"),
     ParamSpec::int("batch", 1, 1_000_000, 64, "samples", "Adam: mini-batch size"),
     ParamSpec::int("skip", 0, 1_000_000_000, 0, "samples", "samples at the start left out (e.g. the tribometer's dwell)"),
+    ParamSpec::int("samples", 0, 1_000_000_000, 0, "samples", "samples used after `skip` (0 = all; e.g. one constant-speed stretch)"),
     ParamSpec::int("seed", 0, 1 << 53, 0, "1", "seed of the initial weights (0 = derived from the run's seed)"),
     ParamSpec::float("mass_g", 0.0, 1e6, 0.0, "g", "condition: stylus mass (0 = not recorded)"),
     ParamSpec::float("speed_cm_s", 0.0, 1e6, 0.0, "cm/s", "condition: scanning speed (0 = not recorded)"),
     ParamSpec::flag("progress", true, "print each epoch to stderr"),
+    ParamSpec::flag("record_time", true, "write the training time into the model and the summary (off: byte-identical reruns)"),
 ])
 .offline_only("it buffers the whole recording in memory and trains when the run ends")
 .example(
@@ -94,7 +98,9 @@ struct Train {
     node: String,
     cfg: FitConfig,
     skip: usize,
+    take: usize,
     progress: bool,
+    record_time: bool,
     seen: usize,
     x: Vec<f64>,
     y: Vec<f64>,
@@ -163,7 +169,12 @@ fn build(p: &Params, ctx: &BuildContext) -> Result<Box<dyn Node>, NodeError> {
         node: ctx.node.clone(),
         cfg,
         skip: p.usize("skip"),
+        take: match p.usize("samples") {
+            0 => usize::MAX,
+            n => n,
+        },
         progress: p.bool("progress"),
+        record_time: p.bool("record_time"),
         seen: 0,
         x: Vec::new(),
         y: Vec::new(),
@@ -181,7 +192,7 @@ impl Node for Train {
         // Offline only: the buffers grow with the recording.
         let n = io.len();
         for i in 0..n {
-            if self.seen >= self.skip {
+            if self.seen >= self.skip && self.x.len() < self.take {
                 self.x.push(io.input(0)[i]);
                 self.y.push(io.input(1)[i]);
             }
@@ -206,7 +217,7 @@ impl Node for Train {
                 );
             }
         };
-        let model = fit(&self.x, &self.y, &self.cfg, &mut report).map_err(|e| match e {
+        let mut model = fit(&self.x, &self.y, &self.cfg, &mut report).map_err(|e| match e {
             super::error::NarxError::Data(m) => NodeError::Data(format!(
                 "{m}{}",
                 if self.skip > 0 {
@@ -217,12 +228,16 @@ impl Node for Train {
             )),
             other => other.into(),
         })?;
+        let seconds = model.training.seconds;
+        if !self.record_time {
+            model.training.seconds = 0.0;
+        }
         model.save(&self.path)?;
         let t = &model.training;
-        let mut s = Summary::default()
-            .value("train_mse", t.train_mse, "1")
-            .value("epochs", t.epochs as f64, "1")
-            .value("seconds", t.seconds, "s");
+        let mut s = Summary::default().value("train_mse", t.train_mse, "1").value("epochs", t.epochs as f64, "1");
+        if self.record_time {
+            s = s.value("seconds", t.seconds, "s");
+        }
         if let Some(v) = t.validation_mse {
             s = s.value("validation_mse", v, "1");
         }
@@ -244,7 +259,7 @@ impl Node for Train {
             }
         }
         Ok(s.line(format!(
-            "wrote {} ({} samples, taps {}/{}/{}, {} epochs, {}, {:.2} s)",
+            "wrote {} ({} samples, taps {}/{}/{}, {} epochs, {}{})",
             self.shown,
             t.samples,
             model.delays.feedback,
@@ -252,7 +267,7 @@ impl Node for Train {
             model.delays.lookahead,
             t.epochs,
             t.stop.describe(),
-            t.seconds
+            if self.record_time { format!(", {seconds:.2} s") } else { String::new() }
         )))
     }
 }

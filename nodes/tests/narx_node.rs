@@ -165,3 +165,21 @@ fn the_narx_node_refuses_bad_model_files() {
     let e = infer(bad.path(), "model = \"new.json\"", vec![0.0; 10], 1000.0, 1).run().unwrap_err();
     assert!(e.contains("new.json") && e.contains("version 7 is not supported"), "{e}");
 }
+
+#[test]
+fn skip_and_samples_cut_a_stretch_and_reruns_without_time_are_identical() {
+    let dir = tempfile::tempdir().unwrap();
+    let u = rbs(3000, 2);
+    let x = Lab::default().force(&u);
+    let params = "path = \"cut.json\"\nhidden = [4]\nfeedback = 1\ninput = 3\nepochs = 5\nprogress = false\n\
+                  skip = 500\nsamples = 2000\nrecord_time = false\nseed = 9";
+    let s = train(dir.path(), params, x.clone(), u.clone()).summary().unwrap();
+    assert!(s.get("seconds").is_none(), "{s:?}");
+    let first = std::fs::read(dir.path().join("cut.json")).unwrap();
+    let m = Model::load(&dir.path().join("cut.json")).unwrap();
+    assert_eq!(m.training.samples, 2000);
+    assert_eq!(m.training.seconds, 0.0);
+    assert_eq!(m.training.data_hash, evflow_nodes::narx::model::data_hash(&[&x[500..2500], &u[500..2500]]));
+    train(dir.path(), params, x, u).summary().unwrap();
+    assert_eq!(std::fs::read(dir.path().join("cut.json")).unwrap(), first, "a rerun wrote other bytes");
+}

@@ -48,5 +48,6 @@ pub fn all_specs() -> Vec<&'static NodeSpec> {
     v.extend_from_slice(rate::SPECS);
     v.extend_from_slice(texture::SPECS);
     v.extend_from_slice(serial::SPECS);
+    v.extend_from_slice(narx::SPECS);
     v
 }

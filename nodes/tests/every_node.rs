@@ -50,6 +50,20 @@ fn fixtures(dir: &Path) {
         }
         w.finish().expect("grid cell finished");
     }
+    // A small NARX model (the `narx` node's example), trained on a chirp.
+    use evflow_nodes::narx::fit::{fit, FitConfig};
+    let x = signal(2000, 7);
+    let u: Vec<f64> = x.iter().map(|v| if *v > 0.0 { 1.0 } else { -1.0 }).collect();
+    let cfg = FitConfig {
+        hidden: vec![4],
+        feedback: 1,
+        input: 3,
+        lookahead: Some(1),
+        options: evflow_nodes::narx::train::Options { max_epochs: 3, ..Default::default() },
+        ..FitConfig::default()
+    };
+    let model = fit(&x, &u, &cfg, &mut |_| {}).expect("fixture model");
+    model.save(&dir.join("models/narx.json")).expect("fixture model written");
 }
 
 struct Case {

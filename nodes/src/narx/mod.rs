@@ -1,9 +1,21 @@
-//! NARX models of the display (dissertation chapter 5): the network
-//! ([`net`], Eq. 5.1), min–max normalization as MATLAB's `mapminmax`
-//! ([`mapminmax`]) and its trainers ([`train`]: Levenberg–Marquardt as
-//! `trainlm`, and Adam). The inverse-model nodes, model files and graphs
-//! build on these.
+//! NARX inverse models of the display (dissertation §5.2.1): a network
+//! learns the actuation u[n] from the measured lateral force, trained open
+//! loop and run closed loop.
 
+pub mod closed_loop;
+pub mod error;
+pub mod eval;
+pub mod fit;
+pub mod labdata;
 pub mod mapminmax;
+pub mod model;
 pub mod net;
+pub mod node;
+pub mod taps;
 pub mod train;
+pub mod train_node;
+
+use evflow_engine::NodeSpec;
+
+/// The node types of this family.
+pub static SPECS: &[&NodeSpec] = &[&train_node::SPEC, &node::SPEC];

@@ -1,144 +1,128 @@
-//! Adam (Kingma & Ba, "Adam: a method for stochastic optimization", ICLR
-//! 2015) on the mean squared error: first-order, mini-batches in a seeded
-//! shuffled order, β₁ = 0.9, β₂ = 0.999, ε = 1e-8; an epoch is one pass
-//! over the training rows; early stopping on the validation block as in
-//! [`super::lm`] (with `max_fail` counted in epochs).
+//! Adam training (Kingma & Ba 2015, "Adam: a method for stochastic
+//! optimization", Algorithm 1, with β1 = 0.9, β2 = 0.999, ε = 1e−8): an
+//! alternative to Levenberg–Marquardt for networks too large for its
+//! P × P system. Mini-batches of `batch` rows in an order reshuffled every
+//! epoch (seeded); one epoch is one pass over the training block; early
+//! stopping on the validation block as for LM.
 
-use super::{finish, interrupted, mse, Data, Epoch, Settings, Stop, Trained, Watch};
+use super::{mse, Data, EarlyStop, Epoch, Options, Report, StopReason};
 use crate::lab::rng::Rng;
-use crate::narx::net::Net;
-use std::sync::atomic::AtomicBool;
+use crate::narx::net::Mlp;
+use std::time::Instant;
 
-/// Adam's settings.
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct Adam {
-    /// Learning rate.
-    pub rate: f64,
-    /// Rows per mini-batch.
-    pub batch: usize,
-    /// Shuffling seed.
-    pub seed: u64,
-}
+const BETA1: f64 = 0.9;
+const BETA2: f64 = 0.999;
+const EPS: f64 = 1e-8;
 
-impl Default for Adam {
-    fn default() -> Self {
-        Adam { rate: 1e-3, batch: 32, seed: 1 }
-    }
-}
-
-/// Trains `net` on `train`, early-stopping on `validation` (may be empty).
+/// Trains `net` in place on `train`, stopping early on `val`.
 pub fn train(
-    mut net: Net,
-    train: &Data,
-    validation: &Data,
-    s: &Settings,
-    a: &Adam,
-    mut progress: impl FnMut(&Epoch),
-    stop: Option<&AtomicBool>,
-) -> Trained {
-    let p = net.params.len();
-    let (b1, b2, eps) = (0.9f64, 0.999f64, 1e-8);
-    let mut m = vec![0.0; p];
-    let mut v = vec![0.0; p];
-    let mut g = vec![0.0; p];
-    let mut row_grad = vec![0.0; p];
-    let mut work = net.work();
-    let mut order: Vec<usize> = (0..train.len()).collect();
-    let mut rng = Rng::substream(a.seed, 0xada);
+    net: &mut Mlp,
+    train: &Data<'_>,
+    val: &Data<'_>,
+    opts: &Options,
+    progress: &mut dyn FnMut(&Epoch),
+) -> Report {
+    let start = Instant::now();
+    let p = net.n_params();
+    let n = train.len();
+    let mut ws = net.workspace();
+    let mut perf = mse(net, train, &mut ws);
+    let mut stop = EarlyStop::new(net.weights(), mse(net, val, &mut ws), perf, opts.max_fail);
+    let (mut m, mut v, mut g, mut row) = (vec![0.0; p], vec![0.0; p], vec![0.0; p], vec![0.0; p]);
+    let mut order: Vec<usize> = (0..n).collect();
+    let mut rng = Rng::new(opts.seed);
+    let batch = opts.batch.max(1);
     let mut t = 0i32;
-    let mut watch = Watch::new();
-    let mut reason = Stop::Epochs;
     let mut epochs = 0;
-    if !validation.is_empty() {
-        watch.update(mse(&net, validation, &mut work), &net, s.max_fail);
-    }
-    for epoch in 1..=s.max_epochs {
-        if interrupted(stop) {
-            reason = Stop::Interrupted;
+    let mut reason = StopReason::MaxEpochs;
+    for epoch in 1..=opts.max_epochs {
+        if n == 0 {
             break;
         }
-        // Fisher–Yates with the seeded stream.
-        for i in (1..order.len()).rev() {
+        if perf == 0.0 {
+            reason = StopReason::Goal;
+            break;
+        }
+        // Fisher–Yates shuffle.
+        for i in (1..n).rev() {
             let j = (rng.uniform() * (i + 1) as f64) as usize;
             order.swap(i, j.min(i));
         }
-        let mut gnorm2 = 0.0;
-        for batch in order.chunks(a.batch.max(1)) {
-            g.iter_mut().for_each(|x| *x = 0.0);
-            for &i in batch {
-                let e = net.gradient(&train.rows[i], &mut work, &mut row_grad) - train.targets[i];
-                for (gk, rk) in g.iter_mut().zip(&row_grad) {
-                    *gk += 2.0 * e * rk / batch.len() as f64;
+        let mut gnorm = 0.0;
+        for chunk in order.chunks(batch) {
+            g.fill(0.0);
+            for &i in chunk {
+                let y = net.jacobian_row(train.row(i), &mut ws, &mut row);
+                let e = y - train.target(i);
+                for (gk, rk) in g.iter_mut().zip(&row) {
+                    *gk += 2.0 * e * rk / chunk.len() as f64;
                 }
             }
-            gnorm2 += g.iter().map(|x| x * x).sum::<f64>();
+            gnorm = g.iter().map(|x| x * x).sum::<f64>().sqrt();
             t += 1;
-            let (c1, c2) = (1.0 - b1.powi(t), 1.0 - b2.powi(t));
-            for k in 0..p {
-                m[k] = b1 * m[k] + (1.0 - b1) * g[k];
-                v[k] = b2 * v[k] + (1.0 - b2) * g[k] * g[k];
-                net.params[k] -= a.rate * (m[k] / c1) / ((v[k] / c2).sqrt() + eps);
+            let (c1, c2) = (1.0 - BETA1.powi(t), 1.0 - BETA2.powi(t));
+            for (k, w) in net.weights_mut().iter_mut().enumerate() {
+                m[k] = BETA1 * m[k] + (1.0 - BETA1) * g[k];
+                v[k] = BETA2 * v[k] + (1.0 - BETA2) * g[k] * g[k];
+                *w -= opts.learning_rate * (m[k] / c1) / ((v[k] / c2).sqrt() + EPS);
             }
         }
+        perf = mse(net, train, &mut ws);
+        let vperf = mse(net, val, &mut ws);
         epochs = epoch;
-        let perf = mse(&net, train, &mut work);
-        let val = if validation.is_empty() { f64::NAN } else { mse(&net, validation, &mut work) };
-        progress(&Epoch { epoch, train: perf, validation: val, step: a.rate });
-        if perf <= s.goal {
-            reason = Stop::Goal;
+        progress(&Epoch {
+            epoch,
+            train_mse: perf,
+            val_mse: vperf,
+            gradient: gnorm,
+            mu: 0.0,
+            seconds: start.elapsed().as_secs_f64(),
+        });
+        if !perf.is_finite() {
+            reason = StopReason::MuMax;
             break;
         }
-        if gnorm2.sqrt() < s.min_grad {
-            reason = Stop::MinGradient;
+        if gnorm < opts.min_grad {
+            reason = StopReason::MinGradient;
             break;
         }
-        if !validation.is_empty() && watch.update(val, &net, s.max_fail) {
-            reason = Stop::Validation;
+        if stop.update(epoch, net.weights(), vperf, perf) {
+            reason = StopReason::ValidationStop;
             break;
         }
     }
-    finish(net, watch, train, validation, epochs, reason)
+    let (w, best_epoch, train_mse, val_mse) = stop.best();
+    let (w, best_epoch, train_mse, val_mse) = (w.to_vec(), best_epoch, train_mse, val_mse);
+    net.weights_mut().copy_from_slice(&w);
+    Report { epochs, best_epoch, train_mse, val_mse, stop: reason, seconds: start.elapsed().as_secs_f64() }
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::narx::train::lm;
-
-    fn curve(n: usize) -> Data {
-        let rows: Vec<Vec<f64>> = (0..n).map(|i| vec![-1.0 + 2.0 * i as f64 / (n - 1) as f64]).collect();
-        let targets = rows.iter().map(|r| (2.0 * r[0]).sin()).collect();
-        Data { rows, targets }
-    }
+    use ndarray::{Array1, Array2};
 
     #[test]
-    fn learns_a_curve_and_lm_needs_far_fewer_epochs_for_the_same_error() {
-        let data = curve(60);
-        let s = Settings { max_epochs: 3000, goal: 1e-4, ..Settings::default() };
-        let adam = train(
-            Net::new(1, &[8], 3),
-            &data,
-            &Data::default(),
-            &s,
-            &Adam { rate: 0.01, batch: 16, seed: 1 },
-            |_| {},
-            None,
-        );
-        assert_eq!(adam.stop, Stop::Goal, "{adam:?}");
-        let lm = lm::train(Net::new(1, &[8], 3), &data, &Data::default(), &s, &lm::Mu::default(), |_| {}, None);
-        assert_eq!(lm.stop, Stop::Goal);
-        assert!(lm.epochs * 10 < adam.epochs, "LM {} vs Adam {} epochs", lm.epochs, adam.epochs);
-    }
-
-    #[test]
-    fn deterministic_per_seed() {
-        let data = curve(30);
-        let s = Settings { max_epochs: 20, ..Settings::default() };
-        let run = |seed| {
-            train(Net::new(1, &[4], 2), &data, &Data::default(), &s, &Adam { seed, ..Adam::default() }, |_| {}, None)
-                .net
-        };
-        assert_eq!(run(1), run(1));
-        assert_ne!(run(1), run(2));
+    fn fits_a_smooth_function() {
+        let mut r = Rng::new(1);
+        let n = 400;
+        let mut x = Array2::zeros((n, 2));
+        let mut t = Array1::zeros(n);
+        for i in 0..n {
+            let (a, b) = (2.0 * r.uniform() - 1.0, 2.0 * r.uniform() - 1.0);
+            x[(i, 0)] = a;
+            x[(i, 1)] = b;
+            t[i] = (1.5 * a).sin() * b + 0.3 * a * a;
+        }
+        let d = Data::new(x.slice(ndarray::s![..300, ..]), t.slice(ndarray::s![..300])).unwrap();
+        let v = Data::new(x.slice(ndarray::s![300.., ..]), t.slice(ndarray::s![300..])).unwrap();
+        let mut net = Mlp::new(2, &[8]).unwrap();
+        net.init_nguyen_widrow(&mut Rng::new(5));
+        let mut ws = net.workspace();
+        let before = mse(&net, &d, &mut ws);
+        let opts = Options { max_epochs: 300, learning_rate: 0.01, batch: 16, max_fail: 1000, ..Options::default() };
+        let rep = train(&mut net, &d, &v, &opts, &mut |_| {});
+        assert!(rep.train_mse < before / 20.0 && rep.train_mse < 2e-3, "{rep:?} (before {before})");
+        assert!(rep.val_mse < 4e-3, "{rep:?}");
     }
 }

@@ -1,204 +1,219 @@
-//! Levenberg–Marquardt training as MATLAB's `trainlm`: each epoch forms
-//! the Jacobian J of the outputs with respect to the parameters and the
-//! errors e, and tries dX = −(JᵀJ + μI)⁻¹Jᵀe, dividing μ by 10 on success
-//! and multiplying it by 10 until a step lowers the error or μ exceeds
-//! μ_max (1e10); μ starts at 1e-3. The solve is faer's Cholesky (LLᵀ) of the
-//! damped normal matrix; a matrix that is not positive definite counts as
-//! a failed step (μ grows).
+//! Levenberg–Marquardt training, as MATLAB `trainlm`.
+//!
+//! Each epoch forms the Jacobian J of the network outputs with respect to
+//! the weights over the training block and the errors e = y − t, then tries
+//! the step
+//!
+//! ```text
+//! dX = −(JᵀJ + μI)⁻¹ Jᵀe
+//! ```
+//!
+//! If the step lowers the training MSE it is taken and μ is multiplied by
+//! `mu_dec` (0.1); otherwise μ is multiplied by `mu_inc` (10) and the step
+//! recomputed, until μ exceeds `mu_max` (1e10), which stops training.
+//! JᵀJ + μI is factored by Cholesky (faer's LLᵀ); a factorization that
+//! fails (the matrix not numerically positive definite) is treated like a
+//! step that did not improve: μ is raised. Training also stops after
+//! `max_epochs`, when the MSE gradient norm 2‖Jᵀe‖/N falls below
+//! `min_grad`, and after `max_fail` epochs in a row whose validation error
+//! rose (the weights of the best validation epoch are returned). Parameter
+//! names and defaults are MATLAB's (`trainlm` documentation, Neural Network
+//! Toolbox). JᵀJ is accumulated over blocks of rows so memory stays
+//! O(P² + block·P) for any recording length.
 
-use super::{finish, interrupted, mse, Data, Epoch, Settings, Stop, Trained, Watch};
-use crate::narx::net::Net;
-use faer::prelude::*;
-use faer::Mat;
-use std::sync::atomic::AtomicBool;
+use super::{mse, Data, EarlyStop, Epoch, Options, Report, StopReason};
+use crate::narx::net::Mlp;
+use faer::linalg::solvers::Solve;
+use faer::{Accum, Mat, Par, Side};
+use std::time::Instant;
 
-/// μ schedule of `trainlm`.
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct Mu {
-    /// Initial μ (1e-3).
-    pub initial: f64,
-    /// Factor on failure (10).
-    pub increase: f64,
-    /// Factor on success (0.1).
-    pub decrease: f64,
-    /// Largest μ (1e10).
-    pub max: f64,
-}
+/// Rows of the Jacobian formed at once.
+const BLOCK: usize = 512;
 
-impl Default for Mu {
-    fn default() -> Self {
-        Mu { initial: 1e-3, increase: 10.0, decrease: 0.1, max: 1e10 }
-    }
-}
-
-/// Trains `net` on `train`, early-stopping on `validation` (may be empty).
-/// `progress` sees every epoch; `stop` interrupts between epochs.
+/// Trains `net` in place on `train`, stopping early on `val` (may be
+/// empty); `progress` sees every epoch. Returns the training summary.
 pub fn train(
-    mut net: Net,
-    train: &Data,
-    validation: &Data,
-    s: &Settings,
-    mu_s: &Mu,
-    mut progress: impl FnMut(&Epoch),
-    stop: Option<&AtomicBool>,
-) -> Trained {
-    let p = net.params.len();
+    net: &mut Mlp,
+    train: &Data<'_>,
+    val: &Data<'_>,
+    opts: &Options,
+    progress: &mut dyn FnMut(&Epoch),
+) -> Report {
+    let start = Instant::now();
+    let p = net.n_params();
     let n = train.len();
-    let mut work = net.work();
-    let mut grad = vec![0.0; p];
-    let mut jac = Mat::<f64>::zeros(n, p);
-    let mut err = Mat::<f64>::zeros(n, 1);
-    let mut mu = mu_s.initial;
-    let mut perf = mse(&net, train, &mut work);
-    let mut watch = Watch::new();
-    let mut reason = Stop::Epochs;
+    let mut ws = net.workspace();
+    let mut perf = mse(net, train, &mut ws);
+    let mut stop = EarlyStop::new(net.weights(), mse(net, val, &mut ws), perf, opts.max_fail);
+    let mut mu = opts.mu;
+    let mut jtj = Mat::<f64>::zeros(p, p);
+    let mut jte = Mat::<f64>::zeros(p, 1);
+    let mut jblock = Mat::<f64>::zeros(BLOCK, p);
+    let mut eblock = Mat::<f64>::zeros(BLOCK, 1);
+    let mut row = vec![0.0; p];
+    let mut trial = vec![0.0; p];
     let mut epochs = 0;
-    if !validation.is_empty() {
-        watch.update(mse(&net, validation, &mut work), &net, s.max_fail);
-    }
-    for epoch in 1..=s.max_epochs {
-        if interrupted(stop) {
-            reason = Stop::Interrupted;
+    let mut reason = StopReason::MaxEpochs;
+    for epoch in 1..=opts.max_epochs {
+        if n == 0 {
             break;
         }
-        if perf <= s.goal {
-            reason = Stop::Goal;
+        if perf == 0.0 {
+            reason = StopReason::Goal;
             break;
         }
-        for (i, (x, t)) in train.rows.iter().zip(&train.targets).enumerate() {
-            let y = net.gradient(x, &mut work, &mut grad);
-            err[(i, 0)] = y - t;
-            for (k, g) in grad.iter().enumerate() {
-                jac[(i, k)] = *g;
+        // JᵀJ and Jᵀe, block by block.
+        let mut first = true;
+        let mut s = 0;
+        while s < n {
+            let m = BLOCK.min(n - s);
+            for i in 0..m {
+                let y = net.jacobian_row(train.row(s + i), &mut ws, &mut row);
+                for (k, v) in row.iter().enumerate() {
+                    jblock[(i, k)] = *v;
+                }
+                eblock[(i, 0)] = y - train.target(s + i);
             }
+            let (jb, eb) = (jblock.as_ref().subrows(0, m), eblock.as_ref().subrows(0, m));
+            let acc = if first { Accum::Replace } else { Accum::Add };
+            faer::linalg::matmul::matmul(jtj.as_mut(), acc, jb.transpose(), jb, 1.0, Par::Seq);
+            faer::linalg::matmul::matmul(jte.as_mut(), acc, jb.transpose(), eb, 1.0, Par::Seq);
+            first = false;
+            s += m;
         }
-        let jt = jac.transpose();
-        let jtj = jt * &jac;
-        let jte = jt * &err;
-        let gnorm = (0..p).map(|k| jte[(k, 0)].powi(2)).sum::<f64>().sqrt() * 2.0 / n.max(1) as f64;
-        if gnorm < s.min_grad {
-            reason = Stop::MinGradient;
+        let gradient = 2.0 * (0..p).map(|k| jte[(k, 0)] * jte[(k, 0)]).sum::<f64>().sqrt() / n as f64;
+        if gradient.is_nan() || gradient < opts.min_grad {
+            reason = StopReason::MinGradient;
             break;
         }
-        epochs = epoch;
+        // Raise μ until a step lowers the training error.
         let mut improved = false;
-        while mu <= mu_s.max {
+        while mu <= opts.mu_max {
             let mut a = jtj.clone();
             for k in 0..p {
                 a[(k, k)] += mu;
             }
-            if let Ok(llt) = a.llt(faer::Side::Lower) {
-                let dx = llt.solve(&jte);
-                let mut trial = net.clone();
-                for k in 0..p {
-                    trial.params[k] -= dx[(k, 0)];
-                }
-                let trial_perf = mse(&trial, train, &mut work);
-                if trial_perf.is_finite() && trial_perf < perf {
-                    net = trial;
-                    perf = trial_perf;
-                    mu *= mu_s.decrease;
-                    improved = true;
-                    break;
+            if let Ok(llt) = a.llt(Side::Lower) {
+                let dx = llt.solve(jte.as_ref());
+                let w = net.weights();
+                let ok = (0..p).all(|k| dx[(k, 0)].is_finite());
+                if ok {
+                    for k in 0..p {
+                        trial[k] = w[k] - dx[(k, 0)];
+                    }
+                    let saved: Vec<f64> = w.to_vec();
+                    net.weights_mut().copy_from_slice(&trial);
+                    let perf2 = mse(net, train, &mut ws);
+                    if perf2 < perf {
+                        perf = perf2;
+                        mu *= opts.mu_dec;
+                        improved = true;
+                        break;
+                    }
+                    net.weights_mut().copy_from_slice(&saved);
                 }
             }
-            mu *= mu_s.increase;
+            mu *= opts.mu_inc;
         }
-        let val = if validation.is_empty() { f64::NAN } else { mse(&net, validation, &mut work) };
-        progress(&Epoch { epoch, train: perf, validation: val, step: mu });
+        epochs = epoch;
+        let vperf = mse(net, val, &mut ws);
+        progress(&Epoch {
+            epoch,
+            train_mse: perf,
+            val_mse: vperf,
+            gradient,
+            mu,
+            seconds: start.elapsed().as_secs_f64(),
+        });
         if !improved {
-            reason = Stop::MaxMu;
+            reason = StopReason::MuMax;
             break;
         }
-        if !validation.is_empty() && watch.update(val, &net, s.max_fail) {
-            reason = Stop::Validation;
+        if stop.update(epoch, net.weights(), vperf, perf) {
+            reason = StopReason::ValidationStop;
             break;
         }
     }
-    finish(net, watch, train, validation, epochs, reason)
+    let (w, best_epoch, train_mse, val_mse) = stop.best();
+    let (w, best_epoch, train_mse, val_mse) = (w.to_vec(), best_epoch, train_mse, val_mse);
+    net.weights_mut().copy_from_slice(&w);
+    Report { epochs, best_epoch, train_mse, val_mse, stop: reason, seconds: start.elapsed().as_secs_f64() }
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::lab::rng::Rng;
+    use ndarray::{Array1, Array2};
 
-    fn curve(n: usize, f: impl Fn(f64) -> f64) -> Data {
-        let rows: Vec<Vec<f64>> = (0..n).map(|i| vec![-1.0 + 2.0 * i as f64 / (n - 1) as f64]).collect();
-        let targets = rows.iter().map(|r| f(r[0])).collect();
-        Data { rows, targets }
-    }
-
-    #[test]
-    fn fits_a_smooth_curve_to_high_accuracy() {
-        let data = curve(60, |x| (2.0 * x).sin());
-        let t =
-            train(Net::new(1, &[8], 3), &data, &Data::default(), &Settings::default(), &Mu::default(), |_| {}, None);
-        assert!(t.train_mse < 1e-6, "{t:?}");
-    }
-
-    #[test]
-    fn a_linear_model_reaches_least_squares_in_a_few_steps() {
-        // y = 0.7·a − 0.2·b + 0.1 plus a fixed disturbance: LM on a linear
-        // model converges to the normal-equations solution.
-        let rows: Vec<Vec<f64>> = (0..50).map(|i| vec![(i as f64 * 0.37).sin(), (i as f64 * 0.11).cos()]).collect();
-        let targets: Vec<f64> = rows
-            .iter()
-            .enumerate()
-            .map(|(i, r)| 0.7 * r[0] - 0.2 * r[1] + 0.1 + 0.01 * (i as f64 * 1.3).sin())
-            .collect();
-        let data = Data { rows: rows.clone(), targets: targets.clone() };
-        let s = Settings { max_epochs: 20, ..Settings::default() };
-        let t = train(Net::new(2, &[], 1), &data, &Data::default(), &s, &Mu::default(), |_| {}, None);
-        // Normal equations with faer.
-        let x = Mat::<f64>::from_fn(50, 3, |i, j| if j < 2 { rows[i][j] } else { 1.0 });
-        let y = Mat::<f64>::from_fn(50, 1, |i, _| targets[i]);
-        let xt = x.transpose();
-        let beta = (xt * &x).llt(faer::Side::Lower).unwrap().solve(&(xt * &y));
-        for k in 0..3 {
-            assert!((t.net.params[k] - beta[(k, 0)]).abs() < 1e-6, "{:?} vs {:?}", t.net.params, beta);
+    /// Samples of a smooth nonlinear function of two inputs.
+    fn problem(n: usize, seed: u64) -> (Array2<f64>, Array1<f64>) {
+        let mut r = Rng::new(seed);
+        let mut x = Array2::zeros((n, 2));
+        let mut t = Array1::zeros(n);
+        for i in 0..n {
+            let (a, b) = (2.0 * r.uniform() - 1.0, 2.0 * r.uniform() - 1.0);
+            x[(i, 0)] = a;
+            x[(i, 1)] = b;
+            t[i] = (1.5 * a).sin() * b + 0.3 * a * a;
         }
+        (x, t)
     }
 
     #[test]
-    fn early_stopping_returns_the_best_validation_network() {
-        // Few noisy samples, a big network: the validation error must rise.
-        let mut data = curve(30, |x| x * x);
-        for (i, t) in data.targets.iter_mut().enumerate() {
-            *t += 0.2 * ((i * 7919) % 13) as f64 / 13.0 - 0.1;
+    fn fits_a_smooth_function_to_small_error() {
+        let (x, t) = problem(300, 1);
+        let (xv, tv) = problem(100, 2);
+        let (d, v) = (Data::new(x.view(), t.view()).unwrap(), Data::new(xv.view(), tv.view()).unwrap());
+        let mut net = Mlp::new(2, &[8]).unwrap();
+        net.init_nguyen_widrow(&mut Rng::new(5));
+        let mut ws = net.workspace();
+        let before = mse(&net, &d, &mut ws);
+        let mut seen = Vec::new();
+        let opts = Options { max_epochs: 200, ..Options::default() };
+        let r = train(&mut net, &d, &v, &opts, &mut |e| seen.push(*e));
+        assert!(r.train_mse < 1e-5 && r.val_mse < 1e-4, "{r:?} (before {before})");
+        // The training error never rises from epoch to epoch.
+        for w in seen.windows(2) {
+            assert!(w[1].train_mse <= w[0].train_mse, "{:?}", w);
         }
-        let val = curve(17, |x| x * x);
-        let mut history = Vec::new();
-        let t = train(
-            Net::new(1, &[20, 20], 5),
-            &data,
-            &val,
-            &Settings::default(),
-            &Mu::default(),
-            |e| history.push(e.validation),
-            None,
-        );
-        assert_eq!(t.stop, Stop::Validation, "{t:?}");
-        let best = history.iter().copied().fold(f64::INFINITY, f64::min);
-        let initial = mse(&Net::new(1, &[20, 20], 5), &val, &mut Net::new(1, &[20, 20], 5).work());
-        assert!((t.validation_mse - best.min(initial)).abs() < 1e-15, "{} vs {best}", t.validation_mse);
+        assert_eq!(r.train_mse, mse(&net, &d, &mut ws));
     }
 
     #[test]
-    fn deterministic_and_interruptible() {
-        let data = curve(40, |x| x.tanh());
-        let run =
-            || train(Net::new(1, &[4], 9), &data, &Data::default(), &Settings::default(), &Mu::default(), |_| {}, None);
-        assert_eq!(run().net, run().net);
-        let flag = AtomicBool::new(true);
-        let t = train(
-            Net::new(1, &[4], 9),
-            &data,
-            &Data::default(),
-            &Settings::default(),
-            &Mu::default(),
-            |_| {},
-            Some(&flag),
-        );
-        assert_eq!((t.stop, t.epochs), (Stop::Interrupted, 0));
+    fn a_linear_problem_is_solved_in_one_step_at_small_mu() {
+        // Without hidden layers the network is linear in its weights: one
+        // Gauss–Newton step (μ → 0) lands on the least-squares solution.
+        let (x, _) = problem(50, 3);
+        let t: Array1<f64> = x.rows().into_iter().map(|r| 0.7 * r[0] - 1.2 * r[1] + 0.4).collect();
+        let d = Data::new(x.view(), t.view()).unwrap();
+        let empty = Data::new(x.slice(ndarray::s![0..0, ..]), t.slice(ndarray::s![0..0])).unwrap();
+        let mut net = Mlp::new(2, &[]).unwrap();
+        let opts = Options { max_epochs: 1, mu: 1e-12, ..Options::default() };
+        let r = train(&mut net, &d, &empty, &opts, &mut |_| {});
+        let w = net.weights();
+        assert!((w[0] - 0.7).abs() < 1e-9 && (w[1] + 1.2).abs() < 1e-9 && (w[2] - 0.4).abs() < 1e-9, "{w:?}");
+        assert!(r.val_mse.is_nan());
+    }
+
+    #[test]
+    fn validation_failures_stop_training_and_keep_the_best_weights() {
+        // Pure noise targets: the network can only overfit, so the
+        // validation error rises and training stops after max_fail epochs.
+        let (x, _) = problem(40, 4);
+        let mut r = Rng::new(9);
+        let t: Array1<f64> = (0..40).map(|_| r.gaussian()).collect();
+        let (xv, _) = problem(40, 6);
+        let tv: Array1<f64> = (0..40).map(|_| r.gaussian()).collect();
+        let (d, v) = (Data::new(x.view(), t.view()).unwrap(), Data::new(xv.view(), tv.view()).unwrap());
+        let mut net = Mlp::new(2, &[12]).unwrap();
+        net.init_nguyen_widrow(&mut Rng::new(2));
+        let mut seen = Vec::new();
+        let rep = train(&mut net, &d, &v, &Options::default(), &mut |e| seen.push(*e));
+        assert_eq!(rep.stop, StopReason::ValidationStop, "{rep:?}");
+        let best = seen.iter().map(|e| e.val_mse).fold(f64::INFINITY, f64::min);
+        let mut ws = net.workspace();
+        assert!(rep.val_mse <= best && (mse(&net, &v, &mut ws) - rep.val_mse).abs() < 1e-12);
+        assert!(rep.epochs >= rep.best_epoch + 6 && rep.epochs < 1000);
     }
 }

@@ -1,0 +1,274 @@
+//! Closed-loop (parallel) inference, dissertation Fig. 5.3(b): the
+//! network's own estimates are fed back in place of the reference, one
+//! sample per call, without allocating.
+//!
+//! Each call takes the newest force sample x[t] and returns the estimate
+//! of u[t − L], L = max(d, 0) the look-ahead latency ([`super::taps`]).
+//! Before the histories have filled, missing force samples count as 0 N and
+//! missing past estimates as u = 0.
+//!
+//! Bounds: the network output (normalized units) is clamped to [−1, 1], the
+//! range the training targets were mapped to, before it is fed back and
+//! mapped back to actuation units — so the estimate always stays within the
+//! training range of u, whatever the force does. A non-finite force sample
+//! is read as 0 N and counted; an output more than 1 beyond the range
+//! (|y| > 2 before clamping, or non-finite, which a tanh network cannot
+//! produce from finite inputs) is counted as a divergence and replaced by
+//! the clamped value (0 for non-finite).
+
+use super::mapminmax::MapMinMax;
+use super::net::{Mlp, Workspace};
+use super::taps::Taps;
+
+/// A running closed-loop NARX network.
+#[derive(Debug, Clone)]
+pub struct ClosedLoop {
+    net: Mlp,
+    ws: Workspace,
+    taps: Taps,
+    xmap: MapMinMax,
+    ymap: MapMinMax,
+    /// Normalized force history, a ring of k_x + L + 1 values.
+    xh: Vec<f64>,
+    /// Normalized estimate history, a ring of k_y values.
+    yh: Vec<f64>,
+    xpos: usize,
+    ypos: usize,
+    row: Vec<f64>,
+    x0: f64,
+    y0: f64,
+    /// Samples whose output was clamped into [−1, 1] (normalized).
+    pub clamped: u64,
+    /// Samples whose output was non-finite or beyond ±2 (normalized) before clamping.
+    pub diverged: u64,
+    /// Non-finite force samples read as 0.
+    pub bad_inputs: u64,
+}
+
+impl ClosedLoop {
+    /// A closed loop over a trained network, its taps and the maps of force
+    /// (`xmap`) and actuation (`ymap`). The network must have
+    /// `taps.n_inputs()` inputs.
+    pub fn new(net: Mlp, taps: Taps, xmap: MapMinMax, ymap: MapMinMax) -> Self {
+        debug_assert_eq!(net.inputs(), taps.n_inputs());
+        let ws = net.workspace();
+        let nx = taps.input + taps.latency() + 1;
+        let x0 = xmap.apply(0.0);
+        let y0 = ymap.apply(0.0).clamp(-1.0, 1.0);
+        let row = vec![0.0; taps.n_inputs()];
+        Self {
+            net,
+            ws,
+            taps,
+            xmap,
+            ymap,
+            xh: vec![x0; nx],
+            yh: vec![y0; taps.feedback.max(1)],
+            xpos: 0,
+            ypos: 0,
+            row,
+            x0,
+            y0,
+            clamped: 0,
+            diverged: 0,
+            bad_inputs: 0,
+        }
+    }
+
+    /// The taps.
+    pub fn taps(&self) -> &Taps {
+        &self.taps
+    }
+
+    /// Back to the start: empty histories, counters at zero.
+    pub fn reset(&mut self) {
+        self.xh.fill(self.x0);
+        self.yh.fill(self.y0);
+        self.xpos = 0;
+        self.ypos = 0;
+        self.clamped = 0;
+        self.diverged = 0;
+        self.bad_inputs = 0;
+    }
+
+    /// Takes the force sample x[t] (N) and returns the estimate of u[t − L].
+    #[inline]
+    pub fn step(&mut self, x: f64) -> f64 {
+        let y = self.estimate(x);
+        self.feed_back(y);
+        self.ymap.reverse(y)
+    }
+
+    /// Like [`ClosedLoop::step`], but feeds back the known actuation
+    /// `u_known` = u[t − L] instead of the estimate (teacher forcing): how a
+    /// closed loop is started from known initial states, as MATLAB's
+    /// `preparets` does with the first k_y targets. Returns the estimate.
+    pub fn step_known(&mut self, x: f64, u_known: f64) -> f64 {
+        let y = self.estimate(x);
+        let known = self.ymap.apply(if u_known.is_finite() { u_known } else { 0.0 }).clamp(-1.0, 1.0);
+        self.feed_back(known);
+        self.ymap.reverse(y)
+    }
+
+    /// The clamped, normalized network output for the newest force sample.
+    #[inline]
+    fn estimate(&mut self, x: f64) -> f64 {
+        let x = if x.is_finite() {
+            x
+        } else {
+            self.bad_inputs += 1;
+            0.0
+        };
+        let nx = self.xh.len();
+        self.xpos = if self.xpos + 1 == nx { 0 } else { self.xpos + 1 };
+        self.xh[self.xpos] = self.xmap.apply(x);
+        // The newest sample in the window is x[n + d]: for d < 0 it lies
+        // −d samples behind the newest one received (x[t], n = t).
+        let skip = (self.taps.latency() as i64 - self.taps.lookahead) as usize;
+        let (xh, xpos, yh, ypos) = (&self.xh, self.xpos, &self.yh, self.ypos);
+        let ny = yh.len();
+        self.taps.fill(&mut self.row, |k| yh[(ypos + ny + 1 - k) % ny], |j| xh[(xpos + 2 * nx - skip - j) % nx]);
+        let raw = self.net.forward(&self.row, &mut self.ws);
+        if raw.is_finite() {
+            if raw.abs() > 2.0 {
+                self.diverged += 1;
+            }
+            if raw.abs() > 1.0 {
+                self.clamped += 1;
+            }
+            raw.clamp(-1.0, 1.0)
+        } else {
+            self.diverged += 1;
+            self.y0
+        }
+    }
+
+    #[inline]
+    fn feed_back(&mut self, y: f64) {
+        if self.taps.feedback > 0 {
+            let ny = self.yh.len();
+            self.ypos = if self.ypos + 1 == ny { 0 } else { self.ypos + 1 };
+            self.yh[self.ypos] = y;
+        }
+    }
+
+    /// Runs a whole force series and returns the estimates aligned with it:
+    /// element n is the estimate of u[n] (the last L samples, whose
+    /// look-ahead lies past the end of `x`, are estimated with 0 N there).
+    pub fn run(&mut self, x: &[f64]) -> Vec<f64> {
+        let lat = self.taps.latency();
+        let mut out = Vec::with_capacity(x.len());
+        for (t, &v) in x.iter().chain(std::iter::repeat_n(&0.0, lat)).enumerate() {
+            let u = self.step(v);
+            if t >= lat {
+                out.push(u);
+            }
+        }
+        out
+    }
+
+    /// Runs a whole force series like [`ClosedLoop::run`], with the first
+    /// `known` estimates replaced by the true actuation `u` in the feedback
+    /// (started from known states, see [`ClosedLoop::step_known`]).
+    pub fn run_known(&mut self, x: &[f64], u: &[f64], known: usize) -> Vec<f64> {
+        let lat = self.taps.latency();
+        let mut out = Vec::with_capacity(x.len());
+        for (t, &v) in x.iter().chain(std::iter::repeat_n(&0.0, lat)).enumerate() {
+            let e = match t.checked_sub(lat) {
+                Some(n) if n < known && n < u.len() => self.step_known(v, u[n]),
+                _ => self.step(v),
+            };
+            if t >= lat {
+                out.push(e);
+            }
+        }
+        out
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::lab::rng::Rng;
+
+    fn map(min: f64, max: f64) -> MapMinMax {
+        MapMinMax { min, max }
+    }
+
+    /// A network that copies one chosen input to its output (a linear
+    /// network with a one-hot weight row), to see which sample each tap reads.
+    fn picker(taps: Taps, which: usize) -> ClosedLoop {
+        let n = taps.n_inputs();
+        let mut w = vec![0.0; n + 1];
+        w[which] = 1.0;
+        let net = Mlp::with_weights(n, &[], w).unwrap();
+        ClosedLoop::new(net, taps, map(-1.0, 1.0), map(-1.0, 1.0))
+    }
+
+    #[test]
+    fn taps_read_the_same_samples_as_the_open_loop_regressor() {
+        // x ramps through [−1, 1]; each input tap picked alone must give the
+        // sample the open-loop regressor has there.
+        let x: Vec<f64> = (0..40).map(|i| -0.95 + 0.045 * i as f64).collect();
+        for taps in [
+            Taps { feedback: 0, input: 3, lookahead: 2 },
+            Taps { feedback: 0, input: 2, lookahead: -1 },
+            Taps { feedback: 0, input: 0, lookahead: 0 },
+            Taps { feedback: 0, input: 4, lookahead: 5 },
+        ] {
+            let (m, _) = taps.regressors(&x, &x);
+            for j in 0..taps.input_taps() {
+                let est = picker(taps, j).run(&x);
+                for r in 0..m.nrows() {
+                    let n = taps.first() + r;
+                    assert!((est[n] - m[(r, j)]).abs() < 1e-12, "{taps:?} tap {j} sample {n}");
+                }
+            }
+        }
+    }
+
+    #[test]
+    fn feedback_taps_read_past_estimates() {
+        // y[n] = 0.5·y[n−2] + x[n]: an impulse must echo every second sample.
+        let taps = Taps { feedback: 2, input: 0, lookahead: 0 };
+        let net = Mlp::with_weights(3, &[], vec![0.0, 0.5, 1.0, 0.0]).unwrap();
+        let mut cl = ClosedLoop::new(net, taps, map(-1.0, 1.0), map(-1.0, 1.0));
+        let y = cl.run(&[0.8, 0.0, 0.0, 0.0, 0.0, 0.0]);
+        let want = [0.8, 0.0, 0.4, 0.0, 0.2, 0.0];
+        for (a, b) in y.iter().zip(want) {
+            assert!((a - b).abs() < 1e-12, "{y:?}");
+        }
+    }
+
+    #[test]
+    fn known_states_are_fed_back_before_the_loop_closes() {
+        // y[n] = y[n−1]: the loop holds whatever was fed back last.
+        let taps = Taps { feedback: 1, input: 0, lookahead: 0 };
+        let net = Mlp::with_weights(2, &[], vec![1.0, 0.0, 0.0]).unwrap();
+        let mut cl = ClosedLoop::new(net, taps, map(-1.0, 1.0), map(-1.0, 1.0));
+        let u = [0.5, -0.3, 0.7, 0.1, 0.1];
+        let est = cl.run_known(&[0.0; 5], &u, 3);
+        let want = [0.0, 0.5, -0.3, 0.7, 0.7];
+        for (a, b) in est.iter().zip(want) {
+            assert!((a - b).abs() < 1e-12, "{est:?}");
+        }
+    }
+
+    #[test]
+    fn outputs_stay_in_the_training_range_and_bad_input_is_counted() {
+        // An unstable loop: y[n] = 3·y[n−1] + x[n] would grow without bound.
+        let taps = Taps { feedback: 1, input: 0, lookahead: 0 };
+        let net = Mlp::with_weights(2, &[], vec![3.0, 1.0, 0.0]).unwrap();
+        let mut cl = ClosedLoop::new(net, taps, map(-2.0, 2.0), map(-0.5, 1.5));
+        let mut r = Rng::new(1);
+        for i in 0..1000 {
+            let x = if i == 500 { f64::NAN } else { 10.0 * r.gaussian() };
+            let u = cl.step(x);
+            assert!((-0.5..=1.5).contains(&u), "{u}");
+        }
+        assert_eq!(cl.bad_inputs, 1);
+        assert!(cl.clamped > 0 && cl.diverged > 0);
+        cl.reset();
+        assert_eq!((cl.clamped, cl.diverged, cl.bad_inputs), (0, 0, 0));
+    }
+}

@@ -136,3 +136,80 @@ fn repeated_recordings_differ_only_by_the_sensor_and_much_less_than_samples() {
         }
     }
 }
+
+#[test]
+fn under_the_virtual_users_finger_the_texture_stays_on_the_surface() {
+    // sim.user strokes rippled paper for 20 s with speed and pressure
+    // varying like a person's: μ = F / (N·tanh(v/v_s)) read back at the
+    // same place on different strokes agrees, whatever the speed — the
+    // texture is a surface, not a time signal.
+    let text = r#"[graph]
+format = 1
+name = "user-on-texture"
+rate = 1000
+connections = [
+  "user.position -> texture.position",
+  "user.velocity -> texture.velocity",
+  "user.load -> texture.load",
+  "texture.force -> f.in",
+  "user.position -> x.in",
+  "user.velocity -> v.in",
+  "user.load -> n.in",
+]
+[nodes.user]
+type = "sim.user"
+seed = 5
+[nodes.texture]
+type = "sim.texture"
+sample = "rippled-paper"
+[nodes.f]
+type = "harness.tap"
+[nodes.x]
+type = "harness.tap"
+[nodes.v]
+type = "harness.tap"
+[nodes.n]
+type = "harness.tap"
+"#;
+    let mut reg = Registry::new();
+    for s in crate::lab::SPECS {
+        reg.add(s);
+    }
+    reg.add(&TAP);
+    let g = parse_graph(Path::new("user-on-texture.toml"), text).unwrap();
+    let checked = check(&g, &reg, &[]).unwrap_or_else(|e| panic!("{e}"));
+    let opts = PlanOptions { max_block: 100, seed: Some(1), base_dir: None, timing: false, out_dir: None };
+    let mut plan = Plan::build(&checked, &opts).unwrap();
+    // μ per 25 µm of position: (min, max, count) over the strokes.
+    let mut bins = vec![(f64::INFINITY, f64::NEG_INFINITY, 0usize); 3200];
+    let (mut speeds, mut loads) = (Vec::new(), Vec::new());
+    for _ in 0..200 {
+        plan.step(100).unwrap();
+        let (f, x) = (plan.output("texture", 0).unwrap(), plan.output("user", 0).unwrap());
+        let (v, n) = (plan.output("user", 1).unwrap(), plan.output("user", 2).unwrap());
+        for k in 0..f.len() {
+            assert!(f[k].is_finite() && f[k].abs() <= 1.9 * 0.17 * n[k] + 1e-12);
+            if v[k].abs() > 0.01 {
+                let mu = f[k] / (n[k] * (v[k] / super::surface::V_SIGN).tanh());
+                let b = &mut bins[((x[k] * 4e4) as usize).min(3199)];
+                *b = (b.0.min(mu), b.1.max(mu), b.2 + 1);
+                speeds.push(v[k].abs());
+                loads.push(n[k]);
+            }
+        }
+    }
+    let span =
+        |x: &[f64]| x.iter().fold(f64::NEG_INFINITY, |a, b| a.max(*b)) - x.iter().fold(f64::INFINITY, |a, b| a.min(*b));
+    assert!(span(&speeds) > 0.03 && span(&loads) > 0.2, "the user varied speed and load");
+    let visited: Vec<_> = bins.iter().filter(|b| b.2 >= 3).collect();
+    assert!(visited.len() > 1600, "{} bins visited on several strokes", visited.len());
+    // Within a 25 µm bin μ moves by at most its slope times 25 µm (about
+    // μ₀·(2π·0.5/2.5 + 2π·0.06/1.25 + roughness) mm⁻¹ · 0.025 mm ≈ 0.008)
+    // plus the patch's small load dependence; across the surface it spans
+    // about ±50 % of μ₀ = 0.17.
+    let within = visited.iter().map(|b| b.1 - b.0).fold(0.0, f64::max);
+    println!("{} bins visited 3 times or more; μ spread within a bin ≤ {within:.4}", visited.len());
+    let across = visited.iter().map(|b| b.1).fold(0.0, f64::max) - visited.iter().map(|b| b.0).fold(1.0, f64::min);
+    assert!(within < 0.012, "μ at one place differs by {within} between strokes");
+    assert!(across > 0.15, "μ spans {across} over the surface");
+}

@@ -2,6 +2,9 @@
 
 use std::path::{Path, PathBuf};
 
+#[path = "alloc_counter.rs"]
+pub mod alloc_counter;
+
 /// The repository's root folder.
 pub fn root() -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR")).parent().expect("tests/ sits in the root").to_path_buf()

@@ -15,59 +15,17 @@
 
 use evflow_engine::live::{self, LiveConfig, LivePlan};
 use evflow_engine::{load_file, Plan, PlanOptions};
-use std::alloc::{GlobalAlloc, Layout, System};
-use std::cell::Cell;
-use std::sync::atomic::{AtomicU64, Ordering};
-
-struct Counting;
-
-thread_local! {
-    static ARMED: Cell<bool> = const { Cell::new(false) };
-}
-static ALLOCS: AtomicU64 = AtomicU64::new(0);
-static ARMINGS: AtomicU64 = AtomicU64::new(0);
-
-fn armed() -> bool {
-    ARMED.try_with(|a| a.get()).unwrap_or(false)
-}
-
-// SAFETY: forwards to the system allocator; counting has no effect on memory.
-unsafe impl GlobalAlloc for Counting {
-    unsafe fn alloc(&self, l: Layout) -> *mut u8 {
-        if armed() {
-            ALLOCS.fetch_add(1, Ordering::SeqCst);
-        }
-        unsafe { System.alloc(l) }
-    }
-    unsafe fn dealloc(&self, p: *mut u8, l: Layout) {
-        if armed() {
-            ALLOCS.fetch_add(1, Ordering::SeqCst);
-        }
-        unsafe { System.dealloc(p, l) }
-    }
-    unsafe fn alloc_zeroed(&self, l: Layout) -> *mut u8 {
-        if armed() {
-            ALLOCS.fetch_add(1, Ordering::SeqCst);
-        }
-        unsafe { System.alloc_zeroed(l) }
-    }
-    unsafe fn realloc(&self, p: *mut u8, l: Layout, n: usize) -> *mut u8 {
-        if armed() {
-            ALLOCS.fetch_add(1, Ordering::SeqCst);
-        }
-        unsafe { System.realloc(p, l, n) }
-    }
-}
+use evflow_tests::alloc_counter;
+use std::sync::atomic::Ordering;
 
 #[global_allocator]
-static GLOBAL: Counting = Counting;
+static GLOBAL: alloc_counter::Counting = alloc_counter::Counting;
 
 fn hook(on: bool) {
     if on {
-        ARMINGS.fetch_add(1, Ordering::SeqCst);
         syscalls::forbid_on_this_thread();
     }
-    ARMED.with(|a| a.set(on));
+    alloc_counter::arm(on);
 }
 
 /// The seccomp filter and the SIGSYS handler that counts trapped calls.
@@ -181,8 +139,8 @@ fn allocations(plan: Plan, seconds: f64) -> Result<Counts, String> {
     }
     let lp = LivePlan::new(plan, &taps).map_err(|e| e.to_string())?;
     let cfg = LiveConfig { duration: Some(seconds), miss_streak: 0, hook: Some(hook), ..LiveConfig::default() };
-    let before = ALLOCS.load(Ordering::SeqCst);
-    let armings = ARMINGS.load(Ordering::SeqCst);
+    let before = alloc_counter::allocations();
+    let armings = alloc_counter::armings();
     let mut session = live::start(lp, &cfg).map_err(|e| e.to_string())?;
     let half = session.control.tick_at(seconds / 2.0);
     for (node, p) in &changes {
@@ -199,9 +157,9 @@ fn allocations(plan: Plan, seconds: f64) -> Result<Counts, String> {
     if let Some(f) = exit.failure {
         return Err(f.to_string());
     }
-    assert_eq!(ARMINGS.load(Ordering::SeqCst), armings + 1, "the hook armed the guard");
+    assert_eq!(alloc_counter::armings(), armings + 1, "the hook armed the guard");
     Ok(Counts {
-        allocations: ALLOCS.load(Ordering::SeqCst) - before,
+        allocations: alloc_counter::allocations() - before,
         syscalls: syscalls::TRAPPED.load(Ordering::SeqCst),
         first_syscall: syscalls::FIRST.load(Ordering::SeqCst),
     })

@@ -9,66 +9,27 @@
 
 use evflow_engine::live::{self, LiveConfig, LivePlan};
 use evflow_engine::{check, graph::parse_graph, Override, Plan, PlanOptions};
-use std::alloc::{GlobalAlloc, Layout, System};
-use std::cell::Cell;
+use evflow_tests::alloc_counter;
 use std::io::{BufRead, BufReader};
 use std::path::Path;
 use std::process::{Command, Stdio};
-use std::sync::atomic::{AtomicU64, Ordering};
-
-struct Counting;
-
-thread_local! {
-    static ARMED: Cell<bool> = const { Cell::new(false) };
-}
-static ALLOCS: AtomicU64 = AtomicU64::new(0);
-static ARMINGS: AtomicU64 = AtomicU64::new(0);
-
-fn armed() -> bool {
-    ARMED.try_with(|a| a.get()).unwrap_or(false)
-}
-
-// SAFETY: forwards to the system allocator; counting has no effect on memory.
-unsafe impl GlobalAlloc for Counting {
-    unsafe fn alloc(&self, l: Layout) -> *mut u8 {
-        if armed() {
-            ALLOCS.fetch_add(1, Ordering::SeqCst);
-        }
-        unsafe { System.alloc(l) }
-    }
-    unsafe fn dealloc(&self, p: *mut u8, l: Layout) {
-        if armed() {
-            ALLOCS.fetch_add(1, Ordering::SeqCst);
-        }
-        unsafe { System.dealloc(p, l) }
-    }
-    unsafe fn realloc(&self, p: *mut u8, l: Layout, n: usize) -> *mut u8 {
-        if armed() {
-            ALLOCS.fetch_add(1, Ordering::SeqCst);
-        }
-        unsafe { System.realloc(p, l, n) }
-    }
-}
 
 #[global_allocator]
-static GLOBAL: Counting = Counting;
+static GLOBAL: alloc_counter::Counting = alloc_counter::Counting;
 
 fn hook(on: bool) {
-    if on {
-        ARMINGS.fetch_add(1, Ordering::SeqCst);
-    }
-    ARMED.with(|a| a.set(on));
+    alloc_counter::arm(on);
 }
 
 #[test]
 fn connected_serial_nodes_do_not_allocate_on_the_real_time_thread() {
     // The counter counts: an allocation while armed is seen.
-    let n0 = ALLOCS.load(Ordering::SeqCst);
-    ARMED.with(|a| a.set(true));
+    let n0 = alloc_counter::allocations();
+    alloc_counter::arm(true);
     let v = std::hint::black_box(vec![1u8; 10]);
     drop(v);
-    ARMED.with(|a| a.set(false));
-    assert_eq!(ALLOCS.load(Ordering::SeqCst) - n0, 2, "one allocation and one free counted");
+    alloc_counter::arm(false);
+    assert_eq!(alloc_counter::allocations() - n0, 2, "one allocation and one free counted");
 
     let tmp = tempfile::tempdir().unwrap();
     let link = tmp.path().join("dev");
@@ -94,7 +55,7 @@ fn connected_serial_nodes_do_not_allocate_on_the_real_time_thread() {
     taps.extend(LivePlan::guard_taps(&plan));
     let lp = LivePlan::new(plan, &taps).unwrap();
     let cfg = LiveConfig { duration: Some(1.0), miss_streak: 0, hook: Some(hook), ..LiveConfig::default() };
-    let before = ALLOCS.load(Ordering::SeqCst);
+    let (before, armings) = (alloc_counter::allocations(), alloc_counter::armings());
     let mut session = live::start(lp, &cfg).unwrap();
     // Drain the taps meanwhile, as the recorder does (a full ring is fine
     // too: the real-time thread drops the tick's samples without waiting).
@@ -113,12 +74,12 @@ fn connected_serial_nodes_do_not_allocate_on_the_real_time_thread() {
     }
     let mut exit = session.join();
     assert!(exit.failure.is_none());
-    let allocations = ALLOCS.load(Ordering::SeqCst) - before;
+    let allocations = alloc_counter::allocations() - before;
     let _ = exit.plan.plan_mut().finish();
     drop(exit);
     dev.kill().unwrap();
     dev.wait().unwrap();
-    assert_eq!(ARMINGS.load(Ordering::SeqCst), 1, "the hook armed the counter");
+    assert_eq!(alloc_counter::armings(), armings + 1, "the hook armed the counter");
     assert!(connected.len() > 900 && connected.iter().all(|&c| c == 1.0), "the device was connected throughout");
     assert_eq!(allocations, 0, "allocations or frees on the real-time thread with the serial nodes connected");
 }

@@ -134,10 +134,7 @@ pub fn train(
             break;
         }
     }
-    let (w, best_epoch, train_mse, val_mse) = stop.best();
-    let (w, best_epoch, train_mse, val_mse) = (w.to_vec(), best_epoch, train_mse, val_mse);
-    net.weights_mut().copy_from_slice(&w);
-    Report { epochs, best_epoch, train_mse, val_mse, stop: reason, seconds: start.elapsed().as_secs_f64() }
+    stop.finish(net.weights_mut(), epochs, reason, start)
 }
 
 #[cfg(test)]

@@ -222,4 +222,12 @@ impl EarlyStop {
     pub fn best(&self) -> (&[f64], usize, f64, f64) {
         (&self.best_w, self.best_epoch, self.best_train, self.best)
     }
+
+    /// Puts the best weights into `weights` and reports the run (both
+    /// trainers end this way).
+    pub fn finish(&self, weights: &mut [f64], epochs: usize, stop: StopReason, start: std::time::Instant) -> Report {
+        let (w, best_epoch, train_mse, val_mse) = self.best();
+        weights.copy_from_slice(w);
+        Report { epochs, best_epoch, train_mse, val_mse, stop, seconds: start.elapsed().as_secs_f64() }
+    }
 }

@@ -2,7 +2,17 @@
 
 use anyhow::{anyhow, Result};
 use evflow_engine::{load_file, Checked, Override};
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
+
+/// Loads and validates `file` with the node library and `sets` applied
+/// (`name=value` or `node.param=value`, as `--set` takes them).
+pub fn load_with(file: &Path, sets: &[impl AsRef<str>]) -> Result<Checked> {
+    let overrides = sets
+        .iter()
+        .map(|s| Override::parse(s.as_ref()).map_err(|e| anyhow!("--set {e}")))
+        .collect::<Result<Vec<_>>>()?;
+    load_file(file, &evflow_nodes::registry(), &overrides).map_err(|e| anyhow!("{e}"))
+}
 
 /// A graph file and command-line overrides.
 #[derive(clap::Args, Debug)]
@@ -24,8 +34,6 @@ impl GraphArgs {
 
     /// Loads and validates the graph with the node library.
     pub fn load(&self) -> Result<Checked> {
-        let overrides = self.overrides()?;
-        let registry = evflow_nodes::registry();
-        load_file(&self.file, &registry, &overrides).map_err(|e| anyhow!("{e}"))
+        load_with(&self.file, &self.set)
     }
 }

@@ -83,7 +83,8 @@ pub fn main(a: Args) -> Result<()> {
         if replaced.contains(&f.node) {
             // A further rate of a multi-rate source: its own recording node,
             // and the connections from those ports move to it.
-            let name = format!("{}__{}", f.node, f.file.rsplit('-').next().unwrap_or("rate"));
+            // Named after its rate (a dot would read as a port separator).
+            let name = format!("{}__{}Hz", f.node, f.rate.to_string().replace('.', "_"));
             let Some(decl) = graph.nodes.iter().find(|n| n.name == f.node).cloned() else { continue };
             graph.nodes.push(evflow_engine::graph::NodeDecl {
                 name: name.clone(),

@@ -6,6 +6,7 @@
 //! with p50, p99 and max.
 
 use super::stats::percentile;
+use crate::cli::graph_args::load_with;
 use anyhow::{anyhow, Result};
 use evflow_engine::{Plan, PlanOptions};
 use evflow_nodes::mesh::raycast::RayCaster;
@@ -141,12 +142,7 @@ fn time_casts(points: &[(f64, f64)], cast: impl Fn(f64, f64) -> Option<u32>) -> 
 /// fraction of ticks whose touch point was on the mesh (`surface.tri` ≥ 0).
 fn time_chain(a: &Args, resolution: usize) -> Result<([f64; 3], f64)> {
     let sets = [format!("surface.resolution={resolution}"), format!("edges.resolution={resolution}")];
-    let overrides = sets
-        .iter()
-        .map(|s| evflow_engine::Override::parse(s).map_err(|e| anyhow!("{e}")))
-        .collect::<Result<Vec<_>>>()?;
-    let registry = evflow_nodes::registry();
-    let checked = evflow_engine::load_file(&a.graph, &registry, &overrides).map_err(|e| anyhow!("{e}"))?;
+    let checked = load_with(&a.graph, &sets)?;
     let opts = PlanOptions { max_block: 1, seed: None, base_dir: None, out_dir: None, timing: false };
     let mut plan = Plan::build(&checked, &opts).map_err(|e| anyhow!("{e}"))?;
     for _ in 0..1000 {

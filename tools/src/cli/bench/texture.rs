@@ -4,6 +4,7 @@
 //! so that the update's cost shows if it ever bunches into one tick.
 
 use super::stats::percentile;
+use crate::cli::graph_args::load_with;
 use anyhow::{anyhow, Result};
 use evflow_engine::{Plan, PlanOptions};
 use std::path::PathBuf;
@@ -25,13 +26,7 @@ pub struct Args {
 
 /// Runs the benchmark and prints a Markdown table.
 pub fn main(a: Args) -> Result<()> {
-    let overrides = a
-        .set
-        .iter()
-        .map(|s| evflow_engine::Override::parse(s).map_err(|e| anyhow!("--set {e}")))
-        .collect::<Result<Vec<_>>>()?;
-    let registry = evflow_nodes::registry();
-    let checked = evflow_engine::load_file(&a.graph, &registry, &overrides).map_err(|e| anyhow!("{e}"))?;
+    let checked = load_with(&a.graph, &a.set)?;
     let opts = PlanOptions { max_block: 1, seed: None, base_dir: None, out_dir: None, timing: false };
     let mut plan = Plan::build(&checked, &opts).map_err(|e| anyhow!("{e}"))?;
     let update_every = (plan.base_rate() / 10.0).round().max(1.0) as u64;

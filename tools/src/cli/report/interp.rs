@@ -41,7 +41,7 @@ pub struct Args {
 }
 
 /// A sample's trained grid and its validation conditions.
-struct Plan {
+struct GridPlan {
     loads: Vec<f64>,
     speeds: Vec<f64>,
     validate: Vec<(f64, f64)>,
@@ -50,15 +50,15 @@ struct Plan {
 /// Fig. 5.6 (3×3 grid, corners trained, the m₂ row and v₂ column validated)
 /// or, for the rippled paper, Fig. 6.8 (60/110 g × 3–7 cm/s trained, 85 g
 /// at 3.5–6.5 cm/s validated).
-fn plan_for(sample: &str) -> Plan {
+fn plan_for(sample: &str) -> GridPlan {
     if sample == "rippled-paper" {
-        Plan {
+        GridPlan {
             loads: vec![60.0, 110.0],
             speeds: vec![3.0, 4.0, 5.0, 6.0, 7.0],
             validate: vec![(85.0, 3.5), (85.0, 4.5), (85.0, 5.5), (85.0, 6.5)],
         }
     } else {
-        Plan {
+        GridPlan {
             loads: vec![60.0, 110.0],
             speeds: vec![3.0, 7.0],
             validate: vec![(85.0, 3.0), (85.0, 5.0), (85.0, 7.0), (60.0, 5.0), (110.0, 5.0)],

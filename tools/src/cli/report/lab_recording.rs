@@ -2,6 +2,7 @@
 //! `graphs/record-textures.toml` run on the simulated lab, reduced to its
 //! constant-speed segments (§5.1.1).
 
+use crate::cli::graph_args::load_with;
 use anyhow::{anyhow, Context, Result};
 use evflow_engine::{run_offline, Plan, PlanOptions, RunOptions};
 use evflow_nodes::recording::format::Recording;
@@ -35,12 +36,7 @@ pub fn record(graph: &Path, c: &Condition<'_>, dir: &Path) -> Result<(f64, Vec<f
         format!("passes={}", c.passes),
         format!("rep={}", c.rep),
     ];
-    let overrides = sets
-        .iter()
-        .map(|s| evflow_engine::Override::parse(s).map_err(|e| anyhow!("{e}")))
-        .collect::<Result<Vec<_>>>()?;
-    let registry = evflow_nodes::registry();
-    let checked = evflow_engine::load_file(graph, &registry, &overrides).map_err(|e| anyhow!("{e}"))?;
+    let checked = load_with(graph, &sets)?;
     let out = dir.join(format!("{}-{}g-{}cms-r{}", c.sample, c.mass, c.speed, c.rep));
     std::fs::create_dir_all(&out).with_context(|| format!("{}: cannot create", out.display()))?;
     let opts = PlanOptions { max_block: 1024, seed: None, base_dir: None, out_dir: Some(out.clone()), timing: false };

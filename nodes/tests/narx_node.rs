@@ -183,3 +183,28 @@ fn skip_and_samples_cut_a_stretch_and_reruns_without_time_are_identical() {
     train(dir.path(), params, x, u).summary().unwrap();
     assert_eq!(std::fs::read(dir.path().join("cut.json")).unwrap(), first, "a rerun wrote other bytes");
 }
+
+#[test]
+fn a_gate_keeps_and_concatenates_the_open_stretches() {
+    // Two open stretches, [300, 1300) and [1800, 2600): the model is trained
+    // on exactly their concatenation (the data hash says so).
+    let dir = tempfile::tempdir().unwrap();
+    let u = rbs(3000, 4);
+    let x = Lab::default().force(&u);
+    let gate: Vec<f64> =
+        (0..3000).map(|i| if (300..1300).contains(&i) || (1800..2600).contains(&i) { 1.0 } else { 0.0 }).collect();
+    let params = "path = \"gated.json\"\nhidden = [4]\nfeedback = 1\ninput = 3\nepochs = 3\nprogress = false\n\
+                  gate = [\"steady\"]\nrecord_time = false\nseed = 9";
+    let mut single = train(dir.path(), params, x.clone(), u.clone());
+    single.inputs.push(("steady", gate, 1000.0));
+    single.summary().unwrap();
+    let m = Model::load(&dir.path().join("gated.json")).unwrap();
+    assert_eq!(m.training.samples, 1800);
+    let cat = |s: &[f64]| [&s[300..1300], &s[1800..2600]].concat();
+    assert_eq!(m.training.data_hash, evflow_nodes::narx::model::data_hash(&[&cat(&x), &cat(&u)]));
+    // A gate that keeps too little is refused, saying how much it kept.
+    let mut single = train(dir.path(), params, x, u);
+    single.inputs.push(("steady", vec![0.0; 3000], 1000.0));
+    let e = single.summary().unwrap_err();
+    assert!(e.contains("gates kept 0 of 3000"), "{e}");
+}

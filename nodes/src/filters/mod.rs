@@ -1,12 +1,14 @@
 //! Filters: `butterworth` (low-/high-pass as second-order sections) and
 //! `delay` (whole-sample delay, the node feedback cycles pass through),
-//! `foaw` (velocity from sampled positions by adaptive windowing).
+//! `foaw` (velocity from sampled positions by adaptive windowing), `segment`
+//! (the constant-speed stretches of a scan).
 
 pub mod butterworth;
 pub mod delay;
 pub mod foaw;
+pub mod segment;
 
 use evflow_engine::NodeSpec;
 
 /// The node types of this family.
-pub static SPECS: &[&NodeSpec] = &[&butterworth::SPEC, &delay::SPEC, &foaw::SPEC];
+pub static SPECS: &[&NodeSpec] = &[&butterworth::SPEC, &delay::SPEC, &foaw::SPEC, &segment::SPEC];

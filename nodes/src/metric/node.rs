@@ -2,10 +2,14 @@
 
 use super::spectral_error::{spectral_rms_error, Band, SpectralError};
 use super::spectrum::{Spectrum, SpectrumAccumulator, SpectrumConfig, Window};
+use crate::filters::segment::open_runs;
 use evflow_engine::{BuildContext, Io, Node, NodeError, NodeSpec, ParamSpec, Params, PortSpec, Role, Summary};
 
 /// Largest FFT length (2²⁰ samples: 17 min at 1 kHz, 105 s at 10 kHz).
 const MAX_NFFT: i64 = 1 << 20;
+
+/// Most gate inputs.
+const MAX_GATES: usize = 8;
 
 /// Declaration of `metric`.
 pub static SPEC: NodeSpec = NodeSpec::new(
@@ -33,6 +37,10 @@ two recordings of one material is 0.07–0.33 (§5.3.1).
 magnitude spectrum inside the band, never 0 Hz; a peak is a bin above its lower neighbour and not \
 below its upper one and above the FFT's rounding level (1e-10 of the largest bin), so leakage \
 sloping down from the mean is not taken for one. 0 when there is no peak (the summary says so).
+* `peak_magnitude_virtual`, `peak_magnitude_real` — the largest averaged magnitude in the band (raw \
+DFT scale) of each force; `peak_psd_ratio` — their ratio squared, the largest power density of the \
+virtual force over the real one: the level the gain sweep of §5.3.2 matches (Table 5.1 picks the gain that gives \"almost the same \
+maximum magnitude of power density\").
 * `samples` (per input) and `segments` (FFT segments averaged).
 
 **Spectrum.** The dissertation sets \"the length of FFT equal to the sampling frequency, 1000 Hz, to \
@@ -61,6 +69,11 @@ Memory is bounded: spectra are accumulated segment by segment (a few buffers of 
 so a run can last any time; `process` does not allocate, and the result does not depend on how the \
 samples were split into blocks.
 
+**Gate.** Each entry of `gate` adds an input of that name (e.g. `gate = [\"steady\"]`, fed by \
+`segment`); then only the samples where every gate is above 0.5 count, and the kept stretches are \
+concatenated before the spectra — the constant-speed segments of §5.1.1. Both forces are kept or \
+left out together, sample for sample.
+
 Checked against analytic spectra: a sine on a bin (A·nfft/2 in that bin only; A·nfft/4 and \
 A·nfft/8 with `hann`), the Rayleigh mean √(π/4·nfft·σ²) of white noise, Parseval, the Dirichlet \
 kernel of a zero-padded boxcar, a naive DFT, and the identities E_s(x, x) = 0, E_s(2x, x) = 1, \
@@ -69,6 +82,7 @@ E_s(x, 2x) = 0.5, E_s = √2 for equal sines on different bins.",
 .ports(&[
     PortSpec::input("virtual", "N", "virtual force f_v, from the display (N or normalized)"),
     PortSpec::input("real", "N", "real force f_r, recorded on the material (same unit)"),
+    PortSpec::input("gate", "1", "one per `gate` entry: the sample counts only where every gate is above 0.5").per("gate"),
 ])
 .params(&[
     ParamSpec::int("nfft", 0, MAX_NFFT, 0, "samples", "FFT (segment) length; 0 = the sampling rate (1 Hz bins)"),
@@ -77,6 +91,7 @@ E_s(x, 2x) = 0.5, E_s = √2 for equal sines on different bins.",
     ParamSpec::float("fmin", 0.0, 1e7, 0.0, "Hz", "lowest frequency counted in E_s"),
     ParamSpec::float("fmax", 0.0, 1e7, 0.0, "Hz", "highest frequency counted in E_s; 0 = Nyquist"),
     ParamSpec::flag("include_dc", false, "count the 0 Hz bin (the mean force) in E_s"),
+    ParamSpec::text_list("gate", "names of gate inputs (e.g. [\"steady\"] from `segment`); none by default"),
 ])
 .example("nfft = 0\nwindow = \"rect\"\noverlap = 0.0\nfmin = 0.0\nfmax = 0.0\ninclude_dc = false");
 
@@ -145,10 +160,20 @@ struct Metric {
     fmin: f64,
     include_dc: bool,
     channels: [Channel; 2],
+    gates: usize,
+    /// Samples left out by the gates.
+    gated_out: u64,
 }
 
 fn build(p: &Params, ctx: &BuildContext) -> Result<Box<dyn Node>, NodeError> {
     let rate = ctx.rate;
+    let gates = p.text_list("gate");
+    if gates.len() > MAX_GATES {
+        return Err(NodeError::param("gate", format!("{} gates; at most {MAX_GATES}", gates.len())));
+    }
+    if let Some(g) = gates.iter().find(|g| *g == "virtual" || *g == "real") {
+        return Err(NodeError::param("gate", format!("`{g}` is taken by a force input; rename the gate")));
+    }
     let nfft = match p.usize("nfft") {
         0 => {
             let n = rate.round();
@@ -179,14 +204,33 @@ fn build(p: &Params, ctx: &BuildContext) -> Result<Box<dyn Node>, NodeError> {
         fmin: p.f64("fmin"),
         include_dc,
         channels: [channel("virtual")?, channel("real")?],
+        gates: p.text_list("gate").len(),
+        gated_out: 0,
     }))
 }
 
 impl Node for Metric {
     fn process(&mut self, io: &mut Io<'_>) -> Result<(), NodeError> {
-        for (i, c) in self.channels.iter_mut().enumerate() {
-            c.push(io.input(i));
+        if self.gates == 0 {
+            for (i, c) in self.channels.iter_mut().enumerate() {
+                c.push(io.input(i));
+            }
+            return Ok(());
         }
+        let mut gates = [&[][..]; MAX_GATES];
+        let n = io.len();
+        for (g, slot) in gates.iter_mut().enumerate().take(self.gates) {
+            *slot = io.input(2 + g);
+        }
+        let mut kept = 0;
+        let (channels, io_ref) = (&mut self.channels, &*io);
+        open_runs(&gates[..self.gates], n, |a, b| {
+            kept += b - a;
+            for (i, c) in channels.iter_mut().enumerate() {
+                c.push(&io_ref.input(i)[a..b]);
+            }
+        });
+        self.gated_out += (n - kept) as u64;
         Ok(())
     }
 
@@ -195,6 +239,7 @@ impl Node for Metric {
             c.stats = Stats::new();
             c.spectrum.reset();
         }
+        self.gated_out = 0;
     }
 
     fn finish(&mut self) -> Result<Summary, NodeError> {
@@ -213,9 +258,17 @@ impl Node for Metric {
             .map(|c| {
                 c.spectrum.spectrum().ok_or_else(|| {
                     NodeError::Data(format!(
-                        "input `{}` received no samples: the run was empty, and E_s, RMS and peak-to-peak \
-                         need at least one sample of each force",
-                        c.name
+                        "input `{}` received no samples{}: E_s, RMS and peak-to-peak need at least one \
+                         sample of each force",
+                        c.name,
+                        if self.gates > 0 {
+                            format!(
+                                " (the gate never opened over {} samples; check the `segment` speed)",
+                                self.gated_out
+                            )
+                        } else {
+                            " (the run was empty)".into()
+                        }
                     ))
                 })
             })
@@ -240,6 +293,8 @@ impl Node for Metric {
         })?;
         let peak = |s: &Spectrum| s.largest_peak(band.first(), band.last()).map_or(0.0, |k| s.freq(k));
         let [v, r] = [&self.channels[0].stats, &self.channels[1].stats];
+        let top = |s: &Spectrum| s.magnitude[band.first()..=band.last()].iter().fold(0.0f64, |a, &m| a.max(m));
+        let (pv, pr) = (top(sv), top(sr));
         let values = [
             ("E_s", es, "1"),
             ("rms_virtual", v.rms(), "N"),
@@ -248,6 +303,9 @@ impl Node for Metric {
             ("pp_real", r.max - r.min, "N"),
             ("peak_psd_freq_virtual", peak(sv), "Hz"),
             ("peak_psd_freq_real", peak(sr), "Hz"),
+            ("peak_magnitude_virtual", pv, "1"),
+            ("peak_magnitude_real", pr, "1"),
+            ("peak_psd_ratio", (pv / pr).powi(2), "1"),
             ("samples", v.n as f64, "1"),
             ("segments", sv.segments as f64, "1"),
         ];
@@ -273,6 +331,9 @@ impl Node for Metric {
             cfg.window.name(),
             cfg.overlap
         ));
+        if self.gates > 0 {
+            summary = summary.line(format!("gate: {} samples kept, {} left out", sv.samples, self.gated_out));
+        }
         if sv.samples < cfg.nfft as u64 {
             summary = summary.line(format!("{} samples, zero-padded to one segment of {}", sv.samples, cfg.nfft));
         } else if sv.trailing > 0 {
@@ -327,6 +388,76 @@ mod tests {
         s.values.iter().find(|(n, _, _)| n == name).unwrap_or_else(|| panic!("no value `{name}`")).1
     }
 
+    #[test]
+    fn a_gate_keeps_and_concatenates_only_the_open_stretches() {
+        // Two open stretches of 1000 samples carry the same 37 Hz tone in
+        // both forces; between and around them the forces differ wildly.
+        // E_s over the gated samples is that of the tones alone: 0.
+        let tone = sine(1.0, 37.0, 1000, 1000);
+        let (mut v, mut r, mut g) = (Vec::new(), Vec::new(), Vec::new());
+        for (k, junk) in [(300, 5.0), (0, 0.0), (200, -3.0), (0, 0.0), (300, 7.0)] {
+            if k == 0 {
+                v.extend(&tone);
+                r.extend(&tone);
+                g.extend(std::iter::repeat_n(1.0, 1000));
+            } else {
+                v.extend(gaussian(k as u64, k).iter().map(|x| junk * x));
+                r.extend(std::iter::repeat_n(junk, k));
+                g.extend(std::iter::repeat_n(0.0, k));
+            }
+        }
+        for block in [1, 77, 4096] {
+            let single = Single {
+                spec: &SPEC,
+                params: "gate = [\"steady\"]",
+                inputs: vec![
+                    ("virtual", v.clone(), 1000.0),
+                    ("real", r.clone(), 1000.0),
+                    ("steady", g.clone(), 1000.0),
+                ],
+                outputs: vec![],
+                base_rate: 1000.0,
+                ticks: v.len() as u64,
+                block,
+                base_dir: Path::new("."),
+            };
+            let (mut plan, _) = single.plan().expect("builds");
+            let mut done = 0;
+            while done < v.len() {
+                let n = plan.max_block().min(v.len() - done);
+                plan.step(n).expect("steps");
+                done += n;
+            }
+            let sums = plan.finish().expect("finishes");
+            let s = &sums.iter().find(|(n, _)| n == "dut").expect("summary").1;
+            assert_eq!(value(s, "samples"), 2000.0);
+            assert_eq!(value(s, "segments"), 2.0);
+            assert!(value(s, "E_s") < 1e-12, "block {block}: {}", value(s, "E_s"));
+            assert!(s.lines.iter().any(|l| l.contains("2000 samples kept, 800 left out")), "{:?}", s.lines);
+        }
+        // A gate that never opens is an error naming it.
+        let e = run_gated_never(&v, &r);
+        assert!(e.contains("gate never opened"), "{e}");
+    }
+
+    fn run_gated_never(v: &[f64], r: &[f64]) -> String {
+        let single = Single {
+            spec: &SPEC,
+            params: "gate = [\"steady\"]",
+            inputs: vec![
+                ("virtual", v.to_vec(), 1000.0),
+                ("real", r.to_vec(), 1000.0),
+                ("steady", vec![0.0; v.len()], 1000.0),
+            ],
+            outputs: vec![],
+            base_rate: 1000.0,
+            ticks: v.len() as u64,
+            block: 512,
+            base_dir: Path::new("."),
+        };
+        single.run().expect_err("no samples kept")
+    }
+
     /// A texture-like force: a mean, a tone at 37 Hz, noise.
     fn force(seed: u64, len: usize) -> Vec<f64> {
         let tone = sine(0.3, 37.0, 1000, len);
@@ -343,6 +474,9 @@ mod tests {
         assert_eq!(value(&s, "samples"), 3066.0);
         assert_eq!(value(&s, "segments"), 3.0); // nfft = rate = 1000: 66 samples left out
         assert!(s.lines.iter().any(|l| l.contains("last 66 samples")), "{:?}", s.lines);
+        // Twice the force is four times the power density at every bin.
+        assert!((value(&s, "peak_psd_ratio") - 4.0).abs() < 1e-12);
+        assert!((value(&s, "peak_magnitude_virtual") / value(&s, "peak_magnitude_real") - 2.0).abs() < 1e-12);
         assert!((value(&run("window = \"hann\"\noverlap = 0.5", &x, &x2).unwrap(), "E_s") - 0.5).abs() < 1e-12);
     }
 

@@ -53,7 +53,11 @@ pub static SPEC: NodeSpec = NodeSpec::new(
      `transition_agreement`, `rms` on the validation block, `noise_force_transition_agreement`, `epochs`, \
      `seconds` (training time; left out, and 0 in the model, with `record_time = false`, for byte-identical \
      reruns). `skip` and `samples` cut one stretch out of the stream (e.g. the constant-speed part of a \
-     tribometer pass, where the pen slides and the force carries the actuation).\n\n\
+     tribometer pass, where the pen slides and the force carries the actuation). Each entry of `gate` \
+     adds an input of that name; with gates only the samples where every gate is above 0.5 are kept \
+     and the kept stretches are concatenated — fed by `segment`, the constant-speed segments of all \
+     passes, extracted and concatenated as §5.1.1 does (a few regressor rows then span a join, as in \
+     the dissertation's concatenated data).\n\n\
      Checked against: finite-difference Jacobians, an exactly solvable linear least-squares problem, \
      MATLAB's `mapminmax` values, early stopping on pure noise, and the simulated lab \
      (nodes/tests/narx_lab.rs).",
@@ -61,6 +65,7 @@ pub static SPEC: NodeSpec = NodeSpec::new(
 .ports(&[
     PortSpec::input("x", "N", "force, the network's input (e.g. the sensor force high-passed at 10 Hz)"),
     PortSpec::input("y", "1", "actuation that produced the force, the network's target"),
+    PortSpec::input("gate", "1", "one per `gate` entry: the sample is kept only where every gate is above 0.5").per("gate"),
 ])
 .params(&[
     ParamSpec::text("path", "", "model file to write (JSON), relative to the run's output folder").required(),
@@ -85,6 +90,7 @@ pub static SPEC: NodeSpec = NodeSpec::new(
     ParamSpec::float("mass_g", 0.0, 1e6, 0.0, "g", "condition: stylus mass (0 = not recorded)"),
     ParamSpec::float("speed_cm_s", 0.0, 1e6, 0.0, "cm/s", "condition: scanning speed (0 = not recorded)"),
     ParamSpec::flag("progress", true, "print each epoch to stderr"),
+    ParamSpec::text_list("gate", "names of gate inputs (e.g. [\"steady\"] from `segment`); none by default"),
     ParamSpec::flag("record_time", true, "write the training time into the model and the summary (off: byte-identical reruns)"),
 ])
 .offline_only("it buffers the whole recording in memory and trains when the run ends")
@@ -102,6 +108,7 @@ struct Train {
     progress: bool,
     record_time: bool,
     seen: usize,
+    gates: usize,
     x: Vec<f64>,
     y: Vec<f64>,
 }
@@ -159,6 +166,10 @@ fn build(p: &Params, ctx: &BuildContext) -> Result<Box<dyn Node>, NodeError> {
         condition: Condition { mass_g: set(p.f64("mass_g")), speed_cm_s: set(p.f64("speed_cm_s")) },
         rate_hz: ctx.rate,
     };
+    let gates = p.text_list("gate").len();
+    if let Some(g) = p.text_list("gate").iter().find(|g| *g == "x" || *g == "y") {
+        return Err(NodeError::param("gate", format!("`{g}` is taken by a data input; rename the gate")));
+    }
     let path = p.str("path");
     if path.is_empty() {
         return Err(NodeError::param("path", "name the model file to write"));
@@ -176,6 +187,7 @@ fn build(p: &Params, ctx: &BuildContext) -> Result<Box<dyn Node>, NodeError> {
         progress: p.bool("progress"),
         record_time: p.bool("record_time"),
         seen: 0,
+        gates,
         x: Vec::new(),
         y: Vec::new(),
     }))
@@ -192,7 +204,8 @@ impl Node for Train {
         // Offline only: the buffers grow with the recording.
         let n = io.len();
         for i in 0..n {
-            if self.seen >= self.skip && self.x.len() < self.take {
+            let open = (0..self.gates).all(|g| io.input(2 + g)[i] > 0.5);
+            if open && self.seen >= self.skip && self.x.len() < self.take {
                 self.x.push(io.input(0)[i]);
                 self.y.push(io.input(1)[i]);
             }
@@ -219,9 +232,14 @@ impl Node for Train {
         };
         let mut model = fit(&self.x, &self.y, &self.cfg, &mut report).map_err(|e| match e {
             super::error::NarxError::Data(m) => NodeError::Data(format!(
-                "{m}{}",
+                "{m}{}{}",
                 if self.skip > 0 {
                     format!(" (after skipping the first {} samples)", self.skip)
+                } else {
+                    String::new()
+                },
+                if self.gates > 0 {
+                    format!(" (the gates kept {} of {} samples)", self.x.len(), self.seen)
                 } else {
                     String::new()
                 }

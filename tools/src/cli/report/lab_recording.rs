@@ -2,9 +2,8 @@
 //! `graphs/record-textures.toml` run on the simulated lab, reduced to its
 //! constant-speed segments (§5.1.1).
 
-use crate::cli::graph_args::load_with;
+use crate::cli::graph_args::run_with;
 use anyhow::{anyhow, Context, Result};
-use evflow_engine::{run_offline, Plan, PlanOptions, RunOptions};
 use evflow_nodes::recording::format::Recording;
 use std::path::Path;
 
@@ -36,12 +35,9 @@ pub fn record(graph: &Path, c: &Condition<'_>, dir: &Path) -> Result<(f64, Vec<f
         format!("passes={}", c.passes),
         format!("rep={}", c.rep),
     ];
-    let checked = load_with(graph, &sets)?;
     let out = dir.join(format!("{}-{}g-{}cms-r{}", c.sample, c.mass, c.speed, c.rep));
     std::fs::create_dir_all(&out).with_context(|| format!("{}: cannot create", out.display()))?;
-    let opts = PlanOptions { max_block: 1024, seed: None, base_dir: None, out_dir: Some(out.clone()), timing: false };
-    let mut plan = Plan::build(&checked, &opts).map_err(|e| anyhow!("{e}"))?;
-    run_offline(&mut plan, RunOptions { duration: None, progress: None }).map_err(|e| anyhow!("{e}"))?;
+    run_with(graph, &sets, &out)?;
     let wav = std::fs::read_dir(&out)
         .with_context(|| format!("{}: no recording", out.display()))?
         .filter_map(|e| e.ok().map(|e| e.path()))

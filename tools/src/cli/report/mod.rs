@@ -7,6 +7,7 @@ pub mod interp;
 pub mod lab_recording;
 pub mod mesh;
 pub mod resample;
+pub mod textures;
 
 /// Arguments of `evflow report`.
 #[derive(clap::Args, Debug)]
@@ -48,6 +49,14 @@ enum Which {
     ///
     /// Example: cargo run --release -p evflow -- report resample --out report
     Resample(resample::Args),
+    /// Virtual against real textures (Fig. 5.7/5.8, Table 5.1): inverse
+    /// NARX models trained per condition, each texture's force synthesized
+    /// and played on the virtual display over the gain sweep; E_s beside
+    /// the repeat baseline and record-and-playback, a Markdown table and
+    /// PNG spectra.
+    ///
+    /// Example: cargo run --release -p evflow -- report textures --out report
+    Textures(textures::Args),
 }
 
 /// Runs the chosen report.
@@ -58,5 +67,6 @@ pub fn main(a: ReportArgs) -> anyhow::Result<()> {
         Which::Freqvel(f) => freqvel::main(f),
         Which::Interp(i) => interp::main(i),
         Which::Resample(r) => resample::main(r),
+        Which::Textures(t) => textures::main(t),
     }
 }

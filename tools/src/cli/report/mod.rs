@@ -6,6 +6,7 @@ pub mod freqvel;
 pub mod interp;
 pub mod lab_recording;
 pub mod mesh;
+pub mod narx;
 pub mod resample;
 pub mod textures;
 
@@ -57,6 +58,13 @@ enum Which {
     ///
     /// Example: cargo run --release -p evflow -- report textures --out report
     Textures(textures::Args),
+    /// Error against run time of the inverse NARX model (issue 6, point
+    /// 10): several network sizes, tap delays and both trainers, each
+    /// trained at one condition and scored by the mean E_s of the textures
+    /// it synthesizes; a table with the Pareto front and a PNG.
+    ///
+    /// Example: cargo run --release -p evflow -- report narx --out report
+    Narx(narx::Args),
 }
 
 /// Runs the chosen report.
@@ -68,5 +76,6 @@ pub fn main(a: ReportArgs) -> anyhow::Result<()> {
         Which::Interp(i) => interp::main(i),
         Which::Resample(r) => resample::main(r),
         Which::Textures(t) => textures::main(t),
+        Which::Narx(n) => narx::main(n),
     }
 }

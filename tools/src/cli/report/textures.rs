@@ -48,13 +48,13 @@ pub struct Args {
 
 /// A trained condition.
 #[derive(Debug, Clone, Copy)]
-struct Cond {
-    mass: f64,
-    speed: f64,
+pub(super) struct Cond {
+    pub(super) mass: f64,
+    pub(super) speed: f64,
 }
 
 impl Cond {
-    fn parse(s: &str) -> Result<Self> {
+    pub(super) fn parse(s: &str) -> Result<Self> {
         let (m, v) = s.split_once(':').ok_or_else(|| anyhow!("--conditions: `{s}` is not MASS:SPEED"))?;
         let (mass, speed) = (
             m.trim().parse::<f64>().map_err(|_| anyhow!("--conditions: mass `{m}` is not a number"))?,
@@ -63,7 +63,7 @@ impl Cond {
         ensure!(mass > 0.0 && speed > 0.0, "--conditions: `{s}`: mass and speed must be positive");
         Ok(Self { mass, speed })
     }
-    fn label(&self) -> String {
+    pub(super) fn label(&self) -> String {
         format!("{} g, {} cm/s", self.mass, self.speed)
     }
     fn model_name(&self) -> String {
@@ -80,10 +80,10 @@ struct Built {
 
 /// One scored scheme at its chosen gain.
 #[derive(Debug, Clone, Copy)]
-struct Scored {
-    gain: f64,
-    es: f64,
-    ratio: f64,
+pub(super) struct Scored {
+    pub(super) gain: f64,
+    pub(super) es: f64,
+    pub(super) ratio: f64,
 }
 
 /// One (texture, condition) row.
@@ -95,7 +95,7 @@ struct Row {
     playback: Scored,
 }
 
-fn value(r: &RunReport, node: &str, name: &str) -> Result<f64> {
+pub(super) fn value(r: &RunReport, node: &str, name: &str) -> Result<f64> {
     r.summaries
         .iter()
         .find(|(n, _)| n == node)
@@ -104,7 +104,7 @@ fn value(r: &RunReport, node: &str, name: &str) -> Result<f64> {
 }
 
 /// The gain whose peak power density is nearest the real one (on a log scale).
-fn choose(runs: &[(f64, RunReport)], node: &str) -> Result<Scored> {
+pub(super) fn choose(runs: &[(f64, RunReport)], node: &str) -> Result<Scored> {
     let mut best: Option<Scored> = None;
     for (gain, r) in runs {
         let s = Scored { gain: *gain, es: value(r, node, "E_s")?, ratio: value(r, node, "peak_psd_ratio")? };
@@ -162,6 +162,64 @@ fn spectra_plot(sample: &str, c: &Cond, narx: &Scored, dir: &Path) -> Result<Plo
     })
 }
 
+/// Records repetitions 1 and 2 of `sample` at `c` into `dir` (one pass each).
+pub(super) fn record_pair(graphs: &Path, sample: &str, c: &Cond, dir: &Path) -> Result<()> {
+    for rep in [1, 2] {
+        let sets = [
+            format!("sample=\"{sample}\""),
+            format!("mass={}", c.mass),
+            format!("speed={}", c.speed),
+            "passes=1".to_string(),
+            format!("rep={rep}"),
+        ];
+        run_with(&graphs.join("record-textures.toml"), &sets, dir)?;
+    }
+    Ok(())
+}
+
+/// Runs graphs/synthesize.toml for `sample` at `c` with `model` once per
+/// gain, each run's outputs in its own folder under `work`.
+pub(super) fn synthesize(
+    graphs: &Path,
+    sample: &str,
+    c: &Cond,
+    model: &Path,
+    gains: &[f64],
+    recordings: &Path,
+    work: &Path,
+) -> Result<Vec<(f64, RunReport)>> {
+    let mut runs = Vec::new();
+    for &gain in gains {
+        let out = work.join(format!("synth-{sample}-{}-{}-{gain}", c.mass, c.speed));
+        std::fs::create_dir_all(&out)?;
+        let sets = [
+            format!("recordings={:?}", recordings.display().to_string()),
+            format!("model={:?}", model.display().to_string()),
+            format!("sample=\"{sample}\""),
+            format!("mass={}", c.mass),
+            format!("speed={}", c.speed),
+            format!("gain={gain}"),
+        ];
+        runs.push((gain, run_with(&graphs.join("synthesize.toml"), &sets, &out)?));
+    }
+    Ok(runs)
+}
+
+/// Trains the model of `c` with graphs/model-build.toml (plus `extra`
+/// overrides) into `dir` and returns its path.
+pub(super) fn train_model(graphs: &Path, c: &Cond, epochs: u32, extra: &[String], dir: &Path) -> Result<PathBuf> {
+    let mut sets = vec![
+        format!("mass={}", c.mass),
+        format!("speed={}", c.speed),
+        format!("epochs={epochs}"),
+        "train.progress=false".to_string(),
+        "train.record_time=true".to_string(),
+    ];
+    sets.extend(extra.iter().cloned());
+    run_with(&graphs.join("model-build.toml"), &sets, dir)?;
+    Ok(std::fs::canonicalize(dir.join(c.model_name()))?)
+}
+
 /// Builds (or finds) the model of each condition.
 fn models(a: &Args, conds: &[Cond], dir: &Path) -> Result<Vec<Built>> {
     let mut built = Vec::new();
@@ -173,15 +231,7 @@ fn models(a: &Args, conds: &[Cond], dir: &Path) -> Result<Vec<Built>> {
             continue;
         }
         eprintln!("training the inverse model at {} …", c.label());
-        let sets = [
-            format!("mass={}", c.mass),
-            format!("speed={}", c.speed),
-            format!("epochs={}", a.epochs),
-            "train.progress=false".to_string(),
-            "train.record_time=true".to_string(),
-        ];
-        run_with(&a.graphs.join("model-build.toml"), &sets, dir)?;
-        built.push(Built { path: std::fs::canonicalize(dir.join(c.model_name()))?, trained: true });
+        built.push(Built { path: train_model(&a.graphs, c, a.epochs, &[], dir)?, trained: true });
     }
     Ok(built)
 }
@@ -225,30 +275,8 @@ pub fn main(a: Args) -> Result<()> {
                 c.label(),
                 a.gains.len()
             );
-            for rep in [1, 2] {
-                let sets = [
-                    format!("sample=\"{s}\""),
-                    format!("mass={}", c.mass),
-                    format!("speed={}", c.speed),
-                    "passes=1".to_string(),
-                    format!("rep={rep}"),
-                ];
-                run_with(&a.graphs.join("record-textures.toml"), &sets, &textures)?;
-            }
-            let mut runs = Vec::new();
-            for &gain in &a.gains {
-                let out = tmp.path().join(format!("synth-{s}-{}-{}-{gain}", c.mass, c.speed));
-                std::fs::create_dir_all(&out)?;
-                let sets = [
-                    format!("recordings={:?}", textures.display().to_string()),
-                    format!("model={:?}", m.path.display().to_string()),
-                    format!("sample=\"{s}\""),
-                    format!("mass={}", c.mass),
-                    format!("speed={}", c.speed),
-                    format!("gain={gain}"),
-                ];
-                runs.push((gain, run_with(&a.graphs.join("synthesize.toml"), &sets, &out)?));
-            }
+            record_pair(&a.graphs, s, c, &textures)?;
+            let runs = synthesize(&a.graphs, s, c, &m.path, &a.gains, &textures, tmp.path())?;
             let narx = choose(&runs, "narx_es")?;
             let playback = choose(&runs, "playback_es")?;
             let repeat = value(&runs[0].1, "repeat_es", "E_s")?;

@@ -1,0 +1,285 @@
+//! `evflow report narx`: error against run time of the inverse NARX model
+//! (issue 6, point 10). For each network setting — hidden layers, tap
+//! delays, trainer — a model is trained for one condition with
+//! `graphs/model-build.toml`; every texture's force at that condition is
+//! synthesized with it and played on the virtual display
+//! (`graphs/synthesize.toml`, gain sweep of §5.3.2), and the mean E_s is set
+//! against the training time. A setting is on the Pareto front when no
+//! other trains faster *and* renders with a lower E_s.
+
+use super::textures::{choose, record_pair, synthesize, train_model, Cond};
+use anyhow::{anyhow, ensure, Context, Result};
+use evflow_nodes::lab::texture::samples::NAMES;
+use evflow_nodes::narx::model::Model;
+use evflow_tools::plot::{write_png, Plot, Series};
+use std::fmt::Write as _;
+use std::path::PathBuf;
+
+/// Arguments of `evflow report narx`.
+#[derive(clap::Args, Debug)]
+pub struct Args {
+    /// Folder for the Markdown table (narx.md), the models and the PNG.
+    #[arg(long, default_value = ".")]
+    out: PathBuf,
+    /// The condition the models are trained and scored at, MASS:SPEED (g, cm/s).
+    #[arg(long, default_value = "60:5")]
+    condition: String,
+    /// Network settings as NAME=HIDDEN/FEEDBACK/INPUT/TRAINER, hidden layers
+    /// joined by `-` (e.g. `small=5/1/10/lm`). Default: eight settings around
+    /// the default network (15-10-5, taps 1/10, LM).
+    #[arg(long, value_delimiter = ',')]
+    settings: Vec<String>,
+    /// Texture samples scored (default: the six of §5.3).
+    #[arg(long, value_delimiter = ',')]
+    samples: Vec<String>,
+    /// Gains of the sweep (§5.3.2).
+    #[arg(long, value_delimiter = ',', default_value = "0.6,0.8,1.0,1.2,1.4")]
+    gains: Vec<f64>,
+    /// Models per setting, trained from different initial weights (seeds
+    /// 1 … N); E_s and time are their means, so one lucky start does not
+    /// decide the comparison.
+    #[arg(long, default_value_t = 5)]
+    seeds: u32,
+    /// Epochs at most per model.
+    #[arg(long, default_value_t = 200)]
+    epochs: u32,
+    /// The folder of the shipped graphs.
+    #[arg(long, default_value = "graphs")]
+    graphs: PathBuf,
+}
+
+/// The settings compared by default; the first is evflow's default network.
+const DEFAULT_SETTINGS: &[&str] = &[
+    "default=15-10-5/1/10/lm",
+    "one-layer-5=5/1/10/lm",
+    "one-layer-15=15/1/10/lm",
+    "wide=30-20-10/1/10/lm",
+    "input-5=15-10-5/1/5/lm",
+    "input-20=15-10-5/1/20/lm",
+    "feedback-2=15-10-5/2/10/lm",
+    "adam=15-10-5/1/10/adam",
+    "adam-one-layer-5=5/1/10/adam",
+];
+
+/// One network setting.
+#[derive(Debug, Clone, PartialEq)]
+struct Setting {
+    name: String,
+    hidden: Vec<usize>,
+    feedback: usize,
+    input: usize,
+    algorithm: String,
+}
+
+impl Setting {
+    fn parse(s: &str) -> Result<Self> {
+        let (name, rest) =
+            s.split_once('=').ok_or_else(|| anyhow!("--settings: `{s}` is not NAME=HIDDEN/FEEDBACK/INPUT/TRAINER"))?;
+        let parts: Vec<&str> = rest.split('/').collect();
+        ensure!(parts.len() == 4, "--settings: `{s}`: give HIDDEN/FEEDBACK/INPUT/TRAINER, e.g. 15-10-5/1/10/lm");
+        let hidden = parts[0]
+            .split('-')
+            .map(|h| h.trim().parse::<usize>().ok().filter(|&h| h > 0))
+            .collect::<Option<Vec<_>>>()
+            .ok_or_else(|| anyhow!("--settings: `{s}`: hidden layers are sizes ≥ 1 joined by `-`"))?;
+        let num = |x: &str, what: &str| {
+            x.trim().parse::<usize>().map_err(|_| anyhow!("--settings: `{s}`: {what} `{x}` is not a whole number"))
+        };
+        let algorithm = parts[3].trim().to_string();
+        ensure!(algorithm == "lm" || algorithm == "adam", "--settings: `{s}`: the trainer is lm or adam");
+        Ok(Self {
+            name: name.trim().into(),
+            hidden,
+            feedback: num(parts[1], "feedback")?,
+            input: num(parts[2], "input")?,
+            algorithm,
+        })
+    }
+
+    fn overrides(&self) -> Vec<String> {
+        let hidden: Vec<String> = self.hidden.iter().map(|h| h.to_string()).collect();
+        vec![
+            format!("train.hidden=[{}]", hidden.join(", ")),
+            format!("train.feedback={}", self.feedback),
+            format!("train.input={}", self.input),
+            format!("train.algorithm=\"{}\"", self.algorithm),
+        ]
+    }
+
+    fn describe(&self) -> String {
+        let h: Vec<String> = self.hidden.iter().map(|h| h.to_string()).collect();
+        format!("{}, k_y {}, k_x {}, {}", h.join("-"), self.feedback, self.input, self.algorithm.to_uppercase())
+    }
+}
+
+/// A trained and scored setting.
+struct Scored {
+    setting: Setting,
+    weights: usize,
+    seconds: f64,
+    epochs: f64,
+    transitions: f64,
+    es: f64,
+    /// Smallest and largest mean E_s of one seed.
+    spread: (f64, f64),
+}
+
+/// Indices of the points no other point beats in both coordinates.
+fn pareto(points: &[(f64, f64)]) -> Vec<bool> {
+    points.iter().map(|&(t, e)| !points.iter().any(|&(t2, e2)| t2 <= t && e2 <= e && (t2 < t || e2 < e))).collect()
+}
+
+/// Runs `evflow report narx`.
+pub fn main(a: Args) -> Result<()> {
+    ensure!(a.seeds >= 1, "--seeds: at least 1");
+    let cond = Cond::parse(&a.condition).map_err(|e| anyhow!("--condition: {e}"))?;
+    let settings: Vec<Setting> = if a.settings.is_empty() {
+        DEFAULT_SETTINGS.iter().map(|s| Setting::parse(s)).collect::<Result<_>>()?
+    } else {
+        a.settings.iter().map(|s| Setting::parse(s)).collect::<Result<_>>()?
+    };
+    let samples: Vec<String> = if a.samples.is_empty() {
+        NAMES.iter().filter(|s| **s != "rippled-paper").map(|s| s.to_string()).collect()
+    } else {
+        a.samples.clone()
+    };
+    for s in &samples {
+        ensure!(NAMES.contains(&s.as_str()), "--samples: unknown sample `{s}` (one of {})", NAMES.join(", "));
+    }
+    std::fs::create_dir_all(&a.out).with_context(|| format!("{}: cannot create", a.out.display()))?;
+    let tmp = tempfile::tempdir().context("cannot create a temporary folder")?;
+    let textures = tmp.path().join("textures");
+    std::fs::create_dir_all(&textures)?;
+    for s in &samples {
+        record_pair(&a.graphs, s, &cond, &textures)?;
+    }
+    let mut scored = Vec::new();
+    for (i, st) in settings.iter().enumerate() {
+        eprintln!(
+            "[{}/{}] {} ({}): training at {}, synthesizing {} textures …",
+            i + 1,
+            settings.len(),
+            st.name,
+            st.describe(),
+            cond.label(),
+            samples.len()
+        );
+        let (mut es, mut seconds, mut epochs, mut transitions, mut weights) = (0.0, 0.0, 0.0, 0.0, 0);
+        let mut spread = (f64::INFINITY, f64::NEG_INFINITY);
+        for seed in 1..=a.seeds {
+            let dir = a.out.join("models").join(&st.name).join(format!("seed-{seed}"));
+            std::fs::create_dir_all(&dir).with_context(|| format!("{}: cannot create", dir.display()))?;
+            let mut sets = st.overrides();
+            sets.push(format!("train.seed={seed}"));
+            let path = train_model(&a.graphs, &cond, a.epochs, &sets, &dir)?;
+            let model = Model::load(&path).map_err(|e| anyhow!("{e}"))?;
+            let mut this = 0.0;
+            for s in &samples {
+                let work = tmp.path().join(&st.name);
+                let runs = synthesize(&a.graphs, s, &cond, &path, &a.gains, &textures, &work)?;
+                this += choose(&runs, "narx_es")?.es / samples.len() as f64;
+            }
+            es += this;
+            spread = (spread.0.min(this), spread.1.max(this));
+            let t = &model.training;
+            seconds += t.seconds;
+            epochs += t.epochs as f64;
+            transitions += t.closed_loop.as_ref().map_or(f64::NAN, |c| c.transition_agreement);
+            weights = model.weights.len();
+        }
+        let n = a.seeds as f64;
+        scored.push(Scored {
+            setting: st.clone(),
+            weights,
+            seconds: seconds / n,
+            epochs: epochs / n,
+            transitions: transitions / n,
+            es: es / n,
+            spread,
+        });
+    }
+    let front = pareto(&scored.iter().map(|s| (s.seconds, s.es)).collect::<Vec<_>>());
+    let mut md = String::new();
+    let _ = writeln!(
+        md,
+        "Error against run time of the inverse NARX model at {} ({} textures, gain sweep {:?}): mean E_s (Eq. 5.2, 2–200 Hz) of the virtual against the real force and training time of graphs/model-build.toml (3066 samples), each the mean over {} models trained from seeds 1–{}.\n",
+        cond.label(),
+        samples.len(),
+        a.gains,
+        a.seeds,
+        a.seeds
+    );
+    let _ = writeln!(md, "| setting | network, taps, trainer | weights | epochs | training time (s) | closed-loop transition agreement | mean E_s | E_s range over seeds | Pareto front |");
+    let _ = writeln!(md, "|---|---|---:|---:|---:|---:|---:|---|---|");
+    for (s, on) in scored.iter().zip(&front) {
+        let _ = writeln!(
+            md,
+            "| {} | {} | {} | {:.0} | {:.2} | {:.3} | {:.3} | {:.2}–{:.2} | {} |",
+            s.setting.name,
+            s.setting.describe(),
+            s.weights,
+            s.epochs,
+            s.seconds,
+            s.transitions,
+            s.es,
+            s.spread.0,
+            s.spread.1,
+            if *on { "yes" } else { "" }
+        );
+    }
+    if let Some(i) = scored.iter().position(|s| s.setting.name == "default") {
+        let _ = writeln!(md, "\nThe default network is {}on the Pareto front.", if front[i] { "" } else { "**not** " });
+    }
+    print!("{md}");
+    let path = a.out.join("narx.md");
+    let tmp_md = a.out.join("narx.md.tmp");
+    std::fs::write(&tmp_md, &md)
+        .and_then(|_| std::fs::rename(&tmp_md, &path))
+        .with_context(|| format!("{}: cannot write", path.display()))?;
+    println!("wrote {}", path.display());
+    let plot = Plot {
+        title: format!("Inverse NARX: E_s against training time at {}", cond.label()),
+        x_label: "training time (s)".into(),
+        y_label: "mean E_s".into(),
+        log_x: true,
+        log_y: false,
+        series: scored
+            .iter()
+            .map(|s| Series::points(format!("{} ({})", s.setting.name, s.setting.describe()), vec![(s.seconds, s.es)]))
+            .collect(),
+    };
+    match write_png(&plot, &a.out.join("narx-work-precision.png")) {
+        Ok(w) => println!("wrote {}{}", w.path.display(), if w.labelled { "" } else { " (no font found: unlabelled)" }),
+        Err(e) => eprintln!("warning: {e}"),
+    }
+    Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn settings_parse_into_model_build_overrides() {
+        let s = Setting::parse("wide=30-20-10/2/15/adam").unwrap();
+        assert_eq!((s.hidden.clone(), s.feedback, s.input, s.algorithm.as_str()), (vec![30, 20, 10], 2, 15, "adam"));
+        assert_eq!(
+            s.overrides(),
+            ["train.hidden=[30, 20, 10]", "train.feedback=2", "train.input=15", "train.algorithm=\"adam\""]
+        );
+        for bad in ["x", "x=15/1/10", "x=15-0/1/10/lm", "x=15/a/10/lm", "x=15/1/10/sgd"] {
+            assert!(Setting::parse(bad).is_err(), "{bad}");
+        }
+        for d in DEFAULT_SETTINGS {
+            Setting::parse(d).unwrap();
+        }
+    }
+
+    #[test]
+    fn the_pareto_front_keeps_what_nothing_beats_in_both() {
+        // (1, 0.5) and (2, 0.4) and (0.5, 0.9) trade off; (3, 0.6) is beaten
+        // by both of the first; a duplicate of a front point stays on it.
+        let p = [(1.0, 0.5), (2.0, 0.4), (3.0, 0.6), (0.5, 0.9), (1.0, 0.5)];
+        assert_eq!(pareto(&p), vec![true, true, false, true, true]);
+    }
+}

@@ -14,7 +14,7 @@ use evflow_nodes::filters::segment::open_runs;
 use evflow_nodes::lab::texture::samples::NAMES;
 use evflow_nodes::metric::spectrum::{averaged_spectrum, SpectrumConfig, Window};
 use evflow_nodes::narx::model::Model;
-use evflow_nodes::recording::format::Recording;
+use evflow_nodes::recording::format::{Channel, Recording, RecordingMeta, RecordingWriter};
 use evflow_tools::plot::{write_png, Plot, Series};
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
@@ -41,6 +41,11 @@ pub struct Args {
     /// Use the models in this folder (narx-MASSg-SPEEDcms.json) instead of training them.
     #[arg(long)]
     models: Option<PathBuf>,
+    /// Also write each texture's grid of synthesized actuation signals U_ij
+    /// (the trained cells, at their chosen gains) here, one folder per
+    /// texture, for `interp` (graphs/texture-live.toml's `grid`).
+    #[arg(long)]
+    grid: Option<PathBuf>,
     /// The folder of the shipped graphs.
     #[arg(long, default_value = "graphs")]
     graphs: PathBuf,
@@ -162,6 +167,33 @@ fn spectra_plot(sample: &str, c: &Cond, narx: &Scored, dir: &Path) -> Result<Plo
     })
 }
 
+/// Writes the synthesized actuation of the run in `from` (its constant-speed
+/// stretch) as the grid cell U_ij of `sample` at `c` into `grid`: channel
+/// `u`, condition load, velocity, material and the chosen gain (Table 5.1,
+/// which `interp`'s `apply_gain` multiplies in). The `narx` node's output
+/// lags the force by its look-ahead; a grid cell is a texture loop, so that
+/// shift of a few samples does not matter.
+fn write_cell(from: &Path, grid: &Path, sample: &str, c: &Cond, gain: f64) -> Result<()> {
+    let rec = recording_in(from)?;
+    let ch = |n: &str| rec.channel(n).ok_or_else(|| anyhow!("{}: no `{n}` channel", from.display()));
+    let (u, gate) = (ch("u")?, ch("steady")?);
+    let mut kept = Vec::new();
+    open_runs(&[gate], u.len().min(gate.len()), |a, b| kept.extend_from_slice(&u[a..b]));
+    ensure!(!kept.is_empty(), "{}: no constant-speed samples", from.display());
+    std::fs::create_dir_all(grid).with_context(|| format!("{}: cannot create", grid.display()))?;
+    let mut meta = RecordingMeta::new(rec.rate(), vec![Channel::new("u", "1")]);
+    meta.condition.load_g = Some(c.mass);
+    meta.condition.velocity_cm_s = Some(c.speed);
+    meta.condition.material = Some(sample.into());
+    meta.condition.gain = Some(gain);
+    meta.source = "evflow report textures: graphs/synthesize.toml, narx.u over the constant-speed stretch".into();
+    let path = grid.join(format!("u-{sample}-{}g-{}cms", c.mass, c.speed));
+    let mut w = RecordingWriter::create(&path, meta).map_err(|e| anyhow!("{e}"))?;
+    w.write_interleaved(&kept).map_err(|e| anyhow!("{e}"))?;
+    w.finish().map_err(|e| anyhow!("{e}"))?;
+    Ok(())
+}
+
 /// Records repetitions 1 and 2 of `sample` at `c` into `dir` (one pass each).
 pub(super) fn record_pair(graphs: &Path, sample: &str, c: &Cond, dir: &Path) -> Result<()> {
     for rep in [1, 2] {
@@ -281,6 +313,9 @@ pub fn main(a: Args) -> Result<()> {
             let playback = choose(&runs, "playback_es")?;
             let repeat = value(&runs[0].1, "repeat_es", "E_s")?;
             let dir = tmp.path().join(format!("synth-{s}-{}-{}-{}", c.mass, c.speed, narx.gain));
+            if let Some(g) = &a.grid {
+                write_cell(&dir, &g.join(format!("narx-{s}")), s, c, narx.gain)?;
+            }
             plots.push((format!("textures-{s}-{}g-{}cms.png", c.mass, c.speed), spectra_plot(s, c, &narx, &dir)?));
             rows.push(Row { sample: s.clone(), cond: *c, repeat, narx, playback });
         }

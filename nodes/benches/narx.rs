@@ -1,5 +1,9 @@
 //! Benchmarks of the NARX family: closed-loop time per sample (what the
-//! `narx` node costs per tick) and one Levenberg–Marquardt epoch.
+//! `narx` node costs per tick), one Levenberg–Marquardt epoch, and the whole
+//! training of the default network on 3066 samples of the simulated lab
+//! (issue 6, point 12; `evflow bench narx` reports the same with the
+//! closed-loop error it reaches, and `bench/narx_peer.py` sets it beside
+//! Python).
 //!
 //! `cargo bench -p evflow-nodes --bench narx`
 
@@ -55,5 +59,22 @@ fn lm_epoch(c: &mut Criterion) {
     g.finish();
 }
 
-criterion_group!(benches, closed_loop, lm_epoch);
+/// The default network (15-10-5, k_y = 1, k_x = 10, d from the
+/// cross-correlation, LM with early stopping) on 3066 samples of a random
+/// binary sequence through the nominal simulated lab, as `evflow bench narx`.
+fn default_training(c: &mut Criterion) {
+    use evflow_nodes::narx::fit::{fit, FitConfig};
+    use evflow_nodes::narx::labdata::{rbs, Lab};
+    let u = rbs(3066, 1);
+    let x = Lab::default().force(&u);
+    let cfg = FitConfig { feedback: 1, input: 10, ..FitConfig::default() };
+    let mut g = c.benchmark_group("fit");
+    g.sample_size(10);
+    g.bench_function("default network, 3066 lab samples, LM to the validation stop", |b| {
+        b.iter(|| black_box(fit(&x, &u, &cfg, &mut |_| {}).unwrap()))
+    });
+    g.finish();
+}
+
+criterion_group!(benches, closed_loop, lm_epoch, default_training);
 criterion_main!(benches);

@@ -19,10 +19,14 @@
 //! rose (the weights of the best validation epoch are returned). Parameter
 //! names and defaults are MATLAB's (`trainlm` documentation, Neural Network
 //! Toolbox). JᵀJ is accumulated over blocks of rows so memory stays
-//! O(P² + block·P) for any recording length.
+//! O(P² + block·P) for any recording length; backpropagation writes each
+//! block's Jᵀ column by column in place, and only the lower triangle of
+//! the symmetric JᵀJ — the half the Cholesky factorization reads — is
+//! formed (half the multiply-adds of the full product).
 
 use super::{mse, Data, EarlyStop, Epoch, Options, Report, StopReason};
 use crate::narx::net::Mlp;
+use faer::linalg::matmul::triangular::{self, BlockStructure};
 use faer::linalg::solvers::Solve;
 use faer::{Accum, Mat, Par, Side};
 use std::time::Instant;
@@ -46,11 +50,13 @@ pub fn train(
     let mut perf = mse(net, train, &mut ws);
     let mut stop = EarlyStop::new(net.weights(), mse(net, val, &mut ws), perf, opts.max_fail);
     let mut mu = opts.mu;
+    // JᵀJ: only its lower triangle is formed and read (Cholesky of the lower half).
     let mut jtj = Mat::<f64>::zeros(p, p);
+    let mut diag = vec![0.0; p];
     let mut jte = Mat::<f64>::zeros(p, 1);
-    let mut jblock = Mat::<f64>::zeros(BLOCK, p);
+    // Jᵀ of a block of rows: column i holds ∂y/∂w of row i, written in place.
+    let mut jt_block = Mat::<f64>::zeros(p, BLOCK);
     let mut eblock = Mat::<f64>::zeros(BLOCK, 1);
-    let mut row = vec![0.0; p];
     let mut trial = vec![0.0; p];
     let mut epochs = 0;
     let mut reason = StopReason::MaxEpochs;
@@ -68,16 +74,24 @@ pub fn train(
         while s < n {
             let m = BLOCK.min(n - s);
             for i in 0..m {
-                let y = net.jacobian_row(train.row(s + i), &mut ws, &mut row);
-                for (k, v) in row.iter().enumerate() {
-                    jblock[(i, k)] = *v;
-                }
+                let col = jt_block.as_mut().col_mut(i).try_as_col_major_mut().expect("a Mat's columns are contiguous");
+                let y = net.jacobian_row(train.row(s + i), &mut ws, col.as_slice_mut());
                 eblock[(i, 0)] = y - train.target(s + i);
             }
-            let (jb, eb) = (jblock.as_ref().subrows(0, m), eblock.as_ref().subrows(0, m));
+            let (jb, eb) = (jt_block.as_ref().subcols(0, m), eblock.as_ref().subrows(0, m));
             let acc = if first { Accum::Replace } else { Accum::Add };
-            faer::linalg::matmul::matmul(jtj.as_mut(), acc, jb.transpose(), jb, 1.0, Par::Seq);
-            faer::linalg::matmul::matmul(jte.as_mut(), acc, jb.transpose(), eb, 1.0, Par::Seq);
+            triangular::matmul(
+                jtj.as_mut(),
+                BlockStructure::TriangularLower,
+                acc,
+                jb,
+                BlockStructure::Rectangular,
+                jb.transpose(),
+                BlockStructure::Rectangular,
+                1.0,
+                Par::Seq,
+            );
+            faer::linalg::matmul::matmul(jte.as_mut(), acc, jb, eb, 1.0, Par::Seq);
             first = false;
             s += m;
         }
@@ -88,12 +102,14 @@ pub fn train(
         }
         // Raise μ until a step lowers the training error.
         let mut improved = false;
+        for (k, d) in diag.iter_mut().enumerate() {
+            *d = jtj[(k, k)];
+        }
         while mu <= opts.mu_max {
-            let mut a = jtj.clone();
-            for k in 0..p {
-                a[(k, k)] += mu;
+            for (k, d) in diag.iter().enumerate() {
+                jtj[(k, k)] = d + mu;
             }
-            if let Ok(llt) = a.llt(Side::Lower) {
+            if let Ok(llt) = jtj.llt(Side::Lower) {
                 let dx = llt.solve(jte.as_ref());
                 let w = net.weights();
                 let ok = (0..p).all(|k| dx[(k, 0)].is_finite());

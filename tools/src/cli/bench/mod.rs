@@ -4,6 +4,8 @@
 //! `evflow run`'s timing; micro-benchmarks are criterion benches.
 
 pub mod mesh;
+pub mod narx;
+pub mod narx_export;
 pub mod stats;
 pub mod texture;
 
@@ -23,6 +25,14 @@ enum Which {
     ///
     /// Example: cargo run --release -p evflow -- bench mesh
     Mesh(mesh::Args),
+    /// The inverse NARX model (chapter 5): training time of the default
+    /// network (15-10-5, LM) on 3066 lab samples, its closed-loop error on a
+    /// held-out recording, and closed-loop inference throughput;
+    /// `--export DIR` writes the data for bench/narx_peer.py. Build with
+    /// --release.
+    ///
+    /// Example: cargo run --release -p evflow -- bench narx --curve
+    Narx(narx::Args),
     /// The texture chain (chapter 6): per-tick compute time of
     /// graphs/texture-live.toml, the ticks that start a 10 Hz table update
     /// apart from the others. Build with --release.
@@ -35,6 +45,7 @@ enum Which {
 pub fn main(a: BenchArgs) -> anyhow::Result<()> {
     match a.which {
         Which::Mesh(m) => mesh::main(m),
+        Which::Narx(n) => narx::main(n),
         Which::Texture(t) => texture::main(t),
     }
 }

@@ -38,17 +38,22 @@ pub fn record(graph: &Path, c: &Condition<'_>, dir: &Path) -> Result<(f64, Vec<f
     let out = dir.join(format!("{}-{}g-{}cms-r{}", c.sample, c.mass, c.speed, c.rep));
     std::fs::create_dir_all(&out).with_context(|| format!("{}: cannot create", out.display()))?;
     run_with(graph, &sets, &out)?;
-    let wav = std::fs::read_dir(&out)
-        .with_context(|| format!("{}: no recording", out.display()))?
-        .filter_map(|e| e.ok().map(|e| e.path()))
-        .find(|p| p.extension().is_some_and(|x| x == "wav"))
-        .ok_or_else(|| anyhow!("{}: the graph wrote no recording", out.display()))?;
-    let rec = Recording::open(&wav).map_err(|e| anyhow!("{e}"))?;
+    let rec = recording_in(&out)?;
     let (force, velocity) = (
-        rec.channel("force").ok_or_else(|| anyhow!("{}: no `force` channel", wav.display()))?,
-        rec.channel("velocity").ok_or_else(|| anyhow!("{}: no `velocity` channel", wav.display()))?,
+        rec.channel("force").ok_or_else(|| anyhow!("{}: no `force` channel", out.display()))?,
+        rec.channel("velocity").ok_or_else(|| anyhow!("{}: no `velocity` channel", out.display()))?,
     );
     Ok((rec.rate(), constant_speed(force, velocity, c.speed, rec.rate())))
+}
+
+/// The only recording a graph run wrote into `dir`.
+pub fn recording_in(dir: &Path) -> Result<Recording> {
+    let wav = std::fs::read_dir(dir)
+        .with_context(|| format!("{}: cannot read", dir.display()))?
+        .filter_map(|e| e.ok().map(|e| e.path()))
+        .find(|p| p.extension().is_some_and(|x| x == "wav"))
+        .ok_or_else(|| anyhow!("{}: the graph wrote no recording", dir.display()))?;
+    Recording::open(&wav).map_err(|e| anyhow!("{e}"))
 }
 
 /// The constant-speed segments of `force` (see [`record`]).

@@ -7,6 +7,7 @@
 //! repeat baseline, each scored by E_s against the second repetition. The
 //! gain is the one whose peak power density matches the real one (§5.3.2).
 
+use super::lab_recording::recording_in;
 use crate::cli::graph_args::run_with;
 use anyhow::{anyhow, ensure, Context, Result};
 use evflow_engine::RunReport;
@@ -14,7 +15,7 @@ use evflow_nodes::filters::segment::open_runs;
 use evflow_nodes::lab::texture::samples::NAMES;
 use evflow_nodes::metric::spectrum::{averaged_spectrum, SpectrumConfig, Window};
 use evflow_nodes::narx::model::Model;
-use evflow_nodes::recording::format::{Channel, Recording, RecordingMeta, RecordingWriter};
+use evflow_nodes::recording::format::{Channel, RecordingMeta, RecordingWriter};
 use evflow_tools::plot::{write_png, Plot, Series};
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
@@ -129,16 +130,6 @@ fn gated_spectrum(x: &[f64], gate: &[f64], rate: f64) -> Result<Vec<f64>> {
         .map_err(|e| anyhow!("{e}"))?
         .map(|s| s.magnitude)
         .ok_or_else(|| anyhow!("no constant-speed samples to take a spectrum of"))
-}
-
-/// The only recording written into `dir`.
-fn recording_in(dir: &Path) -> Result<Recording> {
-    let wav = std::fs::read_dir(dir)
-        .with_context(|| format!("{}: cannot read", dir.display()))?
-        .filter_map(|e| e.ok().map(|e| e.path()))
-        .find(|p| p.extension().is_some_and(|x| x == "wav"))
-        .ok_or_else(|| anyhow!("{}: the graph wrote no recording", dir.display()))?;
-    Recording::open(&wav).map_err(|e| anyhow!("{e}"))
 }
 
 fn spectra_plot(sample: &str, c: &Cond, narx: &Scored, dir: &Path) -> Result<Plot> {

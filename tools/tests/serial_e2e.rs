@@ -121,12 +121,10 @@ fn value(text: &str, key: &str) -> f64 {
     l[key.len()..].trim().trim_start_matches('=').split_whitespace().next().unwrap().parse().unwrap()
 }
 
-#[test]
-fn the_force_the_device_renders_from_the_actuation_comes_back() {
-    let _one = one_at_a_time();
-    let tmp = tempfile::tempdir().unwrap();
-    let (link, log, s) = (tmp.path().join("dev"), tmp.path().join("log"), tmp.path().join("session"));
-    let mut dev = devsim(&link, &log, &[]);
+/// Runs the serial texture graph live for 2 s against the device at `link`,
+/// recording the session into `session`; returns its output, and fails the
+/// test if the run failed.
+fn live_two_seconds(link: &Path, session: &Path) -> String {
     let out = evflow()
         .arg("live")
         .arg(graph())
@@ -135,12 +133,22 @@ fn the_force_the_device_renders_from_the_actuation_comes_back() {
         // A starved test machine must not take the link down here.
         .args(["--set", "timeout=2"])
         .args(["--duration", "2", "--no-realtime", "--miss-streak", "0", "-q", "--session"])
-        .arg(&s)
+        .arg(session)
         .stdin(Stdio::null())
         .output()
         .unwrap();
     let text = String::from_utf8_lossy(&out.stdout).into_owned() + &String::from_utf8_lossy(&out.stderr);
     assert!(out.status.success(), "{text}");
+    text
+}
+
+#[test]
+fn the_force_the_device_renders_from_the_actuation_comes_back() {
+    let _one = one_at_a_time();
+    let tmp = tempfile::tempdir().unwrap();
+    let (link, log, s) = (tmp.path().join("dev"), tmp.path().join("log"), tmp.path().join("session"));
+    let mut dev = devsim(&link, &log, &[]);
+    let text = live_two_seconds(&link, &s);
     std::thread::sleep(Duration::from_millis(800));
     dev.kill().unwrap();
     dev.wait().unwrap();
@@ -310,20 +318,7 @@ fn corrupt_frames_are_counted_and_skipped() {
     let tmp = tempfile::tempdir().unwrap();
     let (link, log, s) = (tmp.path().join("dev"), tmp.path().join("log"), tmp.path().join("session"));
     let mut dev = devsim(&link, &log, &["--corrupt", "0.05", "--seed", "3"]);
-    let out = evflow()
-        .arg("live")
-        .arg(graph())
-        .arg("--set")
-        .arg(format!("port={}", link.display()))
-        // A starved test machine must not take the link down here.
-        .args(["--set", "timeout=2"])
-        .args(["--duration", "2", "--no-realtime", "--miss-streak", "0", "-q", "--session"])
-        .arg(&s)
-        .stdin(Stdio::null())
-        .output()
-        .unwrap();
-    let text = String::from_utf8_lossy(&out.stdout).into_owned() + &String::from_utf8_lossy(&out.stderr);
-    assert!(out.status.success(), "{text}");
+    let text = live_two_seconds(&link, &s);
     // Stop the emulator only once the host has closed, so its counts cover the session.
     std::thread::sleep(Duration::from_millis(300));
     dev.kill().unwrap();

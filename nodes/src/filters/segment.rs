@@ -83,9 +83,57 @@ impl Node for Segment {
     }
 }
 
-/// Keeps the samples where every gate is open: calls `keep(start, end)` for
-/// each maximal run `start..end` of indices `0..len` with all `gates[g][i] > 0.5`.
-/// Shared by the sinks that take a `gate` parameter.
+/// Most gate inputs a sink takes.
+pub const MAX_GATES: usize = 8;
+
+/// The gate inputs of a sink (its `gate` parameter, fed by `segment`): one
+/// definition of "keep the samples where every gate is above 0.5" for the
+/// sinks that take gates (`metric`, `narx.train`).
+#[derive(Debug, Clone, Copy)]
+pub struct Gates {
+    /// Index of the first gate input (they follow the data inputs).
+    first: usize,
+    /// Number of gates.
+    count: usize,
+}
+
+impl Gates {
+    /// Reads the `gate` parameter; the gate inputs follow the node's
+    /// `data_inputs` inputs. (A gate named like another input is refused by
+    /// the validator: port names must be unique.)
+    pub fn from_params(p: &Params, data_inputs: usize) -> Result<Self, NodeError> {
+        let count = p.text_list("gate").len();
+        if count > MAX_GATES {
+            return Err(NodeError::param("gate", format!("{count} gates; at most {MAX_GATES}")));
+        }
+        Ok(Self { first: data_inputs, count })
+    }
+
+    /// Whether there are any gates.
+    pub fn any(&self) -> bool {
+        self.count > 0
+    }
+
+    /// Calls `keep(start, end)` for each maximal run of this call's samples
+    /// with every gate open (the whole call when there are no gates);
+    /// returns how many samples were kept. Does not allocate.
+    pub fn open_runs(&self, io: &Io<'_>, keep: impl FnMut(usize, usize)) -> usize {
+        let mut gates = [&[][..]; MAX_GATES];
+        for (g, slot) in gates.iter_mut().enumerate().take(self.count) {
+            *slot = io.input(self.first + g);
+        }
+        let mut kept = 0;
+        let mut keep = keep;
+        open_runs(&gates[..self.count], io.len(), |a, b| {
+            kept += b - a;
+            keep(a, b);
+        });
+        kept
+    }
+}
+
+/// Calls `keep(start, end)` for each maximal run `start..end` of indices
+/// `0..len` with all `gates[g][i] > 0.5` (every index when `gates` is empty).
 pub fn open_runs(gates: &[&[f64]], len: usize, mut keep: impl FnMut(usize, usize)) {
     let open = |i: usize| gates.iter().all(|g| g[i] > 0.5);
     let mut i = 0;

@@ -2,14 +2,11 @@
 
 use super::spectral_error::{spectral_rms_error, Band, SpectralError};
 use super::spectrum::{Spectrum, SpectrumAccumulator, SpectrumConfig, Window};
-use crate::filters::segment::open_runs;
+use crate::filters::segment::Gates;
 use evflow_engine::{BuildContext, Io, Node, NodeError, NodeSpec, ParamSpec, Params, PortSpec, Role, Summary};
 
 /// Largest FFT length (2²⁰ samples: 17 min at 1 kHz, 105 s at 10 kHz).
 const MAX_NFFT: i64 = 1 << 20;
-
-/// Most gate inputs.
-const MAX_GATES: usize = 8;
 
 /// Declaration of `metric`.
 pub static SPEC: NodeSpec = NodeSpec::new(
@@ -160,20 +157,14 @@ struct Metric {
     fmin: f64,
     include_dc: bool,
     channels: [Channel; 2],
-    gates: usize,
+    gates: Gates,
     /// Samples left out by the gates.
     gated_out: u64,
 }
 
 fn build(p: &Params, ctx: &BuildContext) -> Result<Box<dyn Node>, NodeError> {
     let rate = ctx.rate;
-    let gates = p.text_list("gate");
-    if gates.len() > MAX_GATES {
-        return Err(NodeError::param("gate", format!("{} gates; at most {MAX_GATES}", gates.len())));
-    }
-    if let Some(g) = gates.iter().find(|g| *g == "virtual" || *g == "real") {
-        return Err(NodeError::param("gate", format!("`{g}` is taken by a force input; rename the gate")));
-    }
+    let gates = Gates::from_params(p, 2)?;
     let nfft = match p.usize("nfft") {
         0 => {
             let n = rate.round();
@@ -204,32 +195,20 @@ fn build(p: &Params, ctx: &BuildContext) -> Result<Box<dyn Node>, NodeError> {
         fmin: p.f64("fmin"),
         include_dc,
         channels: [channel("virtual")?, channel("real")?],
-        gates: p.text_list("gate").len(),
+        gates,
         gated_out: 0,
     }))
 }
 
 impl Node for Metric {
     fn process(&mut self, io: &mut Io<'_>) -> Result<(), NodeError> {
-        if self.gates == 0 {
-            for (i, c) in self.channels.iter_mut().enumerate() {
-                c.push(io.input(i));
-            }
-            return Ok(());
-        }
-        let mut gates = [&[][..]; MAX_GATES];
-        let n = io.len();
-        for (g, slot) in gates.iter_mut().enumerate().take(self.gates) {
-            *slot = io.input(2 + g);
-        }
-        let mut kept = 0;
-        let (channels, io_ref) = (&mut self.channels, &*io);
-        open_runs(&gates[..self.gates], n, |a, b| {
-            kept += b - a;
+        let channels = &mut self.channels;
+        let kept = self.gates.open_runs(io, |a, b| {
             for (i, c) in channels.iter_mut().enumerate() {
-                c.push(&io_ref.input(i)[a..b]);
+                c.push(&io.input(i)[a..b]);
             }
         });
+        let n = io.len();
         self.gated_out += (n - kept) as u64;
         Ok(())
     }
@@ -261,7 +240,7 @@ impl Node for Metric {
                         "input `{}` received no samples{}: E_s, RMS and peak-to-peak need at least one \
                          sample of each force",
                         c.name,
-                        if self.gates > 0 {
+                        if self.gates.any() {
                             format!(
                                 " (the gate never opened over {} samples; check the `segment` speed)",
                                 self.gated_out
@@ -331,7 +310,7 @@ impl Node for Metric {
             cfg.window.name(),
             cfg.overlap
         ));
-        if self.gates > 0 {
+        if self.gates.any() {
             summary = summary.line(format!("gate: {} samples kept, {} left out", sv.samples, self.gated_out));
         }
         if sv.samples < cfg.nfft as u64 {
@@ -435,6 +414,9 @@ mod tests {
             assert!(value(s, "E_s") < 1e-12, "block {block}: {}", value(s, "E_s"));
             assert!(s.lines.iter().any(|l| l.contains("2000 samples kept, 800 left out")), "{:?}", s.lines);
         }
+        // A gate may not take a force input's name (the validator says so).
+        let e = run("gate = [\"real\"]", &v, &r).expect_err("refused");
+        assert!(e.contains("two ports named `real`"), "{e}");
         // A gate that never opens is an error naming it.
         let e = run_gated_never(&v, &r);
         assert!(e.contains("gate never opened"), "{e}");

@@ -4,6 +4,7 @@
 use super::fit::{fit, Algorithm, FitConfig};
 use super::model::Condition;
 use super::train::Options;
+use crate::filters::segment::Gates;
 use evflow_engine::{
     BuildContext, Io, Node, NodeError, NodeSpec, ParamSpec, Params, PortSpec, PrepareContext, Role, Summary,
 };
@@ -108,7 +109,7 @@ struct Train {
     progress: bool,
     record_time: bool,
     seen: usize,
-    gates: usize,
+    gates: Gates,
     x: Vec<f64>,
     y: Vec<f64>,
 }
@@ -166,10 +167,7 @@ fn build(p: &Params, ctx: &BuildContext) -> Result<Box<dyn Node>, NodeError> {
         condition: Condition { mass_g: set(p.f64("mass_g")), speed_cm_s: set(p.f64("speed_cm_s")) },
         rate_hz: ctx.rate,
     };
-    let gates = p.text_list("gate").len();
-    if let Some(g) = p.text_list("gate").iter().find(|g| *g == "x" || *g == "y") {
-        return Err(NodeError::param("gate", format!("`{g}` is taken by a data input; rename the gate")));
-    }
+    let gates = Gates::from_params(p, 2)?;
     let path = p.str("path");
     if path.is_empty() {
         return Err(NodeError::param("path", "name the model file to write"));
@@ -202,15 +200,18 @@ impl Node for Train {
 
     fn process(&mut self, io: &mut Io<'_>) -> Result<(), NodeError> {
         // Offline only: the buffers grow with the recording.
-        let n = io.len();
-        for i in 0..n {
-            let open = (0..self.gates).all(|g| io.input(2 + g)[i] > 0.5);
-            if open && self.seen >= self.skip && self.x.len() < self.take {
-                self.x.push(io.input(0)[i]);
-                self.y.push(io.input(1)[i]);
+        let (x, y) = (io.input(0), io.input(1));
+        let (start, skip, take) = (self.seen, self.skip, self.take);
+        let (bx, by) = (&mut self.x, &mut self.y);
+        self.gates.open_runs(io, |a, b| {
+            for i in a..b {
+                if start + i >= skip && bx.len() < take {
+                    bx.push(x[i]);
+                    by.push(y[i]);
+                }
             }
-            self.seen += 1;
-        }
+        });
+        self.seen += io.len();
         Ok(())
     }
 
@@ -238,7 +239,7 @@ impl Node for Train {
                 } else {
                     String::new()
                 },
-                if self.gates > 0 {
+                if self.gates.any() {
                     format!(" (the gates kept {} of {} samples)", self.x.len(), self.seen)
                 } else {
                     String::new()

@@ -22,22 +22,28 @@ pub struct Condition<'a> {
     pub rep: u32,
 }
 
+impl Condition<'_> {
+    /// The `--set` values that make graphs/record-textures.toml record it.
+    pub fn sets(&self) -> [String; 5] {
+        [
+            format!("sample=\"{}\"", self.sample),
+            format!("speed={}", self.speed),
+            format!("mass={}", self.mass),
+            format!("passes={}", self.passes),
+            format!("rep={}", self.rep),
+        ]
+    }
+}
+
 /// Records `c` with `graph` into a folder under `dir` and returns the rate
 /// and the constant-speed force: runs within 2 % of the set speed, less
 /// their first 100 ms (the high-pass filter's response to the reversal),
 /// each less its mean (the friction's sign flips between passes) and faded
 /// in and out over 50 ms so that the joins add no steps, concatenated.
 pub fn record(graph: &Path, c: &Condition<'_>, dir: &Path) -> Result<(f64, Vec<f64>)> {
-    let sets = [
-        format!("sample=\"{}\"", c.sample),
-        format!("speed={}", c.speed),
-        format!("mass={}", c.mass),
-        format!("passes={}", c.passes),
-        format!("rep={}", c.rep),
-    ];
     let out = dir.join(format!("{}-{}g-{}cms-r{}", c.sample, c.mass, c.speed, c.rep));
     std::fs::create_dir_all(&out).with_context(|| format!("{}: cannot create", out.display()))?;
-    run_with(graph, &sets, &out)?;
+    run_with(graph, &c.sets(), &out)?;
     let rec = recording_in(&out)?;
     let (force, velocity) = (
         rec.channel("force").ok_or_else(|| anyhow!("{}: no `force` channel", out.display()))?,

@@ -7,7 +7,7 @@
 //! repeat baseline, each scored by E_s against the second repetition. The
 //! gain is the one whose peak power density matches the real one (§5.3.2).
 
-use super::lab_recording::recording_in;
+use super::lab_recording::{recording_in, Condition};
 use crate::cli::graph_args::run_with;
 use anyhow::{anyhow, ensure, Context, Result};
 use evflow_engine::RunReport;
@@ -188,14 +188,8 @@ fn write_cell(from: &Path, grid: &Path, sample: &str, c: &Cond, gain: f64) -> Re
 /// Records repetitions 1 and 2 of `sample` at `c` into `dir` (one pass each).
 pub(super) fn record_pair(graphs: &Path, sample: &str, c: &Cond, dir: &Path) -> Result<()> {
     for rep in [1, 2] {
-        let sets = [
-            format!("sample=\"{sample}\""),
-            format!("mass={}", c.mass),
-            format!("speed={}", c.speed),
-            "passes=1".to_string(),
-            format!("rep={rep}"),
-        ];
-        run_with(&graphs.join("record-textures.toml"), &sets, dir)?;
+        let rec = Condition { sample, mass: c.mass, speed: c.speed, passes: 1, rep };
+        run_with(&graphs.join("record-textures.toml"), &rec.sets(), dir)?;
     }
     Ok(())
 }

@@ -125,7 +125,9 @@ struct Counts {
 }
 
 /// Runs `plan` live for `seconds`, changing every live parameter of every
-/// node (to its default) halfway, and counts what the real-time thread did.
+/// node halfway (to its default; integers such as `interp.texture` and
+/// `mesh.gradient.scene` to the next index, a real switch), and counts
+/// what the real-time thread did.
 fn allocations(plan: Plan, seconds: f64) -> Result<Counts, String> {
     syscalls::TRAPPED.store(0, Ordering::SeqCst);
     syscalls::FIRST.store(-1, Ordering::SeqCst);
@@ -146,7 +148,8 @@ fn allocations(plan: Plan, seconds: f64) -> Result<Counts, String> {
     for (node, p) in &changes {
         let v = match p.default {
             evflow_engine::spec::ParamDefault::Float(x) => x.to_string(),
-            evflow_engine::spec::ParamDefault::Int(i) => i.to_string(),
+            // A real change (a texture or scene switch); refused harmlessly if out of range.
+            evflow_engine::spec::ParamDefault::Int(i) => (i + 1).to_string(),
             evflow_engine::spec::ParamDefault::Bool(b) => b.to_string(),
             evflow_engine::spec::ParamDefault::Text(t) => t.to_string(),
             _ => continue,

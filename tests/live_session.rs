@@ -155,9 +155,11 @@ fn ctrl_c_ends_the_session_with_the_actuation_at_zero() {
 fn the_rendering_chains_replay_bit_for_bit_multi_rate_sources_included() {
     // sim.user has ports at 1 kHz and at 40 Hz: the session records one file
     // per rate and the replay feeds each back at its own rate.
-    for (g, files) in [
-        ("graphs/texture-live.toml", vec!["inputs/user", "inputs/user-40Hz"]),
-        ("graphs/mesh-live.toml", vec!["inputs/finger", "inputs/finger-40Hz"]),
+    // Each switches its texture or scene halfway through a graph variable,
+    // which sets two nodes of the mesh chain at one tick.
+    for (g, files, change, sets) in [
+        ("graphs/texture-live.toml", vec!["inputs/user", "inputs/user-40Hz"], "0.3:texture=3", 1),
+        ("graphs/mesh-live.toml", vec!["inputs/finger", "inputs/finger-40Hz"], "0.3:scene=4", 2),
     ] {
         let tmp = tempfile::tempdir().unwrap();
         let s = tmp.path().join("s");
@@ -166,11 +168,15 @@ fn the_rendering_chains_replay_bit_for_bit_multi_rate_sources_included() {
             .arg(evflow_tests::root().join(g))
             .arg("--session")
             .arg(&s)
-            .args(["--no-realtime", "--miss-streak", "0", "--duration", "0.6", "-q"])
+            .args(["--no-realtime", "--miss-streak", "0", "--duration", "0.6", "-q", "--change", change])
             .stdin(Stdio::null())
             .status()
             .expect("evflow live");
         assert!(status.success(), "{g}");
+        let events = std::fs::read_to_string(s.join("events.jsonl")).unwrap();
+        let at_300: Vec<&str> =
+            events.lines().filter(|l| l.contains("\"event\":\"set\"") && l.contains("\"tick\":300")).collect();
+        assert_eq!(at_300.len(), sets, "{g}: {events}");
         for f in &files {
             assert!(Recording::open(&s.join(f)).is_ok(), "{g}: {f} missing");
         }

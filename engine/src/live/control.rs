@@ -4,6 +4,7 @@
 
 use super::liveplan::{LiveError, LivePlan};
 use super::message::{Command, Shared, StopReason};
+use super::vars::LiveVar;
 use crate::spec::{NodeSpec, ParamKind};
 use std::sync::atomic::Ordering;
 use std::sync::Arc;
@@ -18,6 +19,8 @@ pub struct Control {
     pub(crate) nodes: Vec<(String, &'static NodeSpec)>,
     pub(crate) taps: Vec<super::liveplan::TapInfo>,
     pub(crate) base_rate: f64,
+    /// Graph variables bound to live parameters ([`Control::bind_vars`]).
+    pub(crate) vars: Vec<LiveVar>,
 }
 
 impl Control {
@@ -27,6 +30,12 @@ impl Control {
     /// the node exists, the parameter is declared live, the value is within
     /// its limits.
     pub fn set(&mut self, node: &str, param: &str, value: &str, at: Option<u64>) -> Result<(), LiveError> {
+        let cmd = self.command(node, param, value, at)?;
+        self.push(&[cmd], "parameter")
+    }
+
+    /// The checked command for `node.param = value` at tick `at`.
+    fn command(&self, node: &str, param: &str, value: &str, at: Option<u64>) -> Result<Command, LiveError> {
         let Some(k) = self.nodes.iter().position(|(n, _)| n == node) else {
             let help = crate::suggest::help(node, self.nodes.iter().map(|(n, _)| n.as_str()));
             return Err(LiveError::Set(format!("no node `{node}` in the running plan; {help}")));
@@ -46,22 +55,68 @@ impl Control {
         }
         let v = parse_value(&p.kind, value.trim())
             .map_err(|why| LiveError::Set(format!("`{node}.{param}` = `{value}`: {why}")))?;
-        let cmd = Command { at: at.unwrap_or(0), node: k as u32, param: p.name, value: v };
-        self.commands.push(cmd).map_err(|_| {
-            self.shared.command_overruns.fetch_add(1, Ordering::Relaxed);
-            LiveError::QueueFull("parameter")
-        })
+        Ok(Command { at: at.unwrap_or(0), node: k as u32, param: p.name, value: v })
     }
 
-    /// Parses `node.param=value` (or `node.param value`) and queues it.
+    /// Pushes `cmds` in one chunk: the real-time thread sees all of them or
+    /// none, so commands stamped with the same tick apply at the same tick.
+    fn push(&mut self, cmds: &[Command], what: &'static str) -> Result<(), LiveError> {
+        let overrun = |s: &Shared| {
+            s.command_overruns.fetch_add(1, Ordering::Relaxed);
+            LiveError::QueueFull(what)
+        };
+        let Ok(chunk) = self.commands.write_chunk_uninit(cmds.len()) else { return Err(overrun(&self.shared)) };
+        chunk.fill_from_iter(cmds.iter().copied());
+        Ok(())
+    }
+
+    /// Tells the control side which graph variables set live parameters
+    /// (see [`crate::live::live_vars`]), so `set_var` and `set_text("name=value")`
+    /// can change them.
+    pub fn bind_vars(&mut self, vars: Vec<LiveVar>) {
+        self.vars = vars;
+    }
+
+    /// The bound variables.
+    pub fn vars(&self) -> &[LiveVar] {
+        &self.vars
+    }
+
+    /// Sets graph variable `name` to `value`: every live parameter written
+    /// `"$name"` takes the value at the same tick `at` (`None`: as soon as
+    /// possible). All values are checked before any is queued.
+    pub fn set_var(&mut self, name: &str, value: &str, at: Option<u64>) -> Result<(), LiveError> {
+        let name = name.trim().trim_start_matches('$');
+        let Some(var) = self.vars.iter().find(|v| v.name == name) else {
+            let help = crate::suggest::help(name, self.vars.iter().map(|v| v.name.as_str()));
+            let known = if self.vars.is_empty() {
+                "this graph has none".to_string()
+            } else {
+                self.vars.iter().map(|v| v.name.as_str()).collect::<Vec<_>>().join(", ")
+            };
+            return Err(LiveError::Set(format!(
+                "no graph variable `{name}` sets a live parameter (live variables: {known}); {help}"
+            )));
+        };
+        let uses = var.uses.clone();
+        // The same tick for every parameter, even "as soon as possible": a
+        // chunk is applied within one tick.
+        let cmds =
+            uses.iter().map(|(node, param)| self.command(node, param, value, at)).collect::<Result<Vec<_>, _>>()?;
+        self.push(&cmds, "parameter")
+    }
+
+    /// Parses `node.param=value` (or `node.param value`), or `var=value`
+    /// for a graph variable bound to live parameters, and queues it.
     pub fn set_text(&mut self, text: &str, at: Option<u64>) -> Result<(), LiveError> {
         let (key, value) = text
             .split_once('=')
             .or_else(|| text.trim().split_once(char::is_whitespace))
-            .ok_or_else(|| LiveError::Set(format!("`{text}`: expected node.param=value")))?;
-        let (node, param) =
-            key.trim().split_once('.').ok_or_else(|| LiveError::Set(format!("`{key}`: expected node.param")))?;
-        self.set(node, param, value, at)
+            .ok_or_else(|| LiveError::Set(format!("`{text}`: expected node.param=value or variable=value")))?;
+        match key.trim().split_once('.') {
+            Some((node, param)) => self.set(node, param, value, at),
+            None => self.set_var(key, value, at),
+        }
     }
 
     /// Asks the session to stop: safety guards fade out, then the

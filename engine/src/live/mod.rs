@@ -34,6 +34,7 @@ mod message;
 mod metrics;
 mod rt;
 mod system;
+mod vars;
 
 /// The ring buffer crate the runner's rings come from.
 pub use rtrb;
@@ -46,6 +47,7 @@ pub use message::{Command, Event, EventKind, Shared, StopReason, TickStat};
 pub use metrics::{Metrics, MetricsSummary};
 pub use rt::{RtExit, RtHook};
 pub use system::{RealtimeReport, RealtimeRequest};
+pub use vars::{live_vars, LiveVar};
 
 use std::sync::Arc;
 use std::thread::JoinHandle;
@@ -203,6 +205,7 @@ pub fn start(plan: LivePlan, config: &LiveConfig) -> Result<Live, LiveError> {
         nodes: (0..plan.plan.len()).map(|k| (plan.plan.node_name(k).to_string(), plan.plan.spec(k))).collect(),
         taps: plan.info.clone(),
         base_rate,
+        vars: Vec::new(),
     };
     let state = rt::RtState {
         plan: Box::new(plan),

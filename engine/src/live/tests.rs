@@ -2,7 +2,7 @@
 //! `tests/live_*.rs` run the node library's graphs).
 
 use super::*;
-use crate::check::check;
+use crate::check::{check, Checked};
 use crate::graph::parse_graph;
 use crate::harness::TAP;
 use crate::node::{BuildContext, Io, Node, NodeError, Refused};
@@ -291,4 +291,62 @@ fn offline_only_nodes_and_unknown_taps_are_refused() {
     let lp = live_plan("", &[]);
     let e = LivePlan::new(lp.plan, &[Tap::new("g", "outt")]).err().unwrap().to_string();
     assert!(e.contains("cannot record `g.outt`") && e.contains("`out`"), "{e}");
+}
+
+/// Two counters whose `level` is one graph variable, each tapped.
+fn two_counters() -> (Checked, LivePlan) {
+    let doc = "[graph]\nformat = 1\nname = \"t\"\nrate = 1000.0\n\
+               connections = [\"a.out -> g.in\", \"g.out -> t.in\", \"b.out -> h.in\", \"h.out -> u.in\"]\n\
+               [vars]\nlevel = 0.0\nstall = 0.0\n\
+               [nodes.a]\ntype = \"test.counter\"\nlevel = \"$level\"\nstall_ms = \"$stall\"\n\
+               [nodes.b]\ntype = \"test.counter\"\nlevel = \"$level\"\n\
+               [nodes.g]\ntype = \"test.guard\"\n[nodes.t]\ntype = \"harness.tap\"\n\
+               [nodes.h]\ntype = \"test.guard\"\n[nodes.u]\ntype = \"harness.tap\"\n";
+    let mut reg = Registry::new();
+    reg.add(&COUNTER).add(&GUARD).add(&TAP);
+    let checked = check(&parse_graph(Path::new("t.toml"), doc).unwrap(), &reg, &[]).unwrap();
+    let plan = Plan::build(&checked, &PlanOptions { max_block: 1, timing: false, ..PlanOptions::default() }).unwrap();
+    let lp = LivePlan::new(plan, &[Tap::new("a", "out"), Tap::new("b", "out")]).unwrap();
+    (checked, lp)
+}
+
+#[test]
+fn a_graph_variable_sets_every_live_parameter_it_names_at_one_tick() {
+    let (checked, lp) = two_counters();
+    let vars = live_vars(&checked);
+    // `stall` names a parameter that cannot change live: not bound.
+    assert_eq!(vars, vec![LiveVar { name: "level".into(), uses: vec![("a".into(), "level"), ("b".into(), "level")] }]);
+    let mut live = start(lp, &config(Some(0.1))).unwrap();
+    live.control.bind_vars(vars);
+    live.control.set_text("level=500", Some(40)).unwrap();
+    live.control.set_var("$level", "7", Some(70)).unwrap();
+    let e = live.control.set_text("stall=1", None).unwrap_err().to_string();
+    assert!(e.contains("no graph variable `stall`") && e.contains("live variables: level"), "{e}");
+    let e = live.control.set_text("level=1e12", None).unwrap_err().to_string();
+    assert!(e.contains("outside its limits"), "{e}");
+    let e = live.control.set_text("levl=1", None).unwrap_err().to_string();
+    assert!(e.contains("`level`"), "suggests the closest name: {e}");
+    let mut p = live.into_parts();
+    p.thread.join();
+    let a = drain(&mut p.taps[0].1);
+    let b = drain(&mut p.taps[1].1);
+    for s in [&a, &b] {
+        assert_eq!((s[39], s[40], s[69], s[70]), (39.0, 540.0, 569.0, 77.0));
+    }
+    // An "as soon as possible" change lands on one tick for both nodes.
+    let (checked, lp) = two_counters();
+    let mut live = start(lp, &config(Some(0.2))).unwrap();
+    live.control.bind_vars(live_vars(&checked));
+    while live.control.ticks() < 20 {
+        std::thread::sleep(Duration::from_millis(1));
+    }
+    for v in 1..=20 {
+        live.control.set_var("level", &format!("{}", v * 1000), None).unwrap();
+    }
+    let mut p = live.into_parts();
+    p.thread.join();
+    let a = drain(&mut p.taps[0].1);
+    let b = drain(&mut p.taps[1].1);
+    assert_eq!(a, b, "both counters changed at the same ticks");
+    assert!(a.iter().any(|&x| x >= 20_000.0), "the changes applied");
 }

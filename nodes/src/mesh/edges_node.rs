@@ -3,7 +3,7 @@
 
 use super::edges::{census, EdgeCensus, EdgeTracker};
 use super::source::{self, Placed};
-use evflow_engine::{BuildContext, Io, Node, NodeError, NodeSpec, ParamSpec, Params, PortSpec, Role, Summary};
+use evflow_engine::{BuildContext, Io, Node, NodeError, NodeSpec, ParamSpec, Params, PortSpec, Refused, Role, Summary};
 
 /// Declaration of `mesh.edges`.
 pub static SPEC: NodeSpec = NodeSpec::new(
@@ -29,6 +29,10 @@ The mesh parameters must name the same mesh as the `mesh.gradient` node that fee
 variable keeps them together); only the triangles and normals are loaded, no BVH. A scene without \
 sharp edges leaves this node out, and pruning never constructs it. A `tri` that is not an index of \
 this mesh, or whose triangle does not hold the point, counts as off the mesh.\n\n\
+**Scenes.** With a `scenes` list (as `mesh.gradient`'s) every mesh's edges are found when the node is \
+built, and the live `scene` index picks the one felt; a change restarts the crossing tracker on the new \
+mesh (no edge is counted between two meshes). Switch it at the same tick as `mesh.gradient`'s through \
+one graph variable.\n\n\
 **Ports** (all at the node's rate): inputs `x`, `y` (m), `tri`; outputs `intensity` (I_e), \
 `sharpness` (S), `angle` (θ of the bend crossed this tick, degrees; 180 when none). **Checked \
 against:** a cube standing on an edge (90°, either winding), an axis-aligned cube stepped off (90° \
@@ -52,11 +56,14 @@ boundary and non-manifold cases (unit tests); fandisk's dihedral angles in the f
     source::OFFSET_X,
     source::OFFSET_Y,
     source::WELD,
+    source::SCENES,
+    source::SCENE,
     ParamSpec::float("max_angle", 1.0, 180.0, 160.0, "deg", "convex bends flatter than this are not edges"),
     ParamSpec::float("max_step", 1e-6, 1e3, 0.01, "m", "largest move per tick taken as motion (longer: a jump)"),
 ])
 .example("shape = \"frustum\"\nconfig = \"1B3H\"");
 
+/// One mesh's edges and the tracker of the finger on it.
 struct MeshEdges {
     placed: Placed,
     census: EdgeCensus,
@@ -64,16 +71,76 @@ struct MeshEdges {
     crossings: u64,
 }
 
-fn build(p: &Params, ctx: &BuildContext) -> Result<Box<dyn Node>, NodeError> {
-    let placed = source::load(p, ctx)?;
-    let max_angle = p.f64("max_angle");
-    let census = census(&placed.mesh, placed.floor, max_angle);
-    let tracker = EdgeTracker::new(census.theta_min, max_angle, p.f64("max_step") / placed.unit, placed.floor);
-    Ok(Box::new(MeshEdges { placed, census, tracker, crossings: 0 }))
+/// The node: the meshes it can switch between (`scenes`), one felt.
+struct EdgesNode {
+    scenes: Vec<MeshEdges>,
+    current: usize,
+    initial: usize,
 }
 
-impl Node for MeshEdges {
+fn build(p: &Params, ctx: &BuildContext) -> Result<Box<dyn Node>, NodeError> {
+    let max_angle = p.f64("max_angle");
+    let scenes = source::load_scenes(p, ctx)?
+        .into_iter()
+        .map(|placed| {
+            let census = census(&placed.mesh, placed.floor, max_angle);
+            let tracker = EdgeTracker::new(census.theta_min, max_angle, p.f64("max_step") / placed.unit, placed.floor);
+            MeshEdges { placed, census, tracker, crossings: 0 }
+        })
+        .collect();
+    let initial = p.usize("scene");
+    Ok(Box::new(EdgesNode { scenes, current: initial, initial }))
+}
+
+impl Node for EdgesNode {
     fn process(&mut self, io: &mut Io<'_>) -> Result<(), NodeError> {
+        let s = &mut self.scenes[self.current];
+        s.process(io);
+        Ok(())
+    }
+
+    fn reset(&mut self) {
+        for s in &mut self.scenes {
+            s.tracker.reset();
+            s.crossings = 0;
+        }
+        self.current = self.initial;
+    }
+
+    fn finish(&mut self) -> Result<Summary, NodeError> {
+        let first = &self.scenes[self.initial];
+        if self.scenes.len() == 1 {
+            return Ok(first.summary(Summary::default(), true));
+        }
+        let c = &first.census;
+        let mut s = Summary::default()
+            .value("theta_min", c.theta_min, "deg")
+            .value("convex_edges", c.convex as f64, "1")
+            .value("crossings", self.scenes.iter().map(|s| s.crossings).sum::<u64>() as f64, "1");
+        for (k, sc) in self.scenes.iter().enumerate() {
+            s = s.line(format!("scene {k}: {}", sc.summary(Summary::default(), false).lines.concat()));
+        }
+        Ok(s)
+    }
+
+    fn set(&mut self, param: &'static str, value: f64) -> Result<(), Refused> {
+        match param {
+            "scene" if (value as usize) < self.scenes.len() => {
+                let next = value as usize;
+                if next != self.current {
+                    // No crossing is counted between two meshes.
+                    self.scenes[next].tracker.reset();
+                    self.current = next;
+                }
+                Ok(())
+            }
+            _ => Err(Refused(param)),
+        }
+    }
+}
+
+impl MeshEdges {
+    fn process(&mut self, io: &mut Io<'_>) {
         for i in 0..io.len() {
             let (x, y) = self.placed.to_mesh(io.input(0)[i], io.input(1)[i]);
             let t = io.input(2)[i];
@@ -87,23 +154,25 @@ impl Node for MeshEdges {
             io.output(1)[i] = e.sharpness;
             io.output(2)[i] = e.theta;
         }
-        Ok(())
     }
 
-    fn reset(&mut self) {
-        self.tracker.reset();
-        self.crossings = 0;
-    }
-
-    fn finish(&mut self) -> Result<Summary, NodeError> {
+    /// Adds this mesh's figures: as named values (`values`) or as a line.
+    fn summary(&self, s: Summary, values: bool) -> Summary {
         let c = &self.census;
-        Ok(Summary::default()
-            .value("theta_min", c.theta_min, "deg")
-            .value("convex_edges", c.convex as f64, "1")
-            .value("crossings", self.crossings as f64, "1")
-            .line(format!(
-                "{}: {} edges, {} boundary, {} non-manifold",
-                self.placed.name, c.edges, c.boundary, c.non_manifold
-            )))
+        let line = format!(
+            "{}: {} edges, {} boundary, {} non-manifold, {} convex edges (θ_min {:.1}°), {} crossings",
+            self.placed.name, c.edges, c.boundary, c.non_manifold, c.convex, c.theta_min, self.crossings
+        );
+        if values {
+            s.value("theta_min", c.theta_min, "deg")
+                .value("convex_edges", c.convex as f64, "1")
+                .value("crossings", self.crossings as f64, "1")
+                .line(format!(
+                    "{}: {} edges, {} boundary, {} non-manifold",
+                    self.placed.name, c.edges, c.boundary, c.non_manifold
+                ))
+        } else {
+            s.line(line)
+        }
     }
 }

@@ -105,6 +105,24 @@ impl Gradient {
         *self = Gradient::new(self.s);
     }
 
+    /// Continues `from`'s estimate on another mesh (a live scene switch):
+    /// the same anchor point (its height read on this mesh) and direction
+    /// of motion, and as the held slope this mesh's slope at the anchor
+    /// along that direction — what the secant tends to — so the first
+    /// ticks on the new mesh need no run-up of `min_step`.
+    pub fn rebase(&mut self, from: &Gradient, mesh: &Mesh, rc: &RayCaster) {
+        self.reset();
+        let Some([x, y, _]) = from.anchor else { return };
+        let hit = rc.cast(x, y);
+        self.anchor = Some([x, y, hit.map_or(self.s.floor, |h| h.z)]);
+        self.dir = from.dir;
+        if let (Some(d), Some(h)) = (self.dir, hit) {
+            let n = mesh.normals[h.tri as usize];
+            let slope = if n[2] != 0.0 { -(n[0] * d[0] + n[1] * d[1]) / n[2] } else { 0.0 };
+            self.slope = if slope.is_finite() { slope } else { 0.0 };
+        }
+    }
+
     /// One tick at the touch point (x, y), mesh units. A non-finite point
     /// holds everything.
     pub fn step(&mut self, mesh: &Mesh, rc: &RayCaster, x: f64, y: f64) -> Estimate {

@@ -5,7 +5,7 @@ use super::calibrate::{calibrate, CacheStatus, Range, ScanSettings};
 use super::gradient::{intensity, Gradient, GradientSettings, SlopeMode};
 use super::raycast::RayCaster;
 use super::source::{self, Placed};
-use evflow_engine::{BuildContext, Io, Node, NodeError, NodeSpec, ParamSpec, Params, PortSpec, Role, Summary};
+use evflow_engine::{BuildContext, Io, Node, NodeError, NodeSpec, ParamSpec, Params, PortSpec, Refused, Role, Summary};
 
 /// Declaration of `mesh.gradient`.
 pub static SPEC: NodeSpec = NodeSpec::new(
@@ -38,6 +38,13 @@ $XDG_CACHE_HOME/evflow, else ~/.cache/evflow), or nowhere with `cache = \"none\"
 so neighbouring triangles share edges, within `weld`), or a generated §4.2 scene (`shape`, `config`, \
 `resolution`; cm). The BVH (obvhs CWBVH) is built when the node is constructed — never for a pruned \
 node. The hit test is f64 and watertight: rays through vertices and edges hit whatever the winding.\n\n\
+**Scenes.** `scenes` lists several meshes (generated-scene configs such as \"4B0H\", or OBJ files); all \
+are loaded, ray-cast structures built and calibrated when the node is built, and the live parameter \
+`scene` (0-based index) picks the one felt. On a change the slope estimate continues on the new mesh from the finger's last point and \
+direction (its held slope: the new mesh's slope there), and \
+the intensity crossfades from the old mesh's to the new one's over `switch_fade` (10 ms) — no click. \
+Change `mesh.gradient` and `mesh.edges` together through a graph variable bound to both (`scene=4` in \
+`graphs/mesh-live.toml`, `docs/live.md`).\n\n\
 **Ports** (all at the node's rate): inputs `x`, `y` (m); outputs `intensity`, `fsq` (√N), `slope`, `z` \
 (height under the finger, m), `tri` (index of the triangle hit, −1 off the mesh; feeds `mesh.edges`).\n\n\
 **Checked against:** planes and ramps scanned in many directions (exact slope), the Eq. 4.7 closed form, \
@@ -62,6 +69,9 @@ gradient of the Gaussian scene (fidelity report), and the robustness cases of `d
     source::OFFSET_X,
     source::OFFSET_Y,
     source::WELD,
+    source::SCENES,
+    source::SCENE,
+    ParamSpec::float("switch_fade", 0.0, 1000.0, 10.0, "ms", "intensity crossfade when `scene` changes"),
     ParamSpec::choice("slope", &["secant", "normal"], "secant", "slope estimate: Eq. 4.1 secant or triangle normal"),
     ParamSpec::float("min_step", 0.0, 1.0, 0.0005, "m", "smallest move that updates the previous hit point"),
     ParamSpec::float("max_step", 1e-6, 1e3, 0.01, "m", "largest move per tick taken as motion (longer: a jump)"),
@@ -91,7 +101,8 @@ gradient of the Gaussian scene (fidelity report), and the robustness cases of `d
 /// Default calibration speeds, m/s (3–7 cm/s is the study's range; slower and faster included).
 pub const DEFAULT_SPEEDS: [f64; 3] = [0.02, 0.05, 0.1];
 
-/// The node, also used by the fidelity report and the benchmark.
+/// One mesh's gradient state: the mesh, its ray caster, estimator and
+/// calibrated range.
 pub struct MeshGradient {
     /// The mesh and its placement.
     pub placed: Placed,
@@ -111,9 +122,8 @@ pub struct MeshGradient {
     misses: u64,
 }
 
-/// Builds the node's state from its parameters.
-pub fn build_state(p: &Params, ctx: &BuildContext) -> Result<MeshGradient, NodeError> {
-    let placed = source::load(p, ctx)?;
+/// Builds one mesh's state from the node's parameters.
+pub fn build_state(p: &Params, ctx: &BuildContext, placed: Placed) -> Result<MeshGradient, NodeError> {
     let rc = RayCaster::new(&placed.mesh);
     let unit = placed.unit;
     let gs = GradientSettings {
@@ -173,8 +183,24 @@ pub fn user_cache_dir() -> Option<std::path::PathBuf> {
         .or_else(|| var("HOME").map(|d| d.join(".cache").join("evflow")))
 }
 
+/// The node: the meshes it can switch between and the crossfade of a switch.
+struct GradientNode {
+    scenes: Vec<MeshGradient>,
+    current: usize,
+    initial: usize,
+    /// (scene faded out, samples of the fade done).
+    fade: Option<(usize, usize)>,
+    fade_len: usize,
+}
+
 fn build(p: &Params, ctx: &BuildContext) -> Result<Box<dyn Node>, NodeError> {
-    Ok(Box::new(build_state(p, ctx)?))
+    let scenes = source::load_scenes(p, ctx)?
+        .into_iter()
+        .map(|placed| build_state(p, ctx, placed))
+        .collect::<Result<Vec<_>, _>>()?;
+    let initial = p.usize("scene");
+    let fade_len = (p.f64("switch_fade") * 1e-3 * ctx.rate).round() as usize;
+    Ok(Box::new(GradientNode { scenes, current: initial, initial, fade: None, fade_len }))
 }
 
 /// One tick's outputs: intensity, F^sq, slope, z (m), triangle (−1: none).
@@ -196,10 +222,45 @@ impl MeshGradient {
     }
 }
 
-impl Node for MeshGradient {
+impl MeshGradient {
+    fn summary(&self, s: Summary, prefix: &str) -> Summary {
+        let on = self.hits as f64 / (self.hits + self.misses).max(1) as f64;
+        let s = if prefix.is_empty() {
+            s.value("f_min", self.range.f_min, "sqrt(N)")
+                .value("f_max", self.range.f_max, "sqrt(N)")
+                .value("triangles", self.placed.mesh.triangles.len() as f64, "1")
+                .value("on_mesh", on, "1")
+        } else {
+            s.line(format!(
+                "{prefix}{}: F^sq range [{:.4}, {:.4}] √N, {} triangles, on the mesh {:.3} of its ticks",
+                self.placed.name,
+                self.range.f_min,
+                self.range.f_max,
+                self.placed.mesh.triangles.len(),
+                on
+            ))
+        };
+        match &self.cache {
+            CacheStatus::Hit(p) => s.line(format!("{prefix}F^sq range from the cache {}", p.display())),
+            CacheStatus::Written(p) => s.line(format!("{prefix}F^sq range calibrated, cached in {}", p.display())),
+            CacheStatus::Failed(e) => s.line(format!("{prefix}F^sq range calibrated; not cached: {e}")),
+            CacheStatus::Disabled => s,
+        }
+    }
+}
+
+impl Node for GradientNode {
     fn process(&mut self, io: &mut Io<'_>) -> Result<(), NodeError> {
         for i in 0..io.len() {
-            let out = self.tick(io.input(0)[i], io.input(1)[i]);
+            let (x, y) = (io.input(0)[i], io.input(1)[i]);
+            let mut out = self.scenes[self.current].tick(x, y);
+            if let Some((from, done)) = self.fade {
+                // The old mesh keeps being felt, fading out, while the new one fades in.
+                let old = self.scenes[from].tick(x, y);
+                let w = (done + 1) as f64 / (self.fade_len + 1) as f64;
+                out[0] = (1.0 - w) * old[0] + w * out[0];
+                self.fade = (done + 1 < self.fade_len).then_some((from, done + 1));
+            }
             for (k, v) in out.into_iter().enumerate() {
                 io.output(k)[i] = v;
             }
@@ -208,23 +269,53 @@ impl Node for MeshGradient {
     }
 
     fn reset(&mut self) {
-        self.est.reset();
-        self.hits = 0;
-        self.misses = 0;
+        for s in &mut self.scenes {
+            s.est.reset();
+            s.hits = 0;
+            s.misses = 0;
+        }
+        self.current = self.initial;
+        self.fade = None;
     }
 
     fn finish(&mut self) -> Result<Summary, NodeError> {
+        let first = &self.scenes[self.initial];
+        if self.scenes.len() == 1 {
+            return Ok(first.summary(Summary::default(), ""));
+        }
+        // The starting scene's figures as values, every scene's as a line.
+        let on = first.hits as f64 / (first.hits + first.misses).max(1) as f64;
         let mut s = Summary::default()
-            .value("f_min", self.range.f_min, "sqrt(N)")
-            .value("f_max", self.range.f_max, "sqrt(N)")
-            .value("triangles", self.placed.mesh.triangles.len() as f64, "1")
-            .value("on_mesh", self.hits as f64 / (self.hits + self.misses).max(1) as f64, "1");
-        s = match &self.cache {
-            CacheStatus::Hit(p) => s.line(format!("F^sq range from the cache {}", p.display())),
-            CacheStatus::Written(p) => s.line(format!("F^sq range calibrated, cached in {}", p.display())),
-            CacheStatus::Failed(e) => s.line(format!("F^sq range calibrated; not cached: {e}")),
-            CacheStatus::Disabled => s,
-        };
+            .value("f_min", first.range.f_min, "sqrt(N)")
+            .value("f_max", first.range.f_max, "sqrt(N)")
+            .value("triangles", first.placed.mesh.triangles.len() as f64, "1")
+            .value("on_mesh", on, "1");
+        for (k, sc) in self.scenes.iter().enumerate() {
+            s = sc.summary(s, &format!("scene {k}: "));
+        }
         Ok(s)
+    }
+
+    fn set(&mut self, param: &'static str, value: f64) -> Result<(), Refused> {
+        match param {
+            "scene" if (value as usize) < self.scenes.len() => {
+                let next = value as usize;
+                if next != self.current {
+                    // The estimate continues on the new mesh from where the finger is.
+                    let from = self.scenes[self.current].est;
+                    let sc = &mut self.scenes[next];
+                    sc.est.rebase(&from, &sc.placed.mesh, &sc.rc);
+                    // Mid-fade, fade from whichever mesh dominates the output now.
+                    let from = match self.fade {
+                        Some((f, done)) if 2 * (done + 1) < self.fade_len + 1 => f,
+                        _ => self.current,
+                    };
+                    self.fade = (self.fade_len > 0 && from != next).then_some((from, 0));
+                    self.current = next;
+                }
+                Ok(())
+            }
+            _ => Err(Refused(param)),
+        }
     }
 }

@@ -27,6 +27,15 @@ pub const UNIT: ParamSpec =
 pub const OFFSET_X: ParamSpec = ParamSpec::float("offset_x", -1e6, 1e6, 0.0, "m", "touch x of the mesh's origin");
 /// `offset_y`: screen position of the mesh origin.
 pub const OFFSET_Y: ParamSpec = ParamSpec::float("offset_y", -1e6, 1e6, 0.0, "m", "touch y of the mesh's origin");
+/// `scenes`: the meshes a session can switch between.
+pub const SCENES: ParamSpec = ParamSpec::text_list(
+    "scenes",
+    "meshes to switch between live: each a generated-scene config (with `shape`, e.g. \"4B0H\") or an OBJ file \
+     (*.obj); empty: the one mesh of `file` or `config`",
+);
+/// `scene`: which of `scenes` is felt (live).
+pub const SCENE: ParamSpec =
+    ParamSpec::int("scene", 0, 255, 0, "1", "index into `scenes` of the mesh felt (changes live)").live();
 /// `weld`: vertex weld tolerance.
 pub const WELD: ParamSpec = ParamSpec::float(
     "weld",
@@ -61,19 +70,63 @@ impl Placed {
     }
 }
 
-/// Loads the mesh the parameters name.
+/// Loads the mesh the parameters name (`file`, else the generated scene
+/// `shape` × `config`).
 pub fn load(p: &Params, ctx: &BuildContext) -> Result<Placed, NodeError> {
-    let unit = p.f64("unit");
-    let offset = [p.f64("offset_x"), p.f64("offset_y")];
     let file = p.str("file");
     if !file.is_empty() {
-        let path = ctx.path(file);
+        return load_entry(p, ctx, file);
+    }
+    load_entry(p, ctx, p.str("config"))
+}
+
+/// Loads every mesh a node can switch between: the `scenes` list, or the
+/// one mesh of [`load`]. Also checks `scene` against the list.
+pub fn load_scenes(p: &Params, ctx: &BuildContext) -> Result<Vec<Placed>, NodeError> {
+    let list = p.text_list("scenes");
+    let scene = p.usize("scene");
+    if list.is_empty() {
+        if scene != 0 {
+            return Err(NodeError::param("scene", format!("{scene}: without a `scenes` list the only scene is 0")));
+        }
+        return Ok(vec![load(p, ctx)?]);
+    }
+    if !p.str("file").is_empty() {
+        return Err(NodeError::param("scenes", "give `file` or `scenes` (which may list OBJ files), not both"));
+    }
+    if scene >= list.len() {
+        return Err(NodeError::param(
+            "scene",
+            format!("{scene} is not an index into the {} scenes given (0 … {})", list.len(), list.len() - 1),
+        ));
+    }
+    list.iter()
+        .enumerate()
+        .map(|(k, e)| {
+            load_entry(p, ctx, e).map_err(|err| NodeError::param("scenes", format!("entry {k} `{e}`: {err}")))
+        })
+        .collect()
+}
+
+/// One mesh: an OBJ file (a name ending in `.obj`) or a generated scene's
+/// config word.
+fn load_entry(p: &Params, ctx: &BuildContext, entry: &str) -> Result<Placed, NodeError> {
+    let unit = p.f64("unit");
+    let offset = [p.f64("offset_x"), p.f64("offset_y")];
+    if entry.to_ascii_lowercase().ends_with(".obj") {
+        let path = ctx.path(entry);
         let mesh = load_obj(&path, p.f64("weld")).map_err(|e| NodeError::Other(e.to_string()))?;
         let floor = mesh.bounds().min[2];
         return Ok(Placed { mesh, floor, unit, offset, name: path.display().to_string() });
     }
     let shape = if p.str("shape") == "frustum" { Shape::Frustum } else { Shape::Gaussian };
-    let config = p.str("config");
-    let mesh = scene(shape, config, p.usize("resolution")).map_err(|e| NodeError::param("config", e.to_string()))?;
-    Ok(Placed { mesh, floor: 0.0, unit, offset, name: format!("{} {config}", p.str("shape")) })
+    if !CONFIGS.contains(&entry) {
+        let help = evflow_engine::suggest::help(entry, CONFIGS.iter().copied());
+        return Err(NodeError::param(
+            "config",
+            format!("unknown scene `{entry}` (one of {}, or an OBJ file); {help}", CONFIGS.join(", ")),
+        ));
+    }
+    let mesh = scene(shape, entry, p.usize("resolution")).map_err(|e| NodeError::param("config", e.to_string()))?;
+    Ok(Placed { mesh, floor: 0.0, unit, offset, name: format!("{} {entry}", p.str("shape")) })
 }

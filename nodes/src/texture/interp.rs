@@ -7,7 +7,8 @@ use super::kernel::SincKernel;
 use super::scheme::{Geometry, Mix, Scheme};
 use crate::rate::clock::Clock;
 use evflow_engine::{
-    BuildContext, Io, Node, NodeError, NodeSpec, ParamSpec, Params, PortSpec, PrepareContext, RateSpec, Role, Summary,
+    BuildContext, Io, Node, NodeError, NodeSpec, ParamSpec, Params, PortSpec, PrepareContext, RateSpec, Refused, Role,
+    Summary,
 };
 use std::path::PathBuf;
 
@@ -40,6 +41,11 @@ before it), so a table is heard one update period after its condition was read.\
 samples per tick (20 per 1 ms tick by default): the 10 Hz update costs the same small amount every tick \
 instead of one large burst. Each sample costs two kernel evaluations of 2·W/c taps (W = `half_width`, c \
 the anti-alias cutoff, smaller for larger velocity steps); nothing is allocated after `prepare`.\n\n\
+**Textures.** `textures` lists several grids (one folder per texture) instead of `folder`; all are \
+loaded when the node is built, and the live parameter `texture` (0-based index into the list) picks the \
+one played: a change takes effect at the next frame (the next 10 Hz update), and `playback` crossfades \
+into it like any new table — no click. Change it live with `interp.texture=1` (or a graph variable \
+bound to it, `docs/live.md`).\n\n\
 **Grid.** `folder` (every recording in it) or `paths`; `material` filters; `channel` picks the channel \
 (default: the recording's only one). Only the cells that `load_range` × `velocity_range` can reach are \
 loaded (the rest are never opened). A reachable cell without a recording, two recordings for one cell, \
@@ -58,8 +64,10 @@ single-column grids, a velocity ratio of 10, missing and duplicate cells (`nodes
     PortSpec::output("table", "frame", "table frames for `playback` (header + U_uu)").at(RateSpec::Param("stream_rate")),
 ])
 .params(&[
-    ParamSpec::text("folder", "", "folder of grid recordings (relative to the graph file); or use `paths`"),
+    ParamSpec::text("folder", "", "folder of grid recordings (relative to the graph file); or use `paths` or `textures`"),
     ParamSpec::text_list("paths", "grid recordings, one per cell (instead of `folder`)"),
+    ParamSpec::text_list("textures", "folders of grid recordings, one per texture (instead of `folder`); `texture` picks one"),
+    ParamSpec::int("texture", 0, 255, 0, "1", "index into `textures` of the texture played (0: the first)").live(),
     ParamSpec::text("material", "", "use only recordings of this condition.material (empty: all)"),
     ParamSpec::text("channel", "", "channel holding U_ij (empty: the recording's only channel)"),
     ParamSpec::choice("scheme", &["improved", "basic"], "improved", "Eq. 6.4 two-part scheme or §5.3.3 basic average"),
@@ -74,11 +82,22 @@ single-column grids, a velocity ratio of 10, missing and duplicate cells (`nodes
 ])
 .example("folder = \"recordings/grid\"\nscheme = \"improved\"\nupdate_rate = 10.0\nstream_rate = 20000.0");
 
+/// One texture's grid and the geometry of its tables.
+struct Texture {
+    grid: Grid,
+    geo: Geometry,
+    shown: String,
+}
+
 /// The state of `interp`.
 struct Interp {
-    grid: Grid,
+    textures: Vec<Texture>,
+    /// The texture of the current frame; the one the next frame takes; the
+    /// one at t = 0.
+    current: usize,
+    pending: usize,
+    initial: usize,
     kernel: SincKernel,
-    geo: Geometry,
     scheme: Scheme,
     frame: usize,
     in_clock: Clock,
@@ -92,16 +111,18 @@ struct Interp {
     mix: Option<Mix>,
     generation: u64,
     scratch: [Vec<f64>; 2],
-    shown: String,
 }
 
 fn build(p: &Params, ctx: &BuildContext) -> Result<Box<dyn Node>, NodeError> {
     let folder = p.str("folder");
     let paths = p.text_list("paths");
-    if folder.is_empty() == paths.is_empty() {
+    let textures = p.text_list("textures");
+    let given = [!folder.is_empty(), !paths.is_empty(), !textures.is_empty()];
+    if given.iter().filter(|&&g| g).count() != 1 {
         return Err(NodeError::param(
             "folder",
-            "give either `folder` (a folder of grid recordings) or `paths` (a list), not both or neither",
+            "give one of `folder` (a folder of grid recordings), `paths` (a list of recordings) or `textures` \
+             (a list of folders, one per texture)",
         ));
     }
     let range = |name: &str| -> Result<Option<(f64, f64)>, NodeError> {
@@ -111,17 +132,35 @@ fn build(p: &Params, ctx: &BuildContext) -> Result<Box<dyn Node>, NodeError> {
             other => Err(NodeError::param(name, format!("give two numbers [lo, hi], not {} values", other.len()))),
         }
     };
-    let src = GridSource {
-        folder: (!folder.is_empty()).then(|| ctx.path(folder)),
-        paths: paths.iter().map(|s| ctx.path(s)).collect::<Vec<PathBuf>>(),
+    let base = GridSource {
+        folder: None,
+        paths: Vec::new(),
         material: p.str("material").to_string(),
         channel: p.str("channel").to_string(),
         load_range: range("load_range")?,
         velocity_range: range("velocity_range")?,
         apply_gain: p.bool("apply_gain"),
     };
-    let shown = if folder.is_empty() { format!("{} recordings", paths.len()) } else { folder.to_string() };
-    let grid = Grid::load(&src).map_err(|e| NodeError::Data(format!("grid: {e}")))?;
+    // (source, how errors and the summary name it)
+    let sources: Vec<(GridSource, String)> = if !textures.is_empty() {
+        textures.iter().map(|t| (GridSource { folder: Some(ctx.path(t)), ..base.clone() }, t.to_string())).collect()
+    } else if !folder.is_empty() {
+        vec![(GridSource { folder: Some(ctx.path(folder)), ..base.clone() }, folder.to_string())]
+    } else {
+        let paths = paths.iter().map(|s| ctx.path(s)).collect::<Vec<PathBuf>>();
+        vec![(GridSource { paths, ..base.clone() }, format!("{} recordings", p.text_list("paths").len()))]
+    };
+    let initial = p.usize("texture");
+    if initial >= sources.len() {
+        return Err(NodeError::param(
+            "texture",
+            format!(
+                "{initial} is not an index into the {} texture(s) given (0 … {})",
+                sources.len(),
+                sources.len() - 1
+            ),
+        ));
+    }
     let update = p.f64("update_rate");
     let stream = ctx.port_rates[2];
     let frame_f = stream / update;
@@ -132,17 +171,32 @@ fn build(p: &Params, ctx: &BuildContext) -> Result<Box<dyn Node>, NodeError> {
             format!("stream_rate/update_rate = {stream}/{update} = {frame_f} must be a whole number of samples ≥ {} (the frame length)", HEADER + 32),
         ));
     }
-    let overlap = (p.f64("overlap") * 1e-3 * grid.rate).round() as usize;
     let kernel = SincKernel::new(p.usize("half_width"), 0.9, 8.6);
-    let geo = Geometry::new(&grid, &kernel, frame - HEADER, overlap, p.f64("loop"))
-        .map_err(|e| NodeError::Data(format!("grid {shown}: {e}")))?;
+    let mut loaded: Vec<Texture> = Vec::with_capacity(sources.len());
+    for (src, shown) in sources {
+        let grid = Grid::load(&src).map_err(|e| NodeError::Data(format!("grid {shown}: {e}")))?;
+        if let Some(first) = loaded.first() {
+            if grid.rate != first.grid.rate {
+                return Err(NodeError::Data(format!(
+                    "grid {shown}: recorded at {} Hz, but texture 0 ({}) at {} Hz; every texture needs the same rate",
+                    grid.rate, first.shown, first.grid.rate
+                )));
+            }
+        }
+        let overlap = (p.f64("overlap") * 1e-3 * grid.rate).round() as usize;
+        let geo = Geometry::new(&grid, &kernel, frame - HEADER, overlap, p.f64("loop"))
+            .map_err(|e| NodeError::Data(format!("grid {shown}: {e}")))?;
+        loaded.push(Texture { grid, geo, shown });
+    }
     let scheme = if p.str("scheme") == "basic" { Scheme::Basic } else { Scheme::Improved };
     Ok(Box::new(Interp {
         in_clock: Clock::new(ctx.port_rates[0], ctx.base_rate, "load")?,
         out_clock: Clock::new(stream, ctx.base_rate, "table")?,
-        grid,
+        textures: loaded,
+        current: initial,
+        pending: initial,
+        initial,
         kernel,
-        geo,
         scheme,
         frame,
         sent: 0,
@@ -152,7 +206,6 @@ fn build(p: &Params, ctx: &BuildContext) -> Result<Box<dyn Node>, NodeError> {
         mix: None,
         generation: 0,
         scratch: [Vec::new(), Vec::new()],
-        shown,
     }))
 }
 
@@ -171,9 +224,10 @@ impl Interp {
     #[inline]
     fn value(&self, pos: usize) -> f64 {
         let Some(mix) = &self.mix else { return 0.0 };
+        let grid = &self.textures[self.current].grid;
         if pos >= HEADER {
             let k = pos - HEADER;
-            return if k < mix.len + mix.overlap { mix.sample(&self.grid, &self.kernel, k) } else { 0.0 };
+            return if k < mix.len + mix.overlap { mix.sample(grid, &self.kernel, k) } else { 0.0 };
         }
         match pos {
             at::MAGIC => MAGIC,
@@ -181,7 +235,7 @@ impl Interp {
             at::LEN => mix.len as f64,
             at::OVERLAP => mix.overlap as f64,
             at::LOOP_CM => mix.loop_cm,
-            at::RATE => self.grid.rate,
+            at::RATE => grid.rate,
             at::LOAD => mix.load,
             at::VELOCITY => mix.velocity,
             at::GENERATION => self.generation as f64,
@@ -211,7 +265,9 @@ impl Node for Interp {
             if pos == 0 {
                 self.latch(s, first, n_in);
                 let (m, v) = self.latest;
-                self.mix = Some(Mix::new(&self.grid, &self.geo, &self.kernel, self.scheme, m, v));
+                self.current = self.pending;
+                let t = &self.textures[self.current];
+                self.mix = Some(Mix::new(&t.grid, &t.geo, &self.kernel, self.scheme, m, v));
                 self.generation = s / self.frame as u64;
             }
             *y = self.value(pos);
@@ -230,20 +286,37 @@ impl Node for Interp {
         self.latest = (0.0, 0.0);
         self.mix = None;
         self.generation = 0;
+        self.current = self.initial;
+        self.pending = self.initial;
     }
 
     fn finish(&mut self) -> Result<Summary, NodeError> {
-        let g = &self.grid;
-        Ok(Summary::default().line(format!(
-            "grid {}: {} load(s) {:?} g × {} velocit(ies) {:?} cm/s loaded at {} Hz; loop {:.3} cm, {} frames sent",
-            self.shown,
-            g.loads.len(),
-            g.loads,
-            g.velocities.len(),
-            g.velocities,
-            g.rate,
-            self.geo.loop_cm,
-            self.sent / self.frame as u64
-        )))
+        let mut s = Summary::default();
+        for (k, t) in self.textures.iter().enumerate() {
+            let g = &t.grid;
+            let which = if self.textures.len() > 1 { format!("texture {k}, ") } else { String::new() };
+            s = s.line(format!(
+                "{which}grid {}: {} load(s) {:?} g × {} velocit(ies) {:?} cm/s loaded at {} Hz; loop {:.3} cm",
+                t.shown,
+                g.loads.len(),
+                g.loads,
+                g.velocities.len(),
+                g.velocities,
+                g.rate,
+                t.geo.loop_cm,
+            ));
+        }
+        Ok(s.line(format!("{} frames sent", self.sent / self.frame as u64)))
+    }
+
+    fn set(&mut self, param: &'static str, value: f64) -> Result<(), Refused> {
+        match param {
+            // Taken at the next frame start; playback crossfades into it.
+            "texture" if (value as usize) < self.textures.len() => {
+                self.pending = value as usize;
+                Ok(())
+            }
+            _ => Err(Refused(param)),
+        }
     }
 }

@@ -62,6 +62,23 @@ pub fn run_chain(
     ticks: u64,
     block: usize,
 ) -> Result<Vec<f64>, String> {
+    run_chain_with(dir, interp, playback, load, velocity, ticks, block, &[])
+}
+
+/// [`run_chain`] with live changes of `interp`'s parameters: `(tick,
+/// param, value)`, applied before that tick as a live session (or a
+/// replay) applies them.
+#[allow(clippy::too_many_arguments)]
+pub fn run_chain_with(
+    dir: &Path,
+    interp: &str,
+    playback: &str,
+    load: &[f64],
+    velocity: &[f64],
+    ticks: u64,
+    block: usize,
+    changes: &[(u64, &'static str, f64)],
+) -> Result<Vec<f64>, String> {
     use evflow_engine::harness::{FEED, TAP};
     use evflow_engine::params::toml_float;
     use evflow_engine::{check, graph::parse_graph, Plan, PlanOptions};
@@ -87,10 +104,15 @@ pub fn run_chain(
         ..PlanOptions::default()
     };
     let mut plan = Plan::build(&checked, &opts).map_err(|e| e.to_string())?;
+    let ip = (0..plan.len()).find(|&k| plan.node_name(k) == "ip").ok_or("no interp in the plan")?;
     let mut out = Vec::new();
     let mut done = 0;
     while done < ticks {
-        let n = (plan.max_block() as u64).min(ticks - done);
+        for &(at, param, value) in changes.iter().filter(|c| c.0 == done) {
+            plan.set(ip, param, value).map_err(|e| format!("tick {at}: {e}"))?;
+        }
+        let next_change = changes.iter().map(|c| c.0).filter(|&t| t > done).min().unwrap_or(u64::MAX);
+        let n = (plan.max_block() as u64).min(ticks - done).min(next_change - done);
         plan.step(n as usize).map_err(|e| e.to_string())?;
         out.extend_from_slice(plan.output("pb", 0).unwrap());
         done += n;

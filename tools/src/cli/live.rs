@@ -43,8 +43,11 @@ pub struct Args {
     #[arg(long = "tap", value_name = "NODE.PORT")]
     taps: Vec<String>,
     /// A scripted parameter change `SECONDS:node.param=value`, applied at
-    /// exactly that tick; may be repeated. (While running, type
-    /// `node.param=value` and Enter, or `stop`.)
+    /// exactly that tick; may be repeated. `SECONDS:variable=value` changes a
+    /// graph variable: every live parameter written `"$variable"` (e.g.
+    /// `texture` in texture-live.toml, `scene` in mesh-live.toml) at that
+    /// same tick. (While running, type the same without `SECONDS:` and
+    /// Enter, or `stop`.)
     #[arg(long = "change", value_name = "S:NODE.PARAM=VALUE")]
     changes: Vec<String>,
     /// SCHED_FIFO priority of the real-time thread (1–99).
@@ -121,9 +124,20 @@ pub fn main(a: Args) -> Result<()> {
         ..LiveConfig::default()
     };
     let mut session = live::start(lp, &cfg).map_err(|e| anyhow!("{e}"))?;
+    let vars = live::live_vars(&checked);
+    let vars_line = vars
+        .iter()
+        .map(|v| {
+            let uses: Vec<String> = v.uses.iter().map(|(n, p)| format!("{n}.{p}")).collect();
+            format!("{} ({})", v.name, uses.join(", "))
+        })
+        .collect::<Vec<_>>()
+        .join("; ");
+    session.control.bind_vars(vars);
     for c in &a.changes {
-        let (t, change) =
-            c.split_once(':').ok_or_else(|| anyhow!("--change {c}: expected SECONDS:node.param=value"))?;
+        let (t, change) = c
+            .split_once(':')
+            .ok_or_else(|| anyhow!("--change {c}: expected SECONDS:node.param=value or SECONDS:variable=value"))?;
         let t: f64 = t.trim().parse().map_err(|_| anyhow!("--change {c}: `{t}` is not a number of seconds"))?;
         let at = session.control.tick_at(t);
         session.control.set_text(change, Some(at)).map_err(|e| anyhow!("--change {c}: {e}"))?;
@@ -195,6 +209,9 @@ pub fn main(a: Args) -> Result<()> {
             dir.display()
         );
         eprintln!("type node.param=value and Enter to change a live parameter, `stop` or Ctrl-C to stop");
+        if !vars_line.is_empty() {
+            eprintln!("or variable=value for a graph variable, which changes its parameters at one tick: {vars_line}");
+        }
     }
     std::thread::Builder::new().name("evflow-console".into()).spawn(move || {
         let stdin = std::io::stdin();

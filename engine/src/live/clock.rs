@@ -20,6 +20,25 @@ pub fn now_ns() -> u64 {
     ORIGIN.get_or_init(Instant::now).elapsed().as_nanos() as u64
 }
 
+/// CPU time this thread has used, in nanoseconds (`CLOCK_THREAD_CPUTIME_ID`):
+/// unlike the monotonic clock it does not advance while the thread is
+/// preempted or descheduled, so the difference around a tick is what the
+/// tick cost, not what the machine did meanwhile. `None` where there is no
+/// such clock.
+#[cfg(unix)]
+pub fn thread_cpu_ns() -> Option<u64> {
+    let mut ts = libc::timespec { tv_sec: 0, tv_nsec: 0 };
+    // SAFETY: `ts` is a valid, writable timespec.
+    let r = unsafe { libc::clock_gettime(libc::CLOCK_THREAD_CPUTIME_ID, &mut ts) };
+    (r == 0).then(|| ts.tv_sec as u64 * 1_000_000_000 + ts.tv_nsec as u64)
+}
+
+/// No per-thread CPU clock off Unix.
+#[cfg(not(unix))]
+pub fn thread_cpu_ns() -> Option<u64> {
+    None
+}
+
 /// Sleeps until the monotonic clock reads `deadline` (absolute, so sleeps
 /// do not accumulate drift), resuming after signals.
 #[cfg(target_os = "linux")]
@@ -86,6 +105,21 @@ pub fn wait_until(deadline: u64, how: Wait) {
 
 #[cfg(test)]
 mod tests {
+    #[test]
+    fn thread_cpu_time_stops_while_asleep_and_runs_while_busy() {
+        let Some(start) = super::thread_cpu_ns() else { return };
+        std::thread::sleep(std::time::Duration::from_millis(30));
+        let slept = super::thread_cpu_ns().unwrap() - start;
+        assert!(slept < 5_000_000, "30 ms asleep used {slept} ns of CPU");
+        let (cpu0, wall0) = (super::thread_cpu_ns().unwrap(), super::now_ns());
+        let mut x = 0u64;
+        while super::thread_cpu_ns().unwrap() - cpu0 < 3_000_000 {
+            x = x.wrapping_mul(6364136223846793005).wrapping_add(1);
+            assert!(super::now_ns() - wall0 < 30_000_000_000, "3 ms of CPU never came");
+        }
+        std::hint::black_box(x);
+    }
+
     use super::*;
 
     #[test]

@@ -39,7 +39,7 @@ mod vars;
 /// The ring buffer crate the runner's rings come from.
 pub use rtrb;
 
-pub use clock::{now_ns, wait_until, Wait};
+pub use clock::{now_ns, thread_cpu_ns, wait_until, Wait};
 pub use control::{parse_value, Control};
 pub use histogram::{Histogram, Percentiles};
 pub use liveplan::{LiveError, LivePlan, Tap, TapInfo};

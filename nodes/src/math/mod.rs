@@ -1,8 +1,9 @@
 //! Arithmetic on streams.
 
+pub mod add;
 pub mod mul;
 
 use evflow_engine::NodeSpec;
 
 /// The node types of this family.
-pub static SPECS: &[&NodeSpec] = &[&mul::SPEC];
+pub static SPECS: &[&NodeSpec] = &[&add::SPEC, &mul::SPEC];

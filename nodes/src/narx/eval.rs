@@ -1,23 +1,41 @@
 //! Scores of an estimated actuation against the reference (dissertation
 //! Fig. 5.4 compares the closed-loop estimate with the reference PRBS9).
+//!
+//! A binary reference has two levels; "sign" below means the side of the
+//! level midway between them — the sign itself for a ±c excitation, on or
+//! off for a 0/c one.
 
 use super::model::ClosedLoopScore;
 
-/// Sign agreement and RMS error of `est` against `reference`, over the
-/// samples where the reference is not 0 (the sign of a binary excitation
-/// is what is compared; RMS over the same samples). `None` when no sample
-/// qualifies or the lengths differ.
+/// The level midway between the reference's extremes (0 for ±c).
+fn midpoint(reference: &[f64]) -> f64 {
+    let (lo, hi) = reference
+        .iter()
+        .filter(|r| r.is_finite())
+        .fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), &r| (lo.min(r), hi.max(r)));
+    if lo.is_finite() && hi.is_finite() {
+        0.5 * (lo + hi)
+    } else {
+        0.0
+    }
+}
+
+/// Level ("sign") agreement and RMS error of `est` against `reference`,
+/// over the samples where the reference is not at its midpoint (the level
+/// of a binary excitation is what is compared; RMS over the same samples).
+/// `None` when no sample qualifies or the lengths differ.
 pub fn score(est: &[f64], reference: &[f64]) -> Option<ClosedLoopScore> {
     if est.len() != reference.len() {
         return None;
     }
+    let mid = midpoint(reference);
     let (mut n, mut agree, mut sq) = (0usize, 0usize, 0.0);
     for (&e, &r) in est.iter().zip(reference) {
-        if r == 0.0 || !r.is_finite() {
+        if r == mid || !r.is_finite() {
             continue;
         }
         n += 1;
-        if e * r > 0.0 {
+        if (e - mid) * (r - mid) > 0.0 {
             agree += 1;
         }
         sq += (e - r) * (e - r);
@@ -30,17 +48,18 @@ pub fn score(est: &[f64], reference: &[f64]) -> Option<ClosedLoopScore> {
     })
 }
 
-/// Fraction of transitions of `reference` (samples where its sign changes)
-/// that `est` reproduces, and fraction of non-transitions it keeps — the
-/// part of a binary actuation an even (square-law) display makes visible
-/// independently of the global sign.
+/// Fraction of transitions of `reference` (samples where it crosses its
+/// midpoint) that `est` reproduces, and fraction of non-transitions it
+/// keeps — for a ±c excitation the part an even (square-law) display makes
+/// visible independently of the global sign.
 pub fn transition_agreement(est: &[f64], reference: &[f64]) -> Option<f64> {
     if est.len() != reference.len() || est.len() < 2 {
         return None;
     }
+    let mid = midpoint(reference);
     let n = est.len() - 1;
-    let agree =
-        (1..est.len()).filter(|&i| (reference[i] * reference[i - 1] < 0.0) == (est[i] * est[i - 1] < 0.0)).count();
+    let cross = |x: &[f64], i: usize| (x[i] - mid) * (x[i - 1] - mid) < 0.0;
+    let agree = (1..est.len()).filter(|&i| cross(reference, i) == cross(est, i)).count();
     Some(agree as f64 / n as f64)
 }
 
@@ -63,5 +82,21 @@ mod tests {
         let flipped: Vec<f64> = r.iter().map(|v| -v).collect();
         assert_eq!(transition_agreement(&flipped, &r), Some(1.0));
         assert_eq!(score(&flipped, &r).unwrap().sign_agreement, 0.0);
+    }
+
+    #[test]
+    fn a_unipolar_reference_is_scored_by_its_level() {
+        // 0/1 levels: the midpoint 0.5 splits on from off.
+        let r = [0.0, 1.0, 1.0, 0.0, 1.0];
+        let s = score(&[0.1, 0.8, 0.4, 0.45, 0.9], &r).unwrap();
+        assert_eq!(s.samples, 5);
+        assert_eq!(s.sign_agreement, 0.8);
+        // The reference crosses 0.5 at 1, 3 and 4, the estimate at 1, 2 and 4.
+        assert_eq!(transition_agreement(&[0.1, 0.8, 0.4, 0.45, 0.9], &r), Some(0.5));
+        // Shifted and scaled copies of a ±1 reference score alike.
+        let pm = [-1.0, 1.0, 1.0, -1.0, 1.0];
+        let e = [-0.8, 0.6, -0.2, -0.1, 0.8];
+        let shifted: Vec<f64> = e.iter().map(|x| 0.5 + 0.5 * x).collect();
+        assert_eq!(score(&e, &pm).unwrap().sign_agreement, score(&shifted, &r).unwrap().sign_agreement);
     }
 }

@@ -17,7 +17,7 @@ use evflow_nodes::metric::spectrum::{averaged_spectrum, SpectrumConfig, Window};
 use evflow_nodes::texture::grid::Grid;
 use evflow_nodes::texture::kernel::SincKernel;
 use evflow_nodes::texture::scheme::{Geometry, Mix, Scheme};
-use evflow_tools::plot::{write_png, Plot, Series};
+use evflow_tools::plot::{Plot, Series};
 use std::path::{Path, PathBuf};
 
 /// Arguments of `evflow report interp`.
@@ -202,12 +202,7 @@ pub fn main(a: Args) -> Result<()> {
         mean(|r| r.improved)
     );
     for (i, plot) in plots.iter().enumerate() {
-        match write_png(plot, &a.out.join(format!("interp-spectra-{}.png", i + 1))) {
-            Ok(w) => {
-                println!("wrote {}{}", w.path.display(), if w.labelled { "" } else { " (no font found: unlabelled)" })
-            }
-            Err(e) => eprintln!("warning: {e}"),
-        }
+        super::save_png(plot, &a.out.join(format!("interp-spectra-{}.png", i + 1)));
     }
     Ok(())
 }

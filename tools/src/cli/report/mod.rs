@@ -8,6 +8,7 @@ pub mod lab_recording;
 pub mod mesh;
 pub mod narx;
 pub mod resample;
+pub mod synthesis;
 pub mod textures;
 
 /// Arguments of `evflow report`.
@@ -65,6 +66,27 @@ enum Which {
     ///
     /// Example: cargo run --release -p evflow -- report narx --out report
     Narx(narx::Args),
+}
+
+/// Writes `plot` to `path` and says so (unlabelled without a font); a plot
+/// that cannot be drawn is a warning, not a failed report.
+fn save_png(plot: &evflow_tools::plot::Plot, path: &std::path::Path) {
+    match evflow_tools::plot::write_png(plot, path) {
+        Ok(w) => println!("wrote {}{}", w.path.display(), if w.labelled { "" } else { " (no font found: unlabelled)" }),
+        Err(e) => eprintln!("warning: {e}"),
+    }
+}
+
+/// Writes a report's Markdown `text` to `path` (through a temporary file,
+/// so an interrupted run leaves no half table) and says so.
+fn save_markdown(path: &std::path::Path, text: &str) -> anyhow::Result<()> {
+    use anyhow::Context;
+    let tmp = path.with_extension("md.tmp");
+    std::fs::write(&tmp, text)
+        .and_then(|_| std::fs::rename(&tmp, path))
+        .with_context(|| format!("{}: cannot write", path.display()))?;
+    println!("wrote {}", path.display());
+    Ok(())
 }
 
 /// Runs the chosen report.

@@ -4,6 +4,7 @@
 pub mod foaw;
 pub mod freqvel;
 pub mod interp;
+pub mod interp_narx;
 pub mod lab_recording;
 pub mod mesh;
 pub mod narx;
@@ -41,9 +42,11 @@ enum Which {
     /// Interpolation over the (load, velocity) grid (Fig. 5.6, 5.9, 6.8):
     /// the basic (§5.3.3) and improved (Eq. 6.4) schemes against the
     /// recording at every untrained condition, E_s beside the repeat
-    /// baseline; a table and PNG spectra.
+    /// baseline; a table and PNG spectra. The cells are the recorded
+    /// forces, or (--cells narx) NARX-synthesized actuation played on the
+    /// virtual display.
     ///
-    /// Example: cargo run --release -p evflow -- report interp --out report
+    /// Example: cargo run --release -p evflow -- report interp --cells narx --out report
     Interp(interp::Args),
     /// Re-sampling for the texture chain (§6.2): error against run time
     /// of rubato's sinc, polynomial and FFT resamplers and the live

@@ -105,3 +105,25 @@ fn playback_ignores_what_is_not_a_table() {
     assert_eq!(s.get("tables"), Some(0.0));
     assert_eq!(s.get("rejected_frames"), Some(40.0));
 }
+
+#[test]
+fn a_loop_of_whole_texture_periods_keeps_the_main_component_in_phase() {
+    let dir = tempfile::tempdir().unwrap();
+    sine_grid(dir.path());
+    let n = 3000;
+    // The longest loop is 1980 samples at 10 cm/s: 19.8 cm, 19.8 periods of
+    // the texture, so the seam (100 ms + 1980 samples in: the first table
+    // arrives after one update) jumps 0.8 of a period; `period = 1.0` makes
+    // it 19 whole periods. One second around the first seam:
+    let level = |interp: &str| {
+        let out = run_chain(dir.path(), interp, TIME, &vec![85.0; n], &vec![10.0; n], n as u64, 1024).unwrap();
+        amplitudes(&out[1580..2580])[10]
+    };
+    let whole = level("folder = \"grid\"\nperiod = 1.0");
+    let cut = level("folder = \"grid\"");
+    assert!((whole - 1.0).abs() < 0.02, "{whole}");
+    // Halves of a Hann window 0.8 of a cycle apart: |cos(0.8·π)| ≈ 0.81.
+    assert!(cut < 0.85, "a seam 0.8 of a period out of phase left the 10 Hz component at {cut}");
+    let e = run_chain(dir.path(), "folder = \"grid\"\nperiod = 25.0", TIME, &[85.0], &[10.0], 1, 1).unwrap_err();
+    assert!(e.contains("period") && e.contains("longer than the loop"), "{e}");
+}

@@ -52,8 +52,11 @@ loaded (the rest are never opened). A reachable cell without a recording, two re
 a cell without a condition, or cells at different rates is an error at load naming the file or cell.\n\n\
 **Loop.** Every table covers the same stretch of texture, from a margin x₀ to x₀ + L: L = `loop` cm, or \
 by default the longest the recordings allow (at most `stream_rate/update_rate − 10 − overlap` samples at \
-v_min); a loop of a whole number of texture periods has no seam at all. Each table holds `overlap` ms \
-more, which `playback` crossfades into the loop's start so the loop has no seam click.\n\n\
+v_min); a loop of a whole number of texture periods has no seam at all: `period` (the texture's main \
+wavelength, e.g. 1/slope of `evflow report freqvel`) rounds the loop down to a whole number of it. At a \
+seam that is not whole the main component jumps in phase, which a 1 Hz-bin spectrum (E_s, Eq. 5.2) sees as \
+a lower, split peak. Each table holds `overlap` ms more, which `playback` crossfades into the loop's \
+start so the loop has no seam click.\n\n\
 **Checked against:** the sine examples of §6.1–6.2 (10 and 20 Hz → 15 Hz: one full-power peak; basic: \
 two half-amplitude peaks; 19 Hz with weights 0.1/0.9 and 12 Hz with 0.8/0.2), clamping, single-row and \
 single-column grids, a velocity ratio of 10, missing and duplicate cells (`nodes/tests/texture_*.rs`).",
@@ -76,6 +79,7 @@ single-column grids, a velocity ratio of 10, missing and duplicate cells (`nodes
     ParamSpec::float("update_rate", 0.01, 1000.0, 10.0, "Hz", "table updates per second (§6.5.1: 10 Hz)"),
     ParamSpec::float("stream_rate", 1.0, 1e7, 20_000.0, "Hz", "rate of the `table` port; frame length = stream_rate/update_rate"),
     ParamSpec::float("loop", 0.0, 1e4, 0.0, "cm", "length of texture each table covers (0: the longest the recordings allow)"),
+    ParamSpec::float("period", 0.0, 1e3, 0.0, "cm", "round the loop down to a whole number of this spatial period (0: off)"),
     ParamSpec::float("overlap", 0.0, 1000.0, 10.0, "ms", "seam overlap read past the loop's end"),
     ParamSpec::int("half_width", 2, 64, 16, "1", "re-sampling kernel half-width W (zero crossings)"),
     ParamSpec::flag("apply_gain", false, "multiply each cell by its condition.gain (Table 5.1)"),
@@ -171,7 +175,8 @@ fn build(p: &Params, ctx: &BuildContext) -> Result<Box<dyn Node>, NodeError> {
             format!("stream_rate/update_rate = {stream}/{update} = {frame_f} must be a whole number of samples ≥ {} (the frame length)", HEADER + 32),
         ));
     }
-    let kernel = SincKernel::new(p.usize("half_width"), 0.9, 8.6);
+    let kernel = SincKernel::for_interp(p.usize("half_width"));
+    let period = p.f64("period");
     let mut loaded: Vec<Texture> = Vec::with_capacity(sources.len());
     for (src, shown) in sources {
         let grid = Grid::load(&src).map_err(|e| NodeError::Data(format!("grid {shown}: {e}")))?;
@@ -184,8 +189,21 @@ fn build(p: &Params, ctx: &BuildContext) -> Result<Box<dyn Node>, NodeError> {
             }
         }
         let overlap = (p.f64("overlap") * 1e-3 * grid.rate).round() as usize;
-        let geo = Geometry::new(&grid, &kernel, frame - HEADER, overlap, p.f64("loop"))
-            .map_err(|e| NodeError::Data(format!("grid {shown}: {e}")))?;
+        let geometry = |want: f64| {
+            Geometry::new(&grid, &kernel, frame - HEADER, overlap, want)
+                .map_err(|e| NodeError::Data(format!("grid {shown}: {e}")))
+        };
+        let mut geo = geometry(p.f64("loop"))?;
+        if period > 0.0 {
+            let whole = (geo.loop_cm / period).floor();
+            if whole < 1.0 {
+                return Err(NodeError::param(
+                    "period",
+                    format!("a period of {period} cm is longer than the loop of {:.3} cm ({shown})", geo.loop_cm),
+                ));
+            }
+            geo = geometry(whole * period)?;
+        }
         loaded.push(Texture { grid, geo, shown });
     }
     let scheme = if p.str("scheme") == "basic" { Scheme::Basic } else { Scheme::Improved };

@@ -21,6 +21,14 @@ use std::f64::consts::PI;
 /// Table points per unit of the scaled argument c·d.
 const OVERSAMPLING: usize = 512;
 
+/// The anti-alias cutoff γ of `interp`'s kernel, as a fraction of the
+/// Nyquist frequency (at ratios ≤ 1; lower for faster reading). Content
+/// above it is removed even at a ratio of 1.
+pub const INTERP_CUTOFF: f64 = 0.9;
+
+/// The Kaiser shape β of `interp`'s kernel.
+pub const INTERP_BETA: f64 = 8.6;
+
 /// The windowed-sinc table and its settings.
 #[derive(Debug, Clone)]
 pub struct SincKernel {
@@ -66,6 +74,11 @@ impl SincKernel {
             })
             .collect();
         Self { half_width, cutoff: cutoff.clamp(1e-3, 1.0), table }
+    }
+
+    /// The kernel `interp` runs: [`INTERP_CUTOFF`], [`INTERP_BETA`], half-width `half_width`.
+    pub fn for_interp(half_width: usize) -> Self {
+        Self::new(half_width, INTERP_CUTOFF, INTERP_BETA)
     }
 
     /// The half-width W.

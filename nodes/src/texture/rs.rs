@@ -113,7 +113,7 @@ pub fn rs(y: &[f64], p: f64, q: f64, method: RsMethod) -> Result<Vec<f64>, RsErr
     let rub = |e: &dyn std::fmt::Display| RsError::Rubato(e.to_string());
     let mut resampler: Box<dyn Resampler<f64>> = match method {
         RsMethod::Kernel(w) => {
-            let k = SincKernel::new(w, 0.9, 8.6);
+            let k = SincKernel::for_interp(w);
             return Ok(k.resample(y, 0.0, 1.0 / ratio, len_out));
         }
         RsMethod::RubatoSinc(len) => {

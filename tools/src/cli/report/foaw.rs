@@ -7,7 +7,7 @@
 use anyhow::{Context, Result};
 use evflow_nodes::filters::foaw::compare::{sample, score, Estimator, TRAJECTORIES};
 use evflow_nodes::filters::foaw::estimator::Fit;
-use evflow_tools::plot::{write_png, Plot, Series};
+use evflow_tools::plot::{Plot, Series};
 use std::path::PathBuf;
 
 /// Arguments of `evflow report foaw`.
@@ -119,12 +119,7 @@ pub fn main(a: Args) -> Result<()> {
     };
     println!();
     for (plot, name) in [(&tradeoff, "foaw-tradeoff.png"), (&traces, "foaw-steps.png")] {
-        match write_png(plot, &a.out.join(name)) {
-            Ok(w) => {
-                println!("wrote {}{}", w.path.display(), if w.labelled { "" } else { " (no font found: unlabelled)" })
-            }
-            Err(e) => eprintln!("warning: {e}"),
-        }
+        super::save_png(plot, &a.out.join(name));
     }
     Ok(())
 }

@@ -9,7 +9,7 @@ use super::lab_recording::{record, Condition};
 use anyhow::{Context, Result};
 use evflow_nodes::lab::texture::samples::NAMES;
 use evflow_nodes::texture::freqvel::relation;
-use evflow_tools::plot::{write_png, Plot, Series};
+use evflow_tools::plot::{Plot, Series};
 use std::path::PathBuf;
 
 /// Arguments of `evflow report freqvel`.
@@ -98,9 +98,6 @@ pub fn main(a: Args) -> Result<()> {
         series,
     };
     println!();
-    match write_png(&plot, &a.out.join("freqvel.png")) {
-        Ok(w) => println!("wrote {}{}", w.path.display(), if w.labelled { "" } else { " (no font found: unlabelled)" }),
-        Err(e) => eprintln!("warning: {e}"),
-    }
+    super::save_png(&plot, &a.out.join("freqvel.png"));
     Ok(())
 }

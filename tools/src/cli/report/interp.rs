@@ -4,10 +4,11 @@
 //! every untrained condition is interpolated from them by the basic scheme
 //! (§5.3.3) and the improved one (Eq. 6.4) and compared with the real
 //! recording at that condition by E_s (Eq. 5.2), beside the repeat baseline
-//! (a second recording of the same condition). The cells here are the
-//! recorded forces themselves (record-and-playback, §6.5.2): this isolates
-//! the interpolation from the NARX models, whose synthesized cells take
-//! their place once they exist.
+//! (a second recording of the same condition). With `--cells recorded` (the
+//! default) the cells are the recorded forces themselves (record-and-
+//! playback, §6.5.2), compared directly: this isolates the interpolation
+//! from the NARX models and the display. `--cells narx` runs the whole
+//! chain of the dissertation instead ([`super::interp_narx`]).
 
 use super::lab_recording::{record, Condition};
 use anyhow::{anyhow, Context, Result};
@@ -17,40 +18,82 @@ use evflow_nodes::metric::spectrum::{averaged_spectrum, SpectrumConfig, Window};
 use evflow_nodes::texture::grid::Grid;
 use evflow_nodes::texture::kernel::SincKernel;
 use evflow_nodes::texture::scheme::{Geometry, Mix, Scheme};
-use evflow_tools::plot::{write_png, Plot, Series};
+use evflow_tools::plot::{Plot, Series};
 use std::path::{Path, PathBuf};
+
+/// What the grid cells are.
+#[derive(clap::ValueEnum, Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Cells {
+    /// The recorded forces at the trained conditions, interpolated and
+    /// compared with the recording directly (no models, no display).
+    Recorded,
+    /// The actuation signals inverse NARX models synthesize at the trained
+    /// conditions (each at its Table 5.1 gain), interpolated and played on
+    /// the virtual display at the untrained condition
+    /// (graphs/texture-cross-validation.toml).
+    Narx,
+}
 
 /// Arguments of `evflow report interp`.
 #[derive(clap::Args, Debug)]
 pub struct Args {
-    /// Folder for the PNG figures.
+    /// Folder for the table and the PNG figures (and, with --cells narx, the models and grids).
     #[arg(long, default_value = ".")]
-    out: PathBuf,
+    pub(super) out: PathBuf,
     /// Texture samples (default: all seven; the rippled paper uses the grid of Fig. 6.8).
     #[arg(long, value_delimiter = ',')]
-    samples: Vec<String>,
-    /// Tribometer passes per recording.
+    pub(super) samples: Vec<String>,
+    /// What the grid cells are: the recorded forces, or NARX-synthesized
+    /// actuation played on the virtual display.
+    #[arg(long, value_enum, default_value_t = Cells::Recorded)]
+    pub(super) cells: Cells,
+    /// Tribometer passes per recording (--cells recorded; the NARX chain
+    /// records one pass, as graphs/synthesize.toml plays).
     #[arg(long, default_value_t = 4)]
-    passes: u32,
+    pub(super) passes: u32,
     /// Band of E_s, Hz.
     #[arg(long, value_delimiter = ',', default_value = "2,200")]
-    band: Vec<f64>,
-    /// The recording graph.
+    pub(super) band: Vec<f64>,
+    /// The recording graph (--cells recorded).
     #[arg(long, default_value = "graphs/record-textures.toml")]
-    graph: PathBuf,
+    pub(super) graph: PathBuf,
+    /// Gains of the sweep that chooses each cell's gain (--cells narx, §5.3.2).
+    #[arg(long, value_delimiter = ',', default_value = "0.6,0.8,1.0,1.2,1.4")]
+    pub(super) gains: Vec<f64>,
+    /// Levenberg–Marquardt epochs at most per model (--cells narx).
+    #[arg(long, default_value_t = 200)]
+    pub(super) epochs: u32,
+    /// Use the models in this folder (narx-MASSg-SPEEDcms.json) instead of
+    /// training them (--cells narx).
+    #[arg(long)]
+    pub(super) models: Option<PathBuf>,
+    /// The folder of the shipped graphs (--cells narx).
+    #[arg(long, default_value = "graphs")]
+    pub(super) graphs: PathBuf,
 }
 
 /// A sample's trained grid and its validation conditions.
-struct GridPlan {
-    loads: Vec<f64>,
-    speeds: Vec<f64>,
-    validate: Vec<(f64, f64)>,
+pub(super) struct GridPlan {
+    /// Trained loads m_i, g.
+    pub(super) loads: Vec<f64>,
+    /// Trained velocities v_j, cm/s.
+    pub(super) speeds: Vec<f64>,
+    /// Untrained (load, velocity) conditions to validate.
+    pub(super) validate: Vec<(f64, f64)>,
+}
+
+impl GridPlan {
+    /// Whether a condition at velocity `v` is interpolated over velocity
+    /// (the schemes differ only there).
+    pub(super) fn velocity_interpolated(&self, v: f64) -> bool {
+        !self.speeds.contains(&v)
+    }
 }
 
 /// Fig. 5.6 (3×3 grid, corners trained, the m₂ row and v₂ column validated)
 /// or, for the rippled paper, Fig. 6.8 (60/110 g × 3–7 cm/s trained, 85 g
 /// at 3.5–6.5 cm/s validated).
-fn plan_for(sample: &str) -> GridPlan {
+pub(super) fn plan_for(sample: &str) -> GridPlan {
     if sample == "rippled-paper" {
         GridPlan {
             loads: vec![60.0, 110.0],
@@ -102,7 +145,7 @@ fn evaluate(a: &Args, sample: &str, tmp: &Path, band: &Band, plots: &mut Vec<Plo
         cells.push(row);
     }
     let grid = Grid::from_signals(p.loads.clone(), p.speeds.clone(), rate, cells);
-    let kernel = SincKernel::new(16, 0.9, 8.6);
+    let kernel = SincKernel::for_interp(16);
     let geo = Geometry::new(&grid, &kernel, 1_000_000, 0, 0.0).map_err(|e| anyhow!("{sample}: {e}"))?;
     let mut rows = Vec::new();
     for &(m, v) in &p.validate {
@@ -156,6 +199,9 @@ pub fn main(a: Args) -> Result<()> {
         anyhow::ensure!(NAMES.contains(&s.as_str()), "--samples: unknown sample `{s}` (one of {})", NAMES.join(", "));
     }
     std::fs::create_dir_all(&a.out).with_context(|| format!("{}: cannot create", a.out.display()))?;
+    if a.cells == Cells::Narx {
+        return super::interp_narx::main(&a, &samples);
+    }
     let tmp = tempfile::tempdir().context("cannot create a temporary folder")?;
     let band = Band::new(1000.0, 1000, a.band[0], a.band[1], false).map_err(|e| anyhow!("--band: {e}"))?;
     let mut plots = Vec::new();
@@ -172,7 +218,7 @@ pub fn main(a: Args) -> Result<()> {
     println!("|---|---:|---:|---:|---:|---:|---|");
     let (mut wins, mut velocity_cases) = (0, 0);
     for r in &rows {
-        let velocity_interpolated = if r.sample == "rippled-paper" { true } else { r.speed == 5.0 };
+        let velocity_interpolated = plan_for(&r.sample).velocity_interpolated(r.speed);
         if velocity_interpolated {
             velocity_cases += 1;
             wins += usize::from(r.improved < r.basic);
@@ -202,12 +248,7 @@ pub fn main(a: Args) -> Result<()> {
         mean(|r| r.improved)
     );
     for (i, plot) in plots.iter().enumerate() {
-        match write_png(plot, &a.out.join(format!("interp-spectra-{}.png", i + 1))) {
-            Ok(w) => {
-                println!("wrote {}{}", w.path.display(), if w.labelled { "" } else { " (no font found: unlabelled)" })
-            }
-            Err(e) => eprintln!("warning: {e}"),
-        }
+        super::save_png(plot, &a.out.join(format!("interp-spectra-{}.png", i + 1)));
     }
     Ok(())
 }

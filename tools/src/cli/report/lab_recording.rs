@@ -23,6 +23,11 @@ pub struct Condition<'a> {
 }
 
 impl Condition<'_> {
+    /// The name graphs/record-textures.toml gives its recording.
+    pub fn name(&self) -> String {
+        format!("{}-{}g-{}cms-r{}", self.sample, self.mass, self.speed, self.rep)
+    }
+
     /// The `--set` values that make graphs/record-textures.toml record it.
     pub fn sets(&self) -> [String; 5] {
         [
@@ -41,15 +46,20 @@ impl Condition<'_> {
 /// each less its mean (the friction's sign flips between passes) and faded
 /// in and out over 50 ms so that the joins add no steps, concatenated.
 pub fn record(graph: &Path, c: &Condition<'_>, dir: &Path) -> Result<(f64, Vec<f64>)> {
-    let out = dir.join(format!("{}-{}g-{}cms-r{}", c.sample, c.mass, c.speed, c.rep));
+    let out = dir.join(c.name());
     std::fs::create_dir_all(&out).with_context(|| format!("{}: cannot create", out.display()))?;
     run_with(graph, &c.sets(), &out)?;
-    let rec = recording_in(&out)?;
+    constant_speed_force(&recording_in(&out)?, c.speed, &out)
+}
+
+/// The rate and the constant-speed force (see [`record`]) of `rec`, a
+/// recording of graphs/record-textures.toml at `speed_cm_s` read from `what`.
+pub fn constant_speed_force(rec: &Recording, speed_cm_s: f64, what: &Path) -> Result<(f64, Vec<f64>)> {
     let (force, velocity) = (
-        rec.channel("force").ok_or_else(|| anyhow!("{}: no `force` channel", out.display()))?,
-        rec.channel("velocity").ok_or_else(|| anyhow!("{}: no `velocity` channel", out.display()))?,
+        rec.channel("force").ok_or_else(|| anyhow!("{}: no `force` channel", what.display()))?,
+        rec.channel("velocity").ok_or_else(|| anyhow!("{}: no `velocity` channel", what.display()))?,
     );
-    Ok((rec.rate(), constant_speed(force, velocity, c.speed, rec.rate())))
+    Ok((rec.rate(), constant_speed(force, velocity, speed_cm_s, rec.rate())))
 }
 
 /// The only recording a graph run wrote into `dir`.

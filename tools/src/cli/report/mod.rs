@@ -4,10 +4,12 @@
 pub mod foaw;
 pub mod freqvel;
 pub mod interp;
+pub mod interp_narx;
 pub mod lab_recording;
 pub mod mesh;
 pub mod narx;
 pub mod resample;
+pub mod synthesis;
 pub mod textures;
 
 /// Arguments of `evflow report`.
@@ -40,9 +42,11 @@ enum Which {
     /// Interpolation over the (load, velocity) grid (Fig. 5.6, 5.9, 6.8):
     /// the basic (§5.3.3) and improved (Eq. 6.4) schemes against the
     /// recording at every untrained condition, E_s beside the repeat
-    /// baseline; a table and PNG spectra.
+    /// baseline; a table and PNG spectra. The cells are the recorded
+    /// forces, or (--cells narx) NARX-synthesized actuation played on the
+    /// virtual display.
     ///
-    /// Example: cargo run --release -p evflow -- report interp --out report
+    /// Example: cargo run --release -p evflow -- report interp --cells narx --out report
     Interp(interp::Args),
     /// Re-sampling for the texture chain (§6.2): error against run time
     /// of rubato's sinc, polynomial and FFT resamplers and the live
@@ -65,6 +69,27 @@ enum Which {
     ///
     /// Example: cargo run --release -p evflow -- report narx --out report
     Narx(narx::Args),
+}
+
+/// Writes `plot` to `path` and says so (unlabelled without a font); a plot
+/// that cannot be drawn is a warning, not a failed report.
+fn save_png(plot: &evflow_tools::plot::Plot, path: &std::path::Path) {
+    match evflow_tools::plot::write_png(plot, path) {
+        Ok(w) => println!("wrote {}{}", w.path.display(), if w.labelled { "" } else { " (no font found: unlabelled)" }),
+        Err(e) => eprintln!("warning: {e}"),
+    }
+}
+
+/// Writes a report's Markdown `text` to `path` (through a temporary file,
+/// so an interrupted run leaves no half table) and says so.
+fn save_markdown(path: &std::path::Path, text: &str) -> anyhow::Result<()> {
+    use anyhow::Context;
+    let tmp = path.with_extension("md.tmp");
+    std::fs::write(&tmp, text)
+        .and_then(|_| std::fs::rename(&tmp, path))
+        .with_context(|| format!("{}: cannot write", path.display()))?;
+    println!("wrote {}", path.display());
+    Ok(())
 }
 
 /// Runs the chosen report.

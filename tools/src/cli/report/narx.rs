@@ -7,11 +7,11 @@
 //! against the training time. A setting is on the Pareto front when no
 //! other trains faster *and* renders with a lower E_s.
 
-use super::textures::{choose, record_pair, synthesize, train_model, Cond};
+use super::synthesis::{choose, record_pair, synthesize, train_model, Cond};
 use anyhow::{anyhow, ensure, Context, Result};
 use evflow_nodes::lab::texture::samples::NAMES;
 use evflow_nodes::narx::model::Model;
-use evflow_tools::plot::{write_png, Plot, Series};
+use evflow_tools::plot::{Plot, Series};
 use std::fmt::Write as _;
 use std::path::PathBuf;
 
@@ -248,10 +248,7 @@ pub fn main(a: Args) -> Result<()> {
             .map(|s| Series::points(format!("{} ({})", s.setting.name, s.setting.describe()), vec![(s.seconds, s.es)]))
             .collect(),
     };
-    match write_png(&plot, &a.out.join("narx-work-precision.png")) {
-        Ok(w) => println!("wrote {}{}", w.path.display(), if w.labelled { "" } else { " (no font found: unlabelled)" }),
-        Err(e) => eprintln!("warning: {e}"),
-    }
+    super::save_png(&plot, &a.out.join("narx-work-precision.png"));
     Ok(())
 }
 

@@ -7,7 +7,7 @@
 use anyhow::{Context, Result};
 use evflow_nodes::texture::rs::RsMethod;
 use evflow_nodes::texture::rs_precision::{measure, tones};
-use evflow_tools::plot::{write_png, Plot, Series};
+use evflow_tools::plot::{Plot, Series};
 use rubato::PolynomialDegree;
 use std::path::PathBuf;
 
@@ -85,9 +85,6 @@ pub fn main(a: Args) -> Result<()> {
         series: families.into_iter().map(|(f, p)| Series::line_points(f, p)).collect(),
     };
     println!();
-    match write_png(&plot, &a.out.join("resample-work-precision.png")) {
-        Ok(w) => println!("wrote {}{}", w.path.display(), if w.labelled { "" } else { " (no font found: unlabelled)" }),
-        Err(e) => eprintln!("warning: {e}"),
-    }
+    super::save_png(&plot, &a.out.join("resample-work-precision.png"));
     Ok(())
 }

@@ -163,6 +163,45 @@ fn report_interp_with_narx_cells_plays_the_grid_on_the_display() {
 }
 
 #[test]
+fn report_textures_sets_narx_between_the_display_floor_and_record_and_playback() {
+    // One texture at two corners, models of at most 20 epochs, two gains.
+    let dir = tempfile::tempdir().unwrap();
+    let (ok, out, err) = evflow(&[
+        "report",
+        "textures",
+        "--out",
+        dir.path().to_str().unwrap(),
+        "--samples",
+        "plastic-sheet",
+        "--conditions",
+        "60:3,110:5",
+        "--epochs",
+        "20",
+        "--gains",
+        "0.8,1.2",
+    ]);
+    assert!(ok, "{err}");
+    let rows: Vec<Vec<String>> = out
+        .lines()
+        .filter(|l| l.starts_with("| plastic-sheet |") && l.contains(" g, "))
+        .map(|l| l.split('|').map(|c| c.trim().to_string()).collect())
+        .collect();
+    assert_eq!(rows.len(), 2, "{out}");
+    let number = |c: &str| c.parse::<f64>().unwrap_or_else(|_| panic!("`{c}` in\n{out}"));
+    for r in &rows {
+        let (repeat, floor, narx, playback) = (number(&r[3]), number(&r[4]), number(&r[5]), number(&r[7]));
+        // The display's own friction adds error no actuation removes: the
+        // floor lies above the repeat baseline (sensor noise only).
+        assert!(floor > 1.5 * repeat, "display floor {floor} vs repeat {repeat}: {r:?}");
+        // The synthesized actuation renders the texture better than playing the force itself.
+        assert!(narx < playback && r[11] == "yes", "{r:?}");
+        assert!(narx > 0.0 && narx.is_finite());
+    }
+    assert!(dir.path().join("textures.md").is_file());
+    assert!(dir.path().join("textures-plastic-sheet-60g-3cms.png").is_file());
+}
+
+#[test]
 fn bad_arguments_are_named() {
     let (ok, _, err) = evflow(&["report", "foaw", "--rate", "0"]);
     assert!(!ok && err.contains("--rate"), "{err}");

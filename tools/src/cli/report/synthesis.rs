@@ -181,11 +181,14 @@ pub(super) fn synthesize(
     Ok(runs)
 }
 
-/// One texture at one trained condition: the repeat baseline and the NARX
-/// and record-and-playback chains at their chosen gains.
+/// One texture at one trained condition: the repeat baseline, the display
+/// floor and the NARX and record-and-playback chains at their chosen gains.
 pub(super) struct Synthesis {
     /// E_s of repetition 1 against repetition 2.
     pub(super) repeat: f64,
+    /// E_s of repetition 1 plus the display's own force (no actuation)
+    /// against repetition 2: the best any actuation can do on the display.
+    pub(super) floor: f64,
     /// NARX synthesis.
     pub(super) narx: Scored,
     /// Record-and-playback.
@@ -207,6 +210,7 @@ pub(super) fn synthesize_condition(
     let runs = synthesize(graphs, sample, c, model, gains, recordings, work)?;
     Ok(Synthesis {
         repeat: value(&runs[0].1, "repeat_es", "E_s")?,
+        floor: value(&runs[0].1, "floor_es", "E_s")?,
         narx: choose(&runs, "narx_es")?,
         playback: choose(&runs, "playback_es")?,
     })

@@ -2,6 +2,7 @@
 
 mod recorder;
 pub mod session;
+mod steal;
 
 use super::graph_args::GraphArgs;
 use anyhow::{anyhow, Context, Result};
@@ -180,11 +181,16 @@ pub fn main(a: Args) -> Result<()> {
             let mut m = Metrics::new();
             let mut shown = Instant::now();
             let tty = std::io::stderr().is_terminal();
+            let steal0 = steal::steal_seconds();
             while !done.load(Ordering::Acquire) {
                 std::thread::sleep(Duration::from_millis(50));
                 m.drain(&mut stats);
                 if show && shown.elapsed() >= Duration::from_secs(1) {
-                    let line = m.summary(&shared, base_rate).line();
+                    let mut line = m.summary(&shared, base_rate).line();
+                    // The host's steal so far: misses that coincide with it are the VM's, not the graph's.
+                    if let Some(st) = steal::steal_seconds().zip(steal0).map(|(b, a)| b - a).filter(|&st| st > 0.0) {
+                        line += &format!(" | host steal {:.0} ms", st * 1e3);
+                    }
                     if tty {
                         eprint!("\r{line}\x1b[K");
                     } else {
@@ -231,8 +237,10 @@ pub fn main(a: Args) -> Result<()> {
     })?;
 
     let started = Instant::now();
+    let steal_before = steal::steal_seconds();
     let exit = parts.thread.join();
     let wall = started.elapsed();
+    let stolen = steal::steal_seconds().zip(steal_before).map(|(b, a)| (b - a).max(0.0));
     done.store(true, Ordering::Release);
     let rec = rec_thread.join().map_err(|_| anyhow!("the recorder thread panicked"))?;
     let metrics = metrics_thread.join().map_err(|_| anyhow!("the metrics thread panicked"))?;
@@ -257,6 +265,7 @@ pub fn main(a: Args) -> Result<()> {
         "stopped": reason,
         "realtime": exit.realtime.to_string(),
         "metrics": metrics_json(&summary),
+        "host_steal_seconds": stolen,
         "files": files,
         "events": rec.events,
     });
@@ -273,6 +282,13 @@ pub fn main(a: Args) -> Result<()> {
         exit.ticks as f64 / base_rate
     );
     println!("real-time thread: {}", exit.realtime);
+    if let Some(st) = stolen.filter(|&st| st > 0.0) {
+        println!(
+            "host steal: {:.0} ms of CPU time taken from this virtual machine by its host during the session \
+             (stalls no setting inside the machine prevents; see docs/live.md)",
+            st * 1e3
+        );
+    }
     println!("{summary}");
     for (f, n, gap, err) in &rec.files {
         let gap = if *gap > 0 {

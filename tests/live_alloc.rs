@@ -180,8 +180,13 @@ fn build(path: &std::path::Path, text: Option<&str>) -> Plan {
         None => load_file(path, &reg, &[]).unwrap_or_else(|e| panic!("{e}")),
     };
     let dir = tempfile::tempdir().unwrap();
-    let opts =
-        PlanOptions { max_block: 1, timing: false, out_dir: Some(dir.path().to_path_buf()), ..Default::default() };
+    let opts = PlanOptions {
+        max_block: 1,
+        mode: evflow_engine::RunMode::Live,
+        timing: false,
+        out_dir: Some(dir.path().to_path_buf()),
+        ..Default::default()
+    };
     Plan::build(&checked, &opts).unwrap_or_else(|e| panic!("{e}"))
 }
 
@@ -254,7 +259,11 @@ fn no_allocation_on_the_real_time_thread() {
                    [nodes.s]\ntype = \"sine\"\n[nodes.a]\ntype = \"test.alloc\"\n";
         let g = evflow_engine::graph::parse_graph(std::path::Path::new("a.toml"), doc).unwrap();
         let checked = evflow_engine::check(&g, &reg, &[]).unwrap();
-        let plan = Plan::build(&checked, &PlanOptions { max_block: 1, ..Default::default() }).unwrap();
+        let plan = Plan::build(
+            &checked,
+            &PlanOptions { max_block: 1, mode: evflow_engine::RunMode::Live, ..Default::default() },
+        )
+        .unwrap();
         let n = allocations(plan, 0.05).unwrap();
         assert!(n.allocations >= 50, "the guard must count the allocating node's allocations ({n:?})");
         if cfg!(all(target_os = "linux", target_arch = "x86_64")) {

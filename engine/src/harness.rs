@@ -6,7 +6,7 @@
 
 use crate::check::check;
 use crate::graph::parse_graph;
-use crate::node::{BuildContext, Io, Node, NodeError};
+use crate::node::{BuildContext, Io, Node, NodeError, RunMode};
 use crate::params::{toml_float, Params};
 use crate::plan::{Plan, PlanOptions};
 use crate::registry::Registry;
@@ -136,6 +136,7 @@ impl Single<'_> {
             base_dir: Some(self.base_dir.to_path_buf()),
             out_dir: Some(self.base_dir.to_path_buf()),
             timing: false,
+            mode: RunMode::Offline,
         };
         let plan = Plan::build(&checked, &opts).map_err(|e| e.to_string())?;
         Ok((plan, out_index))

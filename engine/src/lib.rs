@@ -30,7 +30,7 @@ pub use check::{check, Checked, Override};
 pub use diag::{Diagnostic, Diagnostics};
 pub use graph::Graph;
 pub use load::{load_file, read_graph, LoadError};
-pub use node::{BuildContext, Io, Node, NodeError, PrepareContext, Refused, Summary};
+pub use node::{BuildContext, Io, Node, NodeError, PrepareContext, Refused, RunMode, Summary};
 pub use params::{Params, Value};
 pub use plan::{Plan, PlanOptions};
 pub use registry::Registry;

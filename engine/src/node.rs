@@ -104,12 +104,30 @@ impl BuildContext {
     }
 }
 
-/// What `prepare` is told: the largest block the node will be asked for.
+/// How a plan runs. Nodes that drive hardware decide by it, never by the
+/// block size, whether to touch their device.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum RunMode {
+    /// As fast as the machine allows, over recordings and simulations:
+    /// `evflow run`, sweeps, reports, benches and `evflow replay` (at any
+    /// block size, one tick included). Hardware nodes never open their
+    /// device.
+    #[default]
+    Offline,
+    /// On the live runner's real-time thread, one tick per period (`evflow
+    /// live`): hardware nodes open their device.
+    Live,
+}
+
+/// What `prepare` is told: the largest block the node will be asked for,
+/// and whether the plan runs live.
 #[derive(Debug, Clone, Copy)]
 pub struct PrepareContext {
     /// The largest number of samples per port in one call, at the port's own
     /// rate (index as the node's resolved ports).
     pub max_block: usize,
+    /// How the plan runs.
+    pub mode: RunMode,
 }
 
 /// Results a node reports when the run ends (metrics, files written).

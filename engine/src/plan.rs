@@ -4,7 +4,7 @@
 
 use crate::check::{Checked, Pruned};
 use crate::diag::Loc;
-use crate::node::{BuildContext, Io, Node, NodeError, PrepareContext, Refused, Summary};
+use crate::node::{BuildContext, Io, Node, NodeError, PrepareContext, Refused, RunMode, Summary};
 use crate::rate::{lcm, Ratio};
 use crate::spec::NodeSpec;
 use std::path::PathBuf;
@@ -40,11 +40,14 @@ pub struct PlanOptions {
     pub out_dir: Option<PathBuf>,
     /// Measure run time per node.
     pub timing: bool,
+    /// Offline (the default, whatever the block size) or live: only a live
+    /// plan lets hardware nodes open their devices.
+    pub mode: RunMode,
 }
 
 impl Default for PlanOptions {
     fn default() -> Self {
-        Self { max_block: 4096, seed: None, base_dir: None, out_dir: None, timing: true }
+        Self { max_block: 4096, seed: None, base_dir: None, out_dir: None, timing: true, mode: RunMode::Offline }
     }
 }
 
@@ -91,6 +94,7 @@ pub struct Plan {
     timing: bool,
     pruned: Vec<Pruned>,
     duration: Option<f64>,
+    mode: RunMode,
 }
 
 impl Plan {
@@ -190,7 +194,7 @@ impl Plan {
         }
         for (k, e) in entries.iter_mut().enumerate() {
             let largest = e.in_ratios.iter().chain(&e.out_ratios).map(cap).max().unwrap_or(cap(&e.ratio));
-            e.node.prepare(&PrepareContext { max_block: largest }).map_err(|err| {
+            e.node.prepare(&PrepareContext { max_block: largest, mode: opts.mode }).map_err(|err| {
                 let i = checked.order[k];
                 fail(i, err)
             })?;
@@ -207,6 +211,7 @@ impl Plan {
             timing: opts.timing,
             pruned: checked.pruned.clone(),
             duration: g.duration,
+            mode: opts.mode,
         })
     }
 
@@ -382,6 +387,10 @@ impl Plan {
     /// The base rate in Hz.
     pub fn base_rate(&self) -> f64 {
         self.base_rate
+    }
+    /// How the plan was built to run (see [`RunMode`]).
+    pub fn mode(&self) -> RunMode {
+        self.mode
     }
     /// The largest block in base ticks.
     pub fn max_block(&self) -> usize {

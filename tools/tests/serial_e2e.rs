@@ -139,6 +139,10 @@ fn live_two_seconds(link: &Path, session: &Path) -> String {
         .unwrap();
     let text = String::from_utf8_lossy(&out.stdout).into_owned() + &String::from_utf8_lossy(&out.stderr);
     assert!(out.status.success(), "{text}");
+    // -q: the I/O thread's link notices go to the summary (stdout), not stderr.
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(!err.contains("connected at sample"), "-q printed a link notice: {err}");
+    assert!(text.contains("connected at sample"), "the summary lists the link events: {text}");
     text
 }
 
@@ -239,7 +243,7 @@ fn unplugging_fades_to_zero_and_a_restarted_device_is_found_again() {
             "--no-realtime",
             "--miss-streak",
             "0",
-            "-q",
+            // Not -q: the link notices on stderr are what this test follows.
             "--session",
         ])
         .arg(&s)

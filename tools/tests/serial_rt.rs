@@ -50,7 +50,11 @@ fn connected_serial_nodes_do_not_allocate_on_the_real_time_thread() {
     let g = parse_graph(&path, &std::fs::read_to_string(&path).unwrap()).unwrap();
     let o = [Override::parse(&format!("port={}", link.display())).unwrap()];
     let checked = check(&g, &evflow_nodes::registry(), &o).unwrap();
-    let plan = Plan::build(&checked, &PlanOptions { max_block: 1, timing: false, ..Default::default() }).unwrap();
+    let plan = Plan::build(
+        &checked,
+        &PlanOptions { max_block: 1, mode: evflow_engine::RunMode::Live, timing: false, ..Default::default() },
+    )
+    .unwrap();
     let mut taps = LivePlan::source_taps(&plan);
     taps.extend(LivePlan::guard_taps(&plan));
     let lp = LivePlan::new(plan, &taps).unwrap();

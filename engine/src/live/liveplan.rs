@@ -8,6 +8,12 @@ use crate::spec::{ParamKind, Role};
 /// Why a graph or a request cannot run live.
 #[derive(Debug, thiserror::Error)]
 pub enum LiveError {
+    /// A plan built to run offline handed to the live runner.
+    #[error(
+        "the plan was built to run offline (PlanOptions::mode); build it with RunMode::Live to run it live, \
+         so that its hardware nodes know they may open their devices"
+    )]
+    NotLive,
     /// A node that cannot run live.
     #[error("node `{node}` ({kind}) cannot run live: {reason}")]
     OfflineOnly {
@@ -94,9 +100,13 @@ pub struct LivePlan {
 }
 
 impl LivePlan {
-    /// Checks that every node can run live and that every safety guard can
-    /// be faded out, and resolves the taps.
+    /// Checks that the plan was built to run live ([`crate::RunMode::Live`]),
+    /// that every node can run live and that every safety guard can be
+    /// faded out, and resolves the taps.
     pub fn new(plan: Plan, taps: &[Tap]) -> Result<Self, LiveError> {
+        if plan.mode() != crate::node::RunMode::Live {
+            return Err(LiveError::NotLive);
+        }
         if plan.base_rate() > 20_000.0 {
             return Err(LiveError::RateTooHigh(plan.base_rate()));
         }

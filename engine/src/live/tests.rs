@@ -117,7 +117,11 @@ fn live_plan(counter: &str, taps: &[(&str, &str)]) -> LivePlan {
     reg.add(&COUNTER).add(&GUARD).add(&TAP);
     let g = parse_graph(Path::new("t.toml"), &doc).unwrap();
     let checked = check(&g, &reg, &[]).unwrap();
-    let plan = Plan::build(&checked, &PlanOptions { max_block: 1, timing: false, ..PlanOptions::default() }).unwrap();
+    let plan = Plan::build(
+        &checked,
+        &PlanOptions { max_block: 1, mode: crate::RunMode::Live, timing: false, ..PlanOptions::default() },
+    )
+    .unwrap();
     let taps: Vec<Tap> = taps.iter().map(|(n, p)| Tap::new(n, p)).collect();
     LivePlan::new(plan, &taps).unwrap()
 }
@@ -284,7 +288,8 @@ fn offline_only_nodes_and_unknown_taps_are_refused() {
     let mut reg = Registry::new();
     reg.add(&COUNTER).add(&OFF);
     let checked = check(&parse_graph(Path::new("t.toml"), doc).unwrap(), &reg, &[]).unwrap();
-    let plan = Plan::build(&checked, &PlanOptions::default()).unwrap();
+    let live = PlanOptions { mode: crate::RunMode::Live, ..PlanOptions::default() };
+    let plan = Plan::build(&checked, &live).unwrap();
     let e = LivePlan::new(plan, &[]).err().unwrap().to_string();
     assert_eq!(e, "node `o` (test.off) cannot run live: it writes files while processing");
 
@@ -305,7 +310,11 @@ fn two_counters() -> (Checked, LivePlan) {
     let mut reg = Registry::new();
     reg.add(&COUNTER).add(&GUARD).add(&TAP);
     let checked = check(&parse_graph(Path::new("t.toml"), doc).unwrap(), &reg, &[]).unwrap();
-    let plan = Plan::build(&checked, &PlanOptions { max_block: 1, timing: false, ..PlanOptions::default() }).unwrap();
+    let plan = Plan::build(
+        &checked,
+        &PlanOptions { max_block: 1, mode: crate::RunMode::Live, timing: false, ..PlanOptions::default() },
+    )
+    .unwrap();
     let lp = LivePlan::new(plan, &[Tap::new("a", "out"), Tap::new("b", "out")]).unwrap();
     (checked, lp)
 }
@@ -349,4 +358,17 @@ fn a_graph_variable_sets_every_live_parameter_it_names_at_one_tick() {
     let b = drain(&mut p.taps[1].1);
     assert_eq!(a, b, "both counters changed at the same ticks");
     assert!(a.iter().any(|&x| x >= 20_000.0), "the changes applied");
+}
+
+#[test]
+fn a_plan_built_to_run_offline_is_refused_by_the_live_runner() {
+    let doc = "[graph]\nformat = 1\nname = \"t\"\nrate = 1000.0\nconnections = [\"c.out -> g.in\", \"g.out -> t.in\"]\n\
+               [nodes.c]\ntype = \"test.counter\"\n[nodes.g]\ntype = \"test.guard\"\n[nodes.t]\ntype = \"harness.tap\"\n";
+    let mut reg = Registry::new();
+    reg.add(&COUNTER).add(&GUARD).add(&TAP);
+    let checked = check(&parse_graph(Path::new("t.toml"), doc).unwrap(), &reg, &[]).unwrap();
+    // Blocks of one tick do not make a plan live: only its mode does.
+    let offline = Plan::build(&checked, &PlanOptions { max_block: 1, ..PlanOptions::default() }).unwrap();
+    assert_eq!(offline.mode(), crate::RunMode::Offline);
+    assert!(matches!(LivePlan::new(offline, &[]), Err(LiveError::NotLive)));
 }

@@ -235,8 +235,14 @@ mod tests {
             }
             let checked = check(&accumulator(&x, a, Some(d)), &registry(), &[]).unwrap();
             for requested in [1usize, 4096] {
-                let opts =
-                    PlanOptions { max_block: requested, seed: None, base_dir: None, timing: false, out_dir: None };
+                let opts = PlanOptions {
+                    max_block: requested,
+                    seed: None,
+                    base_dir: None,
+                    timing: false,
+                    out_dir: None,
+                    mode: evflow_engine::RunMode::Offline,
+                };
                 let mut plan = Plan::build(&checked, &opts).unwrap();
                 // The cycle limits blocks to the delay.
                 assert_eq!(plan.max_block(), requested.min(d), "d={d}");

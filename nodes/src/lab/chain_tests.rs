@@ -57,7 +57,14 @@ fn run(text: &str, ticks: usize) -> (Vec<f64>, Vec<f64>) {
     reg.add(&FEED).add(&TAP);
     let g = parse_graph(Path::new("chain.toml"), text).unwrap();
     let checked = check(&g, &reg, &[]).unwrap_or_else(|e| panic!("{e}"));
-    let opts = PlanOptions { max_block: 64, seed: Some(3), base_dir: None, timing: false, out_dir: None };
+    let opts = PlanOptions {
+        max_block: 64,
+        seed: Some(3),
+        base_dir: None,
+        timing: false,
+        out_dir: None,
+        mode: evflow_engine::RunMode::Offline,
+    };
     let mut plan = Plan::build(&checked, &opts).unwrap();
     let (mut force, mut pos) = (Vec::new(), Vec::new());
     let mut done = 0;

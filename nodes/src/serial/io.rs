@@ -232,9 +232,12 @@ impl Io {
         self.report.event(msg);
     }
 
-    /// Tells the user at once (link changes are rare).
+    /// Tells the user at once (link changes are rare), unless notices are
+    /// off ([`set_notices`]); the end-of-run summary lists them anyway.
     fn say(&self, msg: &str) {
-        eprintln!("serial {}: {msg}", self.config.port);
+        if NOTICES.load(std::sync::atomic::Ordering::Relaxed) {
+            eprintln!("serial {}: {msg}", self.config.port);
+        }
     }
 
     /// Publishes the link state to the nodes.
@@ -273,4 +276,14 @@ fn deliver(
             }
         }
     }
+}
+
+/// Whether I/O threads print link changes on stderr as they happen.
+static NOTICES: std::sync::atomic::AtomicBool = std::sync::atomic::AtomicBool::new(true);
+
+/// Turns the I/O threads' immediate stderr notices (link lost, reconnected,
+/// device faults) on or off for the whole process — off for `evflow live
+/// -q`. The notices still reach each node's end-of-run summary.
+pub fn set_notices(on: bool) {
+    NOTICES.store(on, std::sync::atomic::Ordering::Relaxed);
 }

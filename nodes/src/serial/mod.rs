@@ -23,6 +23,8 @@ pub mod input;
 #[cfg(feature = "serial")]
 mod io;
 #[cfg(feature = "serial")]
+pub use io::set_notices;
+#[cfg(feature = "serial")]
 pub mod link;
 #[cfg(feature = "serial")]
 pub mod output;

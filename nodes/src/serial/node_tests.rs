@@ -5,7 +5,7 @@
 
 use super::device::{DeviceConfig, DeviceSession};
 use super::message::{self, Message, Touch};
-use evflow_engine::{check, graph::parse_graph, Override, Plan, PlanOptions};
+use evflow_engine::{check, graph::parse_graph, Override, Plan, PlanOptions, RunMode};
 use serialport::{SerialPort, TTYPort};
 use std::io::{ErrorKind, Read, Write};
 use std::path::Path;
@@ -123,11 +123,16 @@ timeout = 2.0
 type = "stats"
 "#;
 
-fn plan(port: &str, max_block: usize, wait: f64) -> Result<Plan, String> {
+/// A live plan (blocks of one tick) on `port`.
+fn plan(port: &str, wait: f64) -> Result<Plan, String> {
+    plan_as(port, RunMode::Live, 1, wait)
+}
+
+fn plan_as(port: &str, mode: RunMode, max_block: usize, wait: f64) -> Result<Plan, String> {
     let g = parse_graph(Path::new("t.toml"), GRAPH).map_err(|e| e.to_string())?;
     let o = [Override::parse(&format!("port={port}")).unwrap(), Override::parse(&format!("wait={wait}")).unwrap()];
     let checked = check(&g, &crate::registry(), &o).map_err(|e| e.to_string())?;
-    Plan::build(&checked, &PlanOptions { max_block, ..Default::default() }).map_err(|e| e.to_string())
+    Plan::build(&checked, &PlanOptions { max_block, mode, ..Default::default() }).map_err(|e| e.to_string())
 }
 
 /// Per tick: serial.in's outputs (x, y, load, force, contact, connected,
@@ -173,7 +178,7 @@ fn lcs_diff(want: &[i16], have: &[i16]) -> (usize, usize) {
 #[test]
 fn a_live_plan_exchanges_samples_with_the_device() {
     let dev = TestDevice::spawn(DeviceConfig::default());
-    let mut p = plan(&dev.slave, 1, 5.0).unwrap();
+    let mut p = plan(&dev.slave, 5.0).unwrap();
     let rows = run(&mut p, 400);
     let summaries = p.finish().unwrap();
     drop(p); // the link closes: a zero sample goes out last
@@ -212,7 +217,7 @@ fn a_vanished_device_fades_the_output_and_the_link_comes_back() {
     let link = dir.path().join("device");
     let dev = TestDevice::spawn(DeviceConfig::default());
     std::os::unix::fs::symlink(&dev.slave, &link).unwrap();
-    let mut p = plan(link.to_str().unwrap(), 1, 5.0).unwrap();
+    let mut p = plan(link.to_str().unwrap(), 5.0).unwrap();
     let before = run(&mut p, 100);
     assert!(before.iter().all(|(r, _)| r[5] == 1.0));
     assert!(before.last().unwrap().1 != 0.0);
@@ -256,35 +261,41 @@ fn a_vanished_device_fades_the_output_and_the_link_comes_back() {
 
 #[test]
 fn errors_name_the_port_and_the_reason() {
-    let e = plan("/nonexistent/evflow-tty", 1, 0.05).err().unwrap();
+    let e = plan("/nonexistent/evflow-tty", 0.05).err().unwrap();
     assert!(e.contains("/nonexistent/evflow-tty") && e.contains("cannot open"), "{e}");
     assert!(e.contains("dev"), "names the node: {e}");
 
     let dev = TestDevice::spawn(DeviceConfig { version: 2, ..DeviceConfig::default() });
-    let e = plan(&dev.slave, 1, 0.5).err().unwrap();
+    let e = plan(&dev.slave, 0.5).err().unwrap();
     assert!(e.contains("protocol version 2"), "{e}");
     dev.stop();
 }
 
 #[test]
-fn offline_runs_never_open_the_port() {
-    let dev = TestDevice::spawn(DeviceConfig::default());
-    let mut p = plan(&dev.slave, 4096, 2.0).unwrap();
-    p.step(4096).unwrap();
-    let s = p.finish().unwrap();
-    let d = &s.iter().find(|(n, _)| n == "dev").unwrap().1;
-    assert!(d.lines[0].contains("offline run"), "{:?}", d.lines);
-    drop(p);
-    std::thread::sleep(Duration::from_millis(50));
-    let log = dev.stop();
-    assert_eq!((log.hellos, log.received.len()), (0, 0), "the device heard nothing");
+fn offline_runs_never_open_the_port_whatever_their_block_size() {
+    // Blocks of 4096 (`evflow run`, a replay) and of one tick (`evflow run
+    // --block 1`, a replay with --block 1): offline is offline.
+    for max_block in [4096, 1] {
+        let dev = TestDevice::spawn(DeviceConfig::default());
+        let mut p = plan_as(&dev.slave, RunMode::Offline, max_block, 2.0).unwrap();
+        for _ in 0..(4096 / p.max_block()) {
+            p.step(p.max_block()).unwrap();
+        }
+        let s = p.finish().unwrap();
+        let d = &s.iter().find(|(n, _)| n == "dev").unwrap().1;
+        assert!(d.lines[0].contains("offline run"), "{:?}", d.lines);
+        drop(p);
+        std::thread::sleep(Duration::from_millis(50));
+        let log = dev.stop();
+        assert_eq!((log.hellos, log.received.len()), (0, 0), "blocks of {max_block}: the device heard nothing");
+    }
 }
 
 #[test]
 fn one_node_of_each_direction_per_port() {
     let dev = TestDevice::spawn(DeviceConfig::default());
-    let p = plan(&dev.slave, 1, 5.0).unwrap();
-    let e = plan(&dev.slave, 1, 5.0).err().unwrap();
+    let p = plan(&dev.slave, 5.0).unwrap();
+    let e = plan(&dev.slave, 5.0).err().unwrap();
     assert!(e.contains("already has a `serial.in`"), "{e}");
     drop(p);
     dev.stop();
@@ -301,7 +312,8 @@ fn nodes_on_one_port_must_agree_on_its_settings() {
     let g = parse_graph(Path::new("t.toml"), &text).unwrap();
     let o = [Override::parse(&format!("port={}", dev.slave)).unwrap()];
     let checked = check(&g, &crate::registry(), &o).unwrap();
-    let e = Plan::build(&checked, &PlanOptions { max_block: 1, ..Default::default() }).err().unwrap().to_string();
+    let live = PlanOptions { max_block: 1, mode: RunMode::Live, ..Default::default() };
+    let e = Plan::build(&checked, &live).err().unwrap().to_string();
     assert!(e.contains("other settings") && e.contains("baud 921600"), "{e}");
     dev.stop();
 }

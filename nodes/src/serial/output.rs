@@ -2,7 +2,9 @@
 
 use super::link::{self, Link, LinkConfig};
 use super::params::{self, PORT_PARAMS};
-use evflow_engine::{BuildContext, Io, Node, NodeError, NodeSpec, Params, PortSpec, PrepareContext, Role, Summary};
+use evflow_engine::{
+    BuildContext, Io, Node, NodeError, NodeSpec, Params, PortSpec, PrepareContext, Role, RunMode, Summary,
+};
 use std::sync::atomic::Ordering;
 use std::sync::Arc;
 
@@ -81,14 +83,18 @@ impl Node for SerialOut {
         if self.live.is_some() {
             return Ok(());
         }
-        if !params::is_live(ctx) {
-            self.idle = Some(params::offline_reason(ctx.max_block));
+        if ctx.mode != RunMode::Live {
+            self.idle = Some(params::OFFLINE.to_string());
             return Ok(());
         }
         let hz = params::rate_hz(&self.name, self.rate)?;
         let l = link::attach(config, &self.name).map_err(NodeError::Other)?;
         let ring = l.take_out(hz).ok_or_else(|| {
-            NodeError::Other(format!("port {} already has a `serial.out` node; one per port", config.port))
+            NodeError::Other(format!(
+                "port {} already has a `serial.out` node, in this plan or in a running one; one per port (a \
+                 replacement plan cannot take a port the running plan holds: stop the session and start anew)",
+                config.port
+            ))
         })?;
         l.wait_connected().map_err(NodeError::Other)?;
         self.idle = None;

@@ -2,7 +2,7 @@
 //! does with them when its plan is prepared: open the link in a live run,
 //! stay off the device otherwise.
 
-use evflow_engine::{NodeError, ParamSpec, Params, PrepareContext};
+use evflow_engine::{NodeError, ParamSpec, Params};
 use std::time::Duration;
 
 use super::link::LinkConfig;
@@ -28,13 +28,9 @@ pub const PORT_PARAMS: [ParamSpec; 5] = [
     ParamSpec::float("retry", 0.01, 600.0, 0.5, "s", "after a disconnect, reopen the port this often"),
 ];
 
-/// Why a node with a port does not use it.
-pub fn offline_reason(max_block: usize) -> String {
-    format!(
-        "offline run (blocks of {max_block} ticks): the port was not opened; serial nodes talk to the device only in \
-         live runs (ticks of one sample)"
-    )
-}
+/// Why a node with a port does not use it in an offline run or a replay.
+pub const OFFLINE: &str = "offline run: the port was not opened; serial nodes talk to the device only in live \
+     runs (`evflow live`), never in `evflow run`, a sweep, a report or `evflow replay`, whatever the block size";
 
 /// The text of a node without a port.
 pub const NO_PORT: &str = "no port given (port = \"\"): ran without a device";
@@ -49,23 +45,6 @@ pub fn link_config(p: &Params) -> Option<LinkConfig> {
         timeout: Duration::from_secs_f64(p.f64("timeout")),
         retry: Duration::from_secs_f64(p.f64("retry")),
     })
-}
-
-/// The largest block (in the node's samples) a live plan prepares a node
-/// for: the live runner asks for blocks of one tick, which the plan rounds
-/// up to its rate unit (the least common multiple of the graph's rate
-/// divisors: 25 with a 40 Hz node at 1 kHz, 1000 with a 1 Hz one). Offline
-/// runs and replays use 4096 by default.
-pub const LIVE_MAX_BLOCK: usize = 1000;
-
-/// True when the plan runs live (blocks of one tick): the one case in which
-/// a serial node opens its port. Offline runs and replays step in large
-/// blocks, as fast as the machine allows, and must not drive a device. The
-/// engine does not say whether a plan is live; the block size is the sign
-/// (an offline run asked for blocks of at most 1000 ticks would open the
-/// port too).
-pub fn is_live(ctx: &PrepareContext) -> bool {
-    ctx.max_block <= LIVE_MAX_BLOCK
 }
 
 /// A node rate as the u16 of a HELLO.

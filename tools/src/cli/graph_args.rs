@@ -18,8 +18,14 @@ pub fn load_with(file: &Path, sets: &[impl AsRef<str>]) -> Result<Checked> {
 /// written under `out`: what the reports do with the shipped graphs.
 pub fn run_with(file: &Path, sets: &[impl AsRef<str>], out: &Path) -> Result<RunReport> {
     let checked = load_with(file, sets)?;
-    let opts =
-        PlanOptions { max_block: 1024, seed: None, base_dir: None, out_dir: Some(out.to_path_buf()), timing: false };
+    let opts = PlanOptions {
+        max_block: 1024,
+        seed: None,
+        base_dir: None,
+        out_dir: Some(out.to_path_buf()),
+        timing: false,
+        mode: evflow_engine::RunMode::Offline,
+    };
     let mut plan = Plan::build(&checked, &opts).map_err(|e| anyhow!("{}: {e}", file.display()))?;
     run_offline(&mut plan, RunOptions { duration: None, progress: None })
         .map_err(|e| anyhow!("{}: {e}", file.display()))

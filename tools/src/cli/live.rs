@@ -77,13 +77,22 @@ pub struct Args {
 
 /// Runs `evflow live`.
 pub fn main(a: Args) -> Result<()> {
+    // -q: the serial I/O threads' link notices go to the summary only.
+    #[cfg(feature = "serial")]
+    evflow_nodes::serial::set_notices(!a.quiet);
     let checked = a.graph.load()?;
     let graph_text =
         std::fs::read_to_string(&a.graph.file).with_context(|| format!("{}: cannot read", a.graph.file.display()))?;
     std::fs::create_dir_all(&a.out).map_err(|e| anyhow!("{}: cannot create output folder: {e}", a.out.display()))?;
     let seed = a.seed.unwrap_or(checked.graph.seed);
-    let opts =
-        PlanOptions { max_block: 1, seed: Some(seed), base_dir: None, out_dir: Some(a.out.clone()), timing: false };
+    let opts = PlanOptions {
+        max_block: 1,
+        seed: Some(seed),
+        base_dir: None,
+        out_dir: Some(a.out.clone()),
+        timing: false,
+        mode: evflow_engine::RunMode::Live,
+    };
     let plan = Plan::build(&checked, &opts).map_err(|e| anyhow!("{e}"))?;
     let (taps, n_inputs) = taps_of(&plan, &a.taps)?;
     let lp = LivePlan::new(plan, &taps).map_err(|e| anyhow!("{}: {e}", a.graph.file.display()))?;

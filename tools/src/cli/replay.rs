@@ -135,6 +135,7 @@ pub fn main(a: Args) -> Result<()> {
         base_dir: Some(base_dir),
         out_dir: Some(a.out.clone()),
         timing: true,
+        mode: evflow_engine::RunMode::Offline,
     };
     let mut plan = Plan::build(&checked, &opts).map_err(|e| anyhow!("{e}"))?;
     if (plan.base_rate() - m.base_rate).abs() > 1e-9 * m.base_rate {

@@ -135,6 +135,7 @@ fn run_one(checked: &Checked, a: &Args, stop: &AtomicBool) -> Result<RunReport> 
         base_dir: None,
         out_dir: Some(a.out.clone()),
         timing: true,
+        mode: evflow_engine::RunMode::Offline,
     };
     let mut plan = Plan::build(checked, &opts).map_err(|e| anyhow!("{e}"))?;
     let bar = ProgressBar::with_draw_target(None, ProgressDrawTarget::hidden());

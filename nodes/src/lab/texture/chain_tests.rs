@@ -59,7 +59,14 @@ type = "harness.tap"
     reg.add(&crate::filters::butterworth::SPEC).add(&TAP);
     let g = parse_graph(Path::new("texture-chain.toml"), &text).unwrap();
     let checked = check(&g, &reg, &[]).unwrap_or_else(|e| panic!("{e}"));
-    let opts = PlanOptions { max_block: 256, seed: Some(1), base_dir: None, timing: false, out_dir: None };
+    let opts = PlanOptions {
+        max_block: 256,
+        seed: Some(1),
+        base_dir: None,
+        timing: false,
+        out_dir: None,
+        mode: evflow_engine::RunMode::Offline,
+    };
     let mut plan = Plan::build(&checked, &opts).unwrap();
     let mut out = Vec::new();
     let cruise = speed * 1e-2;
@@ -178,7 +185,14 @@ type = "harness.tap"
     reg.add(&TAP);
     let g = parse_graph(Path::new("user-on-texture.toml"), text).unwrap();
     let checked = check(&g, &reg, &[]).unwrap_or_else(|e| panic!("{e}"));
-    let opts = PlanOptions { max_block: 100, seed: Some(1), base_dir: None, timing: false, out_dir: None };
+    let opts = PlanOptions {
+        max_block: 100,
+        seed: Some(1),
+        base_dir: None,
+        timing: false,
+        out_dir: None,
+        mode: evflow_engine::RunMode::Offline,
+    };
     let mut plan = Plan::build(&checked, &opts).unwrap();
     // μ per 25 µm of position: (min, max, count) over the strokes.
     let mut bins = vec![(f64::INFINITY, f64::NEG_INFINITY, 0usize); 3200];

@@ -47,6 +47,7 @@ fn plan(dir: &Path, doc: &str, block: usize) -> Result<Plan, String> {
         base_dir: Some(dir.to_path_buf()),
         out_dir: Some(dir.to_path_buf()),
         timing: false,
+        mode: evflow_engine::RunMode::Offline,
     };
     Plan::build(&checked, &opts).map_err(|e| e.to_string())
 }

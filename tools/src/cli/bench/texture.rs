@@ -28,7 +28,14 @@ pub struct Args {
 /// Runs the benchmark and prints a Markdown table.
 pub fn main(a: Args) -> Result<()> {
     let checked = load_with(&a.graph, &a.set)?;
-    let opts = PlanOptions { max_block: 1, seed: None, base_dir: None, out_dir: None, timing: false };
+    let opts = PlanOptions {
+        max_block: 1,
+        seed: None,
+        base_dir: None,
+        out_dir: None,
+        timing: false,
+        mode: evflow_engine::RunMode::Offline,
+    };
     let mut plan = Plan::build(&checked, &opts).map_err(|e| anyhow!("{e}"))?;
     let update_every = (plan.base_rate() / 10.0).round().max(1.0) as u64;
     for _ in 0..1000 {

@@ -1,6 +1,7 @@
 //! Arithmetic on streams.
 
 pub mod add;
+mod binary;
 pub mod mul;
 
 use evflow_engine::NodeSpec;

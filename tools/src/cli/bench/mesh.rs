@@ -8,7 +8,6 @@
 use super::stats::percentile;
 use crate::cli::graph_args::load_with;
 use anyhow::{anyhow, Result};
-use evflow_engine::{Plan, PlanOptions};
 use evflow_nodes::mesh::raycast::RayCaster;
 use evflow_nodes::mesh::scenes::{scene, Shape};
 use evflow_nodes::mesh::trimesh::Mesh;
@@ -143,15 +142,7 @@ fn time_casts(points: &[(f64, f64)], cast: impl Fn(f64, f64) -> Option<u32>) -> 
 fn time_chain(a: &Args, resolution: usize) -> Result<([f64; 3], f64)> {
     let sets = [format!("surface.resolution={resolution}"), format!("edges.resolution={resolution}")];
     let checked = load_with(&a.graph, &sets)?;
-    let opts = PlanOptions {
-        max_block: 1,
-        seed: None,
-        base_dir: None,
-        out_dir: None,
-        timing: false,
-        mode: evflow_engine::RunMode::Offline,
-    };
-    let mut plan = Plan::build(&checked, &opts).map_err(|e| anyhow!("{e}"))?;
+    let mut plan = super::tick_plan(&checked)?;
     for _ in 0..1000 {
         plan.tick().map_err(|e| anyhow!("{e}"))?;
     }

@@ -41,6 +41,13 @@ enum Which {
     Texture(texture::Args),
 }
 
+/// A plan built tick by tick, as the live runner steps it, but offline (a
+/// bench never opens a device), without per-node timing.
+pub(crate) fn tick_plan(checked: &evflow_engine::Checked) -> anyhow::Result<evflow_engine::Plan> {
+    let opts = evflow_engine::PlanOptions { max_block: 1, timing: false, ..Default::default() };
+    evflow_engine::Plan::build(checked, &opts).map_err(|e| anyhow::anyhow!("{e}"))
+}
+
 /// Runs the chosen benchmark.
 pub fn main(a: BenchArgs) -> anyhow::Result<()> {
     match a.which {

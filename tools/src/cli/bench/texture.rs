@@ -7,7 +7,6 @@ use super::stats::percentile;
 use crate::cli::graph_args::load_with;
 use anyhow::{anyhow, Result};
 use evflow_engine::live::thread_cpu_ns;
-use evflow_engine::{Plan, PlanOptions};
 use std::path::PathBuf;
 use std::time::Instant;
 
@@ -28,15 +27,7 @@ pub struct Args {
 /// Runs the benchmark and prints a Markdown table.
 pub fn main(a: Args) -> Result<()> {
     let checked = load_with(&a.graph, &a.set)?;
-    let opts = PlanOptions {
-        max_block: 1,
-        seed: None,
-        base_dir: None,
-        out_dir: None,
-        timing: false,
-        mode: evflow_engine::RunMode::Offline,
-    };
-    let mut plan = Plan::build(&checked, &opts).map_err(|e| anyhow!("{e}"))?;
+    let mut plan = super::tick_plan(&checked)?;
     let update_every = (plan.base_rate() / 10.0).round().max(1.0) as u64;
     for _ in 0..1000 {
         plan.tick().map_err(|e| anyhow!("{e}"))?;

@@ -124,7 +124,10 @@ fn report_interp_with_narx_cells_plays_the_grid_on_the_display() {
         "0.8,1.2",
     ]);
     assert!(ok, "{err}");
-    let cells = |l: &&str| l.starts_with("| plastic-sheet |") && l.contains(" g, ");
+    // Trained rows name their condition in the second column ("60 g, 3 cm/s");
+    // cross-validation rows give load and speed as numbers there.
+    let condition_column = |l: &str| l.split('|').nth(2).is_some_and(|c| c.contains(" g, "));
+    let cells = |l: &&str| l.starts_with("| plastic-sheet |") && condition_column(l);
     let number = |c: &str| c.trim_end_matches(" %").parse::<f64>().unwrap_or_else(|_| panic!("`{c}` in\n{out}"));
     let rows = |keep: &dyn Fn(&&str) -> bool| -> Vec<Vec<String>> {
         out.lines().filter(keep).map(|l| l.split('|').map(|c| c.trim().to_string()).collect()).collect()
@@ -145,7 +148,7 @@ fn report_interp_with_narx_cells_plays_the_grid_on_the_display() {
     }
     // The cross-validation: five untrained conditions; where the velocity is
     // interpolated (5 cm/s from 3 and 7) the improved scheme scores better.
-    let xval = rows(&|l: &&str| l.starts_with("| plastic-sheet |") && !l.contains(" g, "));
+    let xval = rows(&|l: &&str| l.starts_with("| plastic-sheet |") && !condition_column(l));
     assert_eq!(xval.len(), 5, "{out}");
     for r in &xval {
         let (basic, improved) = (number(&r[5]), number(&r[6]));
@@ -153,8 +156,16 @@ fn report_interp_with_narx_cells_plays_the_grid_on_the_display() {
         if r[3] == "5" {
             assert!(improved < basic && r[7] == "yes", "{r:?}");
         }
+        // Forces first: the recorded forces interpolated, then the nearest
+        // trained condition's inverse model — the improved scheme wins too.
+        let (ff_basic, ff_improved) = (number(&r[12]), number(&r[13]));
+        assert!(ff_basic.is_finite() && ff_improved.is_finite() && ff_improved > 0.0, "{r:?}");
+        if r[3] == "5" {
+            assert!(ff_improved < ff_basic && r[14] == "yes", "{r:?}");
+        }
     }
     assert!(out.contains("better on 3 of 3 velocity-interpolated conditions"), "{out}");
+    assert!(out.contains("the improved scheme is better on 3 of 3 velocity-interpolated conditions. Whole"), "{out}");
     assert!(dir.path().join("interp-narx.md").is_file());
     assert!(
         dir.path().join("grids/narx-plastic-sheet").is_dir()

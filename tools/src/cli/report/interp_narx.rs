@@ -12,6 +12,11 @@
 //! (the same interpolation over the recorded forces, played on the display).
 //! As a control, the same graph runs at every trained condition, where an
 //! interpolation must give the cell back.
+//!
+//! Beside the dissertation's order (interpolate the actuations), the graph
+//! also runs **forces first**: the recorded forces interpolated by the same
+//! scheme, then the inverse model of the nearest trained condition
+//! synthesizes the actuation ([`nearest`]).
 
 use super::interp::{plan_for, Args, GridPlan};
 use super::lab_recording::{constant_speed_force, recording_in, Condition};
@@ -43,8 +48,12 @@ struct Scores {
     playback: f64,
     /// E_s of repetition 1 against repetition 2.
     repeat: f64,
+    /// E_s of forces first: the interpolated forces, the nearest model's actuation, on the display.
+    ff: f64,
     /// Main peak of the NARX chain's force, Hz.
     narx_peak_hz: f64,
+    /// Main peak of the forces-first chain's force, Hz.
+    ff_peak_hz: f64,
     /// Main peak of the real force, Hz.
     real_peak_hz: f64,
 }
@@ -55,7 +64,9 @@ impl Scores {
             narx: value(r, "narx_es", "E_s")?,
             playback: value(r, "playback_es", "E_s")?,
             repeat: value(r, "repeat_es", "E_s")?,
+            ff: value(r, "ff_es", "E_s")?,
             narx_peak_hz: value(r, "narx_es", "peak_psd_freq_virtual")?,
+            ff_peak_hz: value(r, "ff_es", "peak_psd_freq_virtual")?,
             real_peak_hz: value(r, "narx_es", "peak_psd_freq_real")?,
         })
     }
@@ -95,9 +106,29 @@ fn trained_conditions(plans: &[GridPlan]) -> Vec<Cond> {
     conds
 }
 
+/// The trained condition nearest to `c` (load and speed each measured in
+/// units of its axis's span in the plan; a tie goes to the first in the
+/// plan's order, lower load then lower speed), with its model and gain.
+fn nearest<'a>(c: &Cond, trained: &'a [(Cond, PathBuf, f64)]) -> &'a (Cond, PathBuf, f64) {
+    let span = |f: fn(&Cond) -> f64| {
+        let (lo, hi) =
+            trained.iter().map(|t| f(&t.0)).fold((f64::INFINITY, f64::NEG_INFINITY), |(l, h), x| (l.min(x), h.max(x)));
+        if hi > lo {
+            hi - lo
+        } else {
+            1.0
+        }
+    };
+    let (sm, sv) = (span(|c| c.mass), span(|c| c.speed));
+    let d = |t: &Cond| ((t.mass - c.mass) / sm).hypot((t.speed - c.speed) / sv);
+    trained.iter().fold(&trained[0], |best, t| if d(&t.0) < d(&best.0) - 1e-12 { t } else { best })
+}
+
 /// Runs the cross-validation graph for `sample` at `c` with both schemes,
 /// the grids of `sample` in `grids` and its recordings in `recordings`.
-/// `period` is the sample's main period (cm), to which `interp` rounds its loop.
+/// `period` is the sample's main period (cm), to which `interp` rounds its
+/// loop; `near` the model and gain of the nearest trained condition (forces first).
+#[allow(clippy::too_many_arguments)]
 fn cross_validate(
     a: &Args,
     grids: &Path,
@@ -105,6 +136,7 @@ fn cross_validate(
     sample: &str,
     period: f64,
     c: &Cond,
+    near: &(Cond, PathBuf, f64),
     work: &Path,
 ) -> Result<Run> {
     let grid = |what: &str| format!("{:?}", grids.join(format!("{what}-{sample}")).display().to_string());
@@ -122,8 +154,10 @@ fn cross_validate(
             format!("playback_grid={}", grid("playback")),
             format!("scheme=\"{scheme}\""),
             format!("period={period}"),
+            format!("model={:?}", near.1.display().to_string()),
+            format!("ff_gain={}", near.2),
         ];
-        for node in ["narx_es", "playback_es", "repeat_es"] {
+        for node in ["narx_es", "playback_es", "repeat_es", "ff_es"] {
             sets.push(format!("{node}.fmin={}", a.band[0]));
             sets.push(format!("{node}.fmax={}", a.band[1]));
         }
@@ -191,6 +225,12 @@ fn spectra_plot(run: &Run) -> Result<Plot> {
         }
         let name = ["basic (§5.3.3)", "improved (Eq. 6.4)"][k];
         series.push(Series::line(format!("{name}, E_s {:.2}", run.scores[k].narx), pts(ch("narx_force")?)?));
+        if k == 1 {
+            series.push(Series::line(
+                format!("forces first, improved, E_s {:.2}", run.scores[k].ff),
+                pts(ch("ff_force")?)?,
+            ));
+        }
     }
     Ok(Plot {
         title: format!("{}, {}: interpolated NARX cells on the display", run.sample, run.cond.label()),
@@ -238,13 +278,15 @@ pub(super) fn main(a: &Args, samples: &[String]) -> Result<()> {
             write_cell(&played, "playback_u", &grids.join(format!("playback-{s}")), s, c, syn.playback.gain)?;
             syns.push((syn, share_above_cutoff(&cell)?));
         }
+        let near: Vec<(Cond, PathBuf, f64)> =
+            trained.iter().zip(&syns).map(|(c, (syn, _))| (*c, model_of(c).path.clone(), syn.narx.gain)).collect();
         let period = texture_period(&recordings, s, &trained, &a.band)?;
         periods.push((s.clone(), period));
         // The control: each trained condition through the graph, once the grid is whole.
         for (c, (syn, above_cutoff)) in trained.iter().zip(syns) {
             step += 1;
             eprintln!("[{step}/{steps}] {s} at {} (trained): the cell through interp, on the display …", c.label());
-            let run = cross_validate(a, &grids, &recordings, s, period, c, tmp.path())?;
+            let run = cross_validate(a, &grids, &recordings, s, period, c, nearest(c, &near), tmp.path())?;
             cells.push(Cell { syn, above_cutoff, run });
         }
         for &(mass, speed) in &p.validate {
@@ -252,14 +294,15 @@ pub(super) fn main(a: &Args, samples: &[String]) -> Result<()> {
             step += 1;
             eprintln!("[{step}/{steps}] {s} at {} (untrained): interpolating, playing on the display …", c.label());
             record_pair(&a.graphs, s, &c, &recordings)?;
-            let run = cross_validate(a, &grids, &recordings, s, period, &c, tmp.path())?;
-            rows.push((p.velocity_interpolated(speed), run));
+            let near = nearest(&c, &near);
+            let run = cross_validate(a, &grids, &recordings, s, period, &c, near, tmp.path())?;
+            rows.push((p.velocity_interpolated(speed), run, near.0));
         }
     }
     let md = table(a, &periods, &cells, &rows, started.elapsed().as_secs_f64());
     print!("{md}");
     super::save_markdown(&a.out.join("interp-narx.md"), &md)?;
-    for (_, run) in &rows {
+    for (_, run, _) in &rows {
         let name = format!("interp-narx-{}-{}g-{}cms.png", run.sample, run.cond.mass, run.cond.speed);
         super::save_png(&spectra_plot(run)?, &a.out.join(name));
     }
@@ -268,7 +311,7 @@ pub(super) fn main(a: &Args, samples: &[String]) -> Result<()> {
 
 /// The Markdown report: the trained cells with their control, then the
 /// cross-validation.
-fn table(a: &Args, periods: &[(String, f64)], cells: &[Cell], rows: &[(bool, Run)], seconds: f64) -> String {
+fn table(a: &Args, periods: &[(String, f64)], cells: &[Cell], rows: &[(bool, Run, Cond)], seconds: f64) -> String {
     let (lo, hi) = (a.band[0], a.band[1]);
     let mut md = String::new();
     let _ = write!(md, "Loops of whole main periods (`interp`'s `period`, measured on the trained recordings):");
@@ -289,14 +332,14 @@ fn table(a: &Args, periods: &[(String, f64)], cells: &[Cell], rows: &[(bool, Run
     );
     let _ = writeln!(
         md,
-        "| sample | condition | repeat baseline | NARX E_s, synthesize | gain | through interp: basic | improved | above cutoff | record-and-playback E_s | its gain |"
+        "| sample | condition | repeat baseline | NARX E_s, synthesize | gain | through interp: basic | improved | above cutoff | record-and-playback E_s | its gain | forces first: basic | improved |"
     );
-    let _ = writeln!(md, "|---|---|---:|---:|---:|---:|---:|---:|---:|---:|");
+    let _ = writeln!(md, "|---|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|");
     for c in cells {
         let [b, i] = c.run.scores;
         let _ = writeln!(
             md,
-            "| {} | {} | {:.3} | {:.3} | {} | {:.3} | {:.3} | {:.0} % | {:.3} | {} |",
+            "| {} | {} | {:.3} | {:.3} | {} | {:.3} | {:.3} | {:.0} % | {:.3} | {} | {:.3} | {:.3} |",
             c.run.sample,
             c.run.cond.label(),
             c.syn.repeat,
@@ -306,7 +349,9 @@ fn table(a: &Args, periods: &[(String, f64)], cells: &[Cell], rows: &[(bool, Run
             i.narx,
             c.above_cutoff * 100.0,
             c.syn.playback.es,
-            c.syn.playback.gain
+            c.syn.playback.gain,
+            b.ff,
+            i.ff
         );
     }
     let _ = writeln!(
@@ -317,44 +362,58 @@ fn table(a: &Args, periods: &[(String, f64)], cells: &[Cell], rows: &[(bool, Run
     );
     let _ = writeln!(
         md,
-        "| sample | load (g) | speed (cm/s) | repeat baseline | NARX basic (§5.3.3) | NARX improved (Eq. 6.4) | improved better | main peak, Hz: real / basic / improved | record-and-playback basic | record-and-playback improved |"
+        "| sample | load (g) | speed (cm/s) | repeat baseline | NARX basic (§5.3.3) | NARX improved (Eq. 6.4) | improved better | main peak, Hz: real / basic / improved | record-and-playback basic | record-and-playback improved | forces first: model | basic | improved | improved better | main peak, Hz: basic / improved |"
     );
-    let _ = writeln!(md, "|---|---:|---:|---:|---:|---:|---|---|---:|---:|");
-    for (velocity, r) in rows {
+    let _ = writeln!(md, "|---|---:|---:|---:|---:|---:|---|---|---:|---:|---|---:|---:|---|---|");
+    for (velocity, r, near) in rows {
         let [b, i] = r.scores;
-        let verdict = match (velocity, i.narx < b.narx) {
+        let verdict = |better: bool| match (velocity, better) {
             (false, _) => "— (no velocity step)",
             (true, true) => "yes",
             (true, false) => "**no**",
         };
         let _ = writeln!(
             md,
-            "| {} | {} | {} | {:.3} | {:.3} | {:.3} | {verdict} | {} / {} / {} | {:.3} | {:.3} |",
+            "| {} | {} | {} | {:.3} | {:.3} | {:.3} | {} | {} / {} / {} | {:.3} | {:.3} | {} | {:.3} | {:.3} | {} | {} / {} |",
             r.sample,
             r.cond.mass,
             r.cond.speed,
             i.repeat,
             b.narx,
             i.narx,
+            verdict(i.narx < b.narx),
             i.real_peak_hz,
             b.narx_peak_hz,
             i.narx_peak_hz,
             b.playback,
-            i.playback
+            i.playback,
+            near.label(),
+            b.ff,
+            i.ff,
+            verdict(i.ff < b.ff),
+            b.ff_peak_hz,
+            i.ff_peak_hz
         );
     }
-    let mean = |f: &dyn Fn(&Run) -> f64| rows.iter().map(|(_, r)| f(r)).sum::<f64>() / rows.len().max(1) as f64;
-    let velocity: Vec<&Run> = rows.iter().filter(|(v, _)| *v).map(|(_, r)| r).collect();
+    let mean = |f: &dyn Fn(&Run) -> f64| rows.iter().map(|(_, r, _)| f(r)).sum::<f64>() / rows.len().max(1) as f64;
+    let velocity: Vec<&Run> = rows.iter().filter(|(v, _, _)| *v).map(|(_, r, _)| r).collect();
     let wins = velocity.iter().filter(|r| r.scores[1].narx < r.scores[0].narx).count();
+    let ff_wins = velocity.iter().filter(|r| r.scores[1].ff < r.scores[0].ff).count();
     let _ = writeln!(
         md,
         "\nMean E_s: repeat {:.3}; NARX basic {:.3}, improved {:.3}; record-and-playback basic {:.3}, improved {:.3}. \
-         The improved scheme is better on {wins} of {} velocity-interpolated conditions. Whole report: {seconds:.0} s.",
+         The improved scheme is better on {wins} of {} velocity-interpolated conditions.\n\n\
+         Forces first (the recorded forces interpolated, then the nearest trained condition's inverse model): \
+         mean E_s basic {:.3}, improved {:.3}; the improved scheme is better on {ff_wins} of {} velocity-interpolated \
+         conditions. Whole report: {seconds:.0} s.",
         mean(&|r| r.scores[1].repeat),
         mean(&|r| r.scores[0].narx),
         mean(&|r| r.scores[1].narx),
         mean(&|r| r.scores[0].playback),
         mean(&|r| r.scores[1].playback),
+        velocity.len(),
+        mean(&|r| r.scores[0].ff),
+        mean(&|r| r.scores[1].ff),
         velocity.len()
     );
     md

@@ -64,6 +64,13 @@ fn fixtures(dir: &Path) {
     };
     let model = fit(&x, &u, &cfg, &mut |_| {}).expect("fixture model");
     model.save(&dir.join("models/narx.json")).expect("fixture model written");
+    // The same model at two conditions, for `narx.grid`'s example.
+    for (m, v) in [(60.0, 3.0), (110.0, 7.0)] {
+        let mut at = model.clone();
+        at.condition.mass_g = Some(m);
+        at.condition.speed_cm_s = Some(v);
+        at.save(&dir.join(format!("models/narx-{m}g-{v}cms.json"))).expect("fixture grid model written");
+    }
 }
 
 struct Case {

@@ -6,9 +6,11 @@ pub mod closed_loop;
 pub mod error;
 pub mod eval;
 pub mod fit;
+pub mod grid_node;
 pub mod labdata;
 pub mod mapminmax;
 pub mod model;
+pub mod nearest;
 pub mod net;
 pub mod node;
 pub mod taps;
@@ -18,4 +20,4 @@ pub mod train_node;
 use evflow_engine::NodeSpec;
 
 /// The node types of this family.
-pub static SPECS: &[&NodeSpec] = &[&train_node::SPEC, &node::SPEC];
+pub static SPECS: &[&NodeSpec] = &[&train_node::SPEC, &node::SPEC, &grid_node::SPEC];

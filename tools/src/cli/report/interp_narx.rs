@@ -106,22 +106,13 @@ fn trained_conditions(plans: &[GridPlan]) -> Vec<Cond> {
     conds
 }
 
-/// The trained condition nearest to `c` (load and speed each measured in
-/// units of its axis's span in the plan; a tie goes to the first in the
-/// plan's order, lower load then lower speed), with its model and gain.
+/// The trained condition nearest to `c`, with its model and gain
+/// (`evflow_nodes::narx::nearest`: load and speed each in units of its
+/// span; a tie goes to the first in the plan's order, lower load then
+/// lower speed).
 fn nearest<'a>(c: &Cond, trained: &'a [(Cond, PathBuf, f64)]) -> &'a (Cond, PathBuf, f64) {
-    let span = |f: fn(&Cond) -> f64| {
-        let (lo, hi) =
-            trained.iter().map(|t| f(&t.0)).fold((f64::INFINITY, f64::NEG_INFINITY), |(l, h), x| (l.min(x), h.max(x)));
-        if hi > lo {
-            hi - lo
-        } else {
-            1.0
-        }
-    };
-    let (sm, sv) = (span(|c| c.mass), span(|c| c.speed));
-    let d = |t: &Cond| ((t.mass - c.mass) / sm).hypot((t.speed - c.speed) / sv);
-    trained.iter().fold(&trained[0], |best, t| if d(&t.0) < d(&best.0) - 1e-12 { t } else { best })
+    let grid: Vec<(f64, f64)> = trained.iter().map(|t| (t.0.mass, t.0.speed)).collect();
+    &trained[evflow_nodes::narx::nearest::nearest(&grid, c.mass, c.speed).unwrap_or(0)]
 }
 
 /// Runs the cross-validation graph for `sample` at `c` with both schemes,

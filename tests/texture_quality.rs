@@ -7,6 +7,11 @@
 use evflow_engine::{load_file, run_offline, Override, Plan, PlanOptions, RunOptions};
 
 fn e_s_of(graph: &str, scheme: &str, mode: &str) -> f64 {
+    metric_of(graph, "quality", scheme, mode)
+}
+
+/// E_s reported by the `metric` node `node` of `graph` with the scheme and playback mode given.
+fn metric_of(graph: &str, node: &str, scheme: &str, mode: &str) -> f64 {
     let path = evflow_tests::root().join(graph);
     let overrides: Vec<Override> = [format!("scheme=\"{scheme}\""), format!("mode=\"{mode}\"")]
         .iter()
@@ -16,7 +21,7 @@ fn e_s_of(graph: &str, scheme: &str, mode: &str) -> f64 {
     let mut plan = Plan::build(&checked, &PlanOptions::default()).unwrap_or_else(|e| panic!("{e}"));
     let report =
         run_offline(&mut plan, RunOptions { duration: None, progress: None }).unwrap_or_else(|e| panic!("{e}"));
-    report.value("quality", "E_s").expect("quality reports E_s")
+    report.value(node, "E_s").unwrap_or_else(|| panic!("{node} reports E_s"))
 }
 
 fn e_s(scheme: &str, mode: &str) -> f64 {
@@ -43,26 +48,13 @@ fn with_narx_synthesized_cells_on_the_display_the_improved_scheme_is_better_too(
     }
 }
 
-/// E_s of the forces-first chain of graphs/texture-render-quality.toml.
-fn forces_first(scheme: &str, mode: &str) -> f64 {
-    let path = evflow_tests::root().join("graphs/texture-render-quality.toml");
-    let overrides: Vec<Override> = [format!("scheme=\"{scheme}\""), format!("mode=\"{mode}\"")]
-        .iter()
-        .map(|s| Override::parse(s).unwrap())
-        .collect();
-    let checked = load_file(&path, &evflow_nodes::registry(), &overrides).unwrap_or_else(|e| panic!("{e}"));
-    let mut plan = Plan::build(&checked, &PlanOptions::default()).unwrap_or_else(|e| panic!("{e}"));
-    let report =
-        run_offline(&mut plan, RunOptions { duration: None, progress: None }).unwrap_or_else(|e| panic!("{e}"));
-    report.value("forces_quality", "E_s").expect("forces_quality reports E_s")
-}
-
 #[test]
 fn forces_first_the_improved_scheme_is_better_too() {
     // The recorded forces interpolated, then the nearest corner's inverse
     // model (narx.grid) synthesizes the actuation played on the display.
     for mode in ["time", "position"] {
-        let (basic, improved) = (forces_first("basic", mode), forces_first("improved", mode));
+        let forces_first = |scheme| metric_of("graphs/texture-render-quality.toml", "forces_quality", scheme, mode);
+        let (basic, improved) = (forces_first("basic"), forces_first("improved"));
         assert!(improved < basic, "{mode}: improved {improved} vs basic {basic}");
     }
 }

@@ -284,7 +284,14 @@ pub fn check(graph: &Graph, registry: &Registry, overrides: &[Override]) -> Resu
     if !sink.diags.is_empty() {
         return Err(Diagnostics(sink.diags));
     }
-    let mut nodes: Vec<CheckedNode> = nodes.into_iter().map(|n| n.expect("checked above")).collect();
+    // Every node that failed validation has reported why; should one not
+    // have, it is still an error here, never a panic.
+    if let Some(k) = nodes.iter().position(Option::is_none) {
+        let d = &graph.nodes[k];
+        sink.err(d.loc, Some(&d.name), "this node could not be validated", None);
+        return Err(Diagnostics(sink.diags));
+    }
+    let mut nodes: Vec<CheckedNode> = nodes.into_iter().flatten().collect();
     let topo = topology::analyse(&graph, &mut nodes, &edges, &mut sink);
     if !sink.diags.is_empty() {
         return Err(Diagnostics(sink.diags));

@@ -139,6 +139,15 @@ fn unknown_node_in_connection() {
 }
 
 #[test]
+fn an_empty_type_is_an_error_not_a_panic() {
+    // Found by tests/fuzz_loader.rs: `type = ""` once passed parsing
+    // silently and left a node without a type for validation.
+    let d = one_error(&GOOD.replacen("type = \"filt\"", "type = \"\"", 1));
+    assert!(d.message.contains("`type` is empty"), "{d}");
+    assert_eq!(d.node.as_deref(), Some("f"));
+}
+
+#[test]
 fn missing_required_parameter() {
     let d = one_error(&GOOD.replace("need = 0.5\n", ""));
     assert!(d.message.contains("missing required parameter `need`"), "{d}");

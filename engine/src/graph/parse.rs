@@ -200,6 +200,12 @@ fn read_node(cx: &mut Ctx<'_>, key: &Spanned<std::borrow::Cow<'_, str>>, val: &S
         let kloc = cx.loc(k.span());
         if k.get_ref() == "type" {
             match v.get_ref().as_str() {
+                Some("") => cx.err(
+                    kloc,
+                    Some(&name),
+                    "`type` is empty",
+                    Some("name a node type, e.g. `type = \"gain\"`; `evflow nodes` lists them".into()),
+                ),
                 Some(s) => {
                     decl.kind = s.to_string();
                     decl.kind_loc = kloc;

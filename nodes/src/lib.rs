@@ -19,6 +19,7 @@ pub mod safety;
 pub mod serial;
 pub mod sources;
 pub mod sum;
+pub mod synth;
 pub mod texture;
 
 use evflow_engine::{NodeSpec, Registry};
@@ -49,5 +50,6 @@ pub fn all_specs() -> Vec<&'static NodeSpec> {
     v.extend_from_slice(texture::SPECS);
     v.extend_from_slice(serial::SPECS);
     v.extend_from_slice(narx::SPECS);
+    v.extend_from_slice(synth::SPECS);
     v
 }

@@ -41,7 +41,11 @@ directions, the settling count, a NaN sample, block ≡ per-sample processing.",
 ])
 .example("speed = 5.0\ntolerance = 0.02\nsettle = 0.1\ndirection = \"both\"");
 
-struct Segment {
+/// The constant-speed rule of `segment`, one sample at a time: the one
+/// definition the node and the offline users of a recording's velocity
+/// (e.g. `synth.optimize`) share.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct SpeedRule {
     /// |v| bounds in m/s.
     lo: f64,
     hi: f64,
@@ -53,33 +57,64 @@ struct Segment {
     sign: f64,
 }
 
+impl SpeedRule {
+    /// The rule for `speed` cm/s within `tolerance` (relative), settled for
+    /// `settle` s at `rate` Hz, in `direction` (+1 forward, −1 backward, 0 both).
+    pub fn new(speed_cm_s: f64, tolerance: f64, settle: f64, rate: f64, direction: f64) -> Self {
+        let speed = speed_cm_s / 100.0;
+        let settle = (settle * rate).round().max(1.0) as u64;
+        // f64::signum(0.0) is 1: both directions need an explicit 0.
+        let sign = if direction > 0.0 {
+            1.0
+        } else if direction < 0.0 {
+            -1.0
+        } else {
+            0.0
+        };
+        Self { lo: speed * (1.0 - tolerance), hi: speed * (1.0 + tolerance), settle, run: 0, sign }
+    }
+
+    /// Takes the velocity v (m/s) of the next sample; true when the gate is open there.
+    #[inline]
+    pub fn step(&mut self, v: f64) -> bool {
+        // Against the chosen direction, |v| counts as 0 (out of tolerance).
+        let a = if self.sign == 0.0 || v * self.sign > 0.0 { v.abs() } else { 0.0 };
+        // NaN fails both comparisons and restarts the count.
+        self.run = if a >= self.lo && a <= self.hi { self.run.saturating_add(1) } else { 0 };
+        self.run >= self.settle
+    }
+
+    /// The gate over a whole velocity series, from rest.
+    pub fn gate(mut self, velocity: &[f64]) -> Vec<bool> {
+        self.run = 0;
+        velocity.iter().map(|&v| self.step(v)).collect()
+    }
+}
+
+struct Segment {
+    rule: SpeedRule,
+}
+
 fn build(p: &Params, ctx: &BuildContext) -> Result<Box<dyn Node>, NodeError> {
-    let speed = p.f64("speed") / 100.0;
-    let tol = p.f64("tolerance");
-    let settle = (p.f64("settle") * ctx.rate).round().max(1.0) as u64;
     let sign = match p.str("direction") {
         "forward" => 1.0,
         "backward" => -1.0,
         _ => 0.0,
     };
-    Ok(Box::new(Segment { lo: speed * (1.0 - tol), hi: speed * (1.0 + tol), settle, run: 0, sign }))
+    Ok(Box::new(Segment { rule: SpeedRule::new(p.f64("speed"), p.f64("tolerance"), p.f64("settle"), ctx.rate, sign) }))
 }
 
 impl Node for Segment {
     fn process(&mut self, io: &mut Io<'_>) -> Result<(), NodeError> {
         let (v, gate) = io.io(0, 0);
         for (g, v) in gate.iter_mut().zip(v) {
-            // Against the chosen direction, |v| counts as 0 (out of tolerance).
-            let a = if self.sign == 0.0 || v * self.sign > 0.0 { v.abs() } else { 0.0 };
-            // NaN fails both comparisons and restarts the count.
-            self.run = if a >= self.lo && a <= self.hi { self.run.saturating_add(1) } else { 0 };
-            *g = if self.run >= self.settle { 1.0 } else { 0.0 };
+            *g = if self.rule.step(*v) { 1.0 } else { 0.0 };
         }
         Ok(())
     }
 
     fn reset(&mut self) {
-        self.run = 0;
+        self.rule.run = 0;
     }
 }
 

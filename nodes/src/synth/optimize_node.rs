@@ -1,0 +1,206 @@
+//! `synth.optimize`: the optimized synthesis as a source — reads a real
+//! texture force, synthesizes the actuation through a forward model, and
+//! plays it.
+
+use super::lbfgsb::Options;
+use super::model_file::ForwardModel;
+use super::start::carrier;
+use super::synthesize::{synthesize, NoiseWeight, ObjectiveKind, SynthConfig};
+use crate::filters::segment::SpeedRule;
+use crate::metric::spectral_error::Band;
+use crate::metric::spectrum::{SpectrumConfig, Window};
+use crate::narx::model::Model;
+use crate::recording::format::Recording;
+use evflow_engine::{BuildContext, Io, Node, NodeError, NodeSpec, ParamSpec, Params, PortSpec, Role, Summary};
+
+/// Declaration of `synth.optimize`.
+pub static SPEC: NodeSpec = NodeSpec::new(
+    "synth.optimize",
+    "models",
+    Role::Source,
+    "Synthesizes the actuation for a recorded texture force by bounded optimization through a forward model, and plays it.",
+    build,
+)
+.doc(
+    "Optimized synthesis, beyond dissertation §5.2.2 (docs/synthesis.md): instead of asking an \
+     inverse model which actuation made a force, it searches the actuation u whose force — predicted \
+     by a forward model of the display (`forward.train`) and high-passed as the recordings were — is \
+     closest to the real texture force, with u bounded to [−`bound`, `bound`]. Projected L-BFGS, \
+     gradients by backpropagation through the model and the filter.\n\n\
+     **Target.** Channel `channel` of the recording `target` (a texture force, e.g. repetition 1 of \
+     `graphs/record-textures.toml`). With `speed` > 0, only its constant-speed samples count (the \
+     recording's `velocity` channel under `segment`'s rule with `tolerance` and `settle`); 0 counts \
+     every sample. The actuation has one sample per recorded one; the node is a finite source that \
+     ends with the recording (zeros after it).\n\n\
+     **Objective.** `time`: Σ(ŷ − f)²/Σf² over the counted samples (the waveform); `spectral`: E_s² \
+     with the `metric` node's spectra (`nfft` 0 = the rate, `window`, `overlap`, band `fmin`–`fmax`). \
+     Plus the noise an actuation brings: λ·mean(u²), λ = β/mean(f²) from the model's noise model \
+     (`noise = \"learned\"`) or `lambda` (`noise = \"fixed\"`).\n\n\
+     **Start.** `carrier`: the square-law envelope on a Nyquist-rate carrier, \
+     u[n] = (−1)ⁿ·√(max(0, (f[n] + c)/κ)), κ the model's carrier gain, c = −min f; `narx`: the inverse \
+     NARX model `narx_model` run closed loop on the force (§5.2.2); `zero`.\n\n\
+     **Timing.** The synthesis runs on the first block (offline only) and counts in the node's run \
+     time. **Summary.** `objective_start`, `objective_end` (never above the start), `iterations`, \
+     `evaluations`, `lambda`, `seconds`, and why the optimizer stopped.",
+)
+.ports(&[PortSpec::output("u", "1", "the synthesized actuation (1 = 50 V)")])
+.params(&[
+    ParamSpec::text("target", "", "the recording of the real texture force (NAME, relative to the graph file)").required(),
+    ParamSpec::text("channel", "force", "its force channel"),
+    ParamSpec::text("model", "", "forward model file (forward.train)").required(),
+    ParamSpec::float("speed", 0.0, 1e4, 0.0, "cm/s", "count only the constant-speed samples at this speed (0 = all)"),
+    ParamSpec::float("tolerance", 1e-6, 0.5, 0.02, "1", "largest relative deviation from `speed`"),
+    ParamSpec::float("settle", 0.0, 60.0, 0.1, "s", "time the speed must have held"),
+    ParamSpec::choice("start", &["carrier", "narx", "zero"], "carrier", "starting actuation"),
+    ParamSpec::text("narx_model", "", "inverse NARX model for start = \"narx\""),
+    ParamSpec::choice("objective", &["time", "spectral"], "time", "what to match"),
+    ParamSpec::int("nfft", 0, 1 << 20, 0, "samples", "spectral objective: segment length (0 = the rate)"),
+    ParamSpec::choice("window", &["rect", "hann"], "rect", "spectral objective: window"),
+    ParamSpec::float("overlap", 0.0, 0.9, 0.0, "1", "spectral objective: overlap of segments"),
+    ParamSpec::float("fmin", 0.0, 1e7, 2.0, "Hz", "spectral objective: lowest frequency"),
+    ParamSpec::float("fmax", 0.0, 1e7, 200.0, "Hz", "spectral objective: highest frequency (0 = Nyquist)"),
+    ParamSpec::choice("noise", &["learned", "fixed"], "learned", "noise weight from the model, or `lambda`"),
+    ParamSpec::float("lambda", 0.0, 1e6, 0.0, "1", "noise weight λ when noise = \"fixed\""),
+    ParamSpec::int("iterations", 0, 100_000, 100, "1", "largest number of optimizer iterations"),
+    ParamSpec::float("bound", 1e-6, 2.0, 1.0, "1", "|u| ≤ bound"),
+])
+.offline_only("it synthesizes the whole actuation from a recording before playing it")
+.example("target = \"recordings/felt\"\nmodel = \"models/forward.json\"\niterations = 5");
+
+struct Optimize {
+    force: Vec<f64>,
+    keep: Vec<bool>,
+    start: Vec<f64>,
+    model: ForwardModel,
+    cfg: SynthConfig,
+    u: Option<Vec<f64>>,
+    summary: Summary,
+    pos: usize,
+}
+
+fn build(p: &Params, ctx: &BuildContext) -> Result<Box<dyn Node>, NodeError> {
+    let shown = p.str("target");
+    let channel = p.str("channel");
+    let speed = p.f64("speed");
+    let mut wanted = vec![channel.to_string()];
+    if speed > 0.0 {
+        wanted.push("velocity".into());
+    }
+    let rec = Recording::open_channels(&ctx.path(shown), &wanted)?;
+    if (rec.rate() - ctx.rate).abs() > 1e-9 * ctx.rate {
+        return Err(NodeError::param(
+            "target",
+            format!("{shown} was recorded at {} Hz, the node runs at {} Hz", rec.rate(), ctx.rate),
+        ));
+    }
+    let force = rec.channel(channel).unwrap_or_default().to_vec();
+    let keep = if speed > 0.0 {
+        let v = rec.channel("velocity").unwrap_or_default();
+        SpeedRule::new(speed, p.f64("tolerance"), p.f64("settle"), ctx.rate, 0.0).gate(v)
+    } else {
+        vec![true; force.len()]
+    };
+    if !keep.iter().any(|k| *k) {
+        return Err(NodeError::param(
+            "speed",
+            format!("{shown}: its velocity never holds {speed} cm/s within the tolerance; is the speed right?"),
+        ));
+    }
+    let model = ForwardModel::load(&ctx.path(p.str("model")))?;
+    if (model.rate_hz - ctx.rate).abs() > 1e-9 * ctx.rate {
+        return Err(NodeError::param(
+            "model",
+            format!("the model was identified at {} Hz, the node runs at {} Hz", model.rate_hz, ctx.rate),
+        ));
+    }
+    let bound = p.f64("bound");
+    let start = match p.str("start") {
+        "narx" => {
+            let path = p.str("narx_model");
+            if path.is_empty() {
+                return Err(NodeError::param("narx_model", "start = \"narx\" needs the inverse model's file"));
+            }
+            let m = Model::load(&ctx.path(path))?;
+            m.closed_loop()?.run(&force).into_iter().map(|u| u.clamp(-bound, bound)).collect()
+        }
+        "zero" => vec![0.0; force.len()],
+        _ => carrier(&force, &keep, model.carrier_gain_n, bound)?,
+    };
+    let nfft = match p.usize("nfft") {
+        0 => ctx.rate.round() as usize,
+        n => n,
+    };
+    let objective = match p.str("objective") {
+        "spectral" => {
+            let window = Window::from_name(p.str("window")).unwrap_or(Window::Rect);
+            let band = Band::new(ctx.rate, nfft, p.f64("fmin"), p.f64("fmax"), false)
+                .map_err(|e| NodeError::param(e.param, e.message))?;
+            ObjectiveKind::Spectral {
+                cfg: SpectrumConfig { rate: ctx.rate, nfft, window, overlap: p.f64("overlap") },
+                band,
+            }
+        }
+        _ => ObjectiveKind::Time,
+    };
+    let noise = if p.str("noise") == "fixed" { NoiseWeight::Fixed(p.f64("lambda")) } else { NoiseWeight::Learned };
+    let cfg = SynthConfig {
+        objective,
+        noise,
+        bound,
+        options: Options { max_iter: p.usize("iterations"), ..Options::default() },
+    };
+    Ok(Box::new(Optimize { force, keep, start, model, cfg, u: None, summary: Summary::default(), pos: 0 }))
+}
+
+impl Optimize {
+    fn run(&mut self) -> Result<(), NodeError> {
+        let s = synthesize(&self.model, &self.force, &self.keep, &self.start, &self.cfg)?;
+        self.summary = Summary::default()
+            .value("objective_start", s.objective_start, "1")
+            .value("objective_end", s.objective_end, "1")
+            .value("iterations", (s.history.len() - 1) as f64, "1")
+            .value("evaluations", s.evaluations as f64, "1")
+            .value("lambda", s.lambda, "1")
+            .value("seconds", s.seconds, "s")
+            .line(format!(
+                "synthesized {} samples: objective {:.4} → {:.4} in {} iterations ({}), {:.3} s",
+                s.u.len(),
+                s.objective_start,
+                s.objective_end,
+                s.history.len() - 1,
+                s.stop.describe(),
+                s.seconds
+            ));
+        self.u = Some(s.u);
+        Ok(())
+    }
+}
+
+impl Node for Optimize {
+    fn process(&mut self, io: &mut Io<'_>) -> Result<(), NodeError> {
+        if self.u.is_none() {
+            // Offline only: the whole synthesis runs once, on the first block.
+            self.run()?;
+        }
+        let u = self.u.as_deref().unwrap_or_default();
+        let out = io.output(0);
+        let start = self.pos.min(u.len());
+        let k = out.len().min(u.len() - start);
+        out[..k].copy_from_slice(&u[start..start + k]);
+        out[k..].fill(0.0);
+        self.pos = self.pos.saturating_add(out.len());
+        Ok(())
+    }
+
+    fn reset(&mut self) {
+        self.pos = 0;
+    }
+
+    fn remaining(&self) -> Option<u64> {
+        Some(self.force.len().saturating_sub(self.pos) as u64)
+    }
+
+    fn finish(&mut self) -> Result<Summary, NodeError> {
+        Ok(std::mem::take(&mut self.summary))
+    }
+}

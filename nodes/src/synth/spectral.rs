@@ -1,0 +1,219 @@
+//! E_s (dissertation Eq. 5.2) of a series against a fixed target spectrum,
+//! with its gradient: the spectral objective of the synthesis and of the
+//! achievable floor.
+//!
+//! The spectra are those of the `metric` node ([`crate::metric::spectrum`]):
+//! segments of `nfft` samples `hop` apart, windowed, |X_k| averaged over
+//! segments; E_s = ‖S − R‖/‖R‖ over the band's bins. With
+//! X_{p,k} = Σ_n w_n x[s_p + n] e^{−2πikn/N} and S_k = (1/P) Σ_p |X_{p,k}|,
+//!
+//! ```text
+//! ∂|X_{p,k}|/∂x[s_p + n] = w_n · Re( conj(X_{p,k})/|X_{p,k}| · e^{−2πikn/N} )
+//! ```
+//!
+//! so the gradient of J = E_s² on segment p is
+//! w_n · Re(DFT(c)[n]) / P with c_k = 2(S_k − R_k)/‖R‖² · conj(X_{p,k})/|X_{p,k}|
+//! on the band's bins (0 elsewhere): one more FFT per segment. |X| is not
+//! differentiable where X = 0; there the bin contributes no gradient.
+
+use super::error::SynthError;
+use crate::metric::spectral_error::Band;
+use crate::metric::spectrum::{averaged_spectrum, SpectrumConfig, ROUNDING_LEVEL};
+use rustfft::num_complex::Complex;
+use rustfft::{Fft, FftPlanner};
+use std::sync::Arc;
+
+/// A target spectrum and the machinery to score series against it.
+pub struct SpectralTarget {
+    cfg: SpectrumConfig,
+    band: Band,
+    len: usize,
+    /// Target magnitudes on the band's bins.
+    r: Vec<f64>,
+    r_norm2: f64,
+    window: Vec<f64>,
+    fft: Arc<dyn Fft<f64>>,
+    buf: Vec<Complex<f64>>,
+    scratch: Vec<Complex<f64>>,
+    /// Per segment, X on the band's bins (kept from the forward pass).
+    x: Vec<Complex<f64>>,
+    starts: Vec<usize>,
+}
+
+impl std::fmt::Debug for SpectralTarget {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("SpectralTarget")
+            .field("cfg", &self.cfg)
+            .field("band", &self.band)
+            .field("len", &self.len)
+            .finish()
+    }
+}
+
+impl SpectralTarget {
+    /// The target `real` (the kept samples, concatenated) scored in `cfg`'s
+    /// segments over `band`. Series scored later must have `real.len()` samples,
+    /// at least one segment.
+    pub fn new(real: &[f64], cfg: SpectrumConfig, band: Band) -> Result<Self, SynthError> {
+        cfg.validate().map_err(|e| SynthError::Config(e.to_string()))?;
+        let nfft = cfg.nfft;
+        if real.len() < nfft {
+            return Err(SynthError::Data(format!(
+                "the target has {} kept samples, fewer than one spectral segment of {nfft}",
+                real.len()
+            )));
+        }
+        if band.last() > nfft / 2 {
+            return Err(SynthError::Config("the band reaches past the Nyquist bin".into()));
+        }
+        let spec = averaged_spectrum(real, cfg)
+            .map_err(|e| SynthError::Config(e.to_string()))?
+            .ok_or_else(|| SynthError::Data("the target has no spectrum".into()))?;
+        let r: Vec<f64> = band.bins().map(|k| spec.magnitude[k]).collect();
+        let r_norm2: f64 = r.iter().map(|v| v * v).sum();
+        let largest = spec.magnitude.iter().cloned().fold(0.0, f64::max);
+        let in_band = r.iter().cloned().fold(0.0, f64::max);
+        if !(r_norm2.is_finite() && in_band > ROUNDING_LEVEL * largest) {
+            return Err(SynthError::Data("the target has no spectral energy in the band".into()));
+        }
+        let hop = cfg.hop();
+        let starts: Vec<usize> = (0..).map(|p| p * hop).take_while(|s| s + nfft <= real.len()).collect();
+        let fft = FftPlanner::new().plan_fft_forward(nfft);
+        let scratch = vec![Complex::default(); fft.get_inplace_scratch_len()];
+        Ok(Self {
+            cfg,
+            band,
+            len: real.len(),
+            r,
+            r_norm2,
+            window: cfg.window.coefficients(nfft),
+            fft,
+            buf: vec![Complex::default(); nfft],
+            scratch,
+            x: vec![Complex::default(); starts.len() * band.len()],
+            starts,
+        })
+    }
+
+    /// Samples a scored series must have.
+    pub fn len(&self) -> usize {
+        self.len
+    }
+
+    /// True for a target without samples (never: [`SpectralTarget::new`] refuses it).
+    pub fn is_empty(&self) -> bool {
+        self.len == 0
+    }
+
+    /// E_s of `v` against the target.
+    pub fn es(&mut self, v: &[f64]) -> f64 {
+        self.forward(v).sqrt()
+    }
+
+    /// J = E_s² and its forward-pass spectra.
+    fn forward(&mut self, v: &[f64]) -> f64 {
+        let (nfft, nb, first) = (self.cfg.nfft, self.band.len(), self.band.first());
+        let p = self.starts.len() as f64;
+        let mut s = vec![0.0; nb];
+        for (seg, &start) in self.starts.iter().enumerate() {
+            for n in 0..nfft {
+                self.buf[n] = Complex::new(self.window[n] * v[start + n], 0.0);
+            }
+            self.fft.process_with_scratch(&mut self.buf, &mut self.scratch);
+            for (b, sb) in s.iter_mut().enumerate() {
+                let xk = self.buf[first + b];
+                self.x[seg * nb + b] = xk;
+                *sb += xk.norm() / p;
+            }
+        }
+        s.iter().zip(&self.r).map(|(a, b)| (a - b) * (a - b)).sum::<f64>() / self.r_norm2
+    }
+
+    /// J = E_s² of `v`, with ∂J/∂v written into `g` (same length).
+    pub fn value_grad(&mut self, v: &[f64], g: &mut [f64]) -> f64 {
+        let j = self.forward(v);
+        let (nfft, nb, first) = (self.cfg.nfft, self.band.len(), self.band.first());
+        let p = self.starts.len() as f64;
+        // S again (cheap: from the kept X).
+        let mut s = vec![0.0; nb];
+        for seg in 0..self.starts.len() {
+            for (b, sb) in s.iter_mut().enumerate() {
+                *sb += self.x[seg * nb + b].norm() / p;
+            }
+        }
+        g.iter_mut().for_each(|v| *v = 0.0);
+        for (seg, &start) in self.starts.iter().enumerate() {
+            self.buf.iter_mut().for_each(|c| *c = Complex::default());
+            for (b, (sb, rb)) in s.iter().zip(&self.r).enumerate() {
+                let xk = self.x[seg * nb + b];
+                let mag = xk.norm();
+                if mag > 0.0 {
+                    let a = 2.0 * (sb - rb) / self.r_norm2;
+                    self.buf[first + b] = xk.conj() * (a / mag);
+                }
+            }
+            self.fft.process_with_scratch(&mut self.buf, &mut self.scratch);
+            for n in 0..nfft {
+                g[start + n] += self.window[n] * self.buf[n].re / p;
+            }
+        }
+        j
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::lab::rng::Rng;
+    use crate::metric::spectral_error::spectral_rms_error;
+    use crate::metric::spectrum::Window;
+
+    fn series(n: usize, seed: u64) -> Vec<f64> {
+        let mut r = Rng::new(seed);
+        (0..n).map(|k| (k as f64 * 0.11).sin() + 0.3 * r.gaussian()).collect()
+    }
+
+    #[test]
+    fn the_value_is_the_metric_nodes_e_s() {
+        for (window, overlap) in [(Window::Rect, 0.0), (Window::Hann, 0.5)] {
+            let cfg = SpectrumConfig { rate: 1000.0, nfft: 1000, window, overlap };
+            let band = Band::new(1000.0, 1000, 2.0, 200.0, false).unwrap();
+            let (real, virt) = (series(2600, 1), series(2600, 2));
+            let mut t = SpectralTarget::new(&real, cfg, band).unwrap();
+            let sr = averaged_spectrum(&real, cfg).unwrap().unwrap();
+            let sv = averaged_spectrum(&virt, cfg).unwrap().unwrap();
+            let want = spectral_rms_error(&sv.magnitude, &sr.magnitude, &band).unwrap();
+            assert!((t.es(&virt) - want).abs() < 1e-12, "{window:?}: {} vs {want}", t.es(&virt));
+            assert!(t.es(&real) < 1e-12);
+        }
+    }
+
+    #[test]
+    fn the_gradient_matches_central_differences() {
+        for (window, overlap) in [(Window::Rect, 0.0), (Window::Hann, 0.5)] {
+            let cfg = SpectrumConfig { rate: 100.0, nfft: 64, window, overlap };
+            let band = Band::new(100.0, 64, 3.0, 30.0, false).unwrap();
+            let (real, virt) = (series(150, 3), series(150, 4));
+            let mut t = SpectralTarget::new(&real, cfg, band).unwrap();
+            let mut g = vec![0.0; 150];
+            let j = t.value_grad(&virt, &mut g);
+            assert!((j - t.es(&virt).powi(2)).abs() < 1e-14);
+            let h = 1e-6;
+            for k in [0, 5, 40, 63, 64, 100, 127, 128, 149] {
+                let (mut a, mut b) = (virt.clone(), virt.clone());
+                a[k] += h;
+                b[k] -= h;
+                let fd = (t.es(&a).powi(2) - t.es(&b).powi(2)) / (2.0 * h);
+                assert!((fd - g[k]).abs() < 1e-6 * (1.0 + fd.abs()), "{window:?} x[{k}]: {} vs {fd}", g[k]);
+            }
+        }
+    }
+
+    #[test]
+    fn a_target_too_short_or_silent_in_the_band_is_refused() {
+        let cfg = SpectrumConfig { rate: 1000.0, nfft: 1000, window: Window::Rect, overlap: 0.0 };
+        let band = Band::new(1000.0, 1000, 2.0, 200.0, false).unwrap();
+        assert!(SpectralTarget::new(&[1.0; 500], cfg, band).is_err());
+        assert!(SpectralTarget::new(&[1.0; 1500], cfg, band).is_err(), "a constant has no energy above 0 Hz");
+    }
+}

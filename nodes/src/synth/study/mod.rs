@@ -1,0 +1,55 @@
+//! The texture-rendering study (dissertation chapter 5, and beyond it): per
+//! lab profile, texture and condition, every synthesis method — the inverse
+//! NARX model on binary and on multilevel excitation, the optimized
+//! synthesis through a forward model, record-and-playback normalized per
+//! recording — played on the display and scored the same way: the same
+//! gain sweep and rules ([`gains`]), E_s in two readings, beside the repeat
+//! baseline, the display floor and the achievable floor ([`floor`]).
+//!
+//! One module computes every row; `evflow report textures`, the
+//! interpolation cross-validation and the tests call it.
+
+pub mod floor;
+pub mod gains;
+pub mod graphs;
+pub mod models;
+pub mod recordings;
+pub mod row;
+pub mod run;
+pub mod setup;
+pub mod summary;
+
+use std::path::PathBuf;
+
+/// Why a study could not run.
+#[derive(Debug, thiserror::Error)]
+pub enum StudyError {
+    /// A graph that could not be loaded or run.
+    #[error("{file}: {message}")]
+    Graph {
+        /// The graph file.
+        file: PathBuf,
+        /// What went wrong.
+        message: String,
+    },
+    /// A file or folder that cannot be read or written.
+    #[error("{path}: {message}")]
+    Io {
+        /// The file or folder.
+        path: PathBuf,
+        /// What the operating system said.
+        message: String,
+    },
+    /// A file a step should have written and did not.
+    #[error("{0}: missing (run from the repository root, or is --graphs right?)")]
+    Missing(PathBuf),
+    /// A recording that cannot be used.
+    #[error("recording: {0}")]
+    Recording(String),
+    /// Settings that cannot work.
+    #[error("{0}")]
+    Config(String),
+    /// A synthesis step failed.
+    #[error(transparent)]
+    Synth(#[from] super::error::SynthError),
+}

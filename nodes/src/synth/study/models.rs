@@ -1,0 +1,66 @@
+//! The models a texture study builds per lab profile and condition: the
+//! inverse NARX model on binary excitation (`graphs/model-build.toml`,
+//! §5.2.1), the inverse model on multilevel excitation (the same graph
+//! with `excitation = "multilevel"`, §5.4/§7.2), and the forward model
+//! (`graphs/forward-build.toml`).
+
+use super::graphs::run_graph;
+use super::setup::{Cond, Profile};
+use super::StudyError;
+use std::path::{Path, PathBuf};
+
+/// The models of one profile and condition.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Models {
+    /// Inverse NARX, binary excitation.
+    pub narx: PathBuf,
+    /// Inverse NARX, multilevel excitation (None when not built).
+    pub narx_multilevel: Option<PathBuf>,
+    /// Forward model.
+    pub forward: PathBuf,
+    /// Seconds each took to build: inverse binary, inverse multilevel, forward.
+    pub seconds: [f64; 3],
+}
+
+/// Builds the models of `c` on `profile` into `dir`; `epochs` bounds the
+/// NARX training; `multilevel` also builds the multilevel inverse model.
+pub fn build(
+    graphs: &Path,
+    profile: &Profile,
+    c: &Cond,
+    epochs: u32,
+    multilevel: bool,
+    dir: &Path,
+) -> Result<Models, StudyError> {
+    let common = vec![format!("mass={}", c.mass), format!("speed={}", c.speed), profile.set()];
+    let narx_sets = |extra: &[&str]| {
+        let mut s = common.clone();
+        s.push(format!("epochs={epochs}"));
+        s.push("train.progress=false".into());
+        s.push("train.record_time=true".into());
+        s.extend(extra.iter().map(|e| e.to_string()));
+        s
+    };
+    let t = std::time::Instant::now();
+    run_graph(&graphs.join("model-build.toml"), &narx_sets(&[]), dir)?;
+    let narx_s = t.elapsed().as_secs_f64();
+    let narx = found(dir.join(format!("narx-{}.json", c.tag())))?;
+    let mut ml_s = 0.0;
+    let narx_multilevel = if multilevel {
+        let ml_dir = dir.join("multilevel");
+        let t = std::time::Instant::now();
+        run_graph(&graphs.join("model-build.toml"), &narx_sets(&["excitation=\"multilevel\""]), &ml_dir)?;
+        ml_s = t.elapsed().as_secs_f64();
+        Some(found(ml_dir.join(format!("narx-{}.json", c.tag())))?)
+    } else {
+        None
+    };
+    let t = std::time::Instant::now();
+    run_graph(&graphs.join("forward-build.toml"), &common, dir)?;
+    let forward = found(dir.join(format!("forward-{}.json", c.tag())))?;
+    Ok(Models { narx, narx_multilevel, forward, seconds: [narx_s, ml_s, t.elapsed().as_secs_f64()] })
+}
+
+fn found(p: PathBuf) -> Result<PathBuf, StudyError> {
+    std::fs::canonicalize(&p).map_err(|_| StudyError::Missing(p))
+}

@@ -1,0 +1,180 @@
+//! `forward.train`: buffers an excitation recording (actuation and force)
+//! and, when the stream ends, identifies the display's forward model and
+//! writes the model file.
+
+use super::model_file::{ForwardModel, Training};
+use super::output_filter::OutputFilter;
+use super::volterra_fit::{fit, FitConfig};
+use crate::filters::segment::Gates;
+use crate::narx::model::{data_hash, Condition};
+use evflow_engine::{
+    BuildContext, Io, Node, NodeError, NodeSpec, ParamSpec, Params, PortSpec, PrepareContext, Role, Summary,
+};
+use std::path::PathBuf;
+use std::time::Instant;
+
+/// Declaration of `forward.train`.
+pub static SPEC: NodeSpec = NodeSpec::new(
+    "forward.train",
+    "models",
+    Role::Sink,
+    "Identifies a forward model of the display (actuation → force, a second-order Volterra NFIR) and writes the model file at the end.",
+    build,
+)
+.doc(
+    "The *forward* counterpart of `narx.train` (dissertation §5.2.1 identifies the inverse dynamics; \
+     docs/synthesis.md): from an excitation recording it identifies how the display turns an actuation \
+     into lateral force, for the optimized synthesis (`synth.optimize`).\n\n\
+     **Model.** y[n] = c + Σ_i l_i u[n−i] + Σ_ij H_ij u[n−i] u[n−j], i, j < `memory`: a second-order \
+     Volterra series with finite memory (a polynomial NFIR model). A square law between linear \
+     dynamics — amplifier and circuit before it, electroadhesion lag, contact and sensor after it — is \
+     exactly such a system, and its M(M+1)/2 + M + 1 parameters enter linearly: least squares, one \
+     optimum, no initial weights. The recorded force went through the high-pass of §5.1.1 \
+     (`highpass_order`, `highpass_hz`, 0 = none — set them as the graph's `butterworth` node); every \
+     regressor is filtered the same way, so the kernel is the display's own.\n\n\
+     **Ports.** `u`: the actuation (1 = 50 V); `force`: the force it produced (N), after the high-pass. \
+     One model per condition (`mass_g`, `speed_cm_s` are written into it). Gates keep the samples of \
+     the constant-speed forward stretches (`segment`), as for `narx.train`.\n\n\
+     **Excitation.** Multilevel (a `prms` sequence) rather than binary: a ±1 sequence has u² ≡ 1 and \
+     leaves the diagonal of H — the square law's amplitude response — unidentified. Keep its level \
+     where the display slides smoothly (strong actuation can make the contact stick and slip, which no \
+     second-order model holds; docs/synthesis.md), and step the level in blocks so the noise model \
+     sees several actuation powers.\n\n\
+     **Noise model.** The squared residual is regressed on the local mean of u² over `noise_window` \
+     seconds: r² ≈ σ₀² + β·p. The synthesis weighs matching the force against the noise a stronger \
+     actuation brings with β.\n\n\
+     **Errors.** Non-finite samples, a constant force, an actuation of 0, too few kept samples for the \
+     parameters (with the number needed) stop the run; nothing is written. The file (docs/synthesis.md) \
+     is written through a temporary file and a rename.\n\n\
+     **Summary.** `train_rel_rms`, `validation_rel_rms` (‖y − ŷ‖/‖y‖ on the fitted and the held-out \
+     kept samples), `carrier_gain` (N per unit² of a Nyquist-rate carrier), `noise_floor`, `noise_per_u2`, \
+     `samples`, `seconds`.\n\n\
+     Checked against: exact recovery of a square law behind an FIR filter and a high-pass, a noise \
+     model with known growth, the simulated lab (nodes/tests/forward_lab.rs).",
+)
+.ports(&[
+    PortSpec::input("u", "1", "actuation that drove the display"),
+    PortSpec::input("force", "N", "force it produced, after the high-pass"),
+    PortSpec::input("gate", "1", "one per `gate` entry: the sample is kept only where every gate is above 0.5").per("gate"),
+])
+.params(&[
+    ParamSpec::text("path", "", "model file to write (JSON), relative to the run's output folder").required(),
+    ParamSpec::int("memory", 1, 128, 20, "samples", "memory M of the kernels (20 ms at 1 kHz)"),
+    ParamSpec::int("highpass_order", 0, 16, 4, "1", "order of the Butterworth high-pass the force went through (0 = none)"),
+    ParamSpec::float("highpass_hz", 0.0, 1e6, 10.0, "Hz", "its cut-off"),
+    ParamSpec::float("validation", 0.0, 0.89, 0.15, "1", "fraction of the kept samples, at their end, held out"),
+    ParamSpec::float("ridge", 0.0, 1.0, 1e-9, "1", "ridge δ relative to the mean diagonal of ΦᵀΦ"),
+    ParamSpec::float("noise_window", 0.001, 10.0, 0.25, "s", "window of the local actuation power in the noise model"),
+    ParamSpec::float("mass_g", 0.0, 1e6, 0.0, "g", "condition: stylus mass (0 = not recorded)"),
+    ParamSpec::float("speed_cm_s", 0.0, 1e6, 0.0, "cm/s", "condition: scanning speed (0 = not recorded)"),
+    ParamSpec::text_list("gate", "names of gate inputs (e.g. [\"steady\"] from `segment`); none by default"),
+    ParamSpec::flag("record_time", true, "write the identification time into the model and the summary (off: byte-identical reruns)"),
+])
+.offline_only("it buffers the whole recording in memory and identifies the model when the run ends")
+.example("path = \"forward.json\"\nmemory = 8\nhighpass_order = 4\nhighpass_hz = 10.0\nmass_g = 85.0\nspeed_cm_s = 5.0");
+
+struct Train {
+    path: PathBuf,
+    shown: String,
+    cfg: FitConfig,
+    rate: f64,
+    condition: Condition,
+    record_time: bool,
+    gates: Gates,
+    u: Vec<f64>,
+    y: Vec<f64>,
+    keep: Vec<bool>,
+}
+
+fn build(p: &Params, ctx: &BuildContext) -> Result<Box<dyn Node>, NodeError> {
+    let path = p.str("path");
+    if path.is_empty() {
+        return Err(NodeError::param("path", "name the model file to write"));
+    }
+    let filter = OutputFilter::highpass(p.usize("highpass_order"), p.f64("highpass_hz"), ctx.rate)
+        .map_err(|e| NodeError::param("highpass_hz", e.to_string()))?;
+    let window = (p.f64("noise_window") * ctx.rate).round().max(1.0) as usize;
+    let set = |v: f64| (v != 0.0).then_some(v);
+    Ok(Box::new(Train {
+        path: ctx.out_path(path),
+        shown: path.to_string(),
+        cfg: FitConfig {
+            memory: p.usize("memory"),
+            filter,
+            validation: p.f64("validation"),
+            ridge: p.f64("ridge"),
+            noise_window: window,
+        },
+        rate: ctx.rate,
+        condition: Condition { mass_g: set(p.f64("mass_g")), speed_cm_s: set(p.f64("speed_cm_s")) },
+        record_time: p.bool("record_time"),
+        gates: Gates::from_params(p, 2)?,
+        u: Vec::new(),
+        y: Vec::new(),
+        keep: Vec::new(),
+    }))
+}
+
+impl Node for Train {
+    fn prepare(&mut self, ctx: &PrepareContext) -> Result<(), NodeError> {
+        let n = ctx.max_block.max(1 << 16);
+        self.u.reserve(n);
+        self.y.reserve(n);
+        self.keep.reserve(n);
+        Ok(())
+    }
+
+    fn process(&mut self, io: &mut Io<'_>) -> Result<(), NodeError> {
+        // Offline only: the buffers grow with the recording. Every sample is
+        // kept (the filter and the memory need the whole series); the gates
+        // mark the rows.
+        let (u, y) = (io.input(0), io.input(1));
+        let start = self.keep.len();
+        self.u.extend_from_slice(u);
+        self.y.extend_from_slice(y);
+        self.keep.resize(start + io.len(), false);
+        let keep = &mut self.keep;
+        self.gates.open_runs(io, |a, b| keep[start + a..start + b].iter_mut().for_each(|k| *k = true));
+        Ok(())
+    }
+
+    fn reset(&mut self) {
+        self.u.clear();
+        self.y.clear();
+        self.keep.clear();
+    }
+
+    fn finish(&mut self) -> Result<Summary, NodeError> {
+        let t0 = Instant::now();
+        let (model, noise, scores) = fit(&self.u, &self.y, &self.keep, &self.cfg)?;
+        let seconds = t0.elapsed().as_secs_f64();
+        let kept: Vec<f64> = self.u.iter().zip(&self.keep).filter(|(_, k)| **k).map(|(u, _)| *u).collect();
+        let training = Training {
+            scores,
+            actuation_rms: (kept.iter().map(|v| v * v).sum::<f64>() / kept.len().max(1) as f64).sqrt(),
+            actuation_peak: kept.iter().fold(0.0, |m, v| m.max(v.abs())),
+            data_hash: data_hash(&[&self.u, &self.y]),
+            seconds: if self.record_time { seconds } else { 0.0 },
+        };
+        let file = ForwardModel::new(&model, self.rate, &self.cfg.filter, self.condition, noise, training);
+        file.save(&self.path)?;
+        let mut s = Summary::default()
+            .value("train_rel_rms", scores.train_rel_rms, "1")
+            .value("validation_rel_rms", scores.validation_rel_rms, "1")
+            .value("carrier_gain", file.carrier_gain_n, "N")
+            .value("noise_floor", noise.floor_n2, "N²")
+            .value("noise_per_u2", noise.per_u2_n2, "N²")
+            .value("samples", scores.samples as f64, "1");
+        if self.record_time {
+            s = s.value("seconds", seconds, "s");
+        }
+        Ok(s.line(format!(
+            "wrote {} (memory {}, {} kept samples, validation error {:.3}, carrier gain {:.4} N)",
+            self.shown,
+            model.memory(),
+            scores.samples,
+            scores.validation_rel_rms,
+            file.carrier_gain_n
+        )))
+    }
+}

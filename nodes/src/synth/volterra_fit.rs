@@ -1,0 +1,314 @@
+//! Identification of the forward model ([`Volterra`]) from an excitation
+//! recording: actuation u and the force it produced, by linear least
+//! squares.
+//!
+//! Every parameter of the model enters linearly, so the regressor matrix Φ
+//! holds one column per parameter — u[n−i]·u[n−j] (i ≤ j), u[n−i] and 1 —
+//! and the fit is the ridge-stabilized normal equations
+//! (ΦᵀΦ + δ·I)θ = Φᵀy, solved by Cholesky. The recorded force went through
+//! the known output filter (the 10 Hz high-pass), which is linear: each
+//! column of Φ is filtered the same way, so the kernel found is the one
+//! *before* the filter. Only the samples the gates keep (the constant-speed
+//! stretches of a tribometer's forward passes) are rows; the filter runs
+//! over the whole series so that its state at a kept sample is right. The
+//! last `validation` fraction of the kept samples is held out and scored.
+//!
+//! **Noise model.** What the model cannot explain — friction noise, sensor
+//! noise, unmodelled dynamics — is not the same at every actuation level: a
+//! display's friction noise grows with the normal force the actuation adds.
+//! The squared residual is regressed on the local actuation power
+//! p[n] = mean of u² over `noise_window` samples around n: r² ≈ σ₀² + β·p.
+//! The synthesis uses β to weigh matching the force against the noise a
+//! stronger actuation brings ([`super::objective`]).
+
+use super::error::SynthError;
+use super::output_filter::OutputFilter;
+use super::volterra::{upper_index, Volterra, MAX_MEMORY};
+use faer::linalg::solvers::Solve;
+use faer::{Mat, Par, Side};
+
+/// How to identify a model.
+#[derive(Debug, Clone, PartialEq)]
+pub struct FitConfig {
+    /// Memory M, samples.
+    pub memory: usize,
+    /// The filter the recorded force went through.
+    pub filter: OutputFilter,
+    /// Fraction of the kept samples, at their end, held out for validation.
+    pub validation: f64,
+    /// Ridge δ relative to the mean diagonal of ΦᵀΦ.
+    pub ridge: f64,
+    /// Samples over which the local actuation power of the noise model is averaged.
+    pub noise_window: usize,
+}
+
+impl Default for FitConfig {
+    fn default() -> Self {
+        Self { memory: 20, filter: OutputFilter::none(), validation: 0.15, ridge: 1e-9, noise_window: 25 }
+    }
+}
+
+/// The noise the model leaves, as a function of actuation power.
+#[derive(Debug, Clone, Copy, PartialEq, Default, serde::Serialize, serde::Deserialize)]
+pub struct NoiseModel {
+    /// σ₀²: residual power with no actuation, N².
+    pub floor_n2: f64,
+    /// β: residual power added per unit of local mean u², N².
+    pub per_u2_n2: f64,
+}
+
+/// How well a model fits.
+#[derive(Debug, Clone, Copy, PartialEq, serde::Serialize, serde::Deserialize)]
+pub struct FitScores {
+    /// Samples kept by the gates.
+    pub samples: usize,
+    /// Of which used to fit.
+    pub train_rows: usize,
+    /// Of which held out.
+    pub validation_rows: usize,
+    /// ‖y − ŷ‖ / ‖y‖ on the fitted rows.
+    pub train_rel_rms: f64,
+    /// ‖y − ŷ‖ / ‖y‖ on the held-out rows (NaN without any).
+    pub validation_rel_rms: f64,
+}
+
+/// Identifies a model from actuation `u`, recorded force `y` (after the
+/// filter) and the rows to use (`keep[n]`), all of one length.
+pub fn fit(
+    u: &[f64],
+    y: &[f64],
+    keep: &[bool],
+    cfg: &FitConfig,
+) -> Result<(Volterra, NoiseModel, FitScores), SynthError> {
+    let m = cfg.memory;
+    if m == 0 || m > MAX_MEMORY {
+        return Err(SynthError::Config(format!("memory must be 1 ..= {MAX_MEMORY} samples, not {m}")));
+    }
+    if u.len() != y.len() || u.len() != keep.len() {
+        return Err(SynthError::Data(format!(
+            "the actuation ({}), force ({}) and gate ({}) have different lengths",
+            u.len(),
+            y.len(),
+            keep.len()
+        )));
+    }
+    if let Some(i) = u.iter().position(|v| !v.is_finite()) {
+        return Err(SynthError::Data(format!("the actuation is not finite at sample {i}")));
+    }
+    if let Some(i) = y.iter().position(|v| !v.is_finite()) {
+        return Err(SynthError::Data(format!("the force is not finite at sample {i}")));
+    }
+    if !(0.0..0.9).contains(&cfg.validation) {
+        return Err(SynthError::Config(format!("validation must be in [0, 0.9), not {}", cfg.validation)));
+    }
+    let rows: Vec<usize> = (0..u.len()).filter(|&n| keep[n]).collect();
+    let p = m * (m + 1) / 2 + m + 1;
+    let n_val = (rows.len() as f64 * cfg.validation).round() as usize;
+    let n_tr = rows.len() - n_val;
+    if n_tr < 2 * p {
+        return Err(SynthError::Data(format!(
+            "{} kept samples give {n_tr} rows to fit {p} parameters (memory {m}); record at least {} kept samples \
+             (more passes) or shorten the memory",
+            rows.len(),
+            ((2 * p) as f64 / (1.0 - cfg.validation)).ceil() as usize
+        )));
+    }
+    let kept_y: Vec<f64> = rows.iter().map(|&n| y[n]).collect();
+    let mean = kept_y.iter().sum::<f64>() / kept_y.len() as f64;
+    if kept_y.iter().all(|v| (v - mean).abs() <= 1e-12 * mean.abs().max(1e-300)) {
+        return Err(SynthError::Data(format!(
+            "the force is constant ({mean}) over the kept samples: was the display on?"
+        )));
+    }
+    let umax = rows.iter().map(|&n| u[n].abs()).fold(0.0, f64::max);
+    if umax == 0.0 {
+        return Err(SynthError::Data("the actuation is 0 over the kept samples: nothing excites the display".into()));
+    }
+
+    // Regressor columns over the whole series, filtered, then the kept rows.
+    let at = |k: isize| if k >= 0 { u[k as usize] } else { 0.0 };
+    let mut col = vec![0.0; u.len()];
+    let mut phi = Mat::<f64>::zeros(rows.len(), p);
+    let mut fill = |c: usize, f: &dyn Fn(usize) -> f64, phi: &mut Mat<f64>| {
+        for (n, v) in col.iter_mut().enumerate() {
+            *v = f(n);
+        }
+        cfg.filter.apply_in_place(&mut col);
+        for (r, &n) in rows.iter().enumerate() {
+            phi[(r, c)] = col[n];
+        }
+    };
+    for i in 0..m {
+        for j in i..m {
+            let c = upper_index(m, i, j);
+            fill(c, &|n| at(n as isize - i as isize) * at(n as isize - j as isize), &mut phi);
+        }
+    }
+    let q = m * (m + 1) / 2;
+    for i in 0..m {
+        fill(q + i, &|n| at(n as isize - i as isize), &mut phi);
+    }
+    fill(q + m, &|_| 1.0, &mut phi);
+
+    let tr = phi.as_ref().subrows(0, n_tr);
+    let mut ata = Mat::<f64>::zeros(p, p);
+    faer::linalg::matmul::matmul(ata.as_mut(), faer::Accum::Replace, tr.transpose(), tr, 1.0, Par::Seq);
+    let mut aty = Mat::<f64>::zeros(p, 1);
+    let ytr = Mat::<f64>::from_fn(n_tr, 1, |r, _| kept_y[r]);
+    faer::linalg::matmul::matmul(aty.as_mut(), faer::Accum::Replace, tr.transpose(), ytr.as_ref(), 1.0, Par::Seq);
+    let mean_diag = (0..p).map(|k| ata[(k, k)]).sum::<f64>() / p as f64;
+    let delta = cfg.ridge.max(0.0) * mean_diag.max(f64::MIN_POSITIVE);
+    for k in 0..p {
+        ata[(k, k)] += delta;
+    }
+    let llt = ata
+        .llt(Side::Lower)
+        .map_err(|_| SynthError::Data("the regressors are degenerate (raise `ridge` or vary the excitation)".into()))?;
+    let theta = llt.solve(aty.as_ref());
+    let th: Vec<f64> = (0..p).map(|k| theta[(k, 0)]).collect();
+    if th.iter().any(|v| !v.is_finite()) {
+        return Err(SynthError::Data("the fit is not finite (raise `ridge`)".into()));
+    }
+    // The column of u[n−i]·u[n−j], i < j, carries H_ij + H_ji = 2·H_ij.
+    let mut upper = th[..q].to_vec();
+    for i in 0..m {
+        for j in i + 1..m {
+            upper[upper_index(m, i, j)] *= 0.5;
+        }
+    }
+    let model = Volterra::from_upper(&upper, th[q..q + m].to_vec(), th[q + m])?;
+
+    // Residuals on every kept row.
+    let mut resid = vec![0.0; rows.len()];
+    for (r, out) in resid.iter_mut().enumerate() {
+        let pred: f64 = (0..p).map(|k| phi[(r, k)] * th[k]).sum();
+        *out = kept_y[r] - pred;
+    }
+    let rel = |a: usize, b: usize| {
+        let e: f64 = resid[a..b].iter().map(|v| v * v).sum();
+        let s: f64 = kept_y[a..b].iter().map(|v| v * v).sum();
+        if b > a && s > 0.0 {
+            (e / s).sqrt()
+        } else {
+            f64::NAN
+        }
+    };
+    let scores = FitScores {
+        samples: rows.len(),
+        train_rows: n_tr,
+        validation_rows: n_val,
+        train_rel_rms: rel(0, n_tr),
+        validation_rel_rms: rel(n_tr, rows.len()),
+    };
+
+    // Noise model: r² against the local mean of u² on the fitted rows.
+    let w = cfg.noise_window.max(1);
+    let mut cum = vec![0.0; u.len() + 1];
+    for (n, v) in u.iter().enumerate() {
+        cum[n + 1] = cum[n] + v * v;
+    }
+    let local = |n: usize| {
+        let a = n.saturating_sub(w / 2);
+        let b = (n + w - w / 2).min(u.len());
+        (cum[b] - cum[a]) / (b - a) as f64
+    };
+    let (mut sx, mut sy, mut sxx, mut sxy) = (0.0, 0.0, 0.0, 0.0);
+    for (r, &n) in rows.iter().enumerate().take(n_tr) {
+        let (x, e2) = (local(n), resid[r] * resid[r]);
+        sx += x;
+        sy += e2;
+        sxx += x * x;
+        sxy += x * e2;
+    }
+    let nn = n_tr as f64;
+    let var = sxx - sx * sx / nn;
+    let beta = if var > 1e-12 * sxx.max(f64::MIN_POSITIVE) { (sxy - sx * sy / nn) / var } else { 0.0 };
+    let beta = beta.max(0.0);
+    let floor = ((sy - beta * sx) / nn).max(0.0);
+    Ok((model, NoiseModel { floor_n2: floor, per_u2_n2: beta }, scores))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::lab::rng::Rng;
+
+    /// A square-law "display": v = g * u (FIR), y = v² + 0.1·v + 0.02, then
+    /// the output filter. Its exact Volterra kernel is H = g gᵀ, l = 0.1 g.
+    fn plant(u: &[f64], g: &[f64], filter: &OutputFilter) -> Vec<f64> {
+        let mut y: Vec<f64> = (0..u.len())
+            .map(|n| {
+                let v: f64 = g.iter().enumerate().filter(|(i, _)| *i <= n).map(|(i, gi)| gi * u[n - i]).sum();
+                v * v + 0.1 * v + 0.02
+            })
+            .collect();
+        filter.apply_in_place(&mut y);
+        y
+    }
+
+    #[test]
+    fn recovers_the_kernel_of_a_square_law_behind_a_filter_exactly() {
+        let g = [0.9, -0.4, 0.2, 0.05];
+        let mut r = Rng::new(9);
+        let levels = [-1.0, -0.5, 0.0, 0.5, 1.0];
+        let u: Vec<f64> = (0..3000).map(|_| levels[(r.uniform() * 5.0) as usize % 5]).collect();
+        for filter in [OutputFilter::none(), OutputFilter::highpass(4, 10.0, 1000.0).unwrap()] {
+            let y = plant(&u, &g, &filter);
+            let keep: Vec<bool> = (0..u.len()).map(|n| n >= 200).collect();
+            let cfg = FitConfig { memory: 6, filter: filter.clone(), ..FitConfig::default() };
+            let (v, noise, s) = fit(&u, &y, &keep, &cfg).unwrap();
+            for i in 0..6 {
+                for j in 0..6 {
+                    let want = if i < 4 && j < 4 { g[i] * g[j] } else { 0.0 };
+                    assert!((v.quadratic(i, j) - want).abs() < 1e-6, "H[{i}][{j}] {} vs {want}", v.quadratic(i, j));
+                }
+                let want = if i < 4 { 0.1 * g[i] } else { 0.0 };
+                assert!((v.linear()[i] - want).abs() < 1e-6, "l[{i}]");
+            }
+            assert!(s.validation_rel_rms < 1e-6 && s.train_rel_rms < 1e-6, "{s:?}");
+            assert!(noise.per_u2_n2 < 1e-12 && noise.floor_n2 < 1e-12, "{noise:?}");
+        }
+    }
+
+    #[test]
+    fn the_noise_model_finds_noise_that_grows_with_the_actuation_power() {
+        // Residual noise of variance 1e-4 + 4e-4·u² (in blocks of steady power).
+        let g = [1.0, 0.5];
+        let mut r = Rng::new(11);
+        let n = 20000;
+        let amp: Vec<f64> = (0..n).map(|k| [0.2, 0.5, 0.8][(k / 400) % 3]).collect();
+        let u: Vec<f64> = (0..n).map(|k| amp[k] * (2.0 * r.uniform() - 1.0)).collect();
+        let filter = OutputFilter::none();
+        let mut y = plant(&u, &g, &filter);
+        // Noise driven by the block's mean power (the uniform law: E u² = a²/3).
+        for k in 0..n {
+            let p = amp[k] * amp[k] / 3.0;
+            y[k] += (1e-4 + 4e-4 * p).sqrt() * r.gaussian();
+        }
+        let keep = vec![true; n];
+        let cfg = FitConfig { memory: 3, noise_window: 101, ..FitConfig::default() };
+        let (_, noise, _) = fit(&u, &y, &keep, &cfg).unwrap();
+        assert!((noise.per_u2_n2 / 4e-4 - 1.0).abs() < 0.2, "{noise:?}");
+        assert!((noise.floor_n2 / 1e-4 - 1.0).abs() < 0.2, "{noise:?}");
+    }
+
+    #[test]
+    fn unusable_data_is_refused_with_a_reason() {
+        let cfg = FitConfig::default();
+        let u = vec![0.5; 100];
+        let y = vec![0.1; 100];
+        let keep = vec![true; 100];
+        let e = fit(&u, &y, &keep, &cfg).unwrap_err().to_string();
+        assert!(e.contains("kept samples give"), "{e}");
+        let u: Vec<f64> = (0..5000).map(|k| (k as f64).sin()).collect();
+        let e = fit(&u, &vec![0.3; 5000], &vec![true; 5000], &cfg).unwrap_err().to_string();
+        assert!(e.contains("constant"), "{e}");
+        let mut y: Vec<f64> = u.clone();
+        y[7] = f64::NAN;
+        let e = fit(&u, &y, &vec![true; 5000], &cfg).unwrap_err().to_string();
+        assert!(e.contains("sample 7"), "{e}");
+        assert!(fit(&u, &u, &[true; 10], &cfg).is_err(), "lengths");
+        let zero = FitConfig { memory: 0, ..FitConfig::default() };
+        assert!(fit(&u, &u, &vec![true; 5000], &zero).is_err());
+    }
+}

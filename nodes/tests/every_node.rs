@@ -77,9 +77,16 @@ fn fixtures(dir: &Path) {
     let u: Vec<f64> = signal(3000, 5).iter().map(|v| 2.0 * v).collect();
     let y: Vec<f64> = (0..u.len()).map(|n| (0.8 * u[n] - 0.3 * if n > 0 { u[n - 1] } else { 0.0 }).powi(2)).collect();
     let cfg = ForwardConfig { memory: 4, ..ForwardConfig::default() };
-    let (v, noise, scores) = fit_forward(&u, &y, &vec![true; u.len()], &cfg).expect("fixture forward model");
-    let training = Training { scores, actuation_rms: 0.5, actuation_peak: 1.0, data_hash: String::new(), seconds: 0.0 };
-    ForwardModel::new(&v, 1000.0, &cfg.filter, Default::default(), noise, training)
+    let fitted = fit_forward(&u, &y, &vec![true; u.len()], &cfg).expect("fixture forward model");
+    let training = Training {
+        scores: fitted.scores,
+        actuation_rms: 0.5,
+        actuation_peak: 1.0,
+        data_hash: String::new(),
+        seconds: 0.0,
+    };
+    let training = Training { scores: fitted.scores, ..training };
+    ForwardModel::new(&fitted.model, 1000.0, &cfg.filter, Default::default(), fitted.noise, fitted.spectrum, training)
         .save(&dir.join("models/forward.json"))
         .expect("fixture forward model written");
 }

@@ -27,6 +27,7 @@
 
 use super::error::SynthError;
 use super::output_filter::OutputFilter;
+use super::spectral::NoiseSpectrum;
 use super::volterra::{Volterra, MAX_MEMORY};
 use super::volterra_fit::{FitScores, NoiseModel};
 use crate::narx::model::Condition;
@@ -94,6 +95,10 @@ pub struct ForwardModel {
     pub condition: Condition,
     /// Residual noise against actuation power.
     pub noise: NoiseModel,
+    /// Residual spectrum against actuation power (absent when the
+    /// recording was shorter than three one-second segments).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub noise_spectrum: Option<NoiseSpectrum>,
     /// κ, the force a unit Nyquist-rate carrier adds, N.
     pub carrier_gain_n: f64,
     /// Identification record.
@@ -110,6 +115,7 @@ impl ForwardModel {
         filter: &OutputFilter,
         condition: Condition,
         noise: NoiseModel,
+        noise_spectrum: Option<NoiseSpectrum>,
         training: Training,
     ) -> Self {
         Self {
@@ -121,6 +127,7 @@ impl ForwardModel {
             output_filter: FilterSpec { highpass_order: filter.order(), highpass_hz: filter.cutoff_hz() },
             condition,
             noise,
+            noise_spectrum,
             carrier_gain_n: model.carrier_gain(),
             training,
             kernel: Kernel {
@@ -180,6 +187,15 @@ impl ForwardModel {
         for (name, v) in [("noise.floor_n2", self.noise.floor_n2), ("noise.per_u2_n2", self.noise.per_u2_n2)] {
             if !(v.is_finite() && v >= 0.0) {
                 return f(name, format!("{v} is not a power ≥ 0"));
+            }
+        }
+        if let Some(ns) = &self.noise_spectrum {
+            let bins = ns.nfft / 2 + 1;
+            if ns.nfft < 2 || ns.p0.len() != bins || ns.p1.len() != bins {
+                return f("noise_spectrum", format!("nfft {} needs {bins} values in p0 and p1", ns.nfft));
+            }
+            if ns.p0.iter().chain(&ns.p1).any(|v| !(v.is_finite() && *v >= 0.0)) {
+                return f("noise_spectrum", "powers must be finite and ≥ 0".into());
             }
         }
         let kappa = self.volterra()?.carrier_gain();
@@ -284,6 +300,7 @@ mod tests {
             &OutputFilter::highpass(4, 10.0, 1000.0).unwrap(),
             Condition { mass_g: Some(85.0), speed_cm_s: Some(5.0) },
             NoiseModel { floor_n2: 1e-5, per_u2_n2: 2e-5 },
+            Some(NoiseSpectrum { nfft: 4, p0: vec![1e-6, 2e-6, 3e-6], p1: vec![0.0, 1e-6, 1e-6] }),
             training,
         )
     }
@@ -316,6 +333,7 @@ mod tests {
             ("noise.per_u2_n2", Box::new(|v| v["noise"]["per_u2_n2"] = (-1.0).into())),
             ("output_filter", Box::new(|v| v["output_filter"]["highpass_hz"] = 900.0.into())),
             ("rate_hz", Box::new(|v| v["rate_hz"] = 0.0.into())),
+            ("noise_spectrum", Box::new(|v| v["noise_spectrum"]["p0"] = serde_json::json!([1.0]))),
             ("kernel", Box::new(|v| v.as_object_mut().unwrap().remove("kernel").map(|_| ()).unwrap_or(()))),
         ];
         for (want, change) in cases {

@@ -6,7 +6,13 @@
 //! * **time**: J = Σ_K (ŷ − f)² / Σ_K f²  — matching the force sample by
 //!   sample (phase included), the real recording's waveform;
 //! * **spectral**: J = E_s²(ŷ_K, f_K) with the `metric` node's spectra
-//!   ([`super::spectral`]) — matching only what E_s compares.
+//!   ([`super::spectral`]) — matching only what E_s compares;
+//! * **expected**: J = E_s² of the spectra the display is expected to
+//!   deliver — each bin's magnitude √(|Ŷ|² + (π/4)·P_k(p)), with the
+//!   residual noise spectrum P_k(p) = p0_k + p·p1_k the forward model
+//!   learned, p a segment's mean u². Where the display's own noise already
+//!   exceeds the texture, rendering more there gains nothing and adds noise;
+//!   this objective sees it, the others do not.
 //!
 //! **Noise weight.** A display's friction noise grows with the normal force
 //! its actuation adds, so of two actuations that make the same force the
@@ -21,7 +27,7 @@
 //! adjoint, through the model ([`Volterra::eval_grad`]).
 
 use super::output_filter::OutputFilter;
-use super::spectral::SpectralTarget;
+use super::spectral::{NoiseSpectrum, SpectralTarget};
 use super::volterra::Volterra;
 
 /// The distance measure.
@@ -30,6 +36,11 @@ pub enum Loss {
     Time,
     /// E_s² of the kept samples' spectra.
     Spectral(Box<SpectralTarget>),
+    /// E_s² of the spectra the display is expected to deliver: the model's
+    /// force plus the residual noise, whose power grows with the actuation
+    /// ([`super::spectral::SpectralTarget::value_grad_noisy`]). The noise
+    /// weight λ is not added: the noise is in the spectra.
+    Expected(Box<SpectralTarget>, NoiseSpectrum),
 }
 
 /// The objective of one synthesis.
@@ -45,6 +56,8 @@ pub struct Objective<'a> {
     ybar: Vec<f64>,
     yk: Vec<f64>,
     gk: Vec<f64>,
+    pk: Vec<f64>,
+    gpk: Vec<f64>,
 }
 
 impl<'a> Objective<'a> {
@@ -73,6 +86,8 @@ impl<'a> Objective<'a> {
             ybar: vec![0.0; n],
             yk: vec![0.0; kept.len()],
             gk: vec![0.0; kept.len()],
+            pk: vec![0.0; kept.len()],
+            gpk: vec![0.0; kept.len()],
             kept,
         }
     }
@@ -111,6 +126,12 @@ impl<'a> Objective<'a> {
                 s / self.norm
             }
             Loss::Spectral(t) => t.value_grad(&self.yk, &mut self.gk),
+            Loss::Expected(t, noise) => {
+                for (k, &n) in self.kept.iter().enumerate() {
+                    self.pk[k] = u[n] * u[n];
+                }
+                t.value_grad_noisy(&self.yk, &self.pk, noise, &mut self.gk, &mut self.gpk)
+            }
         };
         self.ybar.iter_mut().for_each(|v| *v = 0.0);
         for (k, &n) in self.kept.iter().enumerate() {
@@ -119,6 +140,11 @@ impl<'a> Objective<'a> {
         self.filter.adjoint_in_place(&mut self.ybar);
         g.iter_mut().for_each(|v| *v = 0.0);
         self.model.eval_grad(u, &self.ybar, &mut self.y, g);
+        if let Loss::Expected(..) = self.loss {
+            for (k, &n) in self.kept.iter().enumerate() {
+                g[n] += self.gpk[k] * 2.0 * u[n];
+            }
+        }
         if self.lambda > 0.0 {
             let mut p = 0.0;
             for &n in &self.kept {
@@ -165,6 +191,22 @@ mod tests {
     #[test]
     fn the_time_objective_gradient_matches_central_differences() {
         check_gradient(&|| Loss::Time);
+    }
+
+    #[test]
+    fn the_expected_objective_gradient_matches_central_differences() {
+        check_gradient(&|| {
+            let target: Vec<f64> = (0..300).map(|k| (k as f64 * 0.2).sin()).collect();
+            let kept: Vec<f64> = target[40..280].to_vec();
+            let cfg = SpectrumConfig { rate: 1000.0, nfft: 100, window: Window::Hann, overlap: 0.5 };
+            let band = Band::new(1000.0, 100, 20.0, 300.0, false).unwrap();
+            let noise = NoiseSpectrum {
+                nfft: 100,
+                p0: (0..51).map(|k| 0.001 * (1.0 + k as f64 / 20.0)).collect(),
+                p1: (0..51).map(|k| 0.003 / (1.0 + k as f64 / 5.0)).collect(),
+            };
+            Loss::Expected(Box::new(SpectralTarget::new(&kept, cfg, band).unwrap()), noise)
+        });
     }
 
     #[test]

@@ -33,9 +33,12 @@ pub static SPEC: NodeSpec = NodeSpec::new(
      every sample. The actuation has one sample per recorded one; the node is a finite source that \
      ends with the recording (zeros after it).\n\n\
      **Objective.** `time`: Σ(ŷ − f)²/Σf² over the counted samples (the waveform); `spectral`: E_s² \
-     with the `metric` node's spectra (`nfft` 0 = the rate, `window`, `overlap`, band `fmin`–`fmax`). \
-     Plus the noise an actuation brings: λ·mean(u²), λ = β/mean(f²) from the model's noise model \
-     (`noise = \"learned\"`) or `lambda` (`noise = \"fixed\"`).\n\n\
+     with the `metric` node's spectra (`nfft` 0 = the rate, `window`, `overlap`, band `fmin`–`fmax`); \
+     both plus the noise an actuation brings, λ·mean(u²), λ = β/mean(f²) from the model's noise model \
+     (`noise = \"learned\"`) or `lambda` (`noise = \"fixed\"`). `expected`: E_s² of the spectra the \
+     display is expected to deliver — the model's force plus its learned residual noise spectrum, \
+     which grows with the actuation — over Hann-windowed half-overlapping segments of the model's \
+     noise-spectrum length (`window`, `overlap` and `noise` do not apply).\n\n\
      **Start.** `carrier`: the square-law envelope on a Nyquist-rate carrier, \
      u[n] = (−1)ⁿ·√(max(0, (f[n] + c)/κ)), κ the model's carrier gain, c = −min f; `narx`: the inverse \
      NARX model `narx_model` run closed loop on the force (§5.2.2); `zero`.\n\n\
@@ -53,7 +56,7 @@ pub static SPEC: NodeSpec = NodeSpec::new(
     ParamSpec::float("settle", 0.0, 60.0, 0.1, "s", "time the speed must have held"),
     ParamSpec::choice("start", &["carrier", "narx", "zero"], "carrier", "starting actuation"),
     ParamSpec::text("narx_model", "", "inverse NARX model for start = \"narx\""),
-    ParamSpec::choice("objective", &["time", "spectral"], "time", "what to match"),
+    ParamSpec::choice("objective", &["time", "spectral", "expected"], "time", "what to match"),
     ParamSpec::int("nfft", 0, 1 << 20, 0, "samples", "spectral objective: segment length (0 = the rate)"),
     ParamSpec::choice("window", &["rect", "hann"], "rect", "spectral objective: window"),
     ParamSpec::float("overlap", 0.0, 0.9, 0.0, "1", "spectral objective: overlap of segments"),
@@ -131,6 +134,14 @@ fn build(p: &Params, ctx: &BuildContext) -> Result<Box<dyn Node>, NodeError> {
         n => n,
     };
     let objective = match p.str("objective") {
+        "expected" => {
+            let band = Band::new(ctx.rate, nfft, p.f64("fmin"), p.f64("fmax"), false)
+                .map_err(|e| NodeError::param(e.param, e.message))?;
+            ObjectiveKind::Expected {
+                cfg: SpectrumConfig { rate: ctx.rate, nfft, window: Window::Hann, overlap: 0.5 },
+                band,
+            }
+        }
         "spectral" => {
             let window = Window::from_name(p.str("window")).unwrap_or(Window::Rect);
             let band = Band::new(ctx.rate, nfft, p.f64("fmin"), p.f64("fmax"), false)

@@ -23,6 +23,27 @@ use rustfft::num_complex::Complex;
 use rustfft::{Fft, FftPlanner};
 use std::sync::Arc;
 
+/// A noise power spectrum that grows with the actuation: the expected
+/// |DFT|² of the noise in one windowed segment, per unit of window energy
+/// Σw², at bin k when the segment's mean u² is p: P_k(p) = p0_k + p·p1_k
+/// (k = 0 … nfft/2). Learned with the forward model
+/// ([`super::volterra_fit`]).
+#[derive(Debug, Clone, PartialEq, Default, serde::Serialize, serde::Deserialize)]
+pub struct NoiseSpectrum {
+    /// Segment length the spectrum was taken over (its bins are rate/nfft apart).
+    pub nfft: usize,
+    /// Noise power with no actuation, per bin.
+    pub p0: Vec<f64>,
+    /// Noise power added per unit of mean u², per bin.
+    pub p1: Vec<f64>,
+}
+
+/// E|Y + N| ≈ √(|Y|² + (π/4)·E|N|²): the mean magnitude of a bin holding a
+/// deterministic Y and circular Gaussian noise N — exact at Y = 0 (the
+/// Rayleigh mean √(π/4·E|N|²)) and to first order in E|N|²/|Y|² for a
+/// strong Y.
+pub const RICE: f64 = std::f64::consts::FRAC_PI_4;
+
 /// A target spectrum and the machinery to score series against it.
 pub struct SpectralTarget {
     cfg: SpectrumConfig,
@@ -129,6 +150,74 @@ impl SpectralTarget {
         s.iter().zip(&self.r).map(|(a, b)| (a - b) * (a - b)).sum::<f64>() / self.r_norm2
     }
 
+    /// J = E_s² of the spectrum `v` is expected to have once the noise of
+    /// `noise` is added — each segment's magnitudes √(|X|² + RICE·P_k(p_seg)),
+    /// p_seg the window-weighted mean of `p` (the actuation's u², per sample)
+    /// over the segment — with ∂J/∂v in `gv` and ∂J/∂p in `gp`. The noise
+    /// spectrum must have been taken with this target's nfft.
+    pub fn value_grad_noisy(
+        &mut self,
+        v: &[f64],
+        p: &[f64],
+        noise: &NoiseSpectrum,
+        gv: &mut [f64],
+        gp: &mut [f64],
+    ) -> f64 {
+        let (nfft, nb, first) = (self.cfg.nfft, self.band.len(), self.band.first());
+        let np = self.starts.len();
+        let energy: f64 = self.window.iter().map(|w| w * w).sum();
+        let segp: Vec<f64> = self
+            .starts
+            .iter()
+            .map(|&s| (0..nfft).map(|n| self.window[n] * self.window[n] * p[s + n]).sum::<f64>() / energy)
+            .collect();
+        // Forward: the expected magnitudes M, their mean S.
+        let mut m = vec![0.0; np * nb];
+        let mut s = vec![0.0; nb];
+        for (seg, &start) in self.starts.iter().enumerate() {
+            for n in 0..nfft {
+                self.buf[n] = Complex::new(self.window[n] * v[start + n], 0.0);
+            }
+            self.fft.process_with_scratch(&mut self.buf, &mut self.scratch);
+            for (b, sb) in s.iter_mut().enumerate() {
+                let k = first + b;
+                let xk = self.buf[k];
+                self.x[seg * nb + b] = xk;
+                let pn = energy * (noise.p0[k] + segp[seg] * noise.p1[k]).max(0.0);
+                let mk = (xk.norm_sqr() + RICE * pn).sqrt();
+                m[seg * nb + b] = mk;
+                *sb += mk / np as f64;
+            }
+        }
+        let j = s.iter().zip(&self.r).map(|(a, b)| (a - b) * (a - b)).sum::<f64>() / self.r_norm2;
+        // Backward.
+        gv.iter_mut().for_each(|x| *x = 0.0);
+        gp.iter_mut().for_each(|x| *x = 0.0);
+        for (seg, &start) in self.starts.iter().enumerate() {
+            self.buf.iter_mut().for_each(|c| *c = Complex::default());
+            let mut dseg = 0.0;
+            for (b, (sb, rb)) in s.iter().zip(&self.r).enumerate() {
+                let mk = m[seg * nb + b];
+                if mk > 0.0 {
+                    let a = 2.0 * (sb - rb) / self.r_norm2 / np as f64;
+                    self.buf[first + b] = self.x[seg * nb + b].conj() * (a / mk);
+                    dseg += a * RICE * energy * noise.p1[first + b] / (2.0 * mk);
+                }
+            }
+            self.fft.process_with_scratch(&mut self.buf, &mut self.scratch);
+            for n in 0..nfft {
+                gv[start + n] += self.window[n] * self.buf[n].re;
+                gp[start + n] += dseg * self.window[n] * self.window[n] / energy;
+            }
+        }
+        j
+    }
+
+    /// The target's segment configuration.
+    pub fn config(&self) -> SpectrumConfig {
+        self.cfg
+    }
+
     /// J = E_s² of `v`, with ∂J/∂v written into `g` (same length).
     pub fn value_grad(&mut self, v: &[f64], g: &mut [f64]) -> f64 {
         let j = self.forward(v);
@@ -206,6 +295,45 @@ mod tests {
                 let fd = (t.es(&a).powi(2) - t.es(&b).powi(2)) / (2.0 * h);
                 assert!((fd - g[k]).abs() < 1e-6 * (1.0 + fd.abs()), "{window:?} x[{k}]: {} vs {fd}", g[k]);
             }
+        }
+    }
+
+    #[test]
+    fn the_noisy_gradient_matches_central_differences_and_no_noise_is_the_plain_objective() {
+        let cfg = SpectrumConfig { rate: 100.0, nfft: 64, window: Window::Hann, overlap: 0.5 };
+        let band = Band::new(100.0, 64, 3.0, 30.0, false).unwrap();
+        let (real, virt) = (series(150, 3), series(150, 4));
+        let mut t = SpectralTarget::new(&real, cfg, band).unwrap();
+        let mut r = Rng::new(6);
+        let p: Vec<f64> = (0..150).map(|_| r.uniform()).collect();
+        let quiet = NoiseSpectrum { nfft: 64, p0: vec![0.0; 33], p1: vec![0.0; 33] };
+        let (mut gv, mut gp, mut g) = (vec![0.0; 150], vec![0.0; 150], vec![0.0; 150]);
+        let j0 = t.value_grad_noisy(&virt, &p, &quiet, &mut gv, &mut gp);
+        let j1 = t.value_grad(&virt, &mut g);
+        assert!((j0 - j1).abs() < 1e-14 && gv.iter().zip(&g).all(|(a, b)| (a - b).abs() < 1e-12));
+        let noise = NoiseSpectrum {
+            nfft: 64,
+            p0: (0..33).map(|k| 0.01 * (1.0 + k as f64 / 10.0)).collect(),
+            p1: (0..33).map(|k| 0.02 / (1.0 + k as f64)).collect(),
+        };
+        let j = t.value_grad_noisy(&virt, &p, &noise, &mut gv, &mut gp);
+        assert!(j > 0.0);
+        let f = |t: &mut SpectralTarget, v: &[f64], p: &[f64]| {
+            let (mut a, mut b) = (vec![0.0; 150], vec![0.0; 150]);
+            t.value_grad_noisy(v, p, &noise, &mut a, &mut b)
+        };
+        let h = 1e-6;
+        for k in [0, 40, 63, 64, 100, 127, 149] {
+            let (mut a, mut b) = (virt.clone(), virt.clone());
+            a[k] += h;
+            b[k] -= h;
+            let fd = (f(&mut t, &a, &p) - f(&mut t, &b, &p)) / (2.0 * h);
+            assert!((fd - gv[k]).abs() < 1e-6 * (1.0 + fd.abs()), "v[{k}]: {} vs {fd}", gv[k]);
+            let (mut a, mut b) = (p.clone(), p.clone());
+            a[k] += h;
+            b[k] -= h;
+            let fd = (f(&mut t, &virt, &a) - f(&mut t, &virt, &b)) / (2.0 * h);
+            assert!((fd - gp[k]).abs() < 1e-6 * (1.0 + fd.abs()), "p[{k}]: {} vs {fd}", gp[k]);
         }
     }
 

@@ -21,6 +21,18 @@ use super::error::SynthError;
 /// The square-law envelope start for the force `f`, offset from the
 /// samples where `keep` is set, carrier gain `kappa` (N), clipped to ±`bound`.
 pub fn carrier(f: &[f64], keep: &[bool], kappa: f64, bound: f64) -> Result<Vec<f64>, SynthError> {
+    carrier_scaled(f, keep, kappa, bound, 1.0)
+}
+
+/// [`carrier`] with the offset c scaled by `offset_scale` (below 1 the
+/// troughs of the force are clipped; above 1 the carrier never falls to 0).
+pub fn carrier_scaled(
+    f: &[f64],
+    keep: &[bool],
+    kappa: f64,
+    bound: f64,
+    offset_scale: f64,
+) -> Result<Vec<f64>, SynthError> {
     if !(kappa.is_finite() && kappa > 0.0) {
         return Err(SynthError::Data(format!(
             "the forward model's carrier gain is {kappa} N: a Nyquist-rate carrier raises no friction on this model, \
@@ -28,7 +40,7 @@ pub fn carrier(f: &[f64], keep: &[bool], kappa: f64, bound: f64) -> Result<Vec<f
         )));
     }
     let c = -f.iter().zip(keep).filter(|(_, k)| **k).map(|(v, _)| *v).fold(f64::INFINITY, f64::min);
-    let c = if c.is_finite() { c.max(0.0) } else { 0.0 };
+    let c = if c.is_finite() { c.max(0.0) * offset_scale.max(0.0) } else { 0.0 };
     Ok(f.iter()
         .enumerate()
         .map(|(n, &v)| {

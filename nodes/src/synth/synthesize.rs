@@ -25,6 +25,15 @@ pub enum ObjectiveKind {
         /// Bins.
         band: Band,
     },
+    /// The spectra the display is expected to deliver, with the model's
+    /// learned noise spectrum (segments `cfg` of the noise spectrum's
+    /// length, bins `band`).
+    Expected {
+        /// Segments.
+        cfg: SpectrumConfig,
+        /// Bins.
+        band: Band,
+    },
 }
 
 /// How much the noise an actuation brings weighs.
@@ -125,7 +134,24 @@ pub fn synthesize(
     let loss = match cfg.objective {
         ObjectiveKind::Time => Loss::Time,
         ObjectiveKind::Spectral { cfg, band } => Loss::Spectral(Box::new(SpectralTarget::new(&kept, cfg, band)?)),
+        ObjectiveKind::Expected { cfg, band } => {
+            let noise = model.noise_spectrum.clone().ok_or_else(|| {
+                SynthError::Config(
+                    "the forward model has no noise spectrum (its recording was shorter than three seconds of kept \
+                     samples): use the time or spectral objective, or identify it on a longer recording"
+                        .into(),
+                )
+            })?;
+            if noise.nfft != cfg.nfft {
+                return Err(SynthError::Config(format!(
+                    "the model's noise spectrum has {}-sample segments, the objective {}",
+                    noise.nfft, cfg.nfft
+                )));
+            }
+            Loss::Expected(Box::new(SpectralTarget::new(&kept, cfg, band)?), noise)
+        }
     };
+    let lambda = if matches!(cfg.objective, ObjectiveKind::Expected { .. }) { 0.0 } else { lambda };
     let volterra = model.volterra()?;
     let filter = model.filter()?;
     let mut obj = Objective::new(&volterra, &filter, target, keep, loss, lambda);

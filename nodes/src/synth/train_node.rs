@@ -65,6 +65,7 @@ pub static SPEC: NodeSpec = NodeSpec::new(
     ParamSpec::float("validation", 0.0, 0.89, 0.15, "1", "fraction of the kept samples, at their end, held out"),
     ParamSpec::float("ridge", 0.0, 1.0, 1e-9, "1", "ridge δ relative to the mean diagonal of ΦᵀΦ"),
     ParamSpec::float("noise_window", 0.001, 10.0, 0.25, "s", "window of the local actuation power in the noise model"),
+    ParamSpec::flag("reweight", true, "refit weighted by the inverse residual variance at each actuation power"),
     ParamSpec::float("mass_g", 0.0, 1e6, 0.0, "g", "condition: stylus mass (0 = not recorded)"),
     ParamSpec::float("speed_cm_s", 0.0, 1e6, 0.0, "cm/s", "condition: scanning speed (0 = not recorded)"),
     ParamSpec::text_list("gate", "names of gate inputs (e.g. [\"steady\"] from `segment`); none by default"),
@@ -104,6 +105,8 @@ fn build(p: &Params, ctx: &BuildContext) -> Result<Box<dyn Node>, NodeError> {
             validation: p.f64("validation"),
             ridge: p.f64("ridge"),
             noise_window: window,
+            rate: ctx.rate,
+            reweight: p.bool("reweight"),
         },
         rate: ctx.rate,
         condition: Condition { mass_g: set(p.f64("mass_g")), speed_cm_s: set(p.f64("speed_cm_s")) },
@@ -146,7 +149,8 @@ impl Node for Train {
 
     fn finish(&mut self) -> Result<Summary, NodeError> {
         let t0 = Instant::now();
-        let (model, noise, scores) = fit(&self.u, &self.y, &self.keep, &self.cfg)?;
+        let fitted = fit(&self.u, &self.y, &self.keep, &self.cfg)?;
+        let (model, noise, scores) = (fitted.model, fitted.noise, fitted.scores);
         let seconds = t0.elapsed().as_secs_f64();
         let kept: Vec<f64> = self.u.iter().zip(&self.keep).filter(|(_, k)| **k).map(|(u, _)| *u).collect();
         let training = Training {
@@ -156,7 +160,8 @@ impl Node for Train {
             data_hash: data_hash(&[&self.u, &self.y]),
             seconds: if self.record_time { seconds } else { 0.0 },
         };
-        let file = ForwardModel::new(&model, self.rate, &self.cfg.filter, self.condition, noise, training);
+        let file =
+            ForwardModel::new(&model, self.rate, &self.cfg.filter, self.condition, noise, fitted.spectrum, training);
         file.save(&self.path)?;
         let mut s = Summary::default()
             .value("train_rel_rms", scores.train_rel_rms, "1")

@@ -23,6 +23,7 @@
 
 use super::error::SynthError;
 use super::output_filter::OutputFilter;
+use super::spectral::NoiseSpectrum;
 use super::volterra::{upper_index, Volterra, MAX_MEMORY};
 use faer::linalg::solvers::Solve;
 use faer::{Mat, Par, Side};
@@ -40,11 +41,27 @@ pub struct FitConfig {
     pub ridge: f64,
     /// Samples over which the local actuation power of the noise model is averaged.
     pub noise_window: usize,
+    /// Sample rate, Hz (the noise spectrum's segments are one second long).
+    pub rate: f64,
+    /// Refit weighted by the inverse residual variance at each sample's
+    /// actuation power (feasible generalized least squares): samples where
+    /// the display strays from a second-order model — strong actuation
+    /// that makes the contact stick and slip — count less, samples where
+    /// only the noise floor limits the fit count fully.
+    pub reweight: bool,
 }
 
 impl Default for FitConfig {
     fn default() -> Self {
-        Self { memory: 20, filter: OutputFilter::none(), validation: 0.15, ridge: 1e-9, noise_window: 25 }
+        Self {
+            memory: 20,
+            filter: OutputFilter::none(),
+            validation: 0.15,
+            ridge: 1e-9,
+            noise_window: 25,
+            rate: 1000.0,
+            reweight: true,
+        }
     }
 }
 
@@ -74,12 +91,7 @@ pub struct FitScores {
 
 /// Identifies a model from actuation `u`, recorded force `y` (after the
 /// filter) and the rows to use (`keep[n]`), all of one length.
-pub fn fit(
-    u: &[f64],
-    y: &[f64],
-    keep: &[bool],
-    cfg: &FitConfig,
-) -> Result<(Volterra, NoiseModel, FitScores), SynthError> {
+pub fn fit(u: &[f64], y: &[f64], keep: &[bool], cfg: &FitConfig) -> Result<Fitted, SynthError> {
     let m = cfg.memory;
     if m == 0 || m > MAX_MEMORY {
         return Err(SynthError::Config(format!("memory must be 1 ..= {MAX_MEMORY} samples, not {m}")));
@@ -150,24 +162,26 @@ pub fn fit(
     }
     fill(q + m, &|_| 1.0, &mut phi);
 
-    let tr = phi.as_ref().subrows(0, n_tr);
-    let mut ata = Mat::<f64>::zeros(p, p);
-    faer::linalg::matmul::matmul(ata.as_mut(), faer::Accum::Replace, tr.transpose(), tr, 1.0, Par::Seq);
-    let mut aty = Mat::<f64>::zeros(p, 1);
-    let ytr = Mat::<f64>::from_fn(n_tr, 1, |r, _| kept_y[r]);
-    faer::linalg::matmul::matmul(aty.as_mut(), faer::Accum::Replace, tr.transpose(), ytr.as_ref(), 1.0, Par::Seq);
-    let mean_diag = (0..p).map(|k| ata[(k, k)]).sum::<f64>() / p as f64;
-    let delta = cfg.ridge.max(0.0) * mean_diag.max(f64::MIN_POSITIVE);
-    for k in 0..p {
-        ata[(k, k)] += delta;
+    // Local actuation power of each kept row (the noise model's regressor).
+    let w = cfg.noise_window.max(1);
+    let mut cum = vec![0.0; u.len() + 1];
+    for (n, v) in u.iter().enumerate() {
+        cum[n + 1] = cum[n] + v * v;
     }
-    let llt = ata
-        .llt(Side::Lower)
-        .map_err(|_| SynthError::Data("the regressors are degenerate (raise `ridge` or vary the excitation)".into()))?;
-    let theta = llt.solve(aty.as_ref());
-    let th: Vec<f64> = (0..p).map(|k| theta[(k, 0)]).collect();
-    if th.iter().any(|v| !v.is_finite()) {
-        return Err(SynthError::Data("the fit is not finite (raise `ridge`)".into()));
+    let local = |n: usize| {
+        let a = n.saturating_sub(w / 2);
+        let b = (n + w - w / 2).min(u.len());
+        (cum[b] - cum[a]) / (b - a) as f64
+    };
+    let power: Vec<f64> = rows.iter().map(|&n| local(n)).collect();
+    // Ordinary least squares, then (with `reweight`) weighted by the
+    // inverse residual variance at each row's actuation power.
+    let mut weights = vec![1.0; n_tr];
+    let mut th = solve(&phi, &kept_y, &weights, n_tr, cfg.ridge)?;
+    if cfg.reweight {
+        let resid: Vec<f64> = (0..n_tr).map(|r| kept_y[r] - (0..p).map(|k| phi[(r, k)] * th[k]).sum::<f64>()).collect();
+        weights = inverse_variance(&power[..n_tr], &resid);
+        th = solve(&phi, &kept_y, &weights, n_tr, cfg.ridge)?;
     }
     // The column of u[n−i]·u[n−j], i < j, carries H_ij + H_ji = 2·H_ij.
     let mut upper = th[..q].to_vec();
@@ -202,19 +216,9 @@ pub fn fit(
     };
 
     // Noise model: r² against the local mean of u² on the fitted rows.
-    let w = cfg.noise_window.max(1);
-    let mut cum = vec![0.0; u.len() + 1];
-    for (n, v) in u.iter().enumerate() {
-        cum[n + 1] = cum[n] + v * v;
-    }
-    let local = |n: usize| {
-        let a = n.saturating_sub(w / 2);
-        let b = (n + w - w / 2).min(u.len());
-        (cum[b] - cum[a]) / (b - a) as f64
-    };
     let (mut sx, mut sy, mut sxx, mut sxy) = (0.0, 0.0, 0.0, 0.0);
-    for (r, &n) in rows.iter().enumerate().take(n_tr) {
-        let (x, e2) = (local(n), resid[r] * resid[r]);
+    for r in 0..n_tr {
+        let (x, e2) = (power[r], resid[r] * resid[r]);
         sx += x;
         sy += e2;
         sxx += x * x;
@@ -225,7 +229,132 @@ pub fn fit(
     let beta = if var > 1e-12 * sxx.max(f64::MIN_POSITIVE) { (sxy - sx * sy / nn) / var } else { 0.0 };
     let beta = beta.max(0.0);
     let floor = ((sy - beta * sx) / nn).max(0.0);
-    Ok((model, NoiseModel { floor_n2: floor, per_u2_n2: beta }, scores))
+    let kept_u: Vec<f64> = rows.iter().map(|&n| u[n]).collect();
+    let spectrum = noise_spectrum(&resid, &kept_u, cfg.rate);
+    Ok(Fitted { model, noise: NoiseModel { floor_n2: floor, per_u2_n2: beta }, spectrum, scores })
+}
+
+/// Solves the (weighted, ridge-stabilized) normal equations on the first
+/// `n_tr` rows.
+fn solve(phi: &Mat<f64>, y: &[f64], weights: &[f64], n_tr: usize, ridge: f64) -> Result<Vec<f64>, SynthError> {
+    let p = phi.ncols();
+    let wphi = Mat::<f64>::from_fn(n_tr, p, |r, k| phi[(r, k)] * weights[r].sqrt());
+    let wy = Mat::<f64>::from_fn(n_tr, 1, |r, _| y[r] * weights[r].sqrt());
+    let mut ata = Mat::<f64>::zeros(p, p);
+    faer::linalg::matmul::matmul(ata.as_mut(), faer::Accum::Replace, wphi.transpose(), wphi.as_ref(), 1.0, Par::Seq);
+    let mut aty = Mat::<f64>::zeros(p, 1);
+    faer::linalg::matmul::matmul(aty.as_mut(), faer::Accum::Replace, wphi.transpose(), wy.as_ref(), 1.0, Par::Seq);
+    let mean_diag = (0..p).map(|k| ata[(k, k)]).sum::<f64>() / p as f64;
+    let delta = ridge.max(0.0) * mean_diag.max(f64::MIN_POSITIVE);
+    for k in 0..p {
+        ata[(k, k)] += delta;
+    }
+    let llt = ata
+        .llt(Side::Lower)
+        .map_err(|_| SynthError::Data("the regressors are degenerate (raise `ridge` or vary the excitation)".into()))?;
+    let theta = llt.solve(aty.as_ref());
+    let th: Vec<f64> = (0..p).map(|k| theta[(k, 0)]).collect();
+    if th.iter().any(|v| !v.is_finite()) {
+        return Err(SynthError::Data("the fit is not finite (raise `ridge`)".into()));
+    }
+    Ok(th)
+}
+
+/// Power bins of the reweighting.
+const BINS: usize = 8;
+
+/// 1/σ² per row, σ² the mean squared residual of the rows whose actuation
+/// power falls in the same of [`BINS`] equally populated bins, normalized
+/// to a mean weight of 1.
+fn inverse_variance(power: &[f64], resid: &[f64]) -> Vec<f64> {
+    let n = power.len();
+    let mut order: Vec<usize> = (0..n).collect();
+    order.sort_by(|&a, &b| power[a].total_cmp(&power[b]));
+    let mut w = vec![1.0; n];
+    let per = n.div_ceil(BINS).max(1);
+    for chunk in order.chunks(per) {
+        let var = chunk.iter().map(|&i| resid[i] * resid[i]).sum::<f64>() / chunk.len() as f64;
+        for &i in chunk {
+            w[i] = if var > 0.0 { 1.0 / var } else { 1.0 };
+        }
+    }
+    let mean = w.iter().sum::<f64>() / n.max(1) as f64;
+    w.iter_mut().for_each(|v| *v /= mean);
+    w
+}
+
+/// What [`fit`] finds.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Fitted {
+    /// The model.
+    pub model: Volterra,
+    /// Residual power against local actuation power.
+    pub noise: NoiseModel,
+    /// Residual spectrum against actuation power (None: too few samples for
+    /// three one-second segments).
+    pub spectrum: Option<NoiseSpectrum>,
+    /// How well it fits.
+    pub scores: FitScores,
+}
+
+/// Bins on each side averaged when the noise spectrum is smoothed.
+const SMOOTH: usize = 4;
+
+/// The residual's spectrum against the actuation power: Hann-windowed,
+/// half-overlapping one-second segments of the kept residual `r` (with the
+/// kept actuation `u` beside it); per bin, |DFT|²/Σw² regressed on the
+/// segment's window-weighted mean u² (P_k = p0_k + p·p1_k, both ≥ 0),
+/// then smoothed over ±4 bins.
+pub fn noise_spectrum(r: &[f64], u: &[f64], rate: f64) -> Option<NoiseSpectrum> {
+    use rustfft::num_complex::Complex;
+    let nfft = rate.round() as usize;
+    if nfft < 8 || r.len() < 2 * nfft {
+        return None;
+    }
+    let hop = nfft / 2;
+    let w = crate::metric::spectrum::Window::Hann.coefficients(nfft);
+    let energy: f64 = w.iter().map(|v| v * v).sum();
+    let fft = rustfft::FftPlanner::<f64>::new().plan_fft_forward(nfft);
+    let bins = nfft / 2 + 1;
+    let (mut powers, mut ps) = (Vec::new(), Vec::new());
+    let mut buf = vec![Complex::default(); nfft];
+    let mut start = 0;
+    while start + nfft <= r.len() {
+        for n in 0..nfft {
+            buf[n] = Complex::new(w[n] * r[start + n], 0.0);
+        }
+        fft.process(&mut buf);
+        powers.push(buf[..bins].iter().map(|c| c.norm_sqr() / energy).collect::<Vec<f64>>());
+        ps.push((0..nfft).map(|n| w[n] * w[n] * u[start + n] * u[start + n]).sum::<f64>() / energy);
+        start += hop;
+    }
+    if powers.len() < 3 {
+        return None;
+    }
+    let m = ps.len() as f64;
+    let pm = ps.iter().sum::<f64>() / m;
+    let var: f64 = ps.iter().map(|p| (p - pm) * (p - pm)).sum();
+    let (mut p0, mut p1) = (vec![0.0; bins], vec![0.0; bins]);
+    for k in 0..bins {
+        let ym = powers.iter().map(|pw| pw[k]).sum::<f64>() / m;
+        let slope = if var > 1e-12 * pm.max(1e-300) * pm.max(1e-300) * m {
+            powers.iter().zip(&ps).map(|(pw, p)| (p - pm) * (pw[k] - ym)).sum::<f64>() / var
+        } else {
+            0.0
+        };
+        let slope = slope.max(0.0);
+        p1[k] = slope;
+        p0[k] = (ym - slope * pm).max(0.0);
+    }
+    let smooth = |v: &[f64]| -> Vec<f64> {
+        (0..v.len())
+            .map(|k| {
+                let (a, b) = (k.saturating_sub(SMOOTH), (k + SMOOTH + 1).min(v.len()));
+                v[a..b].iter().sum::<f64>() / (b - a) as f64
+            })
+            .collect()
+    };
+    Some(NoiseSpectrum { nfft, p0: smooth(&p0), p1: smooth(&p1) })
 }
 
 #[cfg(test)]
@@ -256,7 +385,7 @@ mod tests {
             let y = plant(&u, &g, &filter);
             let keep: Vec<bool> = (0..u.len()).map(|n| n >= 200).collect();
             let cfg = FitConfig { memory: 6, filter: filter.clone(), ..FitConfig::default() };
-            let (v, noise, s) = fit(&u, &y, &keep, &cfg).unwrap();
+            let Fitted { model: v, noise, scores: s, .. } = fit(&u, &y, &keep, &cfg).unwrap();
             for i in 0..6 {
                 for j in 0..6 {
                     let want = if i < 4 && j < 4 { g[i] * g[j] } else { 0.0 };
@@ -287,7 +416,7 @@ mod tests {
         }
         let keep = vec![true; n];
         let cfg = FitConfig { memory: 3, noise_window: 101, ..FitConfig::default() };
-        let (_, noise, _) = fit(&u, &y, &keep, &cfg).unwrap();
+        let noise = fit(&u, &y, &keep, &cfg).unwrap().noise;
         assert!((noise.per_u2_n2 / 4e-4 - 1.0).abs() < 0.2, "{noise:?}");
         assert!((noise.floor_n2 / 1e-4 - 1.0).abs() < 0.2, "{noise:?}");
     }

@@ -18,6 +18,7 @@ pub mod row;
 pub mod run;
 pub mod setup;
 pub mod summary;
+pub mod twin;
 
 use std::path::PathBuf;
 

@@ -148,6 +148,11 @@ pub struct RowInputs<'a> {
     pub gains: &'a [f64],
     /// The optimizer's iteration budget.
     pub iterations: usize,
+    /// The optimized synthesis' objective.
+    pub objective: &'a str,
+    /// An optimized actuation computed before (e.g. by another study over
+    /// the same recordings) to play instead of synthesizing one.
+    pub optimized: Option<(PathBuf, f64)>,
     /// Where this row's runs go.
     pub dir: PathBuf,
 }
@@ -160,19 +165,10 @@ pub fn run(i: &RowInputs<'_>) -> Result<Row, StudyError> {
     let rep1 = i.recordings.join(recordings::name(i.sample, &c, 1));
     let (lo, hi) = playback_range(&rep1, c.speed)?;
     // Optimized synthesis, once (it does not depend on the gain).
-    let opt_graph = i.graphs.join("synthesize-optimized.toml");
-    let opt_sets = vec![
-        format!("recordings={}", path(i.recordings)),
-        format!("sample={}", text(i.sample)),
-        format!("mass={}", c.mass),
-        format!("speed={}", c.speed),
-        format!("forward={}", path(&i.models.forward)),
-        format!("narx_model={}", path(&i.models.narx)),
-        format!("iterations={}", i.iterations),
-    ];
-    let opt = run_graph(&opt_graph, &opt_sets, &i.dir)?;
-    let opt_seconds = value(&opt, &opt_graph, "opt", "seconds")?;
-    let optimized = i.dir.join(format!("u-{}-{}", i.sample, c.tag()));
+    let (optimized, opt_seconds) = match &i.optimized {
+        Some(done) => done.clone(),
+        None => optimize(i)?,
+    };
     // Every method over the gain sweep.
     let graph = i.graphs.join("synthesize.toml");
     let mut runs = Vec::new();
@@ -237,4 +233,24 @@ pub fn run(i: &RowInputs<'_>) -> Result<Row, StudyError> {
         methods,
         dir: i.dir.clone(),
     })
+}
+
+/// Runs graphs/synthesize-optimized.toml for the row; returns the actuation
+/// recording and the synthesis time.
+pub fn optimize(i: &RowInputs<'_>) -> Result<(PathBuf, f64), StudyError> {
+    let c = i.cond;
+    std::fs::create_dir_all(&i.dir).map_err(|e| StudyError::Io { path: i.dir.clone(), message: e.to_string() })?;
+    let graph = i.graphs.join("synthesize-optimized.toml");
+    let sets = vec![
+        format!("recordings={}", path(i.recordings)),
+        format!("sample={}", text(i.sample)),
+        format!("mass={}", c.mass),
+        format!("speed={}", c.speed),
+        format!("forward={}", path(&i.models.forward)),
+        format!("narx_model={}", path(&i.models.narx)),
+        format!("iterations={}", i.iterations),
+        format!("objective={}", text(i.objective)),
+    ];
+    let r = run_graph(&graph, &sets, &i.dir)?;
+    Ok((i.dir.join(format!("u-{}-{}", i.sample, c.tag())), value(&r, &graph, "opt", "seconds")?))
 }

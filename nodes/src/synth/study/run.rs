@@ -32,6 +32,8 @@ pub struct StudyConfig {
     pub multilevel: bool,
     /// Also the achievable floor (optimization through the display itself).
     pub floor: bool,
+    /// The optimized synthesis' objective (`synth.optimize`'s `objective`).
+    pub objective: String,
 }
 
 /// Where a study is.
@@ -95,6 +97,8 @@ pub fn run(cfg: &StudyConfig, progress: &mut dyn FnMut(Progress<'_>)) -> Result<
                     recordings: &rec_dir,
                     gains: &cfg.gains,
                     iterations: cfg.iterations,
+                    objective: &cfg.objective,
+                    optimized: None,
                     dir: pdir.join("rows").join(format!("{sample}-{}", c.tag())),
                 };
                 let mut r = row::run(&inputs)?;

@@ -11,6 +11,7 @@ pub mod narx;
 pub mod resample;
 pub mod synthesis;
 pub mod textures;
+pub mod textures_table;
 
 /// Arguments of `evflow report`.
 #[derive(clap::Args, Debug)]

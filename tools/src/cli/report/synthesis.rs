@@ -49,8 +49,6 @@ impl Cond {
 pub(super) struct Built {
     /// The model file.
     pub(super) path: PathBuf,
-    /// Trained by this report (not given with --models).
-    pub(super) trained: bool,
 }
 
 /// One scored chain of synthesize.toml at its chosen gain.
@@ -186,9 +184,6 @@ pub(super) fn synthesize(
 pub(super) struct Synthesis {
     /// E_s of repetition 1 against repetition 2.
     pub(super) repeat: f64,
-    /// E_s of repetition 1 plus the display's own force (no actuation)
-    /// against repetition 2: the best any actuation can do on the display.
-    pub(super) floor: f64,
     /// NARX synthesis.
     pub(super) narx: Scored,
     /// Record-and-playback.
@@ -210,7 +205,6 @@ pub(super) fn synthesize_condition(
     let runs = synthesize(graphs, sample, c, model, gains, recordings, work)?;
     Ok(Synthesis {
         repeat: value(&runs[0].1, "repeat_es", "E_s")?,
-        floor: value(&runs[0].1, "floor_es", "E_s")?,
         narx: choose(&runs, "narx_es")?,
         playback: choose(&runs, "playback_es")?,
     })
@@ -246,11 +240,11 @@ pub(super) fn models(
         if let Some(m) = given {
             let path = m.join(c.model_name());
             ensure!(path.is_file(), "--models: {} is missing (train it with graphs/model-build.toml)", path.display());
-            built.push(Built { path: std::fs::canonicalize(&path)?, trained: false });
+            built.push(Built { path: std::fs::canonicalize(&path)? });
             continue;
         }
         eprintln!("[{}/{}] training the inverse model at {} …", k + 1, conds.len(), c.label());
-        built.push(Built { path: train_model(graphs, c, epochs, &[], dir)?, trained: true });
+        built.push(Built { path: train_model(graphs, c, epochs, &[], dir)? });
     }
     Ok(built)
 }

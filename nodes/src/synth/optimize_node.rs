@@ -41,7 +41,9 @@ pub static SPEC: NodeSpec = NodeSpec::new(
      noise-spectrum length (`window`, `overlap` and `noise` do not apply).\n\n\
      **Start.** `carrier`: the square-law envelope on a Nyquist-rate carrier, \
      u[n] = (−1)ⁿ·√(max(0, (f[n] + c)/κ)), κ the model's carrier gain, c = −min f; `narx`: the inverse \
-     NARX model `narx_model` run closed loop on the force (§5.2.2); `zero`.\n\n\
+     NARX model `narx_model` run closed loop on the force (§5.2.2); `zero`. When the forward model's carrier gain \
+     κ is not positive (its fit explains almost nothing of the force), `carrier` starts from `narx_model` \
+     instead if one is given, and says so.\n\n\
      **Timing.** The synthesis runs on the first block (offline only) and counts in the node's run \
      time. **Summary.** `objective_start`, `objective_end` (never above the start), `iterations`, \
      `evaluations`, `lambda`, `seconds`, and why the optimizer stopped.",
@@ -74,6 +76,8 @@ struct Optimize {
     force: Vec<f64>,
     keep: Vec<bool>,
     start: Vec<f64>,
+    /// Which start was used (for the summary).
+    start_used: &'static str,
     model: ForwardModel,
     cfg: SynthConfig,
     u: Option<Vec<f64>>,
@@ -117,17 +121,25 @@ fn build(p: &Params, ctx: &BuildContext) -> Result<Box<dyn Node>, NodeError> {
         ));
     }
     let bound = p.f64("bound");
-    let start = match p.str("start") {
-        "narx" => {
-            let path = p.str("narx_model");
-            if path.is_empty() {
-                return Err(NodeError::param("narx_model", "start = \"narx\" needs the inverse model's file"));
-            }
-            let m = Model::load(&ctx.path(path))?;
-            m.closed_loop()?.run(&force).into_iter().map(|u| u.clamp(-bound, bound)).collect()
+    let narx_start = |why: &str| -> Result<Vec<f64>, NodeError> {
+        let path = p.str("narx_model");
+        if path.is_empty() {
+            return Err(NodeError::param("narx_model", format!("{why} needs the inverse model's file")));
         }
-        "zero" => vec![0.0; force.len()],
-        _ => carrier(&force, &keep, model.carrier_gain_n, bound)?,
+        let m = Model::load(&ctx.path(path))?;
+        Ok(m.closed_loop()?.run(&force).into_iter().map(|u| u.clamp(-bound, bound)).collect())
+    };
+    let kappa = model.carrier_gain_n;
+    let (start, start_used) = match p.str("start") {
+        "narx" => (narx_start("start = \"narx\"")?, "narx"),
+        "zero" => (vec![0.0; force.len()], "zero"),
+        // A model whose carrier gain is not positive (a display whose force the
+        // model hardly explains) gives the square-law start no meaning: start
+        // from the inverse model when one is given.
+        _ if !(kappa.is_finite() && kappa > 0.0) && !p.str("narx_model").is_empty() => {
+            (narx_start("the fallback start")?, "narx (the model's carrier gain is not positive)")
+        }
+        _ => (carrier(&force, &keep, kappa, bound)?, "carrier"),
     };
     let nfft = match p.usize("nfft") {
         0 => ctx.rate.round() as usize,
@@ -160,7 +172,7 @@ fn build(p: &Params, ctx: &BuildContext) -> Result<Box<dyn Node>, NodeError> {
         bound,
         options: Options { max_iter: p.usize("iterations"), ..Options::default() },
     };
-    Ok(Box::new(Optimize { force, keep, start, model, cfg, u: None, summary: Summary::default(), pos: 0 }))
+    Ok(Box::new(Optimize { force, keep, start, start_used, model, cfg, u: None, summary: Summary::default(), pos: 0 }))
 }
 
 impl Optimize {
@@ -174,8 +186,9 @@ impl Optimize {
             .value("lambda", s.lambda, "1")
             .value("seconds", s.seconds, "s")
             .line(format!(
-                "synthesized {} samples: objective {:.4} → {:.4} in {} iterations ({}), {:.3} s",
+                "synthesized {} samples from the {} start: objective {:.4} → {:.4} in {} iterations ({}), {:.3} s",
                 s.u.len(),
+                self.start_used,
                 s.objective_start,
                 s.objective_end,
                 s.history.len() - 1,

@@ -185,9 +185,9 @@ pub fn run(i: &RowInputs<'_>) -> Result<Row, StudyError> {
             format!("playback_max={hi}"),
             i.profile.set(),
         ];
-        if let Some(ml) = &i.models.narx_multilevel {
-            sets.push(format!("model_ml={}", path(ml)));
-        }
+        // Without a multilevel model its chain plays the binary one (and is not reported).
+        let ml = i.models.narx_multilevel.as_ref().unwrap_or(&i.models.narx);
+        sets.push(format!("model_ml={}", path(ml)));
         runs.push((gain, run_graph(&graph, &sets, &i.dir)?));
     }
     let first = &runs[0].1;

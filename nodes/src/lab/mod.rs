@@ -23,7 +23,11 @@ pub mod user;
 #[cfg(test)]
 mod chain_tests;
 #[cfg(test)]
+mod convergence_tests;
+#[cfg(test)]
 mod display_tests;
+#[cfg(test)]
+mod reference;
 #[cfg(test)]
 mod testutil;
 #[cfg(test)]

@@ -1,7 +1,7 @@
 //! `sim.display`: the virtual electrovibration display.
 
 use super::display_model::DisplayModel;
-use super::{method_of, profile_of, INTEGRATOR_PARAM, NOISE_PARAM, PROFILE_PARAM, SUBSTEPS_PARAM};
+use super::{method_of, profile_of, seed_of, INTEGRATOR_PARAM, NOISE_PARAM, PROFILE_PARAM, SEED_PARAM, SUBSTEPS_PARAM};
 use evflow_engine::{BuildContext, Io, Node, NodeError, NodeSpec, Params, PortSpec, Role, Summary};
 
 /// Declaration of `sim.display`.
@@ -34,7 +34,9 @@ pub static SPEC: NodeSpec = NodeSpec::new(
      state and reports it at the end. Every physical constant comes from the lab profile (`profile`); see \
      docs/simulated-lab.md for the physics, the values and their sources. Checked against: the complex \
      impedance of the circuit, analytic steady sliding, passivity (energy never rises), the quadratic law \
-     (R² > 0.99) and the u → −u symmetry without offset.",
+     (R² > 0.99) and the u → −u symmetry without offset. `seed` (default: from the graph's seed and the \
+     node's name) lets several copies of the display in one graph draw the same noise (common random \
+     numbers), e.g. to compare integrators or actuations on one noise realization.",
 )
 .ports(&[
     PortSpec::input("u", "1", "actuation (1.0 = 50 V at the amplifier output; ±1 = 100 Vpp)"),
@@ -42,7 +44,7 @@ pub static SPEC: NodeSpec = NodeSpec::new(
     PortSpec::input("velocity", "m/s", "sliding velocity of the holder along the display"),
     PortSpec::output("force", "N", "lateral friction force transmitted to the holder (positive opposes +x motion)"),
 ])
-.params(&[PROFILE_PARAM, INTEGRATOR_PARAM, SUBSTEPS_PARAM, NOISE_PARAM])
+.params(&[PROFILE_PARAM, INTEGRATOR_PARAM, SUBSTEPS_PARAM, NOISE_PARAM, SEED_PARAM])
 .example("profile = \"\"\nintegrator = \"exact\"\nsubsteps = 4\nnoise = 1.0");
 
 struct SimDisplay {
@@ -52,7 +54,8 @@ struct SimDisplay {
 fn build(p: &Params, ctx: &BuildContext) -> Result<Box<dyn Node>, NodeError> {
     let profile = profile_of(p, ctx)?;
     let method = method_of(p)?;
-    let model = DisplayModel::new(&profile, ctx.rate, method, p.usize("substeps"), p.f64("noise"), ctx.node_seed())
+    let seed = seed_of(p, ctx);
+    let model = DisplayModel::new(&profile, ctx.rate, method, p.usize("substeps"), p.f64("noise"), seed)
         .map_err(|m| NodeError::param("profile", m))?;
     Ok(Box::new(SimDisplay { model }))
 }
@@ -154,6 +157,53 @@ mod tests {
         assert!(e.contains("did you mean `stiffness_n_per_m`?"), "{e}");
         let e = single("profile = \"missing.toml\"", dir.path(), 10, 10).run().unwrap_err();
         assert!(e.contains("missing.toml") && e.contains("cannot read"), "{e}");
+    }
+
+    /// Two displays `a` and `b` in one graph on the same inputs; their forces.
+    fn twins(params_a: &str, params_b: &str) -> (Vec<f64>, Vec<f64>) {
+        use evflow_engine::{check, graph::parse_graph, Plan, PlanOptions, RunMode};
+        let doc = format!(
+            "[graph]\nformat = 1\nname = \"crn\"\nrate = 1000.0\nseed = 3\nconnections = [\n\
+             \"x.out -> a.u\", \"t.load -> a.load\", \"t.velocity -> a.velocity\",\n\
+             \"x.out -> b.u\", \"t.load -> b.load\", \"t.velocity -> b.velocity\",\n\
+             \"a.force -> e.test\", \"b.force -> e.reference\"]\n\
+             [nodes.x]\ntype = \"prbs\"\norder = 7\n\
+             [nodes.t]\ntype = \"sim.tribometer\"\npasses = 1\n\
+             [nodes.a]\ntype = \"sim.display\"\n{params_a}\n\
+             [nodes.b]\ntype = \"sim.display\"\n{params_b}\n\
+             [nodes.e]\ntype = \"error\"\n"
+        );
+        let graph = parse_graph(Path::new("crn.toml"), &doc).unwrap();
+        let checked = check(&graph, &crate::registry(), &[]).unwrap_or_else(|e| panic!("{e}"));
+        let opts = PlanOptions {
+            max_block: 100,
+            seed: None,
+            base_dir: Some(lab_dir()),
+            out_dir: Some(lab_dir()),
+            timing: false,
+            mode: RunMode::Offline,
+        };
+        let mut plan = Plan::build(&checked, &opts).unwrap();
+        let (mut fa, mut fb) = (Vec::new(), Vec::new());
+        for _ in 0..20 {
+            plan.step(100).unwrap();
+            fa.extend_from_slice(plan.output("a", 0).unwrap());
+            fb.extend_from_slice(plan.output("b", 0).unwrap());
+        }
+        (fa, fb)
+    }
+
+    #[test]
+    fn copies_with_one_seed_draw_the_same_noise_and_without_differ() {
+        let (a, b) = twins("noise = 1.0\nseed = 42", "noise = 1.0\nseed = 42");
+        assert!(a.iter().any(|x| x.abs() > 0.1), "the displays are driven");
+        assert_eq!(a, b, "same seed, same inputs: same output");
+        let (a, b) = twins("noise = 1.0", "noise = 1.0");
+        assert_ne!(a, b, "default seeds differ per node");
+        let (a, b) = twins("noise = 1.0\nseed = 42", "noise = 1.0\nseed = 43");
+        assert_ne!(a, b, "different seeds differ");
+        let (a, b) = twins("noise = 0.0\nseed = 1", "noise = 0.0\nseed = 2");
+        assert_eq!(a, b, "without noise the seed does not matter");
     }
 
     #[test]

@@ -2,26 +2,34 @@
 //! and sliding velocity in, lateral force out, one sample at a time. The
 //! `sim.display` node (display.rs) wraps it; docs/simulated-lab.md derives it.
 //!
-//! Chain per substep (exact method):
-//! 1. amplifier + circuit (electrical.rs) advance by their exact ZOH map with
-//!    the commanded voltage V_cmd = clamp(g·u + V_off + noise, ±V_max) held;
-//! 2. electrostatic force F_e = k_e·v_g² (square law, Meyer et al. 2013);
+//! Chain per substep (every method; `exact` uses the exact maps, `rk4` and
+//! `euler` their one-step maps of the same linear parts, integrator.rs):
+//! 1. amplifier + circuit + charge relaxation (electrical.rs) advance by
+//!    their map with the commanded voltage V_cmd = clamp(g·u + V_off + noise,
+//!    ±V_max) held;
+//! 2. electrostatic force F_e = k_e·v_r², v_r = v_g − q the gap voltage after
+//!    the relaxation high-pass (square law, Meyer et al. 2013);
 //! 3. first-order electroadhesion lag with speed-dependent cutoff
-//!    ω_c = 2π(f_0 + s·|v|) (Balasubramanian, Pool & Vardar 2025), exact
-//!    (F_l ← a F_l + (1−a) F_e, a = e^{−ω_c h});
+//!    ω_c = 2π(f_0 + s·|v|) (Balasubramanian, Pool & Vardar 2025), F_e held
+//!    (F_l ← a F_l + (1−a) F_e, a = e^{−ω_c h} exact, its RK4/Euler
+//!    polynomial otherwise);
 //! 4. normal force N = max(0, F_n + F_l); friction limit μ_s·N, sliding
 //!    friction (μ_k + (μ_s−μ_k)e^{−(v/v_s)²})·N + c_v|v| (Stribeck), μ scaled
 //!    by coloured noise and drift;
 //! 5. the tip (mass m on lateral stiffness k and damping c to the holder,
-//!    which moves at the input velocity) rubs on the glass: exact linear map
-//!    plus the implicit set-valued Coulomb law (integrator.rs).
+//!    which moves at the input velocity) rubs on the glass: the linear map
+//!    plus the implicit set-valued Coulomb law (integrator.rs), the same law
+//!    for every method.
+//!
+//! The splitting (each step's N from the end of its electrical step) makes
+//! every method first order overall; all converge to the event-driven
+//! reference of `reference.rs` (convergence_tests.rs).
 //!
 //! The output is the force the contact transmits to the holder,
 //! F = k·δ + c·(v_holder − v_tip), δ = x_holder − x_tip.
 
 use super::electrical::{self, Circuit};
-use super::expm::Mat;
-use super::integrator::{explicit_step, matvec, CoulombLti, Lti, Method, Plant, V_REG};
+use super::integrator::{decay, CoulombLti, Lti, Method, Plant};
 use super::noise::Ou;
 use super::profile::LabProfile;
 use super::rng::Rng;
@@ -57,8 +65,6 @@ pub struct DisplayModel {
     hs: f64,
     circuit: Circuit,
     elec: Lti,
-    ae: Vec<f64>,
-    be: Vec<f64>,
     mech: CoulombLti,
     ke: f64,
     gain: f64,
@@ -74,9 +80,9 @@ pub struct DisplayModel {
     rng: Rng,
     mu_noise: Ou,
     mu_drift: Ou,
-    x0: [f64; electrical::N],
-    // State.
-    xe: [f64; electrical::N],
+    x0: [f64; electrical::NR],
+    // State: circuit and relaxation, lag, contact (δ, v_tip).
+    xe: [f64; electrical::NR],
     fl: f64,
     xm: [f64; 2],
     stuck: bool,
@@ -100,11 +106,21 @@ impl DisplayModel {
         seed: u64,
     ) -> Result<Self, String> {
         profile.validate()?;
+        let fr = profile.display.electrical.relaxation_hz;
+        if !(rate.is_finite() && rate > 0.0) {
+            return Err(format!("the sample rate {rate} Hz is not a positive number"));
+        }
+        if fr >= 0.5 * rate {
+            return Err(format!(
+                "`display.electrical.relaxation_hz` = {fr} Hz must be below half the sample rate ({} Hz)",
+                0.5 * rate
+            ));
+        }
         let h = 1.0 / rate;
         let hs = h / substeps.max(1) as f64;
         let circuit = Circuit::of(profile);
-        let (ae, be) = circuit.matrices();
-        let elec = Lti::new(ae.clone(), be.clone(), electrical::N, 1, hs, method)?;
+        let (ae, be) = circuit.relaxed_matrices();
+        let elec = Lti::new(ae, be, electrical::NR, 1, hs, method)?;
         let ct = &profile.display.contact;
         let (k, c, m) = (ct.stiffness_n_per_m, ct.damping_ns_per_m, ct.tip_mass_g * 1e-3);
         // States (δ, v_tip); input v_holder; friction f on the tip.
@@ -112,17 +128,8 @@ impl DisplayModel {
         let mech = CoulombLti::new(plant, vec![0.0, -1.0 / m], 1, hs, method)?;
         let a = &profile.display.amplifier;
         let f = &profile.display.friction;
-        // DC steady state of the circuit under the amplifier offset: x = −A⁻¹ B V_off.
-        let amat = Mat { n: electrical::N, a: ae.clone() };
-        let mut rhs = Mat::zeros(electrical::N);
-        for (i, b) in be.iter().enumerate() {
-            rhs.set(i, 0, -b * a.offset_v);
-        }
-        let ss = amat.solve(&rhs).ok_or("the display circuit has no DC steady state")?;
-        let mut x0 = [0.0; electrical::N];
-        for (i, x) in x0.iter_mut().enumerate() {
-            *x = ss.get(i, 0);
-        }
+        // DC steady state of the circuit under the amplifier offset.
+        let x0 = circuit.dc_state(a.offset_v).ok_or("the display circuit has no DC steady state")?;
         let noise_scale = noise.max(0.0);
         let fb = f.noise_bandwidth_hz;
         let mut model = Self {
@@ -131,8 +138,6 @@ impl DisplayModel {
             hs,
             circuit,
             elec,
-            ae,
-            be,
             mech,
             ke: profile.electrostatic_coefficient(),
             gain: a.gain_v,
@@ -178,7 +183,8 @@ impl DisplayModel {
 
     fn reset_dynamics(&mut self) {
         self.xe = self.x0;
-        self.fl = self.ke * self.x0[electrical::GAP] * self.x0[electrical::GAP];
+        let vr = electrical::force_voltage(&self.x0);
+        self.fl = self.ke * vr * vr;
         self.xm = [0.0; 2];
         self.stuck = true;
         self.last_n = 0.0;
@@ -204,23 +210,18 @@ impl DisplayModel {
         let vcmd = (self.gain * u + self.offset + noise).clamp(-self.vmax, self.vmax);
         let mu_scale = (1.0 + self.mu_noise.step() + self.mu_drift.step()).max(0.0);
         let wc = self.lag0 + self.lag_slope * v.abs();
-        if self.method == Method::Exact {
-            let a = (-wc * self.hs).exp();
-            let fric = self.fric;
-            for _ in 0..self.substeps {
-                self.elec.step(&mut self.xe, &[vcmd]);
-                let vg = self.xe[electrical::GAP];
-                let fe = self.ke * vg * vg;
-                self.fl = a * self.fl + (1.0 - a) * fe;
-                let n = (load + self.fl).max(0.0);
-                self.last_n = n;
-                let limit =
-                    if self.stuck { fric.mu_s * mu_scale * n } else { fric.slide(self.xm[1].abs(), n, mu_scale) };
-                let r = self.mech.step(&mut self.xm, &[v], limit, |s| fric.slide(s, n, mu_scale));
-                self.stuck = r.stuck;
-            }
-        } else {
-            self.explicit(vcmd, load, v, wc, mu_scale);
+        let a = decay(self.method, -wc * self.hs);
+        let fric = self.fric;
+        for _ in 0..self.substeps {
+            self.elec.step(&mut self.xe, &[vcmd]);
+            let vr = electrical::force_voltage(&self.xe);
+            let fe = self.ke * vr * vr;
+            self.fl = a * self.fl + (1.0 - a) * fe;
+            let n = (load + self.fl).max(0.0);
+            self.last_n = n;
+            let limit = if self.stuck { fric.mu_s * mu_scale * n } else { fric.slide(self.xm[1].abs(), n, mu_scale) };
+            let r = self.mech.step(&mut self.xm, &[v], limit, |s| fric.slide(s, n, mu_scale));
+            self.stuck = r.stuck;
         }
         let f = self.k * self.xm[0] + self.c * (v - self.xm[1]);
         let ok = f.is_finite()
@@ -238,36 +239,6 @@ impl DisplayModel {
                 0.0
             }
         }
-    }
-
-    /// Explicit Euler / RK4 on the coupled equations, friction regularized.
-    fn explicit(&mut self, vcmd: f64, load: f64, v: f64, wc: f64, mu_scale: f64) {
-        const NE: usize = electrical::N;
-        let mut s = [0.0; 8];
-        s[..NE].copy_from_slice(&self.xe);
-        s[NE] = self.fl;
-        s[NE + 1] = self.xm[0];
-        s[NE + 2] = self.xm[1];
-        let (ae, be, ke, k, c, m, fric) = (&self.ae, &self.be, self.ke, self.k, self.c, self.m, self.fric);
-        for _ in 0..self.substeps {
-            explicit_step(self.method, &mut s, NE + 3, self.hs, |x, d| {
-                matvec(ae, &x[..NE], NE, NE, &mut d[..NE]);
-                for i in 0..NE {
-                    d[i] += be[i] * vcmd;
-                }
-                let vg = x[electrical::GAP];
-                d[NE] = wc * (ke * vg * vg - x[NE]);
-                let n = (load + x[NE]).max(0.0);
-                let vt = x[NE + 2];
-                let f = fric.slide(vt.abs(), n, mu_scale) * (vt / V_REG).clamp(-1.0, 1.0);
-                d[NE + 1] = v - vt;
-                d[NE + 2] = (k * x[NE + 1] + c * (v - vt) - f) / m;
-            });
-        }
-        self.xe.copy_from_slice(&s[..NE]);
-        self.fl = s[NE];
-        self.xm = [s[NE + 1], s[NE + 2]];
-        self.last_n = (load + self.fl).max(0.0);
     }
 
     /// The gap voltage now, V.
@@ -296,9 +267,9 @@ impl DisplayModel {
         self.stuck = v_tip == 0.0;
     }
 
-    /// Sets the circuit state; for tests.
+    /// Sets the circuit state (the relaxation state keeps its value); for tests.
     pub fn set_circuit(&mut self, x: [f64; electrical::N]) {
-        self.xe = x;
+        self.xe[..electrical::N].copy_from_slice(&x);
     }
 
     /// The circuit of this display.

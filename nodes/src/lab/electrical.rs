@@ -12,14 +12,36 @@
 //! C_i v̇_i = i − v_i/R_i      C_g v̇_g = i − v_g/R_g      C_t v̇_t = i − v_t/R_t
 //! ```
 //!
-//! The electrostatic force acts across the gap: F_e = k_e v_g², k_e = ε0A/(2d²).
+//! The electrostatic force acts across the gap: F_e = k_e v_r², k_e = ε0A/(2d²),
+//! where v_r is the gap voltage after an optional first-order charge
+//! relaxation (a high-pass of corner f_r = `relaxation_hz`; 0 = none):
+//!
+//! ```text
+//! q̇ = ω_r (v_g − q),   v_r = v_g − q,   ω_r = 2π f_r
+//! ```
+//!
+//! q is the part of the gap voltage that charge moving in the contact (the
+//! stratum corneum, a moist finger, a lossy coating) has already screened;
+//! V_r(jω) = jω/(jω + ω_r) · V_g(jω). The display models carry q as a fifth
+//! state of the circuit ([`Circuit::relaxed_matrices`]); with f_r = 0 it
+//! stays 0.
 
 use super::profile::LabProfile;
 
 /// Index of the gap voltage in the state.
 pub const GAP: usize = 2;
-/// Number of states.
+/// Number of states of the circuit.
 pub const N: usize = 4;
+/// Index of the relaxation state q in the relaxed circuit's state.
+pub const RELAX: usize = 4;
+/// Number of states of the circuit with its relaxation state.
+pub const NR: usize = 5;
+
+/// The voltage that reaches the square law, v_r = v_g − q, of a relaxed-circuit state.
+#[inline]
+pub fn force_voltage(x: &[f64; NR]) -> f64 {
+    x[GAP] - x[RELAX]
+}
 
 /// The circuit's element values in SI units.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -40,6 +62,8 @@ pub struct Circuit {
     pub rt: f64,
     /// Return resistance, Ω.
     pub rb: f64,
+    /// Charge-relaxation corner, rad/s (0 = none).
+    pub omega_r: f64,
 }
 
 impl Circuit {
@@ -55,6 +79,7 @@ impl Circuit {
             ct: e.tip_capacitance_nf * 1e-9,
             rt: e.tip_resistance_kohm * 1e3,
             rb: e.return_kohm * 1e3,
+            omega_r: 2.0 * std::f64::consts::PI * e.relaxation_hz,
         }
     }
 
@@ -74,6 +99,49 @@ impl Circuit {
         }
         let b = vec![self.omega_a, 0.0, 0.0, 0.0];
         (a, b)
+    }
+
+    /// (A, B) of the circuit with its relaxation state q (index [`RELAX`]),
+    /// 5 × 5 and 5 × 1: the rows of [`Circuit::matrices`] and q̇ = ω_r (v_g − q).
+    pub fn relaxed_matrices(&self) -> (Vec<f64>, Vec<f64>) {
+        let (a4, b4) = self.matrices();
+        let mut a = vec![0.0; NR * NR];
+        for i in 0..N {
+            a[i * NR..i * NR + N].copy_from_slice(&a4[i * N..(i + 1) * N]);
+        }
+        a[RELAX * NR + GAP] = self.omega_r;
+        a[RELAX * NR + RELAX] = -self.omega_r;
+        let mut b = vec![0.0; NR];
+        b[..N].copy_from_slice(&b4);
+        (a, b)
+    }
+
+    /// The relaxed circuit's steady state under a constant command `v` V:
+    /// x = −A⁻¹ B v for the circuit, q = v_g when relaxing (else 0).
+    /// `None` when the circuit has no DC steady state.
+    pub fn dc_state(&self, v: f64) -> Option<[f64; NR]> {
+        let (a, b) = self.matrices();
+        let amat = super::expm::Mat { n: N, a };
+        let mut rhs = super::expm::Mat::zeros(N);
+        for (i, bi) in b.iter().enumerate() {
+            rhs.set(i, 0, -bi * v);
+        }
+        let ss = amat.solve(&rhs)?;
+        let mut x = [0.0; NR];
+        for (i, xi) in x.iter_mut().take(N).enumerate() {
+            *xi = ss.get(i, 0);
+        }
+        x[RELAX] = if self.omega_r > 0.0 { x[GAP] } else { 0.0 };
+        x.iter().all(|v| v.is_finite()).then_some(x)
+    }
+
+    /// The square-law voltage v_r per volt commanded at `f` Hz, as (re, im):
+    /// [`Circuit::gap_response`] times the relaxation's jω/(jω + ω_r).
+    pub fn relaxed_response(&self, f: f64) -> (f64, f64) {
+        let g = self.gap_response(f);
+        let w = 2.0 * std::f64::consts::PI * f;
+        let hp = cdiv((0.0, w), (self.omega_r, w));
+        (g.0 * hp.0 - g.1 * hp.1, g.0 * hp.1 + g.1 * hp.0)
     }
 
     /// Gap voltage per volt commanded at frequency `f` Hz, as (re, im):

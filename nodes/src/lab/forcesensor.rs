@@ -1,8 +1,8 @@
 //! `sim.forcesensor`: the tribometer's force sensor and acquisition.
 
 use super::sensor_model::SensorModel;
-use super::{method_of, profile_of, INTEGRATOR_PARAM, NOISE_PARAM, PROFILE_PARAM, SUBSTEPS_PARAM};
-use evflow_engine::{BuildContext, Io, Node, NodeError, NodeSpec, ParamSpec, Params, PortSpec, Role, Summary};
+use super::{method_of, profile_of, INTEGRATOR_PARAM, NOISE_PARAM, PROFILE_PARAM, SEED_PARAM, SUBSTEPS_PARAM};
+use evflow_engine::{BuildContext, Io, Node, NodeError, NodeSpec, Params, PortSpec, Role, Summary};
 
 /// Declaration of `sim.forcesensor`.
 pub static SPEC: NodeSpec = NodeSpec::new(
@@ -30,20 +30,7 @@ pub static SPEC: NodeSpec = NodeSpec::new(
     PortSpec::input("velocity", "m/s", "carriage velocity (its sign selects the bias)"),
     PortSpec::output("force", "N", "acquired lateral force"),
 ])
-.params(&[
-    PROFILE_PARAM,
-    INTEGRATOR_PARAM,
-    SUBSTEPS_PARAM,
-    NOISE_PARAM,
-    ParamSpec::int(
-        "seed",
-        -1,
-        i64::MAX,
-        -1,
-        "1",
-        "noise and drift seed (−1: from the graph's seed and the node name; set it per repetition)",
-    ),
-])
+.params(&[PROFILE_PARAM, INTEGRATOR_PARAM, SUBSTEPS_PARAM, NOISE_PARAM, SEED_PARAM])
 .example("profile = \"\"\nnoise = 1.0");
 
 struct SimForceSensor {

@@ -23,7 +23,11 @@ pub mod user;
 #[cfg(test)]
 mod chain_tests;
 #[cfg(test)]
+mod convergence_tests;
+#[cfg(test)]
 mod display_tests;
+#[cfg(test)]
+mod reference;
 #[cfg(test)]
 mod testutil;
 #[cfg(test)]
@@ -46,6 +50,17 @@ pub fn seed_of(p: &Params, ctx: &BuildContext) -> u64 {
         _ => ctx.node_seed(),
     }
 }
+
+/// The `seed` parameter of the lab's noisy nodes: copies of a node given the
+/// same seed draw the same noise (common random numbers).
+pub const SEED_PARAM: ParamSpec = ParamSpec::int(
+    "seed",
+    -1,
+    i64::MAX,
+    -1,
+    "1",
+    "noise seed (−1: from the graph's seed and the node name; equal seeds give copies the same noise stream)",
+);
 
 /// The `profile` parameter shared by the lab's nodes.
 pub const PROFILE_PARAM: ParamSpec = ParamSpec::text(

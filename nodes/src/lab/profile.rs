@@ -39,6 +39,9 @@ pub struct Electrical {
     pub tip_capacitance_nf: f64,
     /// Return path resistance (pen body, stylus, ground) in kΩ.
     pub return_kohm: f64,
+    /// Corner of the charge-relaxation high-pass between the gap voltage and
+    /// the square law, Hz (0 = no relaxation). See `electrical.rs`.
+    pub relaxation_hz: f64,
 }
 
 /// Friction at the sliding contact.
@@ -173,6 +176,7 @@ impl Default for LabProfile {
                     tip_resistance_kohm: 100.0,
                     tip_capacitance_nf: 10.0,
                     return_kohm: 10.0,
+                    relaxation_hz: 0.0,
                 },
                 friction: Friction {
                     mu_static: 0.45,
@@ -309,6 +313,15 @@ pub static KEYS: &[Key] = &[
         "pen tip / stratum corneum capacitance"
     ),
     key!("display.electrical", return_kohm, display.electrical, "kΩ", 1e-3, 1e6, "return path resistance"),
+    key!(
+        "display.electrical",
+        relaxation_hz,
+        display.electrical,
+        "Hz",
+        0.0,
+        1e5,
+        "charge-relaxation high-pass corner before the square law (0 = off)"
+    ),
     key!("display.friction", mu_static, display.friction, "1", 0.0, 5.0, "static friction coefficient"),
     key!("display.friction", mu_kinetic, display.friction, "1", 0.0, 5.0, "kinetic friction coefficient"),
     key!("display.friction", stribeck_velocity, display.friction, "m/s", 1e-6, 10.0, "Stribeck velocity"),

@@ -36,9 +36,9 @@ pub fn shipped(name: &str) -> crate::lab::LabProfile {
     crate::lab::LabProfile::load(&path).unwrap_or_else(|e| panic!("{e}"))
 }
 
-/// The three shipped profiles with their names.
+/// The shipped profiles with their names.
 pub fn all_shipped() -> Vec<(&'static str, crate::lab::LabProfile)> {
-    ["nominal", "stiff", "display-b"].into_iter().map(|n| (n, shipped(n))).collect()
+    ["nominal", "stiff", "display-b", "relaxing", "resonant"].into_iter().map(|n| (n, shipped(n))).collect()
 }
 
 /// ±`level` PRBS from a 9-bit maximal LFSR (x⁹ + x⁵ + 1), one value per sample.

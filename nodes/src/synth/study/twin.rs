@@ -7,23 +7,27 @@
 //! actuation sample. The achievable floor ([`super::floor`]) optimizes
 //! through them — through the display itself, not a model of it.
 //!
-//! Forward, per substep (exact integrator): circuit x_e ← Φ_e x_e + Γ_e V_cmd;
-//! F_e = k_e v_g²; lag F_l ← a F_l + (1 − a) F_e; N = max(0, F_n + F_l); the
+//! Forward, per substep (exact integrator): circuit with its charge
+//! relaxation state q (electrical.rs) x_e ← Φ_e x_e + Γ_e V_cmd;
+//! F_e = k_e v_r², v_r = v_g − q (q ≡ 0 without relaxation); lag F_l ← a F_l + (1 − a) F_e; N = max(0, F_n + F_l); the
 //! tip's augmented exact map gives the free motion and the slip s; the
 //! contact sticks if the force that keeps s = 0 is within the static limit,
 //! else it slides with the Stribeck friction (or with that force, if
 //! smaller). Backward: the same steps transposed; the stick/slide branch and
 //! the clamps (amplifier limit, N ≥ 0, sensor full scale) are held as the
 //! forward pass took them (their derivative where they switch is taken as
-//! that of the branch taken), the sensor's quantization is passed straight
-//! through. The tests check the twin against the lab's models sample by
+//! that of the branch taken), the sensor's quantization is exact forward and
+//! passed straight through backward (its derivative is 0 almost everywhere,
+//! which would stop every gradient; the straight-through estimate treats the
+//! rounding as the identity, off by at most half a converter step). The tests check the twin against the lab's models sample by
 //! sample and the gradient against central differences.
 
 use crate::lab::electrical::{self, Circuit};
-use crate::lab::expm::{zoh, Mat};
+use crate::lab::expm::zoh;
 use crate::lab::profile::LabProfile;
 
-const NE: usize = electrical::N;
+/// States of the circuit with its relaxation state.
+const NE: usize = electrical::NR;
 
 /// How a substep's contact step went.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -41,7 +45,8 @@ enum Branch {
 struct Step {
     xe0: [f64; NE],
     xm0: [f64; 2],
-    vg: f64,
+    /// The square-law voltage v_r = v_g − q after the circuit step.
+    vr: f64,
     npre: f64,
     branch: Branch,
     req_sign: f64,
@@ -96,7 +101,7 @@ impl DisplayTwin {
         let sub = substeps.max(1);
         let hs = 1.0 / rate / sub as f64;
         let circuit = Circuit::of(profile);
-        let (ae, be) = circuit.matrices();
+        let (ae, be) = circuit.relaxed_matrices();
         let (phi_e, gam_e) = zoh(&ae, &be, NE, 1, hs).ok_or("the circuit's matrix exponential is not finite")?;
         let ct = &profile.display.contact;
         let (k, c, m) = (ct.stiffness_n_per_m, ct.damping_ns_per_m, ct.tip_mass_g * 1e-3);
@@ -117,16 +122,7 @@ impl DisplayTwin {
         let (phi_m, gam_m) = zoh(&aa, &ba, na, ma, hs).ok_or("the contact's matrix exponential is not finite")?;
         let amp = &profile.display.amplifier;
         let f = &profile.display.friction;
-        let amat = Mat { n: NE, a: ae.clone() };
-        let mut rhs = Mat::zeros(NE);
-        for (i, bi) in be.iter().enumerate() {
-            rhs.set(i, 0, -bi * amp.offset_v);
-        }
-        let ss = amat.solve(&rhs).ok_or("the display circuit has no DC steady state")?;
-        let mut x0 = [0.0; NE];
-        for (i, x) in x0.iter_mut().enumerate() {
-            *x = ss.get(i, 0);
-        }
+        let x0 = circuit.dc_state(amp.offset_v).ok_or("the display circuit has no DC steady state")?;
         Ok(Self {
             sub,
             hs,
@@ -173,7 +169,8 @@ impl DisplayTwin {
         tape.samples.clear();
         tape.velocity.clear();
         let mut xe = self.x0;
-        let mut fl = self.ke * self.x0[electrical::GAP] * self.x0[electrical::GAP];
+        let vr0 = electrical::force_voltage(&self.x0);
+        let mut fl = self.ke * vr0 * vr0;
         let mut xm = [0.0f64; 2];
         let mut stuck = true;
         let mut out = Vec::with_capacity(u.len());
@@ -195,8 +192,8 @@ impl DisplayTwin {
                 for i in 0..NE {
                     xe[i] = y[i] + self.gam_e[i] * vcmd;
                 }
-                let vg = xe[electrical::GAP];
-                let fe = self.ke * vg * vg;
+                let vr = electrical::force_voltage(&xe);
+                let fe = self.ke * vr * vr;
                 fl = a * fl + (1.0 - a) * fe;
                 let npre = ld + fl;
                 let nf = npre.max(0.0);
@@ -226,7 +223,7 @@ impl DisplayTwin {
                     }
                     stuck = false;
                 }
-                tape.steps.push(Step { xe0, xm0, vg, npre, branch, req_sign: required.signum() });
+                tape.steps.push(Step { xe0, xm0, vr, npre, branch, req_sign: required.signum() });
             }
             out.push(self.k * xm[0] + self.c * (v - xm[1]));
         }
@@ -284,7 +281,8 @@ impl DisplayTwin {
                 let bfe = (1.0 - a) * bfl;
                 bfl *= a;
                 let mut bxe1 = bxe;
-                bxe1[electrical::GAP] += bfe * 2.0 * self.ke * s.vg;
+                bxe1[electrical::GAP] += bfe * 2.0 * self.ke * s.vr;
+                bxe1[electrical::RELAX] -= bfe * 2.0 * self.ke * s.vr;
                 // (1) circuit.
                 let mut b0 = [0.0; NE];
                 for (i, bi) in bxe1.iter().enumerate() {

@@ -128,6 +128,12 @@ impl Row {
         }
         Some(f)
     }
+
+    /// The recording graphs/synthesize.toml wrote for this row at `gain`
+    /// (every method's actuation and force, the real force, the gate).
+    pub fn recording(&self, gain: f64) -> PathBuf {
+        self.dir.join(format!("synth-{}-{}-g{gain}", self.sample, self.cond.tag()))
+    }
 }
 
 /// Inputs of [`run`].

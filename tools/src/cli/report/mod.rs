@@ -4,12 +4,12 @@
 pub mod foaw;
 pub mod freqvel;
 pub mod interp;
-pub mod interp_narx;
+pub mod interp_cells;
+pub mod interp_cells_table;
 pub mod lab_recording;
 pub mod mesh;
 pub mod narx;
 pub mod resample;
-pub mod synthesis;
 pub mod textures;
 pub mod textures_table;
 
@@ -44,10 +44,12 @@ enum Which {
     /// the basic (§5.3.3) and improved (Eq. 6.4) schemes against the
     /// recording at every untrained condition, E_s beside the repeat
     /// baseline; a table and PNG spectra. The cells are the recorded
-    /// forces, or (--cells narx) NARX-synthesized actuation played on the
-    /// virtual display.
+    /// forces, or (--cells narx|optimized|playback) one synthesis method's
+    /// actuation played on the virtual display — interpolated in the
+    /// dissertation's order and forces first (interpolate the forces, then
+    /// synthesize with the nearest trained condition's model).
     ///
-    /// Example: cargo run --release -p evflow -- report interp --cells narx --out report
+    /// Example: cargo run --release -p evflow -- report interp --cells optimized --out report
     Interp(interp::Args),
     /// Re-sampling for the texture chain (§6.2): error against run time
     /// of rubato's sinc, polynomial and FFT resamplers and the live

@@ -130,13 +130,15 @@ fn build(p: &Params, ctx: &BuildContext) -> Result<Box<dyn Node>, NodeError> {
         Ok(m.closed_loop()?.run(&force).into_iter().map(|u| u.clamp(-bound, bound)).collect())
     };
     let kappa = model.carrier_gain_n;
+    let kappa_positive = kappa.is_finite() && kappa > 0.0;
+    let has_narx = !p.str("narx_model").is_empty();
     let (start, start_used) = match p.str("start") {
         "narx" => (narx_start("start = \"narx\"")?, "narx"),
         "zero" => (vec![0.0; force.len()], "zero"),
         // A model whose carrier gain is not positive (a display whose force the
         // model hardly explains) gives the square-law start no meaning: start
         // from the inverse model when one is given.
-        _ if !(kappa.is_finite() && kappa > 0.0) && !p.str("narx_model").is_empty() => {
+        _ if has_narx && !kappa_positive => {
             (narx_start("the fallback start")?, "narx (the model's carrier gain is not positive)")
         }
         _ => (carrier(&force, &keep, kappa, bound)?, "carrier"),

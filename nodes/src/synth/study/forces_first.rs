@@ -69,6 +69,7 @@ pub fn optimized(i: &FfInputs<'_>) -> Result<FfScore, StudyError> {
         format!("objective={}", text(i.objective)),
         format!("opt.target={}", path(i.interpolated)),
         "opt.channel=\"ff_in\"".to_string(),
+        "record_time=true".to_string(),
     ];
     let r = run_graph(&graph, &sets, &i.dir)?;
     let seconds = value(&r, &graph, "opt", "seconds")?;

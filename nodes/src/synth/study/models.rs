@@ -56,7 +56,9 @@ pub fn build(
         None
     };
     let t = std::time::Instant::now();
-    run_graph(&graphs.join("forward-build.toml"), &common, dir)?;
+    let mut forward_sets = common.clone();
+    forward_sets.push("record_time=true".into());
+    run_graph(&graphs.join("forward-build.toml"), &forward_sets, dir)?;
     let forward = found(dir.join(format!("forward-{}.json", c.tag())))?;
     Ok(Models { narx, narx_multilevel, forward, seconds: [narx_s, ml_s, t.elapsed().as_secs_f64()] })
 }

@@ -256,6 +256,7 @@ pub fn optimize(i: &RowInputs<'_>) -> Result<(PathBuf, f64), StudyError> {
         format!("narx_model={}", path(&i.models.narx)),
         format!("iterations={}", i.iterations),
         format!("objective={}", text(i.objective)),
+        "record_time=true".to_string(),
     ];
     let r = run_graph(&graph, &sets, &i.dir)?;
     Ok((i.dir.join(format!("u-{}-{}", i.sample, c.tag())), value(&r, &graph, "opt", "seconds")?))

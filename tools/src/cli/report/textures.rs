@@ -59,7 +59,9 @@ pub struct Args {
     /// Also write each texture's grid of actuation signals U_ij (the trained
     /// cells at their Table 5.1 gains) here, one folder per method and
     /// texture — `optimized-SAMPLE`, `narx-SAMPLE`, `playback-SAMPLE` — for
-    /// `interp` (graphs/texture-live.toml's `textures`). Nominal profile only.
+    /// `interp` (graphs/texture-live.toml's `textures`). Nominal profile
+    /// only. (`report interp --cells optimized` writes the same cells
+    /// together with the cross-validation; the shipped grids come from it.)
     #[arg(long)]
     grid: Option<PathBuf>,
     /// The folder of the shipped graphs.

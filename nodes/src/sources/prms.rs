@@ -78,7 +78,7 @@ impl Symbols {
     #[inline]
     fn next(&mut self) -> usize {
         match self {
-            Symbols::Mls { rec, .. } => rec.next() as usize,
+            Symbols::Mls { rec, .. } => rec.step() as usize,
             // Multiply-shift: uniform enough for q ≤ 13 (bias < 2⁻⁶⁰).
             Symbols::Random { rng, q } => ((u128::from(rng.next_u64()) * u128::from(*q)) >> 64) as usize,
         }
@@ -201,7 +201,7 @@ mod tests {
     /// One period of symbols straight from the recurrence.
     fn symbols(q: u32, n: u32) -> Vec<u32> {
         let mut r = Recurrence::new(&prms_field::primitive(q, n).unwrap(), q);
-        (0..prms_field::period(q, n).unwrap()).map(|_| r.next()).collect()
+        (0..prms_field::period(q, n).unwrap()).map(|_| r.step()).collect()
     }
 
     #[test]
@@ -210,7 +210,7 @@ mod tests {
             let s = symbols(q, n);
             let p = s.len();
             let mut r = Recurrence::new(&prms_field::primitive(q, n).unwrap(), q);
-            let twice: Vec<u32> = (0..2 * p).map(|_| r.next()).collect();
+            let twice: Vec<u32> = (0..2 * p).map(|_| r.step()).collect();
             assert_eq!(&twice[..p], &twice[p..], "q {q} n {n}: repeats after q^n − 1");
             // The window of n symbols visits every nonzero state once: no shorter period.
             let mut seen = std::collections::HashSet::new();

@@ -45,9 +45,9 @@ fn prime_factors(mut n: u64) -> Vec<u64> {
     let mut f = Vec::new();
     let mut d = 2;
     while d * d <= n {
-        if n % d == 0 {
+        if n.is_multiple_of(d) {
             f.push(d);
-            while n % d == 0 {
+            while n.is_multiple_of(d) {
                 n /= d;
             }
         }
@@ -175,7 +175,7 @@ impl Recurrence {
     /// The symbol that leaves the window (the sequence's next element); the
     /// recurrence's new symbol enters it.
     #[inline]
-    pub fn next(&mut self) -> u32 {
+    pub fn step(&mut self) -> u32 {
         let out = self.window[0];
         let mut acc: u64 = 0;
         for (&w, &t) in self.window.iter().zip(&self.neg_taps) {

@@ -46,7 +46,7 @@ pub static SPEC: NodeSpec = NodeSpec::new(
      instead if one is given, and says so.\n\n\
      **Timing.** The synthesis runs on the first block (offline only) and counts in the node's run \
      time. **Summary.** `objective_start`, `objective_end` (never above the start), `iterations`, \
-     `evaluations`, `lambda`, `seconds`, and why the optimizer stopped.",
+     `evaluations`, `lambda`, `seconds` (with `record_time`), and why the optimizer stopped.",
 )
 .ports(&[PortSpec::output("u", "1", "the synthesized actuation (1 = 50 V)")])
 .params(&[
@@ -68,6 +68,7 @@ pub static SPEC: NodeSpec = NodeSpec::new(
     ParamSpec::float("lambda", 0.0, 1e6, 0.0, "1", "noise weight λ when noise = \"fixed\""),
     ParamSpec::int("iterations", 0, 100_000, 100, "1", "largest number of optimizer iterations"),
     ParamSpec::float("bound", 1e-6, 2.0, 1.0, "1", "|u| ≤ bound"),
+    ParamSpec::flag("record_time", true, "report the synthesis time as the `seconds` value (off: identical reruns)"),
 ])
 .offline_only("it synthesizes the whole actuation from a recording before playing it")
 .example("target = \"recordings/felt\"\nmodel = \"models/forward.json\"\niterations = 5");
@@ -83,6 +84,8 @@ struct Optimize {
     u: Option<Vec<f64>>,
     summary: Summary,
     pos: usize,
+    /// Report `seconds`.
+    record_time: bool,
 }
 
 fn build(p: &Params, ctx: &BuildContext) -> Result<Box<dyn Node>, NodeError> {
@@ -130,13 +133,15 @@ fn build(p: &Params, ctx: &BuildContext) -> Result<Box<dyn Node>, NodeError> {
         Ok(m.closed_loop()?.run(&force).into_iter().map(|u| u.clamp(-bound, bound)).collect())
     };
     let kappa = model.carrier_gain_n;
+    let kappa_positive = kappa.is_finite() && kappa > 0.0;
+    let has_narx = !p.str("narx_model").is_empty();
     let (start, start_used) = match p.str("start") {
         "narx" => (narx_start("start = \"narx\"")?, "narx"),
         "zero" => (vec![0.0; force.len()], "zero"),
         // A model whose carrier gain is not positive (a display whose force the
         // model hardly explains) gives the square-law start no meaning: start
         // from the inverse model when one is given.
-        _ if !(kappa.is_finite() && kappa > 0.0) && !p.str("narx_model").is_empty() => {
+        _ if has_narx && !kappa_positive => {
             (narx_start("the fallback start")?, "narx (the model's carrier gain is not positive)")
         }
         _ => (carrier(&force, &keep, kappa, bound)?, "carrier"),
@@ -172,7 +177,18 @@ fn build(p: &Params, ctx: &BuildContext) -> Result<Box<dyn Node>, NodeError> {
         bound,
         options: Options { max_iter: p.usize("iterations"), ..Options::default() },
     };
-    Ok(Box::new(Optimize { force, keep, start, start_used, model, cfg, u: None, summary: Summary::default(), pos: 0 }))
+    Ok(Box::new(Optimize {
+        force,
+        keep,
+        start,
+        start_used,
+        model,
+        cfg,
+        u: None,
+        summary: Summary::default(),
+        pos: 0,
+        record_time: p.bool("record_time"),
+    }))
 }
 
 impl Optimize {
@@ -184,7 +200,6 @@ impl Optimize {
             .value("iterations", (s.history.len() - 1) as f64, "1")
             .value("evaluations", s.evaluations as f64, "1")
             .value("lambda", s.lambda, "1")
-            .value("seconds", s.seconds, "s")
             .line(format!(
                 "synthesized {} samples from the {} start: objective {:.4} → {:.4} in {} iterations ({}), {:.3} s",
                 s.u.len(),
@@ -195,6 +210,9 @@ impl Optimize {
                 s.stop.describe(),
                 s.seconds
             ));
+        if self.record_time {
+            self.summary = std::mem::take(&mut self.summary).value("seconds", s.seconds, "s");
+        }
         self.u = Some(s.u);
         Ok(())
     }

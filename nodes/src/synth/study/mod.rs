@@ -6,10 +6,14 @@
 //! gain sweep and rules ([`gains`]), E_s in two readings, beside the repeat
 //! baseline, the display floor and the achievable floor ([`floor`]).
 //!
-//! One module computes every row; `evflow report textures`, the
-//! interpolation cross-validation and the tests call it.
+//! One module computes every row; `evflow report textures`, `evflow report
+//! narx`, the interpolation cross-validation (`evflow report interp
+//! --cells …`: [`xval`], [`forces_first`]) and the tests call it. The
+//! cells of the live texture grids are cut from its runs ([`cells`]).
 
+pub mod cells;
 pub mod floor;
+pub mod forces_first;
 pub mod gains;
 pub mod graphs;
 pub mod models;
@@ -17,8 +21,10 @@ pub mod recordings;
 pub mod row;
 pub mod run;
 pub mod setup;
+pub mod spectrum;
 pub mod summary;
 pub mod twin;
+pub mod xval;
 
 use std::path::PathBuf;
 

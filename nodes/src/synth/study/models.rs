@@ -56,9 +56,45 @@ pub fn build(
         None
     };
     let t = std::time::Instant::now();
-    run_graph(&graphs.join("forward-build.toml"), &common, dir)?;
+    let mut forward_sets = common.clone();
+    forward_sets.push("record_time=true".into());
+    run_graph(&graphs.join("forward-build.toml"), &forward_sets, dir)?;
     let forward = found(dir.join(format!("forward-{}.json", c.tag())))?;
     Ok(Models { narx, narx_multilevel, forward, seconds: [narx_s, ml_s, t.elapsed().as_secs_f64()] })
+}
+
+/// Trains the inverse NARX model of `c` on `profile` alone
+/// (graphs/model-build.toml, binary excitation) into `dir`, with `extra`
+/// overrides (`--set` style, e.g. another network: `train.hidden=[5]`);
+/// returns the model file.
+pub fn inverse(
+    graphs: &Path,
+    profile: &Profile,
+    c: &Cond,
+    epochs: u32,
+    extra: &[String],
+    dir: &Path,
+) -> Result<PathBuf, StudyError> {
+    let mut sets = vec![
+        format!("mass={}", c.mass),
+        format!("speed={}", c.speed),
+        profile.set(),
+        format!("epochs={epochs}"),
+        "train.progress=false".to_string(),
+        "train.record_time=true".to_string(),
+    ];
+    sets.extend(extra.iter().cloned());
+    run_graph(&graphs.join("model-build.toml"), &sets, dir)?;
+    found(dir.join(format!("narx-{}.json", c.tag())))
+}
+
+/// The models of `c` built before into `dir` (`narx-TAG.json` and
+/// `forward-TAG.json`; no multilevel model): for a report that is given
+/// its models instead of building them.
+pub fn given(dir: &Path, c: &Cond) -> Result<Models, StudyError> {
+    let narx = found(dir.join(format!("narx-{}.json", c.tag())))?;
+    let forward = found(dir.join(format!("forward-{}.json", c.tag())))?;
+    Ok(Models { narx, narx_multilevel: None, forward, seconds: [0.0; 3] })
 }
 
 fn found(p: PathBuf) -> Result<PathBuf, StudyError> {

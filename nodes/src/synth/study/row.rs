@@ -128,6 +128,12 @@ impl Row {
         }
         Some(f)
     }
+
+    /// The recording graphs/synthesize.toml wrote for this row at `gain`
+    /// (every method's actuation and force, the real force, the gate).
+    pub fn recording(&self, gain: f64) -> PathBuf {
+        self.dir.join(format!("synth-{}-{}-g{gain}", self.sample, self.cond.tag()))
+    }
 }
 
 /// Inputs of [`run`].
@@ -250,6 +256,7 @@ pub fn optimize(i: &RowInputs<'_>) -> Result<(PathBuf, f64), StudyError> {
         format!("narx_model={}", path(&i.models.narx)),
         format!("iterations={}", i.iterations),
         format!("objective={}", text(i.objective)),
+        "record_time=true".to_string(),
     ];
     let r = run_graph(&graph, &sets, &i.dir)?;
     Ok((i.dir.join(format!("u-{}-{}", i.sample, c.tag())), value(&r, &graph, "opt", "seconds")?))

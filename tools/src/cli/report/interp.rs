@@ -7,8 +7,10 @@
 //! (a second recording of the same condition). With `--cells recorded` (the
 //! default) the cells are the recorded forces themselves (record-and-
 //! playback, §6.5.2), compared directly: this isolates the interpolation
-//! from the NARX models and the display. `--cells narx` runs the whole
-//! chain of the dissertation instead ([`super::interp_narx`]).
+//! from the models and the display. `--cells narx|optimized|playback` runs
+//! the whole chain instead, on the texture study: the cells are one
+//! method's actuation, played on the virtual display, in the dissertation's
+//! order and forces first ([`super::interp_cells`]).
 
 use super::lab_recording::{record, Condition};
 use anyhow::{anyhow, Context, Result};
@@ -30,25 +32,37 @@ pub enum Cells {
     /// The actuation signals inverse NARX models synthesize at the trained
     /// conditions (each at its Table 5.1 gain), interpolated and played on
     /// the virtual display at the untrained condition
-    /// (graphs/texture-cross-validation.toml).
+    /// (graphs/texture-cross-validation.toml); forces first with the
+    /// nearest trained condition's inverse model.
     Narx,
+    /// The optimized synthesis' actuation (through a forward model of each
+    /// trained condition, `report textures`' best method), interpolated and
+    /// played the same way; forces first optimizes offline through the
+    /// nearest trained condition's forward model.
+    Optimized,
+    /// Record-and-playback's cells (the forces normalized per recording),
+    /// interpolated and played the same way.
+    Playback,
 }
 
 /// Arguments of `evflow report interp`.
 #[derive(clap::Args, Debug)]
 pub struct Args {
-    /// Folder for the table and the PNG figures (and, with --cells narx, the models and grids).
+    /// Folder for the table and the PNG figures (and, with synthesized
+    /// cells, the models and the grids: `grids/METHOD-SAMPLE`,
+    /// `grids/playback-SAMPLE`, `grids/forces-SAMPLE`).
     #[arg(long, default_value = ".")]
     pub(super) out: PathBuf,
     /// Texture samples (default: all seven; the rippled paper uses the grid of Fig. 6.8).
     #[arg(long, value_delimiter = ',')]
     pub(super) samples: Vec<String>,
-    /// What the grid cells are: the recorded forces, or NARX-synthesized
-    /// actuation played on the virtual display.
+    /// What the grid cells are: the recorded forces, or one synthesis
+    /// method's actuation played on the virtual display (narx, optimized,
+    /// playback).
     #[arg(long, value_enum, default_value_t = Cells::Recorded)]
     pub(super) cells: Cells,
-    /// Tribometer passes per recording (--cells recorded; the NARX chain
-    /// records one pass, as graphs/synthesize.toml plays).
+    /// Tribometer passes per recording (--cells recorded; the synthesized
+    /// cells record one pass, as graphs/synthesize.toml plays).
     #[arg(long, default_value_t = 4)]
     pub(super) passes: u32,
     /// Band of E_s, Hz.
@@ -57,17 +71,20 @@ pub struct Args {
     /// The recording graph (--cells recorded).
     #[arg(long, default_value = "graphs/record-textures.toml")]
     pub(super) graph: PathBuf,
-    /// Gains of the sweep that chooses each cell's gain (--cells narx, §5.3.2).
+    /// Gains of the sweep that chooses each cell's gain (synthesized cells, §5.3.2).
     #[arg(long, value_delimiter = ',', default_value = "0.6,0.8,1.0,1.2,1.4")]
     pub(super) gains: Vec<f64>,
-    /// Levenberg–Marquardt epochs at most per model (--cells narx).
+    /// Levenberg–Marquardt epochs at most per inverse model (synthesized cells).
     #[arg(long, default_value_t = 200)]
     pub(super) epochs: u32,
-    /// Use the models in this folder (narx-MASSg-SPEEDcms.json) instead of
-    /// training them (--cells narx).
+    /// Iterations at most of the optimized synthesis (synthesized cells).
+    #[arg(long, default_value_t = 100)]
+    pub(super) iterations: usize,
+    /// Use the models in this folder (narx-MASSg-SPEEDcms.json and
+    /// forward-MASSg-SPEEDcms.json) instead of building them (synthesized cells).
     #[arg(long)]
     pub(super) models: Option<PathBuf>,
-    /// The folder of the shipped graphs (--cells narx).
+    /// The folder of the shipped graphs (synthesized cells).
     #[arg(long, default_value = "graphs")]
     pub(super) graphs: PathBuf,
 }
@@ -199,8 +216,8 @@ pub fn main(a: Args) -> Result<()> {
         anyhow::ensure!(NAMES.contains(&s.as_str()), "--samples: unknown sample `{s}` (one of {})", NAMES.join(", "));
     }
     std::fs::create_dir_all(&a.out).with_context(|| format!("{}: cannot create", a.out.display()))?;
-    if a.cells == Cells::Narx {
-        return super::interp_narx::main(&a, &samples);
+    if a.cells != Cells::Recorded {
+        return super::interp_cells::main(&a, &samples);
     }
     let tmp = tempfile::tempdir().context("cannot create a temporary folder")?;
     let band = Band::new(1000.0, 1000, a.band[0], a.band[1], false).map_err(|e| anyhow!("--band: {e}"))?;

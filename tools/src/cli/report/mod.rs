@@ -4,12 +4,12 @@
 pub mod foaw;
 pub mod freqvel;
 pub mod interp;
-pub mod interp_narx;
+pub mod interp_cells;
+pub mod interp_cells_table;
 pub mod lab_recording;
 pub mod mesh;
 pub mod narx;
 pub mod resample;
-pub mod synthesis;
 pub mod textures;
 pub mod textures_table;
 
@@ -44,10 +44,12 @@ enum Which {
     /// the basic (§5.3.3) and improved (Eq. 6.4) schemes against the
     /// recording at every untrained condition, E_s beside the repeat
     /// baseline; a table and PNG spectra. The cells are the recorded
-    /// forces, or (--cells narx) NARX-synthesized actuation played on the
-    /// virtual display.
+    /// forces, or (--cells narx|optimized|playback) one synthesis method's
+    /// actuation played on the virtual display — interpolated in the
+    /// dissertation's order and forces first (interpolate the forces, then
+    /// synthesize with the nearest trained condition's model).
     ///
-    /// Example: cargo run --release -p evflow -- report interp --cells narx --out report
+    /// Example: cargo run --release -p evflow -- report interp --cells optimized --out report
     Interp(interp::Args),
     /// Re-sampling for the texture chain (§6.2): error against run time
     /// of rubato's sinc, polynomial and FFT resamplers and the live
@@ -55,18 +57,22 @@ enum Which {
     ///
     /// Example: cargo run --release -p evflow -- report resample --out report
     Resample(resample::Args),
-    /// Virtual against real textures (Fig. 5.7/5.8, Table 5.1): inverse
-    /// NARX models trained per condition, each texture's force synthesized
-    /// and played on the virtual display over the gain sweep; E_s beside
-    /// the repeat baseline and record-and-playback, a Markdown table and
-    /// PNG spectra.
+    /// Virtual against real textures (Fig. 5.7/5.8, Table 5.1), on the
+    /// texture study: every method (inverse NARX on binary and multilevel
+    /// excitation, optimized synthesis through a forward model, fair
+    /// playback) on every lab profile, played on the virtual display over
+    /// the gain sweep; E_s beside the repeat baseline, the display floor and
+    /// the achievable floor, Markdown tables, rows.csv and PNG spectra;
+    /// `--grid` writes each method's cells for the live grids.
     ///
     /// Example: cargo run --release -p evflow -- report textures --out report
     Textures(textures::Args),
     /// Error against run time of the inverse NARX model (issue 6, point
     /// 10): several network sizes, tap delays and both trainers, each
-    /// trained at one condition and scored by the mean E_s of the textures
-    /// it synthesizes; a table with the Pareto front and a PNG.
+    /// trained at one condition and scored on the texture study (as
+    /// `report textures` scores every method: gain sweep, Table 5.1 rule and
+    /// best gain) by the mean E_s of the textures it synthesizes; a table
+    /// with the Pareto front and a PNG.
     ///
     /// Example: cargo run --release -p evflow -- report narx --out report
     Narx(narx::Args),

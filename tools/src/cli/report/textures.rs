@@ -4,14 +4,15 @@
 //! (`evflow_nodes::synth::study`); this command parses, calls, prints and
 //! draws.
 
-use super::synthesis::{gated_spectrum, write_cell, Cond as CellCond};
 use super::textures_table::{csv, markdown};
 use anyhow::{anyhow, ensure, Context, Result};
 use evflow_nodes::lab::texture::samples::NAMES;
 use evflow_nodes::recording::format::Recording;
+use evflow_nodes::synth::study::cells::write_actuation;
 use evflow_nodes::synth::study::row::{Method, Row};
 use evflow_nodes::synth::study::run::{run, Progress, StudyConfig};
 use evflow_nodes::synth::study::setup::{Cond, Profile};
+use evflow_nodes::synth::study::spectrum::gated;
 use evflow_tools::plot::{Plot, Series};
 use indicatif::{ProgressBar, ProgressStyle};
 use std::path::PathBuf;
@@ -58,7 +59,9 @@ pub struct Args {
     /// Also write each texture's grid of actuation signals U_ij (the trained
     /// cells at their Table 5.1 gains) here, one folder per method and
     /// texture — `optimized-SAMPLE`, `narx-SAMPLE`, `playback-SAMPLE` — for
-    /// `interp` (graphs/texture-live.toml's `textures`). Nominal profile only.
+    /// `interp` (graphs/texture-live.toml's `textures`). Nominal profile
+    /// only. (`report interp --cells optimized` writes the same cells
+    /// together with the cross-validation; the shipped grids come from it.)
     #[arg(long)]
     grid: Option<PathBuf>,
     /// The folder of the shipped graphs.
@@ -134,9 +137,14 @@ pub fn main(a: Args) -> Result<()> {
             ] {
                 let Some(res) = r.method(m) else { continue };
                 let gain = res.chosen.table51.gain;
-                let from = synth_recording(r, gain);
-                let c = CellCond { mass: r.cond.mass, speed: r.cond.speed };
-                write_cell(&from, channel, &g.join(format!("{folder}-{}", r.sample)), &r.sample, &c, gain)?;
+                write_actuation(
+                    &r.recording(gain),
+                    channel,
+                    &g.join(format!("{folder}-{}", r.sample)),
+                    &r.sample,
+                    &r.cond,
+                    gain,
+                )?;
             }
         }
         println!("wrote the grids under {}", g.display());
@@ -144,34 +152,26 @@ pub fn main(a: Args) -> Result<()> {
     Ok(())
 }
 
-/// The recording graphs/synthesize.toml wrote for `r` at `gain`.
-fn synth_recording(r: &Row, gain: f64) -> PathBuf {
-    r.dir.join(format!("synth-{}-{}-g{gain}", r.sample, r.cond.tag()))
-}
-
 /// Spectra of the real force and of each method's virtual force at its Table 5.1 gain.
 fn spectra_plot(r: &Row) -> Result<Plot> {
     let pts = |s: &[f64]| -> Vec<(f64, f64)> {
         s.iter().enumerate().skip(2).take(199).map(|(k, y)| (k as f64, *y)).collect()
     };
-    let read = |gain: f64| -> Result<Recording> {
-        let p = synth_recording(r, gain);
-        Recording::open(&p).map_err(|e| anyhow!("{e}"))
-    };
+    let read = |gain: f64| -> Result<Recording> { Recording::open(&r.recording(gain)).map_err(|e| anyhow!("{e}")) };
     let base = read(r.methods.first().map_or(1.0, |m| m.chosen.table51.gain))?;
     let ch = |rec: &Recording, n: &str| -> Result<Vec<f64>> {
         rec.channel(n).map(|c| c.to_vec()).ok_or_else(|| anyhow!("no `{n}` channel"))
     };
     let gate = ch(&base, "steady")?;
     let mut series =
-        vec![Series::line("real (repetition 2)", pts(&gated_spectrum(&ch(&base, "real_force")?, &gate, base.rate())?))];
+        vec![Series::line("real (repetition 2)", pts(&gated(&ch(&base, "real_force")?, &gate, base.rate())?))];
     for m in &r.methods {
         let rec = read(m.chosen.table51.gain)?;
         let channel = format!("{}_force", m.method.chain());
         if let Ok(f) = ch(&rec, &channel) {
             let label =
                 format!("{} (gain {}, E_s {:.2})", m.method.label(), m.chosen.table51.gain, m.chosen.table51.welch);
-            series.push(Series::line(label, pts(&gated_spectrum(&f, &gate, rec.rate())?)));
+            series.push(Series::line(label, pts(&gated(&f, &gate, rec.rate())?)));
         }
     }
     Ok(Plot {

@@ -67,18 +67,31 @@ struct Entry {
     out_lens: Vec<usize>,
     scratch: Vec<Vec<f64>>,
     split: bool,
+    /// Time in build and prepare.
+    setup: Duration,
+    /// Time in process, emit and absorb.
     elapsed: Duration,
+    /// Time in finish.
+    finishing: Duration,
 }
 
-/// Run time of one node.
+/// Run time of one node: all the work the node did for the run, wherever
+/// the node does it — a node that reads its data when built, or trains
+/// when the run ends (`narx.train`, `forward.train`), is charged for it.
 #[derive(Debug, Clone)]
 pub struct NodeTime {
     /// Node name.
     pub node: String,
     /// Node type.
     pub kind: &'static str,
-    /// Time spent in `process` (and `emit`/`absorb`).
+    /// All of it: `setup + process + finish`.
     pub elapsed: Duration,
+    /// Time spent building and preparing the node (before the first block).
+    pub setup: Duration,
+    /// Time spent in `process` (and `emit`/`absorb`).
+    pub process: Duration,
+    /// Time spent in `finish` when the run ended.
+    pub finish: Duration,
 }
 
 /// A compiled graph.
@@ -145,7 +158,9 @@ impl Plan {
                 out_dir: opts.out_dir.clone().unwrap_or_default(),
                 seed,
             };
+            let built = Instant::now();
             let node = (n.spec.build)(&n.params, &ctx).map_err(|e| fail(i, e))?;
+            let setup = if opts.timing { built.elapsed() } else { Duration::ZERO };
             let mut in_slots = Vec::new();
             let mut in_ratios = Vec::new();
             for p in n.inputs() {
@@ -182,7 +197,9 @@ impl Plan {
                 out_slots: slot_of[i].clone(),
                 out_ratios,
                 split,
+                setup,
                 elapsed: Duration::ZERO,
+                finishing: Duration::ZERO,
             });
         }
         let cap = |r: &Ratio| if r.div == 1 { max_block * r.mul } else { max_block.div_ceil(r.div) } as usize;
@@ -194,10 +211,14 @@ impl Plan {
         }
         for (k, e) in entries.iter_mut().enumerate() {
             let largest = e.in_ratios.iter().chain(&e.out_ratios).map(cap).max().unwrap_or(cap(&e.ratio));
+            let started = Instant::now();
             e.node.prepare(&PrepareContext { max_block: largest, mode: opts.mode }).map_err(|err| {
                 let i = checked.order[k];
                 fail(i, err)
             })?;
+            if opts.timing {
+                e.setup += started.elapsed();
+            }
         }
         Ok(Plan {
             name: g.name.clone(),
@@ -261,10 +282,14 @@ impl Plan {
             let k = self.late[li];
             let e = &mut self.entries[k];
             let mut none: [Vec<f64>; 0] = [];
+            let started = self.timing.then(Instant::now);
             let result = {
                 let mut io = Io::new(&self.pool, &e.in_slots, &e.in_lens, &mut none, &[], e.ratio.first(t0));
                 e.node.absorb(&mut io)
             };
+            if let Some(s) = started {
+                e.elapsed += s.elapsed();
+            }
             if let Err(err) = result {
                 return Err(self.failure(k, err));
             }
@@ -286,11 +311,17 @@ impl Plan {
     }
 
     /// Ends the run: every node's `finish`, in plan order (sinks rename their
-    /// files here). Returns each node's summary.
+    /// files here; trainers train). Returns each node's summary. The time
+    /// each `finish` takes is charged to its node ([`Plan::times`]).
     pub fn finish(&mut self) -> Result<Vec<(String, Summary)>, Box<NodeFailure>> {
         let mut out = Vec::new();
         for k in 0..self.entries.len() {
-            match self.entries[k].node.finish() {
+            let started = self.timing.then(Instant::now);
+            let result = self.entries[k].node.finish();
+            if let Some(s) = started {
+                self.entries[k].finishing += s.elapsed();
+            }
+            match result {
                 Ok(s) if !s.is_empty() => out.push((self.entries[k].name.clone(), s)),
                 Ok(_) => {}
                 Err(e) => return Err(self.failure(k, e)),
@@ -299,11 +330,13 @@ impl Plan {
         Ok(out)
     }
 
-    /// Back to t = 0: every node reset, every buffer zeroed.
+    /// Back to t = 0: every node reset, every buffer zeroed, the process
+    /// and finish times zeroed (the setup was done once and stays).
     pub fn reset(&mut self) {
         for e in &mut self.entries {
             e.node.reset();
             e.elapsed = Duration::ZERO;
+            e.finishing = Duration::ZERO;
         }
         for b in &mut self.pool {
             b.fill(0.0);
@@ -323,9 +356,20 @@ impl Plan {
         Some(&self.pool[s][..e.out_lens[port_index]])
     }
 
-    /// Run time of each node so far.
+    /// Run time of each node so far: setup, processing and finish (see
+    /// [`NodeTime`]; all zero when the plan was built without timing).
     pub fn times(&self) -> Vec<NodeTime> {
-        self.entries.iter().map(|e| NodeTime { node: e.name.clone(), kind: e.kind, elapsed: e.elapsed }).collect()
+        self.entries
+            .iter()
+            .map(|e| NodeTime {
+                node: e.name.clone(),
+                kind: e.kind,
+                elapsed: e.setup + e.elapsed + e.finishing,
+                setup: e.setup,
+                process: e.elapsed,
+                finish: e.finishing,
+            })
+            .collect()
     }
 
     /// Nodes in execution order: (name, type, rate in Hz).

@@ -84,3 +84,81 @@ pub fn run_offline(plan: &mut Plan, mut opts: RunOptions<'_>) -> Result<RunRepor
     let summaries = plan.finish()?;
     Ok(RunReport { ticks: done, base_rate: plan.base_rate(), elapsed, times: plan.times(), summaries })
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::check::check;
+    use crate::graph::parse_graph;
+    use crate::harness::FEED;
+    use crate::node::{BuildContext, Io, Node, NodeError};
+    use crate::params::Params;
+    use crate::plan::PlanOptions;
+    use crate::registry::Registry;
+    use crate::spec::{NodeSpec, PortSpec, Role};
+    use std::path::Path;
+    use std::sync::atomic::{AtomicU64, Ordering};
+
+    /// What the trainer below measured itself, in ns: its build, its finish.
+    static BUILD_NS: AtomicU64 = AtomicU64::new(0);
+    static FINISH_NS: AtomicU64 = AtomicU64::new(0);
+
+    /// A sink that does its real work when the run ends, as `narx.train`
+    /// does: it spins in `finish` (and, less, in `build`) until its own
+    /// clock says it is done, and records how long that was.
+    static TRAINER: NodeSpec =
+        NodeSpec::new("test.trainer", "test", Role::Sink, "works when the run ends (test only)", build_trainer)
+            .ports(&[PortSpec::input("in", "1", "anything")]);
+
+    fn spin(least: Duration) -> Duration {
+        let t = Instant::now();
+        while t.elapsed() < least {
+            std::hint::spin_loop();
+        }
+        t.elapsed()
+    }
+
+    fn build_trainer(_: &Params, _: &BuildContext) -> Result<Box<dyn Node>, NodeError> {
+        let took = spin(Duration::from_millis(1));
+        BUILD_NS.store(took.as_nanos() as u64, Ordering::SeqCst);
+        Ok(Box::new(Trainer))
+    }
+
+    struct Trainer;
+
+    impl Node for Trainer {
+        fn process(&mut self, _io: &mut Io<'_>) -> Result<(), NodeError> {
+            Ok(())
+        }
+        fn reset(&mut self) {}
+        fn finish(&mut self) -> Result<Summary, NodeError> {
+            let took = spin(Duration::from_millis(5));
+            FINISH_NS.store(took.as_nanos() as u64, Ordering::SeqCst);
+            Ok(Summary::default())
+        }
+    }
+
+    #[test]
+    fn work_done_when_the_run_ends_is_charged_to_the_node() {
+        let doc = "[graph]\nformat = 1\nname = \"t\"\nrate = 1000.0\nconnections = [\"f.out -> t.in\"]\n\
+                   [nodes.f]\ntype = \"harness.feed\"\nvalues = [1.0, 2.0, 3.0]\n[nodes.t]\ntype = \"test.trainer\"\n";
+        let mut reg = Registry::new();
+        reg.add(&FEED).add(&TRAINER);
+        let checked = check(&parse_graph(Path::new("t.toml"), doc).unwrap(), &reg, &[]).unwrap();
+        let mut plan = Plan::build(&checked, &PlanOptions::default()).unwrap();
+        let report = run_offline(&mut plan, RunOptions::default()).unwrap();
+        let t = report.times.iter().find(|t| t.node == "t").unwrap();
+        // The engine's clock brackets the node's own: whatever the machine
+        // does meanwhile, the charged time cannot be less than what the node
+        // measured inside its hooks.
+        let (build, finish) =
+            (Duration::from_nanos(BUILD_NS.load(Ordering::SeqCst)), Duration::from_nanos(FINISH_NS.load(Ordering::SeqCst)));
+        assert!(t.finish >= finish && finish >= Duration::from_millis(5), "{t:?} vs {finish:?}");
+        assert!(t.setup >= build && build >= Duration::from_millis(1), "{t:?} vs {build:?}");
+        assert_eq!(t.elapsed, t.setup + t.process + t.finish);
+        // Without timing nothing is charged.
+        let mut plan = Plan::build(&checked, &PlanOptions { timing: false, ..PlanOptions::default() }).unwrap();
+        let report = run_offline(&mut plan, RunOptions::default()).unwrap();
+        assert!(report.times.iter().all(|t| t.elapsed.is_zero()));
+    }
+}

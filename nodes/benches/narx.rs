@@ -11,6 +11,7 @@ use criterion::{criterion_group, criterion_main, Criterion};
 use evflow_nodes::narx::closed_loop::ClosedLoop;
 use evflow_nodes::narx::mapminmax::MapMinMax;
 use evflow_nodes::narx::net::Mlp;
+use evflow_nodes::narx::packed::Tanh;
 use evflow_nodes::narx::taps::Taps;
 use evflow_nodes::narx::train::{lm, Data, Options};
 use std::hint::black_box;
@@ -21,21 +22,75 @@ fn network(taps: Taps, hidden: &[usize]) -> Mlp {
     net
 }
 
+/// The closed loop as it ran before the blocked layout (issue 13, point 6):
+/// `Mlp::forward` on a row filled through modulo-indexed rings — the
+/// baseline the new loop is measured against, in the same run.
+struct Reference {
+    net: Mlp,
+    ws: evflow_nodes::narx::net::Workspace,
+    taps: Taps,
+    xh: Vec<f64>,
+    yh: Vec<f64>,
+    xpos: usize,
+    ypos: usize,
+    row: Vec<f64>,
+}
+
+impl Reference {
+    fn new(net: Mlp, taps: Taps) -> Self {
+        let ws = net.workspace();
+        let row = vec![0.0; taps.n_inputs()];
+        let nx = taps.input + taps.latency() + 1;
+        Self { net, ws, taps, xh: vec![0.0; nx], yh: vec![0.0; taps.feedback.max(1)], xpos: 0, ypos: 0, row }
+    }
+
+    fn step(&mut self, x: f64) -> f64 {
+        let nx = self.xh.len();
+        self.xpos = if self.xpos + 1 == nx { 0 } else { self.xpos + 1 };
+        self.xh[self.xpos] = x;
+        let skip = (self.taps.latency() as i64 - self.taps.lookahead) as usize;
+        let (xh, xpos, yh, ypos) = (&self.xh, self.xpos, &self.yh, self.ypos);
+        let ny = yh.len();
+        self.taps.fill(&mut self.row, |k| yh[(ypos + ny + 1 - k) % ny], |j| xh[(xpos + 2 * nx - skip - j) % nx]);
+        let y = self.net.forward(&self.row, &mut self.ws).clamp(-1.0, 1.0);
+        if self.taps.feedback > 0 {
+            self.ypos = if self.ypos + 1 == ny { 0 } else { self.ypos + 1 };
+            self.yh[self.ypos] = y;
+        }
+        y
+    }
+}
+
+/// One closed-loop sample of the shipped model size (15-10-5, taps 1/10/3,
+/// as graphs/data/models/*.json) and of the dissertation's (taps 10/10/−1):
+/// the loop before this layout, and the loop now with the exact and the
+/// fast tanh. Throughput = 1 / time per sample.
 fn closed_loop(c: &mut Criterion) {
     let map = MapMinMax { min: -1.0, max: 1.0 };
     let force: Vec<f64> = (0..1024).map(|i| (i as f64 * 0.37).sin() * 0.3).collect();
     for (name, taps) in [
-        ("closed_loop_sample/15-10-5, taps 1/10/3", Taps { feedback: 1, input: 10, lookahead: 3 }),
-        ("closed_loop_sample/15-10-5, taps 10/10/-1 (dissertation)", Taps { feedback: 10, input: 10, lookahead: -1 }),
+        ("15-10-5, taps 1-10-3 (shipped)", Taps { feedback: 1, input: 10, lookahead: 3 }),
+        ("15-10-5, taps 10-10--1 (dissertation)", Taps { feedback: 10, input: 10, lookahead: -1 }),
     ] {
-        let mut cl = ClosedLoop::new(network(taps, &[15, 10, 5]), taps, map, map);
+        let mut g = c.benchmark_group(format!("closed_loop_sample/{name}"));
+        let mut reference = Reference::new(network(taps, &[15, 10, 5]), taps);
         let mut i = 0;
-        c.bench_function(name, |b| {
+        g.bench_function("before (Mlp::forward, modulo rings)", |b| {
             b.iter(|| {
                 i = (i + 1) & 1023;
-                black_box(cl.step(black_box(force[i])))
+                black_box(reference.step(black_box(force[i])))
             })
         });
+        for tanh in [Tanh::Exact, Tanh::Fast] {
+            let mut cl = ClosedLoop::with_tanh(network(taps, &[15, 10, 5]), taps, map, map, tanh);
+            g.bench_function(format!("blocked, {} tanh", tanh.name()), |b| {
+                b.iter(|| {
+                    i = (i + 1) & 1023;
+                    black_box(cl.step(black_box(force[i])))
+                })
+            });
+        }
+        g.finish();
     }
 }
 

@@ -15,26 +15,38 @@
 //! (|y| > 2 before clamping, or non-finite, which a tanh network cannot
 //! produce from finite inputs) is counted as a divergence and replaced by
 //! the clamped value (0 for non-finite).
+//!
+//! Speed: the network runs in the blocked layout of [`super::packed`], with
+//! the exact or the fast tanh ([`Tanh`]; exact unless asked). The histories
+//! are mirrored rings — each sample is written twice, at p and p + n, with p
+//! moving backwards — so the window of the last n samples, newest first, is
+//! always the contiguous slice `[p, p + n)`: the network reads the feedback
+//! and force taps in place, with no shifting, no copy and no modulo.
 
 use super::mapminmax::MapMinMax;
-use super::net::{Mlp, Workspace};
+use super::net::Mlp;
+use super::packed::{PackedMlp, Tanh};
 use super::taps::Taps;
 
 /// A running closed-loop NARX network.
 #[derive(Debug, Clone)]
 pub struct ClosedLoop {
-    net: Mlp,
-    ws: Workspace,
+    net: PackedMlp,
     taps: Taps,
     xmap: MapMinMax,
     ymap: MapMinMax,
-    /// Normalized force history, a ring of k_x + L + 1 values.
+    /// Normalized force history, a mirrored ring of nx = k_x + L + 1 values
+    /// (2·nx entries; newest first from `xpos`).
     xh: Vec<f64>,
-    /// Normalized estimate history, a ring of k_y values.
+    /// Normalized estimate history, a mirrored ring of ny = max(k_y, 1) values.
     yh: Vec<f64>,
+    nx: usize,
+    ny: usize,
     xpos: usize,
     ypos: usize,
-    row: Vec<f64>,
+    /// Samples between the newest force sample and the newest input tap
+    /// (L − d: −d for d < 0, else 0).
+    skip: usize,
     x0: f64,
     y0: f64,
     /// Samples whose output was clamped into [−1, 1] (normalized).
@@ -49,24 +61,30 @@ impl ClosedLoop {
     /// A closed loop over a trained network, its taps and the maps of force
     /// (`xmap`) and actuation (`ymap`). The network must have
     /// `taps.n_inputs()` inputs.
+    /// Runs the exact tanh ([`ClosedLoop::with_tanh`] chooses).
     pub fn new(net: Mlp, taps: Taps, xmap: MapMinMax, ymap: MapMinMax) -> Self {
+        Self::with_tanh(net, taps, xmap, ymap, Tanh::Exact)
+    }
+
+    /// Like [`ClosedLoop::new`], with the given tanh in the hidden layers.
+    pub fn with_tanh(net: Mlp, taps: Taps, xmap: MapMinMax, ymap: MapMinMax, tanh: Tanh) -> Self {
         debug_assert_eq!(net.inputs(), taps.n_inputs());
-        let ws = net.workspace();
         let nx = taps.input + taps.latency() + 1;
+        let ny = taps.feedback.max(1);
         let x0 = xmap.apply(0.0);
         let y0 = ymap.apply(0.0).clamp(-1.0, 1.0);
-        let row = vec![0.0; taps.n_inputs()];
         Self {
-            net,
-            ws,
+            net: PackedMlp::new(&net, tanh),
             taps,
             xmap,
             ymap,
-            xh: vec![x0; nx],
-            yh: vec![y0; taps.feedback.max(1)],
+            xh: vec![x0; 2 * nx],
+            yh: vec![y0; 2 * ny],
+            nx,
+            ny,
             xpos: 0,
             ypos: 0,
-            row,
+            skip: (taps.latency() as i64 - taps.lookahead) as usize,
             x0,
             y0,
             clamped: 0,
@@ -78,6 +96,11 @@ impl ClosedLoop {
     /// The taps.
     pub fn taps(&self) -> &Taps {
         &self.taps
+    }
+
+    /// The tanh of the hidden layers.
+    pub fn tanh(&self) -> Tanh {
+        self.net.tanh()
     }
 
     /// Back to the start: empty histories, counters at zero.
@@ -119,16 +142,17 @@ impl ClosedLoop {
             self.bad_inputs += 1;
             0.0
         };
-        let nx = self.xh.len();
-        self.xpos = if self.xpos + 1 == nx { 0 } else { self.xpos + 1 };
-        self.xh[self.xpos] = self.xmap.apply(x);
+        let nx = self.nx;
+        self.xpos = if self.xpos == 0 { nx - 1 } else { self.xpos - 1 };
+        let v = self.xmap.apply(x);
+        self.xh[self.xpos] = v;
+        self.xh[self.xpos + nx] = v;
         // The newest sample in the window is x[n + d]: for d < 0 it lies
         // −d samples behind the newest one received (x[t], n = t).
-        let skip = (self.taps.latency() as i64 - self.taps.lookahead) as usize;
-        let (xh, xpos, yh, ypos) = (&self.xh, self.xpos, &self.yh, self.ypos);
-        let ny = yh.len();
-        self.taps.fill(&mut self.row, |k| yh[(ypos + ny + 1 - k) % ny], |j| xh[(xpos + 2 * nx - skip - j) % nx]);
-        let raw = self.net.forward(&self.row, &mut self.ws);
+        let start = self.xpos + self.skip;
+        let xs = &self.xh[start..self.xpos + nx];
+        let fb = &self.yh[self.ypos..self.ypos + self.taps.feedback];
+        let raw = self.net.forward(fb, xs);
         if raw.is_finite() {
             if raw.abs() > 2.0 {
                 self.diverged += 1;
@@ -146,9 +170,10 @@ impl ClosedLoop {
     #[inline]
     fn feed_back(&mut self, y: f64) {
         if self.taps.feedback > 0 {
-            let ny = self.yh.len();
-            self.ypos = if self.ypos + 1 == ny { 0 } else { self.ypos + 1 };
+            let ny = self.ny;
+            self.ypos = if self.ypos == 0 { ny - 1 } else { self.ypos - 1 };
             self.yh[self.ypos] = y;
+            self.yh[self.ypos + ny] = y;
         }
     }
 

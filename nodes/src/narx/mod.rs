@@ -5,6 +5,7 @@
 pub mod closed_loop;
 pub mod error;
 pub mod eval;
+pub mod fast_tanh;
 pub mod fit;
 pub mod grid_node;
 pub mod labdata;
@@ -13,6 +14,7 @@ pub mod model;
 pub mod nearest;
 pub mod net;
 pub mod node;
+pub mod packed;
 pub mod taps;
 pub mod train;
 pub mod train_node;

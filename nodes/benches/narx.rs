@@ -11,7 +11,7 @@ use criterion::{criterion_group, criterion_main, Criterion};
 use evflow_nodes::narx::closed_loop::ClosedLoop;
 use evflow_nodes::narx::mapminmax::MapMinMax;
 use evflow_nodes::narx::net::Mlp;
-use evflow_nodes::narx::packed::Tanh;
+use evflow_nodes::narx::packed::{PackedMlp, Tanh};
 use evflow_nodes::narx::taps::Taps;
 use evflow_nodes::narx::train::{lm, Data, Options};
 use std::hint::black_box;
@@ -94,6 +94,35 @@ fn closed_loop(c: &mut Criterion) {
     }
 }
 
+/// The forward pass alone on independent rows (open loop, as in training
+/// and evaluation): no sample waits for the one before, so this is the
+/// throughput bound of the closed loop, which must wait.
+fn forward(c: &mut Criterion) {
+    let taps = Taps { feedback: 1, input: 10, lookahead: 3 };
+    let net = network(taps, &[15, 10, 5]);
+    let mut r = evflow_nodes::lab::rng::Rng::new(3);
+    let rows: Vec<f64> = (0..1024 * 15).map(|_| 2.0 * r.uniform() - 1.0).collect();
+    let mut g = c.benchmark_group("forward_sample/15-10-5, 15 inputs");
+    let mut ws = net.workspace();
+    let mut i = 0;
+    g.bench_function("Mlp::forward (exact tanh)", |b| {
+        b.iter(|| {
+            i = (i + 1) & 1023;
+            black_box(net.forward(black_box(&rows[i * 15..(i + 1) * 15]), &mut ws))
+        })
+    });
+    for tanh in [Tanh::Exact, Tanh::Fast] {
+        let mut p = PackedMlp::new(&net, tanh);
+        g.bench_function(format!("blocked, {} tanh", tanh.name()), |b| {
+            b.iter(|| {
+                i = (i + 1) & 1023;
+                black_box(p.forward(black_box(&rows[i * 15..(i + 1) * 15]), &[]))
+            })
+        });
+    }
+    g.finish();
+}
+
 fn lm_epoch(c: &mut Criterion) {
     let taps = Taps { feedback: 1, input: 10, lookahead: 3 };
     let n = 3000;
@@ -131,5 +160,5 @@ fn default_training(c: &mut Criterion) {
     g.finish();
 }
 
-criterion_group!(benches, closed_loop, lm_epoch, default_training);
+criterion_group!(benches, closed_loop, forward, lm_epoch, default_training);
 criterion_main!(benches);

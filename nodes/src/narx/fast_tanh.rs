@@ -96,33 +96,57 @@ pub fn tanh(x: f64) -> f64 {
 /// scalar version: equal results, bit for bit).
 #[inline(always)]
 pub fn tanh_lanes<const N: usize>(x: [f64; N]) -> [f64; N] {
+    tanh_impl::<N, false>(x)
+}
+
+/// [`tanh_lanes`] with fused multiply-adds in the range reduction and the
+/// polynomial: fewer instructions and fewer roundings (the bound holds with
+/// room to spare), for code compiled with FMA enabled — without hardware
+/// FMA each `mul_add` is a library call, far slower.
+#[inline(always)]
+pub fn tanh_lanes_fused<const N: usize>(x: [f64; N]) -> [f64; N] {
+    tanh_impl::<N, true>(x)
+}
+
+/// a·b + c, fused or not.
+#[inline(always)]
+fn madd<const FUSED: bool>(a: f64, b: f64, c: f64) -> f64 {
+    if FUSED {
+        a.mul_add(b, c)
+    } else {
+        a * b + c
+    }
+}
+
+#[inline(always)]
+fn tanh_impl<const N: usize, const FUSED: bool>(x: [f64; N]) -> [f64; N] {
     let mut out = [0.0; N];
     for i in 0..N {
         // NaN stays NaN: the comparison is false and the NaN flows through.
         let a = x[i].abs();
         let a = if a > SATURATE { SATURATE } else { a };
         let t = 2.0 * a;
-        let m = t * std::f64::consts::LOG2_E + MAGIC;
+        let m = madd::<FUSED>(t, std::f64::consts::LOG2_E, MAGIC);
         let k = m - MAGIC;
-        let r = (t - k * LN2_HI) - k * LN2_LO;
+        let r = madd::<FUSED>(-k, LN2_LO, madd::<FUSED>(-k, LN2_HI, t));
         // Estrin's scheme for q = r·Σ_{n=1}^{12} rⁿ⁻¹/n!.
         let r2 = r * r;
         let r4 = r2 * r2;
         let r8 = r4 * r4;
-        let p01 = C[0] + C[1] * r;
-        let p23 = C[2] + C[3] * r;
-        let p45 = C[4] + C[5] * r;
-        let p67 = C[6] + C[7] * r;
-        let p89 = C[8] + C[9] * r;
-        let pab = C[10] + C[11] * r;
-        let p0 = p01 + p23 * r2;
-        let p1 = p45 + p67 * r2;
-        let p2 = p89 + pab * r2;
-        let q = r * ((p0 + p1 * r4) + p2 * r8);
+        let p01 = madd::<FUSED>(C[1], r, C[0]);
+        let p23 = madd::<FUSED>(C[3], r, C[2]);
+        let p45 = madd::<FUSED>(C[5], r, C[4]);
+        let p67 = madd::<FUSED>(C[7], r, C[6]);
+        let p89 = madd::<FUSED>(C[9], r, C[8]);
+        let pab = madd::<FUSED>(C[11], r, C[10]);
+        let p0 = madd::<FUSED>(p23, r2, p01);
+        let p1 = madd::<FUSED>(p67, r2, p45);
+        let p2 = madd::<FUSED>(pab, r2, p89);
+        let q = r * madd::<FUSED>(p2, r8, madd::<FUSED>(p1, r4, p0));
         // 2^k from its bits: the low bits of m hold k (0 ≤ k ≤ 58).
         let kb = m.to_bits().wrapping_sub(MAGIC.to_bits());
         let s = f64::from_bits(kb.wrapping_add(1023) << 52);
-        let em1 = s * q + (s - 1.0);
+        let em1 = madd::<FUSED>(s, q, s - 1.0);
         // One division: (E − 1)/(E + 1) near 0 (relative accuracy), the
         // equal 1 − 2/(E + 1) beyond SWITCH (monotone up to saturation,
         // where the quotient of two rounded large numbers wiggles by an ulp).
@@ -234,6 +258,23 @@ mod tests {
             assert!((tanh(x) - x).abs() <= x * 4.0 * f64::EPSILON, "{x}: {}", tanh(x));
         }
         assert!(tanh(f64::NAN).is_nan());
+    }
+
+    #[test]
+    fn fused_variant_is_within_the_bound_too() {
+        // Fewer points: without hardware FMA each mul_add is a library call.
+        let xs = (-200_000..=200_000)
+            .map(|i| i as f64 * 1.25e-4)
+            .chain((-64 * 60..64 * 60).map(|i| (i as f64 / 64.0).exp2()));
+        let mut e = 0.0f64;
+        for x in xs {
+            let y = tanh_lanes_fused([x])[0];
+            assert!(y.abs() <= 1.0 && tanh_lanes_fused([-x])[0] == -y, "{x}");
+            e = e.max((y - x.tanh()).abs());
+        }
+        assert!(e <= MAX_ABS_ERROR, "{e:e}");
+        assert_eq!(tanh_lanes_fused([f64::INFINITY])[0], 1.0);
+        assert!(tanh_lanes_fused([f64::NAN])[0].is_nan());
     }
 
     #[test]

@@ -6,6 +6,7 @@
 use super::closed_loop::ClosedLoop;
 use super::model::Model;
 use super::nearest::nearest;
+use super::packed::Tanh;
 use evflow_engine::{BuildContext, Io, Node, NodeError, NodeSpec, ParamSpec, Params, PortSpec, Role, Summary};
 
 /// Declaration of `narx.grid`.
@@ -34,7 +35,7 @@ pub static SPEC: NodeSpec = NodeSpec::new(
      **Parameters.** `models`: model files written by `narx.train` (relative to the graph file), each \
      with its condition (`condition.mass_g`, `condition.speed_cm_s`); two at one condition, a model \
      without a condition or one at another rate are refused when the graph is built, naming the file. \
-     Outputs are bounded as `narx`'s.",
+     Outputs are bounded as `narx`'s. `tanh`: as `narx`'s (`exact` by default, or `fast`).",
 )
 .ports(&[
     PortSpec::input("force", "N", "desired lateral force"),
@@ -47,6 +48,7 @@ pub static SPEC: NodeSpec = NodeSpec::new(
     ParamSpec::text_list("models", "model files written by narx.train, one per trained condition").required(),
     ParamSpec::float("update_rate", 0.01, 1000.0, 10.0, "Hz", "how often the nearest model is chosen"),
     ParamSpec::float("crossfade", 0.0, 1000.0, 10.0, "ms", "crossfade from one model to the next"),
+    ParamSpec::choice("tanh", &["exact", "fast"], "exact", "hidden-layer tanh: exact (std) or fast (|error| ≤ 1e-15)"),
 ])
 .example("models = [\"models/narx-60g-3cms.json\", \"models/narx-110g-7cms.json\"]");
 
@@ -72,6 +74,7 @@ fn build(p: &Params, ctx: &BuildContext) -> Result<Box<dyn Node>, NodeError> {
     if names.is_empty() {
         return Err(NodeError::param("models", "name at least one model file (written by narx.train)"));
     }
+    let tanh = p.str("tanh").parse::<Tanh>().map_err(|m| NodeError::param("tanh", m))?;
     let (mut loops, mut conditions) = (Vec::new(), Vec::new());
     for name in names {
         let path = ctx.path(name);
@@ -101,7 +104,7 @@ fn build(p: &Params, ctx: &BuildContext) -> Result<Box<dyn Node>, NodeError> {
                 ),
             ));
         }
-        loops.push(model.closed_loop()?);
+        loops.push(model.closed_loop_with(tanh)?);
         conditions.push((m, v));
     }
     let every = ((ctx.rate / p.f64("update_rate")).round() as u64).max(1);

@@ -28,6 +28,7 @@ use super::closed_loop::ClosedLoop;
 use super::error::NarxError;
 use super::mapminmax::MapMinMax;
 use super::net::Mlp;
+use super::packed::Tanh;
 use super::taps::Taps;
 use super::train::StopReason;
 use serde::{Deserialize, Serialize};
@@ -168,9 +169,14 @@ impl Model {
         Mlp::with_weights(self.architecture.inputs, &self.architecture.hidden, self.weights.clone())
     }
 
-    /// A closed loop running this model.
+    /// A closed loop running this model (exact tanh).
     pub fn closed_loop(&self) -> Result<ClosedLoop, NarxError> {
-        Ok(ClosedLoop::new(self.network()?, self.delays, self.normalization.x, self.normalization.y))
+        self.closed_loop_with(Tanh::Exact)
+    }
+
+    /// A closed loop running this model with the given tanh.
+    pub fn closed_loop_with(&self, tanh: Tanh) -> Result<ClosedLoop, NarxError> {
+        Ok(ClosedLoop::with_tanh(self.network()?, self.delays, self.normalization.x, self.normalization.y, tanh))
     }
 
     /// Checks every field; errors name `path` and the field.

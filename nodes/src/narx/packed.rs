@@ -144,27 +144,31 @@ impl PackedMlp {
             // was built; the function only needs those.
             return unsafe { self.forward_avx2(head, tail) };
         }
-        self.forward_portable(head, tail)
+        self.forward_impl::<false>(head, tail)
     }
 
-    /// The forward pass compiled for AVX2 and FMA (the same code; no fused
-    /// multiply-add is written, so results equal the portable build's).
+    /// The forward pass compiled for AVX2 and FMA: the same code, with
+    /// fused multiply-adds in the sums and the tanh when the tanh is fast
+    /// (the exact tanh keeps separate roundings, equal to the portable build).
     #[cfg(target_arch = "x86_64")]
     #[target_feature(enable = "avx2,fma")]
     unsafe fn forward_avx2(&mut self, head: &[f64], tail: &[f64]) -> f64 {
-        self.forward_portable(head, tail)
+        match self.tanh {
+            Tanh::Exact => self.forward_impl::<false>(head, tail),
+            Tanh::Fast => self.forward_impl::<true>(head, tail),
+        }
     }
 
     #[inline(always)]
-    fn forward_portable(&mut self, head: &[f64], tail: &[f64]) -> f64 {
+    fn forward_impl<const FUSED: bool>(&mut self, head: &[f64], tail: &[f64]) -> f64 {
         let last = self.layers.len() - 1;
         let tanh: Act = self.tanh.into();
         let (first, rest) = self.layers.split_first().expect("a network has an output layer");
-        layer(first, head, tail, if last == 0 { Act::Linear } else { tanh }, &mut self.a);
+        layer::<FUSED>(first, head, tail, if last == 0 { Act::Linear } else { tanh }, &mut self.a);
         let (mut cur, mut next) = (&mut self.a, &mut self.b);
         for (k, lay) in rest.iter().enumerate() {
             let act = if k + 1 == last { Act::Linear } else { tanh };
-            layer(lay, &cur[..lay.r], &[], act, next);
+            layer::<FUSED>(lay, &cur[..lay.r], &[], act, next);
             std::mem::swap(&mut cur, &mut next);
         }
         cur[0]
@@ -207,14 +211,14 @@ const GROUP: usize = 4;
 /// One layer: `out[i] = act(b[i] + Σ_j w[i][j]·x[j])`, x = head ++ tail,
 /// every neuron of the padded output written.
 #[inline(always)]
-fn layer(lay: &Layer, head: &[f64], tail: &[f64], act: Act, out: &mut [f64]) {
+fn layer<const FUSED: bool>(lay: &Layer, head: &[f64], tail: &[f64], act: Act, out: &mut [f64]) {
     let mut c0 = 0;
     while c0 < lay.sp {
         match (lay.sp - c0) / LANES {
-            1 => group::<1>(lay, c0, head, tail, act, out),
-            2 => group::<2>(lay, c0, head, tail, act, out),
-            3 => group::<3>(lay, c0, head, tail, act, out),
-            _ => group::<GROUP>(lay, c0, head, tail, act, out),
+            1 => group::<1, FUSED>(lay, c0, head, tail, act, out),
+            2 => group::<2, FUSED>(lay, c0, head, tail, act, out),
+            3 => group::<3, FUSED>(lay, c0, head, tail, act, out),
+            _ => group::<GROUP, FUSED>(lay, c0, head, tail, act, out),
         }
         c0 += GROUP * LANES;
     }
@@ -222,17 +226,52 @@ fn layer(lay: &Layer, head: &[f64], tail: &[f64], act: Act, out: &mut [f64]) {
 
 /// B neuron blocks from column c0: one pass over the inputs, B·LANES sums.
 #[inline(always)]
-fn group<const B: usize>(lay: &Layer, c0: usize, head: &[f64], tail: &[f64], act: Act, out: &mut [f64]) {
+fn group<const B: usize, const FUSED: bool>(
+    lay: &Layer,
+    c0: usize,
+    head: &[f64],
+    tail: &[f64],
+    act: Act,
+    out: &mut [f64],
+) {
     let sp = lay.sp;
     // −0.0 as `Iterator::sum` starts, so that signed zeros come out as in
     // `Mlp::forward`.
     let mut acc = [[-0.0f64; LANES]; B];
-    let rows = lay.w.chunks_exact(sp);
-    for (wj, &x) in rows.zip(head.iter().chain(tail)) {
-        let wj = &wj[c0..c0 + B * LANES];
-        for (a, w) in acc.iter_mut().zip(wj.chunks_exact(LANES)) {
+    if FUSED {
+        // Two partial sums per neuron (inputs of even and odd rank), added
+        // at the end: half the length of the chain of dependent adds, which
+        // is what a layer's time is bound by at these sizes.
+        let mut odd = [[0.0f64; LANES]; B];
+        let mut rows = lay.w.chunks_exact(sp);
+        let mut xs = head.iter().chain(tail);
+        while let (Some(w0), Some(&x0)) = (rows.next(), xs.next()) {
+            let w0 = &w0[c0..c0 + B * LANES];
+            for (a, w) in acc.iter_mut().zip(w0.chunks_exact(LANES)) {
+                for l in 0..LANES {
+                    a[l] = w[l].mul_add(x0, a[l]);
+                }
+            }
+            let (Some(w1), Some(&x1)) = (rows.next(), xs.next()) else { break };
+            let w1 = &w1[c0..c0 + B * LANES];
+            for (a, w) in odd.iter_mut().zip(w1.chunks_exact(LANES)) {
+                for l in 0..LANES {
+                    a[l] = w[l].mul_add(x1, a[l]);
+                }
+            }
+        }
+        for (a, o) in acc.iter_mut().zip(&odd) {
             for l in 0..LANES {
-                a[l] += w[l] * x;
+                a[l] += o[l];
+            }
+        }
+    } else {
+        for (wj, &x) in lay.w.chunks_exact(sp).zip(head.iter().chain(tail)) {
+            let wj = &wj[c0..c0 + B * LANES];
+            for (a, w) in acc.iter_mut().zip(wj.chunks_exact(LANES)) {
+                for l in 0..LANES {
+                    a[l] += w[l] * x;
+                }
             }
         }
     }

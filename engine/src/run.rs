@@ -151,8 +151,10 @@ mod tests {
         // The engine's clock brackets the node's own: whatever the machine
         // does meanwhile, the charged time cannot be less than what the node
         // measured inside its hooks.
-        let (build, finish) =
-            (Duration::from_nanos(BUILD_NS.load(Ordering::SeqCst)), Duration::from_nanos(FINISH_NS.load(Ordering::SeqCst)));
+        let (build, finish) = (
+            Duration::from_nanos(BUILD_NS.load(Ordering::SeqCst)),
+            Duration::from_nanos(FINISH_NS.load(Ordering::SeqCst)),
+        );
         assert!(t.finish >= finish && finish >= Duration::from_millis(5), "{t:?} vs {finish:?}");
         assert!(t.setup >= build && build >= Duration::from_millis(1), "{t:?} vs {build:?}");
         assert_eq!(t.elapsed, t.setup + t.process + t.finish);

@@ -123,6 +123,38 @@ fn forward(c: &mut Criterion) {
     g.finish();
 }
 
+/// The tanh alone: four values per call, independent of each other from
+/// call to call (throughput) or each call's input the last call's output
+/// (latency: what one hidden layer adds to a closed-loop sample's chain of
+/// dependent work), beside `f64::tanh` on the same four values.
+fn tanh(c: &mut Criterion) {
+    use evflow_nodes::narx::fast_tanh::tanh_lanes;
+    let xs: Vec<[f64; 4]> = (0..1024).map(|i| [0.01 * i as f64 - 5.0, 0.3, -1.7 + 0.001 * i as f64, 2.5]).collect();
+    let mut g = c.benchmark_group("tanh/4 values");
+    let mut i = 0;
+    g.bench_function("f64::tanh, independent", |b| {
+        b.iter(|| {
+            i = (i + 1) & 1023;
+            black_box(black_box(xs[i]).map(f64::tanh))
+        })
+    });
+    g.bench_function("fast, independent", |b| {
+        b.iter(|| {
+            i = (i + 1) & 1023;
+            black_box(tanh_lanes(black_box(xs[i])))
+        })
+    });
+    let mut v = [0.1, 0.2, 0.3, 0.4];
+    g.bench_function("fast, dependent chain", |b| {
+        b.iter(|| {
+            let y = tanh_lanes(v);
+            v = [y[0] + 0.5, y[1] - 0.5, y[2] * 2.0, y[3] + 0.25];
+        })
+    });
+    g.finish();
+    black_box(v);
+}
+
 fn lm_epoch(c: &mut Criterion) {
     let taps = Taps { feedback: 1, input: 10, lookahead: 3 };
     let n = 3000;
@@ -160,5 +192,5 @@ fn default_training(c: &mut Criterion) {
     g.finish();
 }
 
-criterion_group!(benches, closed_loop, forward, lm_epoch, default_training);
+criterion_group!(benches, closed_loop, forward, tanh, lm_epoch, default_training);
 criterion_main!(benches);

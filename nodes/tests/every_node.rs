@@ -85,7 +85,6 @@ fn fixtures(dir: &Path) {
         data_hash: String::new(),
         seconds: 0.0,
     };
-    let training = Training { scores: fitted.scores, ..training };
     ForwardModel::new(&fitted.model, 1000.0, &cfg.filter, Default::default(), fitted.noise, fitted.spectrum, training)
         .save(&dir.join("models/forward.json"))
         .expect("fixture forward model written");

@@ -104,16 +104,16 @@ fn report_interp_improved_beats_basic_on_the_rippled_paper() {
     assert!(out.contains("better on 4 of 4 velocity-interpolated conditions"), "{out}");
 }
 
-#[test]
-fn report_interp_with_narx_cells_plays_the_grid_on_the_display() {
-    // The plastic sheet (Fig. 5.6): inverse models at the four corners
-    // (at most 20 epochs; early stopping ends them near there), two gains.
+/// `evflow report interp --cells METHOD` on the plastic sheet (Fig. 5.6):
+/// models at the four corners (at most 20 epochs; early stopping ends them
+/// near there), two gains. Returns the output folder and what it printed.
+fn interp_cells(method: &str) -> (tempfile::TempDir, String) {
     let dir = tempfile::tempdir().unwrap();
     let (ok, out, err) = evflow(&[
         "report",
         "interp",
         "--cells",
-        "narx",
+        method,
         "--out",
         dir.path().to_str().unwrap(),
         "--samples",
@@ -124,14 +124,27 @@ fn report_interp_with_narx_cells_plays_the_grid_on_the_display() {
         "0.8,1.2",
     ]);
     assert!(ok, "{err}");
-    // Trained rows name their condition in the second column ("60 g, 3 cm/s");
-    // cross-validation rows give load and speed as numbers there.
-    let condition_column = |l: &str| l.split('|').nth(2).is_some_and(|c| c.contains(" g, "));
-    let cells = |l: &&str| l.starts_with("| plastic-sheet |") && condition_column(l);
+    (dir, out)
+}
+
+/// The plastic sheet's table rows, cells split: the trained ones (which name
+/// their condition in the second column, "60 g, 3 cm/s") or the
+/// cross-validation ones (load and speed as numbers there).
+fn plastic_rows(out: &str, trained: bool) -> Vec<Vec<String>> {
+    out.lines()
+        .filter(|l| {
+            l.starts_with("| plastic-sheet |") && l.split('|').nth(2).is_some_and(|c| c.contains(" g, ")) == trained
+        })
+        .map(|l| l.split('|').map(|c| c.trim().to_string()).collect())
+        .collect()
+}
+
+#[test]
+fn report_interp_with_narx_cells_plays_the_grid_on_the_display() {
+    // The plastic sheet (Fig. 5.6): inverse models at the four corners
+    // (at most 20 epochs; early stopping ends them near there), two gains.
+    let (dir, out) = interp_cells("narx");
     let number = |c: &str| c.trim_end_matches(" %").parse::<f64>().unwrap_or_else(|_| panic!("`{c}` in\n{out}"));
-    let rows = |keep: &dyn Fn(&&str) -> bool| -> Vec<Vec<String>> {
-        out.lines().filter(keep).map(|l| l.split('|').map(|c| c.trim().to_string()).collect()).collect()
-    };
     // The control: at a trained corner the basic scheme plays the cell
     // itself, and the chain (interp → playback → display) scores what
     // synthesize.toml scored for it. The improved scheme re-samples it with
@@ -139,7 +152,7 @@ fn report_interp_with_narx_cells_plays_the_grid_on_the_display() {
     // NARX actuation: much worse wherever most of the cell's power is there.
     // (A cell the short pass at 7 cm/s scores near 1.2 — worse than a silent
     // display — differs more: within 0.2 each, 0.1 on average.)
-    let trained = rows(&cells);
+    let trained = plastic_rows(&out, true);
     assert_eq!(trained.len(), 4, "{out}");
     let mut off = 0.0;
     for r in &trained {
@@ -153,7 +166,7 @@ fn report_interp_with_narx_cells_plays_the_grid_on_the_display() {
     assert!(off < 0.1, "the cells through interp differ from the cells by {off} on average\n{out}");
     // The cross-validation: five untrained conditions; where the velocity is
     // interpolated (5 cm/s from 3 and 7) the improved scheme scores better.
-    let xval = rows(&|l: &&str| l.starts_with("| plastic-sheet |") && !condition_column(l));
+    let xval = plastic_rows(&out, false);
     assert_eq!(xval.len(), 5, "{out}");
     for r in &xval {
         let (basic, improved) = (number(&r[5]), number(&r[6]));
@@ -182,35 +195,12 @@ fn report_interp_with_narx_cells_plays_the_grid_on_the_display() {
 fn report_interp_with_optimized_cells_scores_both_orders() {
     // The plastic sheet with the optimized synthesis' cells (the study's
     // best method), models of at most 20 epochs, two gains.
-    let dir = tempfile::tempdir().unwrap();
-    let (ok, out, err) = evflow(&[
-        "report",
-        "interp",
-        "--cells",
-        "optimized",
-        "--out",
-        dir.path().to_str().unwrap(),
-        "--samples",
-        "plastic-sheet",
-        "--epochs",
-        "20",
-        "--gains",
-        "0.8,1.2",
-    ]);
-    assert!(ok, "{err}");
+    let (dir, out) = interp_cells("optimized");
     let number = |c: &str| c.trim_end_matches(" %").parse::<f64>().unwrap_or_else(|_| panic!("`{c}` in\n{out}"));
-    let rows = |trained: bool| -> Vec<Vec<String>> {
-        out.lines()
-            .filter(|l| {
-                l.starts_with("| plastic-sheet |") && l.split('|').nth(2).is_some_and(|c| c.contains(" g, ")) == trained
-            })
-            .map(|l| l.split('|').map(|c| c.trim().to_string()).collect())
-            .collect()
-    };
     // The control: at a trained corner the basic scheme gives the cell back;
     // forces first there optimizes the cell's own force through its own
     // forward model, and lands near the cell.
-    let trained = rows(true);
+    let trained = plastic_rows(&out, true);
     assert_eq!(trained.len(), 4, "{out}");
     for r in &trained {
         let (synth, basic, ff_basic) = (number(&r[4]), number(&r[6]), number(&r[11]));
@@ -219,7 +209,7 @@ fn report_interp_with_optimized_cells_scores_both_orders() {
     }
     // Forces first with the optimized synthesis: where the velocity is
     // interpolated, the improved scheme wins and beats record-and-playback.
-    let xval = rows(false);
+    let xval = plastic_rows(&out, false);
     assert_eq!(xval.len(), 5, "{out}");
     for r in xval.iter().filter(|r| r[3] == "5") {
         let (playback, ff_basic, ff_improved) = (number(&r[10]), number(&r[12]), number(&r[13]));

@@ -2,6 +2,7 @@
 //! sidecar, described in `docs/recording-format.md`) and the nodes that read
 //! and write it, `recording.in` ([`source`]) and `recording.out` ([`sink`]).
 
+pub mod atomic;
 pub mod format;
 pub mod sink;
 pub mod source;

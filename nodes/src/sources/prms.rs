@@ -182,7 +182,7 @@ mod tests {
     use evflow_engine::harness::Single;
     use std::path::Path;
 
-    fn run(params: &str, ticks: u64, block: usize) -> Vec<f64> {
+    fn single(params: &str, ticks: u64, block: usize) -> Single<'_> {
         Single {
             spec: &SPEC,
             params,
@@ -193,9 +193,10 @@ mod tests {
             block,
             base_dir: Path::new("."),
         }
-        .run()
-        .unwrap()
-        .remove(0)
+    }
+
+    fn run(params: &str, ticks: u64, block: usize) -> Vec<f64> {
+        single(params, ticks, block).run().unwrap().remove(0)
     }
 
     /// One period of symbols straight from the recurrence.
@@ -318,19 +319,7 @@ mod tests {
     #[test]
     fn bad_parameters_are_refused_by_name() {
         for (params, name) in [("q = 4", "q"), ("q = 13\norder = 40", "order"), ("level = -1", "level")] {
-            let err = Single {
-                spec: &SPEC,
-                params,
-                inputs: vec![],
-                outputs: vec!["out"],
-                base_rate: 1000.0,
-                ticks: 1,
-                block: 1,
-                base_dir: Path::new("."),
-            }
-            .run()
-            .err()
-            .unwrap_or_else(|| panic!("{params} accepted"));
+            let err = single(params, 1, 1).run().err().unwrap_or_else(|| panic!("{params} accepted"));
             assert!(err.to_string().contains(name), "{params}: {err}");
         }
     }

@@ -249,29 +249,10 @@ impl ForwardModel {
 
     /// Writes the model to `path` (through `path.tmp` and a rename).
     pub fn save(&self, path: &Path) -> Result<(), SynthError> {
-        let io =
-            |e: std::io::Error| SynthError::Io { path: path.into(), message: format!("cannot write the model: {e}") };
         let text = serde_json::to_string_pretty(self)
             .map_err(|e| SynthError::Io { path: path.into(), message: format!("cannot encode the model: {e}") })?;
-        if let Some(dir) = path.parent().filter(|d| !d.as_os_str().is_empty()) {
-            std::fs::create_dir_all(dir).map_err(io)?;
-        }
-        let mut tmp = path.as_os_str().to_owned();
-        tmp.push(".tmp");
-        let tmp = std::path::PathBuf::from(tmp);
-        let result = (|| {
-            use std::io::Write;
-            let mut f = std::fs::File::create(&tmp)?;
-            f.write_all(text.as_bytes())?;
-            f.write_all(b"\n")?;
-            f.sync_all()?;
-            std::fs::rename(&tmp, path)
-        })();
-        if let Err(e) = result {
-            let _ = std::fs::remove_file(&tmp);
-            return Err(io(e));
-        }
-        Ok(())
+        crate::recording::atomic::write_atomically(path, &text)
+            .map_err(|e| SynthError::Io { path: path.into(), message: format!("cannot write the model: {e}") })
     }
 }
 

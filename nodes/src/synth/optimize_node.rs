@@ -38,7 +38,9 @@ pub static SPEC: NodeSpec = NodeSpec::new(
      (`noise = \"learned\"`) or `lambda` (`noise = \"fixed\"`). `expected`: E_s² of the spectra the \
      display is expected to deliver — the model's force plus its learned residual noise spectrum, \
      which grows with the actuation — over Hann-windowed half-overlapping segments of the model's \
-     noise-spectrum length (`window`, `overlap` and `noise` do not apply).\n\n\
+     noise-spectrum length (`window`, `overlap` and `noise` do not apply). Where fewer samples count than \
+     one segment (one pass at 7 cm/s keeps less than a second), both spectral objectives give way to `time`, \
+     and the summary says so.\n\n\
      **Start.** `carrier`: the square-law envelope on a Nyquist-rate carrier, \
      u[n] = (−1)ⁿ·√(max(0, (f[n] + c)/κ)), κ the model's carrier gain, c = −min f; `narx`: the inverse \
      NARX model `narx_model` run closed loop on the force (§5.2.2); `zero`. When the forward model's carrier gain \
@@ -79,6 +81,8 @@ struct Optimize {
     start: Vec<f64>,
     /// Which start was used (for the summary).
     start_used: &'static str,
+    /// Which objective was used (for the summary).
+    objective_used: &'static str,
     model: ForwardModel,
     cfg: SynthConfig,
     u: Option<Vec<f64>>,
@@ -150,25 +154,28 @@ fn build(p: &Params, ctx: &BuildContext) -> Result<Box<dyn Node>, NodeError> {
         0 => ctx.rate.round() as usize,
         n => n,
     };
-    let objective = match p.str("objective") {
+    // A counted stretch shorter than one spectral segment (one pass at
+    // 7 cm/s keeps less than a second) has no spectrum: the spectral
+    // objectives give way to the waveform, and the summary says so.
+    let short = keep.iter().filter(|k| **k).count() < nfft;
+    let (objective, objective_used) = match p.str("objective") {
+        "expected" | "spectral" if short => {
+            (ObjectiveKind::Time, "time (fewer counted samples than one spectral segment)")
+        }
         "expected" => {
             let band = Band::new(ctx.rate, nfft, p.f64("fmin"), p.f64("fmax"), false)
                 .map_err(|e| NodeError::param(e.param, e.message))?;
-            ObjectiveKind::Expected {
-                cfg: SpectrumConfig { rate: ctx.rate, nfft, window: Window::Hann, overlap: 0.5 },
-                band,
-            }
+            let cfg = SpectrumConfig { rate: ctx.rate, nfft, window: Window::Hann, overlap: 0.5 };
+            (ObjectiveKind::Expected { cfg, band }, "expected")
         }
         "spectral" => {
             let window = Window::from_name(p.str("window")).unwrap_or(Window::Rect);
             let band = Band::new(ctx.rate, nfft, p.f64("fmin"), p.f64("fmax"), false)
                 .map_err(|e| NodeError::param(e.param, e.message))?;
-            ObjectiveKind::Spectral {
-                cfg: SpectrumConfig { rate: ctx.rate, nfft, window, overlap: p.f64("overlap") },
-                band,
-            }
+            let cfg = SpectrumConfig { rate: ctx.rate, nfft, window, overlap: p.f64("overlap") };
+            (ObjectiveKind::Spectral { cfg, band }, "spectral")
         }
-        _ => ObjectiveKind::Time,
+        _ => (ObjectiveKind::Time, "time"),
     };
     let noise = if p.str("noise") == "fixed" { NoiseWeight::Fixed(p.f64("lambda")) } else { NoiseWeight::Learned };
     let cfg = SynthConfig {
@@ -182,6 +189,7 @@ fn build(p: &Params, ctx: &BuildContext) -> Result<Box<dyn Node>, NodeError> {
         keep,
         start,
         start_used,
+        objective_used,
         model,
         cfg,
         u: None,
@@ -201,9 +209,10 @@ impl Optimize {
             .value("evaluations", s.evaluations as f64, "1")
             .value("lambda", s.lambda, "1")
             .line(format!(
-                "synthesized {} samples from the {} start: objective {:.4} → {:.4} in {} iterations ({}), {:.3} s",
+                "synthesized {} samples from the {} start, objective {}: {:.4} → {:.4} in {} iterations ({}), {:.3} s",
                 s.u.len(),
                 self.start_used,
+                self.objective_used,
                 s.objective_start,
                 s.objective_end,
                 s.history.len() - 1,
@@ -244,5 +253,72 @@ impl Node for Optimize {
 
     fn finish(&mut self) -> Result<Summary, NodeError> {
         Ok(std::mem::take(&mut self.summary))
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::recording::format::{Channel, RecordingMeta, RecordingWriter};
+    use crate::synth::model_file::Training;
+    use crate::synth::volterra_fit::{fit, FitConfig};
+    use evflow_engine::harness::Single;
+
+    /// A forward model of a square law behind a two-tap filter, and a
+    /// texture force of `n` samples, written into `dir`.
+    fn fixtures(dir: &std::path::Path, n: usize) {
+        let u: Vec<f64> = (0..3000).map(|k| ((k * 7919) % 1000) as f64 / 500.0 - 1.0).collect();
+        let y: Vec<f64> =
+            (0..u.len()).map(|k| (0.8 * u[k] - 0.3 * if k > 0 { u[k - 1] } else { 0.0 }).powi(2)).collect();
+        let cfg = FitConfig { memory: 4, ..FitConfig::default() };
+        let fitted = fit(&u, &y, &vec![true; u.len()], &cfg).unwrap();
+        let training = Training {
+            scores: fitted.scores,
+            actuation_rms: 0.5,
+            actuation_peak: 1.0,
+            data_hash: String::new(),
+            seconds: 0.0,
+        };
+        ForwardModel::new(
+            &fitted.model,
+            1000.0,
+            &cfg.filter,
+            Default::default(),
+            fitted.noise,
+            fitted.spectrum,
+            training,
+        )
+        .save(&dir.join("f.json"))
+        .unwrap();
+        let meta = RecordingMeta::new(1000.0, vec![Channel::new("force", "N")]);
+        let mut w = RecordingWriter::create(&dir.join("short.wav"), meta).unwrap();
+        for k in 0..n {
+            w.write_frame(&[0.05 * (k as f64 * 0.2).sin()]).unwrap();
+        }
+        w.finish().unwrap();
+    }
+
+    #[test]
+    fn a_target_shorter_than_one_spectral_segment_is_matched_by_its_waveform_and_says_so() {
+        let dir = tempfile::tempdir().unwrap();
+        fixtures(dir.path(), 600);
+        for (objective, used) in [("expected", "objective time (fewer counted samples"), ("time", "objective time:")] {
+            let params = format!("target = \"short\"\nmodel = \"f.json\"\nobjective = \"{objective}\"\niterations = 5");
+            let single = Single {
+                spec: &SPEC,
+                params: &params,
+                inputs: vec![],
+                outputs: vec!["u"],
+                base_rate: 1000.0,
+                ticks: 600,
+                block: 128,
+                base_dir: dir.path(),
+            };
+            let u = single.run().unwrap_or_else(|e| panic!("{objective}: {e}")).remove(0);
+            assert_eq!(u.len(), 600);
+            assert!(u.iter().all(|v| v.is_finite() && v.abs() <= 1.0));
+            let lines = single.summary().unwrap().lines.join("\n");
+            assert!(lines.contains(used), "{objective}: {lines}");
+        }
     }
 }

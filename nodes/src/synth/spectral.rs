@@ -44,6 +44,24 @@ pub struct NoiseSpectrum {
 /// strong Y.
 pub const RICE: f64 = std::f64::consts::FRAC_PI_4;
 
+/// One segment's window, FFT plan and buffers.
+struct SegmentFft {
+    window: Vec<f64>,
+    fft: Arc<dyn Fft<f64>>,
+    buf: Vec<Complex<f64>>,
+    scratch: Vec<Complex<f64>>,
+}
+
+impl SegmentFft {
+    /// The windowed segment of `v` starting at `start`, transformed into `buf`.
+    fn transform(&mut self, v: &[f64], start: usize) {
+        for (b, (w, x)) in self.buf.iter_mut().zip(self.window.iter().zip(&v[start..])) {
+            *b = Complex::new(w * x, 0.0);
+        }
+        self.fft.process_with_scratch(&mut self.buf, &mut self.scratch);
+    }
+}
+
 /// A target spectrum and the machinery to score series against it.
 pub struct SpectralTarget {
     cfg: SpectrumConfig,
@@ -52,10 +70,7 @@ pub struct SpectralTarget {
     /// Target magnitudes on the band's bins.
     r: Vec<f64>,
     r_norm2: f64,
-    window: Vec<f64>,
-    fft: Arc<dyn Fft<f64>>,
-    buf: Vec<Complex<f64>>,
-    scratch: Vec<Complex<f64>>,
+    seg: SegmentFft,
     /// Per segment, X on the band's bins (kept from the forward pass).
     x: Vec<Complex<f64>>,
     starts: Vec<usize>,
@@ -107,10 +122,12 @@ impl SpectralTarget {
             len: real.len(),
             r,
             r_norm2,
-            window: cfg.window.coefficients(nfft),
-            fft,
-            buf: vec![Complex::default(); nfft],
-            scratch,
+            seg: SegmentFft {
+                window: cfg.window.coefficients(nfft),
+                fft,
+                buf: vec![Complex::default(); nfft],
+                scratch,
+            },
             x: vec![Complex::default(); starts.len() * band.len()],
             starts,
         })
@@ -133,16 +150,13 @@ impl SpectralTarget {
 
     /// J = E_s² and its forward-pass spectra.
     fn forward(&mut self, v: &[f64]) -> f64 {
-        let (nfft, nb, first) = (self.cfg.nfft, self.band.len(), self.band.first());
+        let (nb, first) = (self.band.len(), self.band.first());
         let p = self.starts.len() as f64;
         let mut s = vec![0.0; nb];
         for (seg, &start) in self.starts.iter().enumerate() {
-            for n in 0..nfft {
-                self.buf[n] = Complex::new(self.window[n] * v[start + n], 0.0);
-            }
-            self.fft.process_with_scratch(&mut self.buf, &mut self.scratch);
+            self.seg.transform(v, start);
             for (b, sb) in s.iter_mut().enumerate() {
-                let xk = self.buf[first + b];
+                let xk = self.seg.buf[first + b];
                 self.x[seg * nb + b] = xk;
                 *sb += xk.norm() / p;
             }
@@ -165,23 +179,20 @@ impl SpectralTarget {
     ) -> f64 {
         let (nfft, nb, first) = (self.cfg.nfft, self.band.len(), self.band.first());
         let np = self.starts.len();
-        let energy: f64 = self.window.iter().map(|w| w * w).sum();
+        let energy: f64 = self.seg.window.iter().map(|w| w * w).sum();
         let segp: Vec<f64> = self
             .starts
             .iter()
-            .map(|&s| (0..nfft).map(|n| self.window[n] * self.window[n] * p[s + n]).sum::<f64>() / energy)
+            .map(|&s| (0..nfft).map(|n| self.seg.window[n] * self.seg.window[n] * p[s + n]).sum::<f64>() / energy)
             .collect();
         // Forward: the expected magnitudes M, their mean S.
         let mut m = vec![0.0; np * nb];
         let mut s = vec![0.0; nb];
         for (seg, &start) in self.starts.iter().enumerate() {
-            for n in 0..nfft {
-                self.buf[n] = Complex::new(self.window[n] * v[start + n], 0.0);
-            }
-            self.fft.process_with_scratch(&mut self.buf, &mut self.scratch);
+            self.seg.transform(v, start);
             for (b, sb) in s.iter_mut().enumerate() {
                 let k = first + b;
-                let xk = self.buf[k];
+                let xk = self.seg.buf[k];
                 self.x[seg * nb + b] = xk;
                 let pn = energy * (noise.p0[k] + segp[seg] * noise.p1[k]).max(0.0);
                 let mk = (xk.norm_sqr() + RICE * pn).sqrt();
@@ -194,20 +205,20 @@ impl SpectralTarget {
         gv.iter_mut().for_each(|x| *x = 0.0);
         gp.iter_mut().for_each(|x| *x = 0.0);
         for (seg, &start) in self.starts.iter().enumerate() {
-            self.buf.iter_mut().for_each(|c| *c = Complex::default());
+            self.seg.buf.iter_mut().for_each(|c| *c = Complex::default());
             let mut dseg = 0.0;
             for (b, (sb, rb)) in s.iter().zip(&self.r).enumerate() {
                 let mk = m[seg * nb + b];
                 if mk > 0.0 {
                     let a = 2.0 * (sb - rb) / self.r_norm2 / np as f64;
-                    self.buf[first + b] = self.x[seg * nb + b].conj() * (a / mk);
+                    self.seg.buf[first + b] = self.x[seg * nb + b].conj() * (a / mk);
                     dseg += a * RICE * energy * noise.p1[first + b] / (2.0 * mk);
                 }
             }
-            self.fft.process_with_scratch(&mut self.buf, &mut self.scratch);
+            self.seg.fft.process_with_scratch(&mut self.seg.buf, &mut self.seg.scratch);
             for n in 0..nfft {
-                gv[start + n] += self.window[n] * self.buf[n].re;
-                gp[start + n] += dseg * self.window[n] * self.window[n] / energy;
+                gv[start + n] += self.seg.window[n] * self.seg.buf[n].re;
+                gp[start + n] += dseg * self.seg.window[n] * self.seg.window[n] / energy;
             }
         }
         j
@@ -232,18 +243,18 @@ impl SpectralTarget {
         }
         g.iter_mut().for_each(|v| *v = 0.0);
         for (seg, &start) in self.starts.iter().enumerate() {
-            self.buf.iter_mut().for_each(|c| *c = Complex::default());
+            self.seg.buf.iter_mut().for_each(|c| *c = Complex::default());
             for (b, (sb, rb)) in s.iter().zip(&self.r).enumerate() {
                 let xk = self.x[seg * nb + b];
                 let mag = xk.norm();
                 if mag > 0.0 {
                     let a = 2.0 * (sb - rb) / self.r_norm2;
-                    self.buf[first + b] = xk.conj() * (a / mag);
+                    self.seg.buf[first + b] = xk.conj() * (a / mag);
                 }
             }
-            self.fft.process_with_scratch(&mut self.buf, &mut self.scratch);
+            self.seg.fft.process_with_scratch(&mut self.seg.buf, &mut self.seg.scratch);
             for n in 0..nfft {
-                g[start + n] += self.window[n] * self.buf[n].re / p;
+                g[start + n] += self.seg.window[n] * self.seg.buf[n].re / p;
             }
         }
         j

@@ -12,10 +12,13 @@
 //! cells of the live texture grids are cut from its runs ([`cells`]).
 
 pub mod cells;
+pub mod constant_speed;
+pub mod crossval;
 pub mod floor;
 pub mod forces_first;
 pub mod gains;
 pub mod graphs;
+pub mod grid_plan;
 pub mod models;
 pub mod recordings;
 pub mod row;
@@ -59,4 +62,19 @@ pub enum StudyError {
     /// A synthesis step failed.
     #[error(transparent)]
     Synth(#[from] super::error::SynthError),
+    /// An error in one step, with the step named.
+    #[error("{what}: {error}")]
+    At {
+        /// The step (e.g. "felt-fabric at 85 g, 5 cm/s, improved scheme").
+        what: String,
+        /// What went wrong there.
+        error: Box<StudyError>,
+    },
+}
+
+impl StudyError {
+    /// This error, in the step `what`.
+    pub fn at(self, what: String) -> Self {
+        StudyError::At { what, error: Box::new(self) }
+    }
 }

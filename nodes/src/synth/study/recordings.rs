@@ -46,17 +46,6 @@ pub fn gate(path: &Path, speed_cm_s: f64) -> Result<Vec<bool>, StudyError> {
     Ok(SpeedRule::new(speed_cm_s, 0.02, 0.1, rate, 0.0).gate(&v))
 }
 
-/// The objective `synth.optimize` can take for the recording `path` at
-/// `speed_cm_s`: `preferred` when its constant-speed stretch holds at
-/// least one spectral segment (`rate` samples: the spectral objectives'
-/// one-second segments), else "time" (the waveform, which has no segment
-/// length) — one pass at 7 cm/s keeps less than a second.
-pub fn objective_for<'a>(path: &Path, speed_cm_s: f64, preferred: &'a str) -> Result<&'a str, StudyError> {
-    let (rate, _) = channel(path, "velocity")?;
-    let kept = gate(path, speed_cm_s)?.iter().filter(|k| **k).count();
-    Ok(if preferred == "time" || kept as f64 >= rate.round() { preferred } else { "time" })
-}
-
 /// Record-and-playback's normalization of a recording (§5.2.2: each force
 /// sequence normalized): the extremes of its force over its constant-speed
 /// stretch, which `normalize` maps to ±1.

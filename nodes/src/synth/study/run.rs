@@ -32,9 +32,9 @@ pub struct StudyConfig {
     pub multilevel: bool,
     /// Also the achievable floor (optimization through the display itself).
     pub floor: bool,
-    /// The optimized synthesis' objective (`synth.optimize`'s `objective`);
-    /// "time" where a pass keeps less than one spectral segment
-    /// ([`recordings::objective_for`]).
+    /// The optimized synthesis' objective (`synth.optimize`'s `objective`,
+    /// which takes the waveform where a pass keeps less than one spectral
+    /// segment).
     pub objective: String,
 }
 
@@ -90,9 +90,6 @@ pub fn run(cfg: &StudyConfig, progress: &mut dyn FnMut(Progress<'_>)) -> Result<
                 done += 1;
                 progress(Progress::Row(profile, sample, *c, done, total));
                 recordings::record_pair(&cfg.graphs, profile, sample, c, &rec_dir)?;
-                // A pass shorter than a spectral segment (7 cm/s) falls back to the waveform objective.
-                let rep1 = rec_dir.join(recordings::name(sample, c, 1));
-                let objective = recordings::objective_for(&rep1, c.speed, &cfg.objective)?;
                 let inputs = RowInputs {
                     graphs: &cfg.graphs,
                     profile,
@@ -102,7 +99,7 @@ pub fn run(cfg: &StudyConfig, progress: &mut dyn FnMut(Progress<'_>)) -> Result<
                     recordings: &rec_dir,
                     gains: &cfg.gains,
                     iterations: cfg.iterations,
-                    objective,
+                    objective: &cfg.objective,
                     optimized: None,
                     dir: pdir.join("rows").join(format!("{sample}-{}", c.tag())),
                 };

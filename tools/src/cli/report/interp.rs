@@ -17,6 +17,7 @@ use anyhow::{anyhow, Context, Result};
 use evflow_nodes::lab::texture::samples::NAMES;
 use evflow_nodes::metric::spectral_error::{spectral_rms_error, Band};
 use evflow_nodes::metric::spectrum::{averaged_spectrum, SpectrumConfig, Window};
+use evflow_nodes::synth::study::grid_plan::GridPlan;
 use evflow_nodes::texture::grid::Grid;
 use evflow_nodes::texture::kernel::SincKernel;
 use evflow_nodes::texture::scheme::{Geometry, Mix, Scheme};
@@ -89,43 +90,6 @@ pub struct Args {
     pub(super) graphs: PathBuf,
 }
 
-/// A sample's trained grid and its validation conditions.
-pub(super) struct GridPlan {
-    /// Trained loads m_i, g.
-    pub(super) loads: Vec<f64>,
-    /// Trained velocities v_j, cm/s.
-    pub(super) speeds: Vec<f64>,
-    /// Untrained (load, velocity) conditions to validate.
-    pub(super) validate: Vec<(f64, f64)>,
-}
-
-impl GridPlan {
-    /// Whether a condition at velocity `v` is interpolated over velocity
-    /// (the schemes differ only there).
-    pub(super) fn velocity_interpolated(&self, v: f64) -> bool {
-        !self.speeds.contains(&v)
-    }
-}
-
-/// Fig. 5.6 (3×3 grid, corners trained, the m₂ row and v₂ column validated)
-/// or, for the rippled paper, Fig. 6.8 (60/110 g × 3–7 cm/s trained, 85 g
-/// at 3.5–6.5 cm/s validated).
-pub(super) fn plan_for(sample: &str) -> GridPlan {
-    if sample == "rippled-paper" {
-        GridPlan {
-            loads: vec![60.0, 110.0],
-            speeds: vec![3.0, 4.0, 5.0, 6.0, 7.0],
-            validate: vec![(85.0, 3.5), (85.0, 4.5), (85.0, 5.5), (85.0, 6.5)],
-        }
-    } else {
-        GridPlan {
-            loads: vec![60.0, 110.0],
-            speeds: vec![3.0, 7.0],
-            validate: vec![(85.0, 3.0), (85.0, 5.0), (85.0, 7.0), (60.0, 5.0), (110.0, 5.0)],
-        }
-    }
-}
-
 /// Magnitude spectrum (1 Hz bins, Hann, half overlap).
 fn spectrum(x: &[f64], rate: f64) -> Result<Vec<f64>> {
     let cfg = SpectrumConfig { rate, nfft: rate.round() as usize, window: Window::Hann, overlap: 0.5 };
@@ -146,7 +110,7 @@ struct Row {
 }
 
 fn evaluate(a: &Args, sample: &str, tmp: &Path, band: &Band, plots: &mut Vec<Plot>) -> Result<Vec<Row>> {
-    let p = plan_for(sample);
+    let p = GridPlan::of(sample);
     let rec = |mass: f64, speed: f64, rep: u32| {
         record(&a.graph, &Condition { sample, mass, speed, passes: a.passes, rep }, tmp)
     };
@@ -235,7 +199,7 @@ pub fn main(a: Args) -> Result<()> {
     println!("|---|---:|---:|---:|---:|---:|---|");
     let (mut wins, mut velocity_cases) = (0, 0);
     for r in &rows {
-        let velocity_interpolated = plan_for(&r.sample).velocity_interpolated(r.speed);
+        let velocity_interpolated = GridPlan::of(&r.sample).velocity_interpolated(r.speed);
         if velocity_interpolated {
             velocity_cases += 1;
             wins += usize::from(r.improved < r.basic);

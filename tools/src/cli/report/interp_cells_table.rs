@@ -3,57 +3,11 @@
 //! the cross-validation in both orders.
 
 use super::interp::Args;
-use evflow_nodes::synth::study::gains::AtGain;
+use evflow_nodes::synth::study::crossval::{Cell, Run, SchemeRun};
 use evflow_nodes::synth::study::row::Method;
-use evflow_nodes::synth::study::setup::Cond;
-use evflow_nodes::synth::study::xval::{Scores, GRAPH};
+use evflow_nodes::synth::study::xval::GRAPH;
 use evflow_nodes::texture::kernel::INTERP_CUTOFF;
 use std::fmt::Write as _;
-use std::path::PathBuf;
-
-/// One scheme's run at one condition.
-pub(super) struct SchemeRun {
-    /// What the cross-validation graph scored.
-    pub(super) scores: Scores,
-    /// Forces first with the cells' method: E_s, main peak (Hz), and the
-    /// recording and channel of the display's force (None: no such order,
-    /// as for playback cells).
-    pub(super) ff: Option<(f64, f64, PathBuf, &'static str)>,
-    /// The graph's recording.
-    pub(super) recording: PathBuf,
-}
-
-impl SchemeRun {
-    fn ff_es(&self) -> f64 {
-        self.ff.as_ref().map_or(f64::NAN, |f| f.0)
-    }
-}
-
-/// One condition through the graph with both schemes.
-pub(super) struct Run {
-    /// The texture sample.
-    pub(super) sample: String,
-    /// The condition.
-    pub(super) cond: Cond,
-    /// The nearest trained condition (forces first).
-    pub(super) near: Cond,
-    /// Basic, improved.
-    pub(super) schemes: [SchemeRun; 2],
-}
-
-/// One trained cell and the control run at its condition.
-pub(super) struct Cell {
-    /// Repeat baseline at the condition (rect E_s).
-    pub(super) repeat: f64,
-    /// The cell's method at its Table 5.1 gain, as graphs/synthesize.toml scored it.
-    pub(super) cell: AtGain,
-    /// Record-and-playback at its Table 5.1 gain.
-    pub(super) playback: AtGain,
-    /// Share of the cell's power above `interp`'s anti-alias cutoff.
-    pub(super) above_cutoff: f64,
-    /// The control.
-    pub(super) run: Run,
-}
 
 fn num(x: f64) -> String {
     if x.is_finite() {

@@ -1,6 +1,7 @@
 //! The tables of `evflow report textures`: Markdown for people, CSV for
 //! everything else.
 
+use evflow_nodes::lab::texture::samples::NAMES;
 use evflow_nodes::narx::model::Model;
 use evflow_nodes::synth::model_file::ForwardModel;
 use evflow_nodes::synth::study::row::{Method, Row};
@@ -195,7 +196,10 @@ fn table_51(md: &mut String, study: &Study, cfg: &StudyConfig) {
     for c in &cfg.conds {
         let mut line = format!("| {} |", c.label());
         for s in samples {
-            let diss = TABLE_51.iter().find(|(l, _)| *l == c.label()).and_then(|(_, g)| ts_index(s).map(|i| g[i]));
+            let diss = TABLE_51
+                .iter()
+                .find(|(l, _)| *l == c.label())
+                .and_then(|(_, g)| NAMES.iter().position(|n| n == s).and_then(|i| g.get(i)));
             let r = study.rows.iter().find(|r| r.profile == "nominal" && &r.sample == s && r.cond == *c);
             let g = |m: Method| r.and_then(|r| r.method(m)).map_or("–".into(), |m| m.chosen.table51.gain.to_string());
             let _ = write!(
@@ -210,13 +214,6 @@ fn table_51(md: &mut String, study: &Study, cfg: &StudyConfig) {
         let _ = writeln!(md, "{line}");
     }
     let _ = writeln!(md);
-}
-
-/// TS1–TS6 of §5.3 (Fig. 5.5) in Table 5.1's column order.
-pub fn ts_index(sample: &str) -> Option<usize> {
-    ["dotted-sheet", "chair-fabric", "felt-fabric", "painting-canvas", "plastic-sheet", "scrunched-paper"]
-        .iter()
-        .position(|s| *s == sample)
 }
 
 fn targets(md: &mut String, study: &Study, cfg: &StudyConfig) {

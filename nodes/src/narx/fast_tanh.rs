@@ -58,19 +58,19 @@ pub const DEGREE: usize = 12;
 pub const MAX_ABS_ERROR: f64 = 1.0e-15;
 
 /// |x| beyond which tanh(x) is ±1 in f64 (1 − tanh(20) < 2e-17).
-const SATURATE: f64 = 20.0;
+pub(super) const SATURATE: f64 = 20.0;
 /// Where the last step switches from (E − 1)/(E + 1) to 1 − 2/(E + 1).
-const SWITCH: f64 = 0.5;
+pub(super) const SWITCH: f64 = 0.5;
 /// 1.5·2^52: adding it rounds a value below 2^51 to an integer, which then
 /// sits in the low bits of the sum.
-const MAGIC: f64 = 6_755_399_441_055_744.0;
+pub(super) const MAGIC: f64 = 6_755_399_441_055_744.0;
 /// ln 2 in two parts: the high part has 21 trailing zero bits, so k·LN2_HI
 /// is exact for every k used here (k ≤ 58); fdlibm's split.
-const LN2_HI: f64 = f64::from_bits(0x3fe6_2e42_fee0_0000); // 6.93147180369123816490e-01
-const LN2_LO: f64 = f64::from_bits(0x3dea_39ef_3579_3c76); // 1.90821492927058770002e-10
+pub(super) const LN2_HI: f64 = f64::from_bits(0x3fe6_2e42_fee0_0000); // 6.93147180369123816490e-01
+pub(super) const LN2_LO: f64 = f64::from_bits(0x3dea_39ef_3579_3c76); // 1.90821492927058770002e-10
 
 /// 1/n! for n = 1 … 12: the coefficients of e^r − 1 = Σ rⁿ/n!.
-const C: [f64; DEGREE] = [
+pub(super) const C: [f64; DEGREE] = [
     1.0,
     1.0 / 2.0,
     1.0 / 6.0,

@@ -6,6 +6,7 @@ pub mod closed_loop;
 pub mod error;
 pub mod eval;
 pub mod fast_tanh;
+pub mod fast_tanh_avx2;
 pub mod fit;
 pub mod grid_node;
 pub mod labdata;

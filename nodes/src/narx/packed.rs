@@ -26,8 +26,8 @@
 //!
 //! Nothing allocates after [`PackedMlp::new`].
 
-use super::fast_tanh;
 use super::net::Mlp;
+use super::{fast_tanh, fast_tanh_avx2};
 use std::str::FromStr;
 
 /// Neurons per block: the width of the vectors the sums run in.
@@ -179,7 +179,7 @@ impl PackedMlp {
 }
 
 /// Whether this CPU runs the AVX2 build.
-fn has_avx2() -> bool {
+pub(crate) fn has_avx2() -> bool {
     #[cfg(target_arch = "x86_64")]
     {
         std::arch::is_x86_feature_detected!("avx2") && std::arch::is_x86_feature_detected!("fma")
@@ -288,6 +288,9 @@ fn group<const B: usize, const FUSED: bool>(
         let y = match act {
             Act::Linear => z,
             Act::Exact => z.map(f64::tanh),
+            // SAFETY: FUSED is instantiated only by `forward_avx2`, which
+            // runs after `has_avx2` found AVX2 and FMA.
+            Act::Fast if FUSED => unsafe { fast_tanh_avx2::tanh4_fused(z) },
             Act::Fast => fast_tanh::tanh_lanes(z),
         };
         out[c..c + LANES].copy_from_slice(&y);

@@ -25,6 +25,7 @@ pub mod run;
 pub mod spec;
 pub mod suggest;
 pub mod sweep;
+pub mod sweep_files;
 
 pub use check::{check, Checked, Override};
 pub use diag::{Diagnostic, Diagnostics};

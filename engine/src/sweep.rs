@@ -58,13 +58,16 @@ pub fn parse_axis(s: &str) -> Result<Axis, String> {
     if values.is_empty() {
         return Err(format!("`{s}`: no values to sweep"));
     }
-    Ok(Axis { name: name.to_string(), values, loc: Default::default() })
+    Ok(Axis { name: name.to_string(), values, files: None, linked: Vec::new(), loc: Default::default() })
 }
 
 /// The runs of a sweep over `graph_axes` with `extra` axes from the command
 /// line (replacing graph axes of the same name, else added after them);
 /// axes of a variable fixed by `pinned` (`--set`) are dropped. No axes give
-/// one point with no values.
+/// one point with no values. A files axis must have been expanded
+/// ([`crate::sweep_files::expand`]); each of its points also sets the
+/// variables linked to its value (after the axis' own, so they win over a
+/// `--set` of the same name: the file's metadata describes the file).
 pub fn points(graph_axes: &[Axis], extra: &[Axis], pinned: &[Override]) -> Vec<Point> {
     let mut axes: Vec<&Axis> = Vec::new();
     for a in graph_axes {
@@ -81,9 +84,12 @@ pub fn points(graph_axes: &[Axis], extra: &[Axis], pinned: &[Override]) -> Vec<P
         out = out
             .into_iter()
             .flat_map(|p| {
-                a.values.iter().map(move |v| {
+                a.values.iter().enumerate().map(move |(i, v)| {
                     let mut q = p.clone();
                     q.values.push((a.name.clone(), v.clone()));
+                    if let Some(linked) = a.linked.get(i) {
+                        q.values.extend(linked.iter().cloned());
+                    }
                     q
                 })
             })

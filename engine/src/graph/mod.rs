@@ -64,13 +64,20 @@ pub struct Var {
 }
 
 /// One axis of a sweep: a graph variable and the values it takes in turn
-/// (`[sweep]` table, `mass = [60.0, 85.0, 110.0]`).
+/// (`[sweep]` table, `mass = [60.0, 85.0, 110.0]`), or one value per file
+/// matching a pattern (`recording = { files = "recordings/*.json" }`,
+/// expanded by [`crate::sweep_files::expand`]).
 #[derive(Debug, Clone, PartialEq)]
 pub struct Axis {
     /// The variable swept (declared in `[vars]`).
     pub name: String,
-    /// Its values, in order.
+    /// Its values, in order (empty for a files axis not yet expanded).
     pub values: Vec<Value>,
+    /// The file pattern of a files axis, relative to the graph's folder.
+    pub files: Option<String>,
+    /// Per value, the other variables its run sets with it (read from
+    /// each file's metadata by a files axis); empty for listed values.
+    pub linked: Vec<Vec<(String, Value)>>,
     /// Where it is set.
     pub loc: Loc,
 }

@@ -237,7 +237,8 @@ pub(crate) fn valid_name(s: &str) -> bool {
     !s.is_empty() && s.chars().all(|c| c.is_ascii_alphanumeric() || c == '_' || c == '-')
 }
 
-/// `[sweep]`: one non-empty list of values per swept variable.
+/// `[sweep]`: one non-empty list of values per swept variable, or a table
+/// `{ files = "PATTERN" }`.
 fn read_sweep(cx: &mut Ctx<'_>, v: &Spanned<DeValue<'_>>, g: &mut Graph) {
     let DeValue::Table(t) = v.get_ref() else {
         let loc = cx.loc(v.span());
@@ -247,6 +248,21 @@ fn read_sweep(cx: &mut Ctx<'_>, v: &Spanned<DeValue<'_>>, g: &mut Graph) {
     for (k, val) in t.iter() {
         let loc = cx.loc(k.span());
         let name = k.get_ref().to_string();
+        if let DeValue::Table(spec) = val.get_ref() {
+            let pattern = spec.iter().find(|(k, _)| k.get_ref() == "files").map(|(_, v)| v.get_ref());
+            match (pattern, spec.len()) {
+                (Some(DeValue::String(p)), 1) if !p.trim().is_empty() => {
+                    g.sweep.push(Axis { name, values: Vec::new(), files: Some(p.to_string()), linked: Vec::new(), loc })
+                }
+                _ => cx.err(
+                    loc,
+                    None,
+                    format!("sweep `{name}`: a table here takes one key, `files`, a file pattern"),
+                    Some(format!("e.g. `{name} = {{ files = \"recordings/*.json\" }}`")),
+                ),
+            }
+            continue;
+        }
         let DeValue::Array(items) = val.get_ref() else {
             cx.err(
                 loc,
@@ -272,7 +288,7 @@ fn read_sweep(cx: &mut Ctx<'_>, v: &Spanned<DeValue<'_>>, g: &mut Graph) {
             }
         }
         if values.len() == items.len() {
-            g.sweep.push(Axis { name, values, loc });
+            g.sweep.push(Axis { name, values, files: None, linked: Vec::new(), loc });
         }
     }
 }

@@ -35,6 +35,10 @@ impl Graph {
         if !self.sweep.is_empty() {
             let _ = writeln!(s, "\n[sweep]");
             for a in &self.sweep {
+                if let Some(files) = &a.files {
+                    let _ = writeln!(s, "{} = {{ files = {} }}", key(&a.name), toml_string(files));
+                    continue;
+                }
                 let values: Vec<String> = a.values.iter().map(|v| v.to_string()).collect();
                 let _ = writeln!(s, "{} = [{}]", key(&a.name), values.join(", "));
             }

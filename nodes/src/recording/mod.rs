@@ -6,6 +6,7 @@ pub mod atomic;
 pub mod format;
 pub mod sink;
 pub mod source;
+pub mod sweep_fields;
 
 use evflow_engine::NodeSpec;
 

@@ -62,8 +62,16 @@ pub fn main(a: Args) -> Result<()> {
         println!("\nfeedback cycles broken by: {}", names.join(", "));
     }
     if !g.sweep.is_empty() {
-        let axes: Vec<String> = g.sweep.iter().map(|ax| format!("{} ({} values)", ax.name, ax.values.len())).collect();
-        let runs = evflow_engine::sweep::points(&g.sweep, &[], &a.graph.overrides()?).len();
+        let sweep = evflow_engine::sweep_files::expand(g, &evflow_nodes::recording::sweep_fields::sweep_fields)
+            .map_err(|e| anyhow!("{}: {e}", g.file.display()))?;
+        let axes: Vec<String> = sweep
+            .iter()
+            .map(|ax| match &ax.files {
+                Some(p) => format!("{} ({} files matching `{p}`)", ax.name, ax.values.len()),
+                None => format!("{} ({} values)", ax.name, ax.values.len()),
+            })
+            .collect();
+        let runs = evflow_engine::sweep::points(&sweep, &[], &a.graph.overrides()?).len();
         println!(
             "
 sweep: {} → {runs} runs (`evflow run` runs them all)",

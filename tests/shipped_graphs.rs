@@ -66,7 +66,9 @@ fn every_run_of_every_shipped_sweep_validates() {
     use evflow_engine::sweep::points;
     for (path, text) in evflow_tests::shipped_graphs() {
         let g = evflow_engine::graph::parse_graph(&path, &text).unwrap_or_else(|e| panic!("{e}"));
-        for p in points(&g.sweep, &[], &[]) {
+        let sweep = evflow_engine::sweep_files::expand(&g, &[], &evflow_nodes::recording::sweep_fields::sweep_fields)
+            .unwrap_or_else(|e| panic!("{}: {e}", path.display()));
+        for p in points(&sweep, &[], &[]) {
             if let Err(e) = evflow_engine::check(&g, &evflow_nodes::registry(), &p.overrides()) {
                 panic!("{}: sweep run {}: {e}", path.display(), p.label());
             }

@@ -9,11 +9,16 @@
 //! The engine does not read metadata itself: the caller passes a reader
 //! (`evflow run` passes the recording format's, in the nodes crate).
 //!
-//! Patterns: a path relative to the graph file's folder whose last part may
-//! hold `*` (any run of characters) and `?` (one character); the folders
-//! before it are taken as written. Matches are sorted by name; a pattern
+//! Patterns: a path relative to the graph file's folder (or absolute) whose
+//! last part may hold `*` (any run of characters) and `?` (one character);
+//! the folders before it are taken as written, after `${name}` is replaced
+//! by the graph variable's value (with `--set` applied), so that
+//! `files = "${recordings}/*.json"` and `--set recordings=~/lab/prbs` point
+//! one graph at any folder. Matches are sorted by name; a pattern
 //! that matches nothing is an error naming the folder it looked in.
 
+use crate::check::interpolate::{interpolate, InterpolateError};
+use crate::check::Override;
 use crate::graph::{Axis, Graph};
 use crate::params::Value;
 use std::path::{Path, PathBuf};
@@ -49,6 +54,17 @@ pub enum FilesError {
         /// The file-name pattern.
         name: String,
     },
+    /// The pattern names a variable the graph does not declare, or leaves
+    /// a `${` open.
+    #[error("sweep `{axis}`: `{pattern}`: {message}")]
+    Variable {
+        /// The axis.
+        axis: String,
+        /// The pattern as written.
+        pattern: String,
+        /// What is wrong.
+        message: String,
+    },
     /// A matching file's metadata could not be read.
     #[error("sweep `{axis}`: {}: {message}", path.display())]
     Metadata {
@@ -67,16 +83,32 @@ pub type MetadataReader<'a> = &'a dyn Fn(&Path) -> Result<Vec<(String, Value)>, 
 /// The graph's sweep axes with every files axis expanded: its values the
 /// matching paths (as the pattern writes them, relative to the graph's
 /// folder), each linked to the metadata fields `read` gives for it that
-/// name another declared variable of the graph. Axes of listed values are
-/// returned as they are.
-pub fn expand(graph: &Graph, read: MetadataReader<'_>) -> Result<Vec<Axis>, FilesError> {
+/// name another declared variable of the graph. `overrides` (`--set`) apply
+/// to the variables a pattern names. Axes of listed values are returned as
+/// they are.
+pub fn expand(graph: &Graph, overrides: &[Override], read: MetadataReader<'_>) -> Result<Vec<Axis>, FilesError> {
     let base = graph.file.parent().map(Path::to_path_buf).unwrap_or_default();
+    let mut vars = graph.vars.clone();
+    for o in overrides {
+        if let Some(v) = vars.iter_mut().find(|v| v.name == o.key) {
+            v.value = o.value.clone();
+        }
+    }
     let mut out = Vec::with_capacity(graph.sweep.len());
     for axis in &graph.sweep {
-        let Some(pattern) = &axis.files else {
+        let Some(written) = &axis.files else {
             out.push(axis.clone());
             continue;
         };
+        let pattern = interpolate(written, &vars).map_err(|e| FilesError::Variable {
+            axis: axis.name.clone(),
+            pattern: written.clone(),
+            message: match e {
+                InterpolateError::Unknown(name) => format!("no graph variable `{name}`"),
+                InterpolateError::Unclosed => "a `${` without its `}`".to_string(),
+            },
+        })?;
+        let pattern = &pattern;
         let mut values = Vec::new();
         let mut linked = Vec::new();
         for shown in matches(&base, &axis.name, pattern)? {
@@ -199,7 +231,7 @@ mod tests {
                 ("velocity_cm_s".into(), Value::Float(3.0)),
             ])
         };
-        let axes = expand(&g, &read).unwrap();
+        let axes = expand(&g, &[], &read).unwrap();
         let labels: Vec<String> = points(&axes, &[], &[]).iter().map(|p| p.label()).collect();
         assert_eq!(labels, ["recording=recs/a.json rate=10000 load_g=60", "recording=recs/b.json rate=1000 load_g=60"]);
         // Saved and parsed again, the axis is still a files axis.
@@ -208,18 +240,38 @@ mod tests {
     }
 
     #[test]
+    fn patterns_take_variables_and_overrides() {
+        let dir = tempfile::tempdir().unwrap();
+        for sub in ["one", "two"] {
+            std::fs::create_dir(dir.path().join(sub)).unwrap();
+            std::fs::write(dir.path().join(sub).join(format!("{sub}.json")), "").unwrap();
+        }
+        let ok = |_: &Path| -> Result<Vec<(String, Value)>, String> { Ok(vec![]) };
+        let g = graph(dir.path(), "recording = { files = \"${recording}/*.json\" }");
+        let with = |v: &str| {
+            let o = [Override { key: "recording".into(), value: Value::Text(v.into()) }];
+            expand(&g, &o, &ok).map(|a| a[0].values.clone())
+        };
+        assert_eq!(with("one").unwrap(), vec![Value::Text("one/one.json".into())]);
+        assert_eq!(with("two").unwrap(), vec![Value::Text("two/two.json".into())]);
+        let g = graph(dir.path(), "recording = { files = \"${nope}/*.json\" }");
+        let e = expand(&g, &[], &ok).unwrap_err();
+        assert!(e.to_string().contains("nope"), "{e}");
+    }
+
+    #[test]
     fn bad_patterns_and_empty_folders_are_errors_naming_them() {
         let dir = tempfile::tempdir().unwrap();
         let ok = |_: &Path| -> Result<Vec<(String, Value)>, String> { Ok(vec![]) };
-        let e = expand(&graph(dir.path(), "recording = { files = \"*.json\" }"), &ok).unwrap_err();
+        let e = expand(&graph(dir.path(), "recording = { files = \"*.json\" }"), &[], &ok).unwrap_err();
         assert!(e.to_string().contains("no file in") && e.to_string().contains("`*.json`"), "{e}");
-        let e = expand(&graph(dir.path(), "recording = { files = \"r*/x.json\" }"), &ok).unwrap_err();
+        let e = expand(&graph(dir.path(), "recording = { files = \"r*/x.json\" }"), &[], &ok).unwrap_err();
         assert!(e.to_string().contains("file name only"), "{e}");
-        let e = expand(&graph(dir.path(), "recording = { files = \"missing/*.json\" }"), &ok).unwrap_err();
+        let e = expand(&graph(dir.path(), "recording = { files = \"missing/*.json\" }"), &[], &ok).unwrap_err();
         assert!(e.to_string().contains("cannot list"), "{e}");
         std::fs::write(dir.path().join("x.json"), "").unwrap();
         let failing = |_: &Path| -> Result<Vec<(String, Value)>, String> { Err("sidecar is not valid JSON".into()) };
-        let e = expand(&graph(dir.path(), "recording = { files = \"*.json\" }"), &failing).unwrap_err();
+        let e = expand(&graph(dir.path(), "recording = { files = \"*.json\" }"), &[], &failing).unwrap_err();
         assert!(e.to_string().contains("x.json") && e.to_string().contains("not valid JSON"), "{e}");
         // A table with another key is refused when the graph is read.
         let text = "[graph]\nformat = 1\nrate = 1000.0\n[vars]\nr = \"\"\n[sweep]\nr = { glob = \"*.json\" }\n";

@@ -62,8 +62,12 @@ pub fn main(a: Args) -> Result<()> {
         println!("\nfeedback cycles broken by: {}", names.join(", "));
     }
     if !g.sweep.is_empty() {
-        let sweep = evflow_engine::sweep_files::expand(g, &evflow_nodes::recording::sweep_fields::sweep_fields)
-            .map_err(|e| anyhow!("{}: {e}", g.file.display()))?;
+        let sweep = evflow_engine::sweep_files::expand(
+            g,
+            &a.graph.overrides()?,
+            &evflow_nodes::recording::sweep_fields::sweep_fields,
+        )
+        .map_err(|e| anyhow!("{}: {e}", g.file.display()))?;
         let axes: Vec<String> = sweep
             .iter()
             .map(|ax| match &ax.files {

@@ -63,8 +63,9 @@ pub fn main(a: Args) -> Result<()> {
     }
 
     // Validate every run of the sweep before anything is built or written.
-    let sweep = evflow_engine::sweep_files::expand(&graph, &evflow_nodes::recording::sweep_fields::sweep_fields)
-        .map_err(|e| anyhow!("{}: {e}", graph.file.display()))?;
+    let sweep =
+        evflow_engine::sweep_files::expand(&graph, &overrides, &evflow_nodes::recording::sweep_fields::sweep_fields)
+            .map_err(|e| anyhow!("{}: {e}", graph.file.display()))?;
     let runs = points(&sweep, &axes, &overrides);
     let mut checked: Vec<(Point, Checked)> = Vec::with_capacity(runs.len());
     for p in runs {

@@ -18,16 +18,26 @@ fn run(graph: &Path, out: &Path) -> RunOutput {
     let duration = plan.duration().map(|d| d.min(5.0));
     let report = run_offline(&mut plan, RunOptions { duration, progress: None }).unwrap_or_else(|e| panic!("{e}"));
     let mut files = BTreeMap::new();
-    for entry in std::fs::read_dir(out).unwrap() {
-        let p = entry.unwrap().path();
-        files.insert(p.file_name().unwrap().to_string_lossy().into_owned(), std::fs::read(&p).unwrap());
-    }
+    collect(out, out, &mut files);
     let values = report
         .summaries
         .iter()
         .flat_map(|(n, s)| s.values.iter().map(move |(k, v, _)| (n.clone(), k.clone(), *v)))
         .collect();
     (files, values)
+}
+
+/// Every file under `dir` (subfolders too), by its path relative to `root`.
+fn collect(root: &Path, dir: &Path, files: &mut BTreeMap<String, Vec<u8>>) {
+    for entry in std::fs::read_dir(dir).unwrap() {
+        let p = entry.unwrap().path();
+        if p.is_dir() {
+            collect(root, &p, files);
+        } else {
+            let name = p.strip_prefix(root).unwrap().to_string_lossy().into_owned();
+            files.insert(name, std::fs::read(&p).unwrap());
+        }
+    }
 }
 
 #[test]

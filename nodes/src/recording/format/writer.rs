@@ -64,7 +64,8 @@ pub struct RecordingWriter {
 impl RecordingWriter {
     /// Starts an atomically committed recording at `path` (`NAME.wav`,
     /// `NAME.json` or `NAME`): writes to `NAME.wav.tmp` / `NAME.json.tmp`
-    /// until [`RecordingWriter::finish`] renames them.
+    /// until [`RecordingWriter::finish`] renames them. A missing folder on
+    /// the way is created.
     pub fn create(path: &Path, meta: RecordingMeta) -> Result<Self, RecordingError> {
         let target = RecordingPaths::new(path);
         Self::start(target.temporary(), target, meta, false)
@@ -92,6 +93,11 @@ impl RecordingWriter {
     ) -> Result<Self, RecordingError> {
         meta.check().map_err(|message| RecordingError::InvalidMeta { path: target.wav.clone(), message })?;
         let channels = meta.channels.len();
+        // A recording may name a folder of its own (`grid/u-felt-60g-3cms`):
+        // create it, as a shell's `mkdir -p` would.
+        if let Some(dir) = now.wav.parent().filter(|d| !d.as_os_str().is_empty()) {
+            std::fs::create_dir_all(dir).map_err(|e| RecordingError::io(dir, e))?;
+        }
         let mut opts = OpenOptions::new();
         opts.read(true).write(true);
         if live {

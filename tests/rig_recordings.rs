@@ -1,0 +1,135 @@
+//! A lab's own recordings through the shipped chains (issue 14, point 4):
+//! the test records PRBS excitations and a texture at 10 kHz itself (on the
+//! simulated lab, as a rig would, force low-passed at 500 Hz), then runs
+//! `graphs/model-build-recordings.toml` over that folder — one model per
+//! recording, each at the condition its sidecar states — and
+//! `graphs/synthesize-recordings.toml` over the texture, which must find
+//! the model of the texture's condition and write its cell.
+
+use evflow_engine::{check, graph::parse_graph, run_offline, sweep, sweep_files, Override, Plan, PlanOptions};
+use evflow_engine::{RunOptions, Value};
+use evflow_nodes::recording::format::Recording;
+use evflow_nodes::recording::sweep_fields::sweep_fields;
+use std::path::Path;
+
+/// Records the simulated lab at 10 kHz: `u` (a PRBS of order 20 clocked at
+/// 1 kHz, or zero for a texture-like recording with the display off),
+/// `force` low-passed at 500 Hz, `velocity`; one pass.
+fn record(out: &Path, name: &str, mass: f64, speed: f64, seed: u64) {
+    let text = format!(
+        r#"[graph]
+format = 1
+rate = 10000.0
+seed = {seed}
+connections = [
+    "excite.out -> display.u",
+    "tribometer.load -> display.load",
+    "tribometer.velocity -> display.velocity",
+    "display.force -> sensor.surface_force",
+    "tribometer.velocity -> sensor.velocity",
+    "sensor.force -> lowpass.in",
+    "excite.out -> record.u",
+    "lowpass.out -> record.force",
+    "tribometer.velocity -> record.velocity",
+]
+[nodes.excite]
+type = "prbs"
+rate = 10000.0
+order = 20
+clock = 10
+[nodes.tribometer]
+type = "sim.tribometer"
+rate = 10000.0
+speed = {speed}
+mass = {mass}
+passes = 1
+[nodes.display]
+type = "sim.display"
+[nodes.sensor]
+type = "sim.forcesensor"
+[nodes.lowpass]
+type = "butterworth"
+kind = "lowpass"
+order = 4
+cutoff = 500.0
+[nodes.record]
+type = "recording.out"
+path = "{name}"
+channels = ["u", "force", "velocity"]
+units = ["1", "N", "m/s"]
+load_g = {mass}
+velocity_cm_s = {speed}
+material = "lab-sample"
+"#
+    );
+    let g = parse_graph(&out.join("make.toml"), &text).unwrap_or_else(|e| panic!("{e}"));
+    let c = check(&g, &evflow_nodes::registry(), &[]).unwrap_or_else(|e| panic!("{e}"));
+    let mut plan =
+        Plan::build(&c, &PlanOptions { out_dir: Some(out.to_path_buf()), ..Default::default() }).unwrap();
+    run_offline(&mut plan, RunOptions::default()).unwrap();
+}
+
+/// Runs every point of a shipped graph's sweep with `overrides`, writing into `out`.
+fn run_sweep(graph: &str, overrides: &[(&str, &str)], out: &Path) -> usize {
+    let path = evflow_tests::root().join("graphs").join(graph);
+    let g = parse_graph(&path, &std::fs::read_to_string(&path).unwrap()).unwrap_or_else(|e| panic!("{e}"));
+    let o: Vec<Override> =
+        overrides.iter().map(|(k, v)| Override { key: k.to_string(), value: Value::Text(v.to_string()) }).collect();
+    let axes = sweep_files::expand(&g, &o, &sweep_fields).unwrap_or_else(|e| panic!("{e}"));
+    let points = sweep::points(&axes, &[], &o);
+    for p in &points {
+        let mut all = o.clone();
+        all.extend(p.overrides());
+        let c = check(&g, &evflow_nodes::registry(), &all).unwrap_or_else(|e| panic!("{}: {e}", p.label()));
+        let mut plan = Plan::build(&c, &PlanOptions { out_dir: Some(out.to_path_buf()), ..Default::default() })
+            .unwrap_or_else(|e| panic!("{}: {e}", p.label()));
+        run_offline(&mut plan, RunOptions::default()).unwrap_or_else(|e| panic!("{}: {e}", p.label()));
+    }
+    points.len()
+}
+
+#[test]
+fn ten_khz_recordings_train_models_and_synthesize_cells() {
+    let dir = tempfile::tempdir().unwrap();
+    let (prbs, textures, models, cells) =
+        (dir.path().join("prbs"), dir.path().join("textures"), dir.path().join("models"), dir.path().join("cells"));
+    for d in [&prbs, &textures, &models, &cells] {
+        std::fs::create_dir(d).unwrap();
+    }
+    record(&prbs, "a-85g-5cms", 85.0, 5.0, 1);
+    record(&prbs, "b-60g-4cms", 60.0, 4.0, 2);
+    record(&textures, "sample-60g-4cms-r1", 60.0, 4.0, 3);
+    assert_eq!(Recording::open(&prbs.join("a-85g-5cms.json")).unwrap().rate(), 10_000.0);
+
+    let runs = run_sweep(
+        "model-build-recordings.toml",
+        &[("recordings", prbs.to_str().unwrap()), ("epochs", "5")],
+        &models,
+    );
+    assert_eq!(runs, 2);
+    for (name, mass, speed) in [("narx-85g-5cms.json", 85.0, 5.0), ("narx-60g-4cms.json", 60.0, 4.0)] {
+        let m = evflow_nodes::narx::model::Model::load(&models.join(name)).unwrap_or_else(|e| panic!("{name}: {e}"));
+        // The model runs at the graph's 1 kHz, not the recording's 10 kHz,
+        // and carries the sidecar's condition.
+        assert_eq!(m.rate_hz, 1000.0, "{name}");
+        assert_eq!((m.condition.mass_g, m.condition.speed_cm_s), (Some(mass), Some(speed)), "{name}");
+    }
+
+    let runs = run_sweep(
+        "synthesize-recordings.toml",
+        &[("textures", textures.to_str().unwrap()), ("models", models.to_str().unwrap())],
+        &cells,
+    );
+    assert_eq!(runs, 1);
+    let cell = Recording::open(&cells.join("narx-lab-sample/u-lab-sample-60g-4cms.json")).unwrap();
+    let texture = Recording::open(&textures.join("sample-60g-4cms-r1.json")).unwrap();
+    assert_eq!(cell.rate(), 1000.0);
+    assert_eq!(cell.meta().condition.load_g, Some(60.0));
+    assert_eq!(cell.meta().condition.material.as_deref(), Some("lab-sample"));
+    // One cell sample per 10 texture samples (± the resampler's edges).
+    let ratio = cell.frames() as f64 / texture.frames() as f64;
+    assert!((ratio - 0.1).abs() < 0.002, "{} cell frames for {} texture frames", cell.frames(), texture.frames());
+    let u = cell.channel("u").unwrap();
+    assert!(u.iter().all(|v| v.is_finite()), "non-finite actuation");
+    assert!(u.iter().any(|v| v.abs() > 0.1), "the cell is silent");
+}

@@ -1,34 +1,185 @@
 //! The graph-file loader never panics: arbitrary text and mutated graph
-//! files (every shipped graph, mutated line- and byte-wise) go through
-//! parsing, validation and — when valid — plan construction. Bounded in
-//! time for the normal test suite; `fuzz/` has a cargo-fuzz target for
-//! longer runs.
+//! files (every shipped graph and every corpus case, mutated line- and
+//! byte-wise) go through parsing, validation and — when valid — plan
+//! construction.
+//!
+//! **Deterministic by default.** `cargo test` draws the property tests'
+//! cases from a fixed seed ([`CI_SEED`]), so a run fails or passes the same
+//! way every time, and it replays every file of `tests/fuzz_corpus/` — each
+//! case that ever failed, plus hand-picked nasty inputs — with a plain test
+//! (`tests/fuzz_corpus/README.md` says how to add one).
+//!
+//! **Open-ended fuzzing is opt-in:** `EVFLOW_FUZZ_CASES=N` draws N cases per
+//! property from a fresh random seed, printed with the results;
+//! `EVFLOW_FUZZ_SEED=S` replays seed S. A failing case's text is saved under
+//! the target folder (the path is printed) for the corpus. `fuzz/` has a
+//! cargo-fuzz target for longer runs. README.md, "Fuzzing", has the commands.
 
 use evflow_engine::{check, graph::parse_graph, Plan, PlanOptions};
 use proptest::prelude::*;
+use proptest::test_runner::{RngAlgorithm, RngSeed, TestRunner};
+use std::cell::RefCell;
+use std::path::{Path, PathBuf};
+use std::sync::OnceLock;
 
-fn seeds() -> Vec<String> {
-    evflow_tests::shipped_graphs().into_iter().map(|(_, text)| text).collect()
+/// The seed of the deterministic run (any fixed value; changing it draws
+/// another fixed set of cases).
+const CI_SEED: u64 = 0x00E7_F10A;
+
+/// Cases per property in the deterministic run (about 1.5 s for all three).
+const CI_CASES: u32 = 400;
+
+/// The deterministic configuration of `cargo test`: fixed seed and
+/// algorithm (set here, so no `PROPTEST_*` variable can change the draw),
+/// and no failure file written into the source tree — the corpus keeps
+/// failures instead.
+fn ci_config() -> ProptestConfig {
+    ProptestConfig {
+        cases: CI_CASES,
+        max_shrink_iters: 200,
+        rng_algorithm: RngAlgorithm::ChaCha,
+        rng_seed: RngSeed::Fixed(CI_SEED),
+        failure_persistence: None,
+        ..ProptestConfig::default()
+    }
 }
 
-/// Loads, validates and (when valid) builds; must return, never panic.
-fn load(text: &str) {
-    let registry = evflow_nodes::registry();
-    let dir = tempfile::tempdir().expect("temp dir");
-    let file = dir.path().join("fuzz.toml");
-    if let Ok(g) = parse_graph(&file, text) {
-        if let Ok(c) = check(&g, &registry, &[]) {
-            // Building may fail (missing files) but must not panic; nodes
-            // that write files write them into the temp dir.
-            let _ = Plan::build(
-                &c,
-                &PlanOptions { max_block: 64, out_dir: Some(dir.path().to_path_buf()), ..Default::default() },
-            );
+/// The opt-in open-ended run, from `EVFLOW_FUZZ_CASES` / `EVFLOW_FUZZ_SEED`:
+/// `Some((seed, cases))` when either is set. One seed per test process, so
+/// one printed seed replays the whole run.
+fn fuzz_env() -> Option<(u64, u32)> {
+    static RUN: OnceLock<Option<(u64, u32)>> = OnceLock::new();
+    *RUN.get_or_init(|| {
+        let var = |name: &str| std::env::var(name).ok().filter(|v| !v.trim().is_empty());
+        let (cases, seed) = (var("EVFLOW_FUZZ_CASES"), var("EVFLOW_FUZZ_SEED"));
+        if cases.is_none() && seed.is_none() {
+            return None;
+        }
+        let cases = cases.map_or(CI_CASES, |v| {
+            v.trim().parse().unwrap_or_else(|_| panic!("EVFLOW_FUZZ_CASES={v}: expected a whole number of cases"))
+        });
+        let seed = seed.map_or_else(fresh_seed, |v| {
+            v.trim().parse().unwrap_or_else(|_| panic!("EVFLOW_FUZZ_SEED={v}: expected an unsigned 64-bit integer"))
+        });
+        eprintln!("fuzz_loader: seed {seed}, {cases} cases per property (EVFLOW_FUZZ_SEED={seed} replays this run)");
+        Some((seed, cases))
+    })
+}
+
+/// A seed that differs from run to run (std's per-process hash keys mixed
+/// with the clock).
+fn fresh_seed() -> u64 {
+    use std::hash::{BuildHasher, Hasher};
+    let mut h = std::collections::hash_map::RandomState::new().build_hasher();
+    h.write_u128(std::time::SystemTime::now().duration_since(std::time::UNIX_EPOCH).map_or(0, |d| d.as_nanos()));
+    h.finish()
+}
+
+/// The configuration the property tests run with: the deterministic one
+/// unless open-ended fuzzing was asked for.
+fn config() -> ProptestConfig {
+    match fuzz_env() {
+        Some((seed, cases)) => ProptestConfig { cases, rng_seed: RngSeed::Fixed(seed), ..ci_config() },
+        None => ci_config(),
+    }
+}
+
+/// The corpus folder: one file per case, every file but README.md.
+fn corpus_dir() -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR")).join("fuzz_corpus")
+}
+
+/// Every corpus case, sorted by file name, with its text (invalid UTF-8
+/// read lossily, as the property tests read arbitrary bytes).
+fn corpus() -> Vec<(PathBuf, String)> {
+    let dir = corpus_dir();
+    let mut files: Vec<PathBuf> = std::fs::read_dir(&dir)
+        .unwrap_or_else(|e| panic!("{}: {e}", dir.display()))
+        .map(|e| e.expect("corpus entry").path())
+        .filter(|p| p.is_file() && p.file_name().is_some_and(|n| n != "README.md"))
+        .collect();
+    files.sort();
+    files
+        .into_iter()
+        .map(|p| {
+            let bytes = std::fs::read(&p).unwrap_or_else(|e| panic!("{}: {e}", p.display()));
+            let text = String::from_utf8_lossy(&bytes).into_owned();
+            (p, text)
+        })
+        .collect()
+}
+
+/// The texts the mutations start from: the shipped graphs and the corpus.
+fn bases() -> &'static [String] {
+    static BASES: OnceLock<Vec<String>> = OnceLock::new();
+    BASES.get_or_init(|| evflow_tests::shipped_graphs().into_iter().chain(corpus()).map(|(_, text)| text).collect())
+}
+
+/// How far a text got through the loader.
+#[derive(Debug)]
+enum Outcome {
+    /// Refused by the parser, with its message.
+    Parse(String),
+    /// Refused by validation, with its message.
+    Check(String),
+    /// Valid, but a node could not be built (e.g. a missing file).
+    Build(String),
+    /// Valid, and the plan was built.
+    Built,
+}
+
+impl Outcome {
+    /// The error message, if any.
+    fn message(&self) -> Option<&str> {
+        match self {
+            Outcome::Parse(m) | Outcome::Check(m) | Outcome::Build(m) => Some(m),
+            Outcome::Built => None,
         }
     }
 }
 
-#[derive(Debug, Clone)]
+/// Loads, validates and (when valid) builds.
+fn load(text: &str) -> Outcome {
+    let registry = evflow_nodes::registry();
+    let dir = tempfile::tempdir().expect("temp dir");
+    let file = dir.path().join("fuzz.toml");
+    let g = match parse_graph(&file, text) {
+        Ok(g) => g,
+        Err(e) => return Outcome::Parse(e.to_string()),
+    };
+    let c = match check(&g, &registry, &[]) {
+        Ok(c) => c,
+        Err(e) => return Outcome::Check(e.to_string()),
+    };
+    // Nodes that write files write them into the temp dir.
+    match Plan::build(&c, &PlanOptions { max_block: 64, out_dir: Some(dir.path().to_path_buf()), ..Default::default() })
+    {
+        Ok(_) => Outcome::Built,
+        Err(e) => Outcome::Build(e.to_string()),
+    }
+}
+
+/// [`load`] for a property test: on a panic the text is saved to
+/// `<target>/tmp/fuzz_loader/<property>.toml` (overwritten, so after
+/// shrinking it holds the minimal case) before the panic goes on.
+fn load_or_save(property: &str, text: &str) {
+    if let Err(panic) = std::panic::catch_unwind(|| load(text)) {
+        let dir = Path::new(env!("CARGO_TARGET_TMPDIR")).join("fuzz_loader");
+        let path = dir.join(format!("{property}.toml"));
+        static TOLD: std::sync::Mutex<Vec<String>> = std::sync::Mutex::new(Vec::new());
+        if std::fs::create_dir_all(&dir).and_then(|()| std::fs::write(&path, text)).is_ok() {
+            // Once per property: shrinking panics many times into one file.
+            let mut told = TOLD.lock().unwrap_or_else(|e| e.into_inner());
+            if !told.iter().any(|p| p == property) {
+                told.push(property.to_string());
+                eprintln!("fuzz_loader: the failing text is in {} (add it to tests/fuzz_corpus/)", path.display());
+            }
+        }
+        std::panic::resume_unwind(panic);
+    }
+}
+
+#[derive(Debug, Clone, PartialEq)]
 enum Mutation {
     DeleteLine(usize),
     DuplicateLine(usize),
@@ -126,26 +277,141 @@ fn apply(text: &str, m: &Mutation) -> String {
     lines.join("\n")
 }
 
+/// A base text (by index, modulo the number of bases) and the mutations
+/// applied to it in turn.
+fn mutated_case() -> impl Strategy<Value = (usize, Vec<Mutation>)> {
+    (any::<usize>(), prop::collection::vec(mutation(), 1..6))
+}
+
+/// The text of a [`mutated_case`].
+fn mutated_text(base: usize, muts: &[Mutation]) -> String {
+    let bases = bases();
+    muts.iter().fold(bases[base % bases.len()].clone(), |text, m| apply(&text, m))
+}
+
+/// Short text over the characters TOML graph files are made of.
+const TEXT_CASE: &str = "[\\[\\]a-z0-9_.=\" \\n\\->$,{}#]{0,300}";
+
+/// Arbitrary bytes, read as text lossily.
+fn bytes_case() -> impl Strategy<Value = Vec<u8>> {
+    prop::collection::vec(any::<u8>(), 0..200)
+}
+
 proptest! {
-    #![proptest_config(ProptestConfig { cases: 400, max_shrink_iters: 200, ..ProptestConfig::default() })]
+    #![proptest_config(config())]
 
     #[test]
-    fn mutated_graphs_never_panic(seed in any::<usize>(), muts in prop::collection::vec(mutation(), 1..6)) {
-        let seeds = seeds();
-        let mut text = seeds[seed % seeds.len()].clone();
-        for m in &muts {
-            text = apply(&text, m);
+    fn mutated_graphs_never_panic((base, muts) in mutated_case()) {
+        load_or_save("mutated_graphs_never_panic", &mutated_text(base, &muts));
+    }
+
+    #[test]
+    fn arbitrary_text_never_panics(text in TEXT_CASE) {
+        load_or_save("arbitrary_text_never_panics", &text);
+    }
+
+    #[test]
+    fn arbitrary_bytes_never_panic(bytes in bytes_case()) {
+        load_or_save("arbitrary_bytes_never_panic", &String::from_utf8_lossy(&bytes));
+    }
+}
+
+/// What a corpus file expects beyond "no panic", from its comment lines:
+/// `# expect: built` (the plan builds) or `# expect-error: TEXT` (the
+/// loader refuses it with a message containing TEXT).
+#[derive(Debug, PartialEq)]
+enum Expect {
+    Built,
+    Error(String),
+}
+
+fn expectations(text: &str) -> Vec<Expect> {
+    text.lines()
+        .filter_map(|l| {
+            let l = l.trim_start();
+            if l.trim_end() == "# expect: built" {
+                Some(Expect::Built)
+            } else {
+                l.strip_prefix("# expect-error:").map(|m| Expect::Error(m.trim().to_string()))
+            }
+        })
+        .collect()
+}
+
+/// Every corpus case: no panic, and the outcome its comments expect.
+#[test]
+fn corpus_cases_load_without_panic_and_as_expected() {
+    let cases = corpus();
+    assert!(cases.len() >= 10, "the corpus in {} has only {} cases", corpus_dir().display(), cases.len());
+    let mut failures = Vec::new();
+    for (path, text) in &cases {
+        let name = path.file_name().unwrap_or_default().to_string_lossy();
+        let outcome = match std::panic::catch_unwind(|| load(text)) {
+            Ok(o) => o,
+            Err(_) => {
+                failures.push(format!("{name}: panicked"));
+                continue;
+            }
+        };
+        for e in expectations(text) {
+            let met = match (&e, &outcome) {
+                (Expect::Built, Outcome::Built) => true,
+                (Expect::Error(want), o) => o.message().is_some_and(|m| m.contains(want.as_str())),
+                _ => false,
+            };
+            if !met {
+                failures.push(format!("{name}: expected {e:?}, got {outcome:?}"));
+            }
         }
-        load(&text);
     }
+    assert!(failures.is_empty(), "{} corpus case(s) failed:\n{}", failures.len(), failures.join("\n"));
+}
 
-    #[test]
-    fn arbitrary_text_never_panics(text in "[\\[\\]a-z0-9_.=\" \\n\\->$,{}#]{0,300}") {
-        load(&text);
+#[test]
+fn expectations_are_read_from_comment_lines() {
+    let text = "# a case\n  # expect-error: `type` is empty\n# expect: built\n# expect:built\nx = 1 # expect: built\n";
+    assert_eq!(expectations(text), [Expect::Error("`type` is empty".into()), Expect::Built]);
+}
+
+/// Runs `strategy` through a proptest runner with `config` and returns
+/// every case it drew, in order.
+fn drawn<S: Strategy>(config: ProptestConfig, strategy: S) -> Vec<S::Value>
+where
+    S::Value: Clone,
+{
+    let seen = RefCell::new(Vec::new());
+    TestRunner::new(config)
+        .run(&strategy, |v| {
+            seen.borrow_mut().push(v);
+            Ok(())
+        })
+        .expect("recording cases cannot fail");
+    seen.into_inner()
+}
+
+/// Fails at the first case where two draws differ (without printing
+/// hundreds of graph files).
+fn same_draws<T: PartialEq>(what: &str, a: &[T], b: &[T]) {
+    assert_eq!(a.len(), b.len(), "{what}: case counts differ");
+    if let Some(i) = a.iter().zip(b).position(|(x, y)| x != y) {
+        panic!("{what}: case {i} differs between two runs of the CI configuration");
     }
+}
 
-    #[test]
-    fn arbitrary_bytes_never_panic(bytes in prop::collection::vec(any::<u8>(), 0..200)) {
-        load(&String::from_utf8_lossy(&bytes));
+/// The deterministic run is deterministic: two runners on the CI
+/// configuration draw the same cases, case for case, for each property's
+/// strategy — so a random seed slipping into `ci_config` fails here — and
+/// `cargo test` uses that configuration unless fuzzing was asked for.
+#[test]
+fn the_ci_configuration_draws_the_same_cases_every_run() {
+    let texts = || drawn(ci_config(), mutated_case().prop_map(|(b, m)| mutated_text(b, &m)));
+    let first = texts();
+    assert_eq!(first.len(), CI_CASES as usize);
+    assert!(first.iter().any(|t| t != &first[0]), "the cases vary");
+    same_draws("mutated graphs", &first, &texts());
+    same_draws("arbitrary text", &drawn(ci_config(), TEXT_CASE), &drawn(ci_config(), TEXT_CASE));
+    same_draws("arbitrary bytes", &drawn(ci_config(), bytes_case()), &drawn(ci_config(), bytes_case()));
+    if fuzz_env().is_none() {
+        assert_eq!(config(), ci_config());
     }
 }

@@ -3,7 +3,7 @@
 use super::*;
 use crate::serial::message::{Message, Touch};
 use proptest::prelude::*;
-use proptest::test_runner::{Config, RngSeed};
+use proptest::test_runner::{Config, RngAlgorithm, RngSeed};
 
 /// A message from a number (deterministic variety of types and lengths).
 fn message(k: u32) -> Message {
@@ -44,8 +44,16 @@ fn seqs(frames: &[Frame]) -> Vec<u16> {
     frames.iter().map(|f| f.seq).collect()
 }
 
+/// Fixed seed and algorithm (set here, so no `PROPTEST_*` variable changes
+/// the cases a run draws) and no failure file: deterministic in CI.
 fn config() -> Config {
-    Config { cases: 256, rng_seed: RngSeed::Fixed(0x5E71A1), failure_persistence: None, ..Config::default() }
+    Config {
+        cases: 256,
+        rng_algorithm: RngAlgorithm::ChaCha,
+        rng_seed: RngSeed::Fixed(0x5E71A1),
+        failure_persistence: None,
+        ..Config::default()
+    }
 }
 
 #[test]

@@ -7,7 +7,9 @@
 //!   a file none of them splits is one column.
 //! * Empty lines and lines starting with `#` are skipped.
 //! * The first remaining line is a header when none of its cells is a
-//!   number. A header cell is a name with an optional unit in brackets or
+//!   number. Without one, a `#` comment line right above the first row
+//!   that holds one name per column is the header (`np.savetxt` writes
+//!   its `header` argument so). A header cell is a name with an optional unit in brackets or
 //!   parentheses: `force [N]`, `time (s)`.
 //! * Every other cell must be a finite number (`1.5`, `-2e-3`; with a
 //!   semicolon, tab or space delimiter also the decimal comma `1,5`). Cells
@@ -90,6 +92,9 @@ pub(super) struct Table {
     pub delimiter: Delimiter,
     /// Whether the delimiter was detected (not given).
     pub detected: bool,
+    /// The line of a `#` comment taken as the header (`np.savetxt` writes
+    /// its `header` so), if that is where the header came from.
+    pub header_from_comment: Option<usize>,
 }
 
 impl Table {
@@ -186,7 +191,21 @@ pub(super) fn parse(text: &str, path: &Path, delimiter: Option<Delimiter>) -> Re
     if lines.is_empty() {
         return Err(ImportError::Empty { path: path.to_path_buf(), what: "a header row and no data rows".into() });
     }
-    Ok(Table { header, columns, samples, lines, delimiter, detected })
+    // No header row: the comment line right above the first row is the
+    // header if it holds one name per column (`np.savetxt(…, header=…)`).
+    let mut header_from_comment = None;
+    if header.is_none() {
+        let above = lines[0].checked_sub(2).and_then(|i| text.lines().nth(i)).map(|l| l.trim_end_matches('\r'));
+        if let Some(names) = above.and_then(|l| l.trim_start().strip_prefix('#')) {
+            if let Ok(cells) = split(names.trim(), delimiter) {
+                if cells.len() == columns && cells.iter().all(|c| !c.is_empty() && number(c, delimiter).is_none()) {
+                    header = Some(cells.iter().map(|c| head(c)).collect());
+                    header_from_comment = Some(lines[0] - 1);
+                }
+            }
+        }
+    }
+    Ok(Table { header, columns, samples, lines, delimiter, detected, header_from_comment })
 }
 
 /// The first of tab, semicolon, comma that splits every sniffed line into
@@ -370,6 +389,18 @@ mod tests {
             "t.csv:3: 3 cell(s) where the header has 2 (comma delimiter, detected; give another with --delimiter)"
         );
         assert_eq!(err("a,b\n\"1,2\n"), "t.csv:2: a quoted cell is not closed on this line");
+    }
+
+    #[test]
+    fn a_commented_header_right_above_the_rows_is_the_header() {
+        let t = parse("# written by np.savetxt\n# time [s],force [N]\n0,1\n1,2\n", p(), None).unwrap();
+        assert_eq!(t.header_from_comment, Some(2));
+        assert_eq!(t.header.unwrap()[1], Head { name: "force".into(), unit: "N".into() });
+        // Not right above, the wrong count, or numbers: a comment stays one.
+        for text in ["# time,force\n\n0,1\n", "# time,force,u\n0,1\n", "# 1,2\n0,1\n", "# a note\n0,1\n"] {
+            let t = parse(text, p(), None).unwrap();
+            assert_eq!((t.header, t.header_from_comment), (None, None), "{text:?}");
+        }
     }
 
     #[test]

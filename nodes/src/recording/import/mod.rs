@@ -243,8 +243,8 @@ impl Default for ImportOptions {
 impl ImportOptions {
     /// Adds a `key=value` entry to the condition. The keys `load_g`,
     /// `velocity_cm_s` and `gain` take numbers and `material` text; any other
-    /// key takes a number if the value reads as one, `true`/`false`, else
-    /// text. A key already set is an error.
+    /// key takes an integer or a number if the value reads as one,
+    /// `true`/`false`, else text. A key already set is an error.
     pub fn add_condition(&mut self, entry: &str) -> Result<(), ImportError> {
         let usage = |m: String| ImportError::Usage(format!("--condition {entry}: {m}"));
         let Some((key, value)) = entry.split_once('=') else {
@@ -267,7 +267,9 @@ impl ImportOptions {
             }
             "material" => c.material.replace(value.to_string()).is_some(),
             _ => {
-                let v = if let Ok(x) = value.parse::<f64>() {
+                let v = if let Ok(i) = value.parse::<i64>() {
+                    serde_json::Value::from(i)
+                } else if let Ok(x) = value.parse::<f64>() {
                     serde_json::Number::from_f64(x)
                         .map(serde_json::Value::Number)
                         .ok_or_else(|| usage(format!("`{value}` is not a finite number")))?
@@ -416,6 +418,9 @@ pub fn read(src: &Path, opts: &ImportOptions) -> Result<Imported, ImportError> {
                 }
             };
             let t = csv::parse(&text, src, delimiter)?;
+            if let Some(line) = t.header_from_comment {
+                notes.push(format!("header read from the comment on line {line}"));
+            }
             let description = format!(
                 "{} rows, {} delimiter{}",
                 t.rows(),

@@ -331,7 +331,7 @@ fn csv_variants_round_trip_with_rate_from_the_time_column() {
         (c.load_g, c.velocity_cm_s, c.material.as_deref(), c.gain),
         (Some(85.0), Some(4.0), Some("felt"), Some(1.0))
     );
-    assert_eq!(c.extra["trial"], serde_json::json!(3.0));
+    assert_eq!(c.extra["trial"], serde_json::json!(3));
     assert_eq!(c.extra["operator"], serde_json::json!("jk"));
     assert_eq!(c.extra["lowpassed"], serde_json::json!(true));
     assert_eq!(

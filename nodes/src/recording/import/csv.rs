@@ -11,6 +11,8 @@
 //!   that holds one name per column is the header (`np.savetxt` writes
 //!   its `header` argument so). A header cell is a name with an optional unit in brackets or
 //!   parentheses: `force [N]`, `time (s)`.
+//! * The text is UTF-8, or UTF-16 with a byte-order mark, or else Latin-1
+//!   (decoded by the caller).
 //! * Every other cell must be a finite number (`1.5`, `-2e-3`; with a
 //!   semicolon, tab or space delimiter also the decimal comma `1,5`). Cells
 //!   may be quoted (`"1.5"`, RFC 4180 quoting).

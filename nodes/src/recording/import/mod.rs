@@ -410,13 +410,7 @@ pub fn read(src: &Path, opts: &ImportOptions) -> Result<Imported, ImportError> {
             Columns { heads: None, columns: a.channels, samples: a.samples, lines: None, description: a.description }
         }
         Kind::Text(delimiter) => {
-            let text = match String::from_utf8(bytes) {
-                Ok(t) => t,
-                Err(e) => {
-                    notes.push("the file is not UTF-8: read as Latin-1".into());
-                    e.into_bytes().iter().map(|&b| char::from(b)).collect()
-                }
-            };
+            let text = decode_text(bytes, &mut notes);
             let t = csv::parse(&text, src, delimiter)?;
             if let Some(line) = t.header_from_comment {
                 notes.push(format!("header read from the comment on line {line}"));
@@ -437,6 +431,40 @@ pub fn read(src: &Path, opts: &ImportOptions) -> Result<Imported, ImportError> {
         }
     };
     assemble(src, table, opts, notes)
+}
+
+/// The text of a delimited file: UTF-8 (with or without a byte-order
+/// mark), UTF-16 with a byte-order mark (Excel's "Unicode text"), else
+/// Latin-1 (every byte a character), with a note saying which.
+fn decode_text(bytes: Vec<u8>, notes: &mut Vec<String>) -> String {
+    let utf16 = |le: bool| {
+        let units = bytes[2..].chunks_exact(2).map(|p| {
+            if le {
+                u16::from_le_bytes([p[0], p[1]])
+            } else {
+                u16::from_be_bytes([p[0], p[1]])
+            }
+        });
+        char::decode_utf16(units).map(|c| c.unwrap_or(char::REPLACEMENT_CHARACTER)).collect::<String>()
+    };
+    match bytes.get(..2) {
+        Some([0xff, 0xfe]) => {
+            notes.push("the file is UTF-16 (little-endian)".into());
+            return utf16(true);
+        }
+        Some([0xfe, 0xff]) => {
+            notes.push("the file is UTF-16 (big-endian)".into());
+            return utf16(false);
+        }
+        _ => {}
+    }
+    match String::from_utf8(bytes) {
+        Ok(t) => t,
+        Err(e) => {
+            notes.push("the file is not UTF-8: read as Latin-1".into());
+            e.into_bytes().iter().map(|&b| char::from(b)).collect()
+        }
+    }
 }
 
 /// Reads `src` and writes it as a recording at `dest` (see [`destination`]
@@ -529,6 +557,12 @@ fn assemble(src: &Path, t: Columns, opts: &ImportOptions, mut notes: Vec<String>
         return Err(options(format!(
             "columns {} are all time columns (named time or t); keep one, or rename the others with --channels",
             time.iter().map(|k| (k + 1).to_string()).collect::<Vec<_>>().join(", ")
+        )));
+    }
+    let tol = opts.time_tolerance;
+    if !(tol.is_finite() && (0.0..1.0).contains(&tol)) {
+        return Err(ImportError::Usage(format!(
+            "--time-tolerance {tol}: a fraction of the time step, at least 0 and below 1 (e.g. 0.01)"
         )));
     }
     let mut inferred = None;

@@ -401,6 +401,10 @@ fn names_units_and_rate_from_the_options() {
     );
     assert_eq!(err(&with_rate(-3.0)), "--rate -3: not a positive number of Hz");
     assert_eq!(
+        err(&ImportOptions { time_tolerance: -0.1, ..ImportOptions::default() }),
+        "--time-tolerance -0.1: a fraction of the time step, at least 0 and below 1 (e.g. 0.01)"
+    );
+    assert_eq!(
         err(&with_rate(2.1)),
         format!("{p}: --rate 2.1 Hz disagrees with the 2 Hz of time column `Time` (more than 1 % apart)")
     );
@@ -506,8 +510,20 @@ fn unsupported_files_are_refused_by_name() {
         .ends_with("holds no samples: a header row and no data rows"));
     fs::write(&p, "").unwrap();
     assert!(read(&p, &ImportOptions::default()).unwrap_err().to_string().contains("holds no samples"));
-    fs::write(&p, [0xff, 0xfe, 0x00, 0x31, b'\n', 0x80]).unwrap();
+    fs::write(&p, [0xfe, 0x00, 0x31, b'\n', 0x80]).unwrap();
     assert!(matches!(read(&p, &ImportOptions::default()), Err(ImportError::Cell { line: 2, .. })));
+    // UTF-16 with a byte-order mark, as Excel's "Unicode text" saves.
+    for le in [true, false] {
+        let text = "time\tforce [N]\r\n0\t1,5\r\n0,5\t2\r\n";
+        let mut b = if le { vec![0xff, 0xfe] } else { vec![0xfe, 0xff] };
+        for u in text.encode_utf16() {
+            b.extend(if le { u.to_le_bytes() } else { u.to_be_bytes() });
+        }
+        fs::write(&p, b).unwrap();
+        let got = read(&p, &ImportOptions::default()).unwrap();
+        assert_eq!((got.meta.rate, got.samples()), (2.0, &[1.5, 2.0][..]));
+        assert!(got.notes[0].starts_with("the file is UTF-16"), "{:?}", got.notes);
+    }
 }
 
 #[test]

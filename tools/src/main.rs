@@ -44,6 +44,26 @@ enum Command {
     ///
     /// Example: evflow nodes butterworth
     Nodes(cli::nodes::Args),
+    /// Import a lab's .npy or CSV file as an evflow recording (WAV + JSON).
+    ///
+    /// Reads NAME.npy (NumPy: 1-D, or frames × channels; float or integer)
+    /// or NAME.csv / .tsv / .txt (numbers in columns; an optional header row
+    /// of names with units in brackets, `time [s],force [N],u`) and writes
+    /// the recording NAME.wav + NAME.json beside it, or at --out. The rate is
+    /// --rate, or comes from a `time` or `t` column whose steps are uniform
+    /// (the column is then dropped). The condition (--load-g,
+    /// --velocity-cm-s, --material, --gain, --condition KEY=VALUE) goes into
+    /// the sidecar, where graphs read it. Nothing is written when anything
+    /// is wrong; an existing recording is replaced only with --force.
+    /// docs/rig.md says what to record and how.
+    ///
+    /// Examples — a CSV with a `time [s]` column, then an .npy array of two
+    /// columns (u, force) sampled at 10 kHz:
+    ///
+    ///   evflow import prbs-85g-4cms.csv --load-g 85 --velocity-cm-s 4 --material display-a
+    ///
+    ///   evflow import force.npy --rate 10000 --channels u,force --units ,N --out recordings/prbs-85g-4cms
+    Import(cli::import::Args),
     /// Run a graph live, in real time (1 tick per base-rate period), and
     /// record the session (inputs, outputs, parameter changes) for replay.
     ///
@@ -102,6 +122,7 @@ fn main() -> ExitCode {
         Command::Check(a) => cli::check::main(a),
         Command::Nodes(a) => cli::nodes::main(a),
         Command::Dot(a) => cli::dot::main(a),
+        Command::Import(a) => cli::import::main(a),
         Command::Live(a) => cli::live::main(a),
         Command::Replay(a) => cli::replay::main(a),
         Command::Report(a) => cli::report::main(a),

@@ -26,16 +26,71 @@ fn files_in(dir: &Path) -> Vec<String> {
 
 #[test]
 fn help_explains_each_command_with_an_example() {
-    for cmd in ["run", "check", "nodes", "dot"] {
+    for cmd in ["run", "check", "nodes", "dot", "import"] {
         let o = evflow(&[cmd, "--help"]);
         let (out, _) = text(&o);
         assert!(o.status.success(), "{cmd} --help");
         assert!(out.contains("Example"), "`evflow {cmd} --help` shows no example:\n{out}");
     }
     let (out, _) = text(&evflow(&["--help"]));
-    for cmd in ["run", "check", "nodes", "dot"] {
+    for cmd in ["run", "check", "nodes", "dot", "import"] {
         assert!(out.contains(cmd), "{out}");
     }
+}
+
+#[test]
+fn import_writes_a_recording_and_says_what_it_wrote() {
+    let dir = tempfile::tempdir().unwrap();
+    let src = dir.path().join("prbs-85g-4cms.csv");
+    let mut csv = String::from("time [s],u,force [N]\n");
+    for i in 0..2000 {
+        let u = if (i * 7919) % 13 < 6 { -1.0 } else { 1.0 };
+        csv += &format!("{},{u},{}\n", i as f64 / 10_000.0, 0.05 * u);
+    }
+    std::fs::write(&src, csv).unwrap();
+    let out = dir.path().join("recordings/");
+    let args = [
+        "import",
+        src.to_str().unwrap(),
+        "--out",
+        out.to_str().unwrap(),
+        "--load-g",
+        "85",
+        "--velocity-cm-s",
+        "4",
+        "--material",
+        "display-a",
+        "--condition",
+        "trial=2",
+    ];
+    let o = evflow(&args);
+    let (stdout, stderr) = text(&o);
+    assert!(o.status.success(), "{stderr}");
+    for want in [
+        "prbs-85g-4cms.wav + ",
+        "rate       10000 Hz",
+        "frames     2000 (0.2 s)",
+        "channels   u, force [N]",
+        "condition  load_g=85, velocity_cm_s=4, material=display-a, trial=2",
+        "note: rate 10000 Hz from time column `time`",
+    ] {
+        assert!(stdout.contains(want), "`{want}` missing:\n{stdout}");
+    }
+    assert_eq!(files_in(&out), ["prbs-85g-4cms.json", "prbs-85g-4cms.wav"]);
+    let sidecar = std::fs::read_to_string(out.join("prbs-85g-4cms.json")).unwrap();
+    assert!(sidecar.contains("\"load_g\": 85.0"), "{sidecar}");
+
+    // Again: refused, the recording kept; a bad row: nothing written.
+    let o = evflow(&args);
+    assert!(!o.status.success());
+    assert!(text(&o).1.contains("already exists; give --force"), "{}", text(&o).1);
+    let bad = dir.path().join("bad.csv");
+    std::fs::write(&bad, "t,force\n0,1\n0.001,x\n").unwrap();
+    let o = evflow(&["import", bad.to_str().unwrap(), "--out", dir.path().join("b/c").to_str().unwrap()]);
+    let (_, stderr) = text(&o);
+    assert!(!o.status.success());
+    assert!(stderr.contains("bad.csv:3: column 2 (`force`): `x` is not a number"), "{stderr}");
+    assert!(!dir.path().join("b").exists());
 }
 
 #[test]

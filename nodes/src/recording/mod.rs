@@ -1,9 +1,11 @@
 //! Recordings: the on-disk format ([`format`](mod@format): 64-bit float WAV + JSON
 //! sidecar, described in `docs/recording-format.md`) and the nodes that read
-//! and write it, `recording.in` ([`source`]) and `recording.out` ([`sink`]).
+//! and write it, `recording.in` ([`source`]) and `recording.out` ([`sink`]);
+//! [`import`](mod@import) turns a lab's `.npy` and CSV files into recordings.
 
 pub mod atomic;
 pub mod format;
+pub mod import;
 pub mod sink;
 pub mod source;
 pub mod sweep_fields;

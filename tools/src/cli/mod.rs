@@ -6,6 +6,7 @@ pub mod check;
 pub mod devsim;
 pub mod dot;
 pub mod graph_args;
+pub mod import;
 pub mod live;
 pub mod nodes;
 pub mod replay;

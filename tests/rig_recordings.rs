@@ -6,8 +6,8 @@
 //! `graphs/synthesize-recordings.toml` over the texture, which must find
 //! the model of the texture's condition and write its cell.
 
+use evflow_engine::RunOptions;
 use evflow_engine::{check, graph::parse_graph, run_offline, sweep, sweep_files, Override, Plan, PlanOptions};
-use evflow_engine::{RunOptions, Value};
 use evflow_nodes::recording::format::Recording;
 use evflow_nodes::recording::sweep_fields::sweep_fields;
 use std::path::Path;
@@ -64,8 +64,7 @@ material = "lab-sample"
     );
     let g = parse_graph(&out.join("make.toml"), &text).unwrap_or_else(|e| panic!("{e}"));
     let c = check(&g, &evflow_nodes::registry(), &[]).unwrap_or_else(|e| panic!("{e}"));
-    let mut plan =
-        Plan::build(&c, &PlanOptions { out_dir: Some(out.to_path_buf()), ..Default::default() }).unwrap();
+    let mut plan = Plan::build(&c, &PlanOptions { out_dir: Some(out.to_path_buf()), ..Default::default() }).unwrap();
     run_offline(&mut plan, RunOptions::default()).unwrap();
 }
 
@@ -73,8 +72,8 @@ material = "lab-sample"
 fn run_sweep(graph: &str, overrides: &[(&str, &str)], out: &Path) -> usize {
     let path = evflow_tests::root().join("graphs").join(graph);
     let g = parse_graph(&path, &std::fs::read_to_string(&path).unwrap()).unwrap_or_else(|e| panic!("{e}"));
-    let o: Vec<Override> =
-        overrides.iter().map(|(k, v)| Override { key: k.to_string(), value: Value::Text(v.to_string()) }).collect();
+    // As `--set k=v` reads them: TOML syntax, bare words (paths) as text.
+    let o: Vec<Override> = overrides.iter().map(|(k, v)| Override::parse(&format!("{k}={v}")).unwrap()).collect();
     let axes = sweep_files::expand(&g, &o, &sweep_fields).unwrap_or_else(|e| panic!("{e}"));
     let points = sweep::points(&axes, &[], &o);
     for p in &points {
@@ -101,11 +100,8 @@ fn ten_khz_recordings_train_models_and_synthesize_cells() {
     record(&textures, "sample-60g-4cms-r1", 60.0, 4.0, 3);
     assert_eq!(Recording::open(&prbs.join("a-85g-5cms.json")).unwrap().rate(), 10_000.0);
 
-    let runs = run_sweep(
-        "model-build-recordings.toml",
-        &[("recordings", prbs.to_str().unwrap()), ("epochs", "5")],
-        &models,
-    );
+    let runs =
+        run_sweep("model-build-recordings.toml", &[("recordings", prbs.to_str().unwrap()), ("epochs", "5")], &models);
     assert_eq!(runs, 2);
     for (name, mass, speed) in [("narx-85g-5cms.json", 85.0, 5.0), ("narx-60g-4cms.json", 60.0, 4.0)] {
         let m = evflow_nodes::narx::model::Model::load(&models.join(name)).unwrap_or_else(|e| panic!("{name}: {e}"));

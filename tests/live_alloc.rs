@@ -191,9 +191,10 @@ fn build(path: &std::path::Path, text: Option<&str>) -> Plan {
 }
 
 /// Graphs covering node types no shipped live graph uses yet.
-const EXTRA: &[(&str, &str)] = &[(
-    "filters-and-metric",
-    r#"
+const EXTRA: &[(&str, &str)] = &[
+    (
+        "filters-and-metric",
+        r#"
 [graph]
 format = 1
 name = "filters-and-metric"
@@ -226,7 +227,44 @@ nfft = 256
 [nodes.st]
 type = "stats"
 "#,
-)];
+    ),
+    (
+        "rate-nodes",
+        r#"
+[graph]
+format = 1
+name = "rate-nodes"
+rate = 1000.0
+connections = [
+    "force.out -> down.in", "down.out -> up.in", "up.out -> level.in",
+    "ir.out -> smooth.in", "smooth.out -> path.in",
+]
+[nodes.force]
+type = "sine"
+rate = 10000.0
+frequency = 50.0
+[nodes.down]
+type = "decimate"
+rate = 1000.0
+[nodes.up]
+type = "resample"
+rate = 2000.0
+quality = "best"
+[nodes.level]
+type = "stats"
+[nodes.ir]
+type = "sine"
+rate = 40.0
+frequency = 1.0
+[nodes.smooth]
+type = "resample"
+rate = 1000.0
+quality = "fast"
+[nodes.path]
+type = "stats"
+"#,
+    ),
+];
 
 /// A node that allocates in `process`: the guard must see it.
 mod allocating {

@@ -56,8 +56,11 @@ fn report_resample_scores_every_method() {
         evflow(&["report", "resample", "--out", dir.path().to_str().unwrap(), "--samples", "2000", "--repeats", "1"]);
     assert!(ok, "{err}");
     let rows = out.lines().filter(|l| l.starts_with("| ") && !l.starts_with("| method")).count();
-    assert_eq!(rows, 14, "{out}");
+    assert_eq!(rows, 17, "{out}");
     assert!(out.contains("rubato fft") && out.contains("kaiser sinc W=16"), "{out}");
+    for q in ["fast", "balanced", "best"] {
+        assert!(out.contains(&format!("| resample node {q} |")), "{out}");
+    }
 }
 
 #[test]

@@ -4,6 +4,7 @@
 
 pub mod interpolate;
 mod params;
+mod rate_hint;
 mod topology;
 
 use crate::diag::{Diagnostic, Diagnostics, Loc};

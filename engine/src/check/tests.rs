@@ -235,8 +235,43 @@ type = "harness.tap"
 "#;
     let d = one_error(text);
     assert!(d.message.contains("rate mismatch: `fast.out` runs at 1000 Hz but `m.b` at 40 Hz"), "{d}");
-    assert!(d.help.as_deref().unwrap().contains("hold"), "{d}");
     assert_eq!(d.loc.line, 5);
+    // 1000 Hz into 40 Hz: an integer step down, with the lines to paste.
+    let help = d.help.unwrap();
+    for want in [
+        "insert a `decimate` node (an integer step down, 1000 Hz ÷ 25",
+        "[nodes.fast_40hz]\n      type = \"decimate\"\n      rate = 40.0\n",
+        "replace \"fast.out -> m.b\" with\n      \"fast.out -> fast_40hz.in\",\n      \"fast_40hz.out -> m.b\",",
+    ] {
+        assert!(help.contains(want), "{want}\n---\n{help}");
+    }
+}
+
+/// The rate node each step needs: `hold` for a slow control stream going
+/// up, `resample` for a ratio that is not an integer, a fresh node name
+/// when the natural one is taken.
+#[test]
+fn rate_mismatch_suggests_the_node_that_fits() {
+    let graph = |slow: f64, other: f64| {
+        format!(
+            "[graph]\nformat = 1\nname = \"rates\"\nrate = 1000\n\
+             connections = [\"other.out -> m.a\", \"slow.out -> m.b\", \"m.out -> tap.in\"]\n\
+             [nodes.slow]\ntype = \"slow\"\nrate = {slow:?}\n[nodes.other]\ntype = \"slow\"\nrate = {other:?}\n\
+             [nodes.m]\ntype = \"mix\"\n[nodes.tap]\ntype = \"harness.tap\"\n\
+             [nodes.slow_1000hz]\ntype = \"slow\"\n"
+        )
+    };
+    let help = |slow, other| one_error(&graph(slow, other)).help.unwrap();
+    let h = help(40.0, 1000.0);
+    assert!(h.contains("insert a `hold` node (the 40 Hz stream is slower than the 1000 Hz base clock"), "{h}");
+    assert!(h.contains("[nodes.slow_1000hz_2]\n      type = \"hold\"\n      rate = 1000.0\n"), "{h}");
+    let h = help(40.0, 100.0);
+    assert!(h.contains("insert a `resample` node (40 Hz up to 100 Hz, interpolated"), "{h}");
+    assert!(h.contains("type = \"resample\"\n      rate = 100.0\n      quality = \"balanced\"\n"), "{h}");
+    let h = help(250.0, 100.0);
+    assert!(h.contains("insert a `resample` node (a step down by 2.5000, not a whole number"), "{h}");
+    let h = help(1000.0, 40.0);
+    assert!(h.contains("insert a `decimate` node") && h.contains("\"slow_40hz.out -> m.b\""), "{h}");
 }
 
 #[test]

@@ -1,7 +1,7 @@
 //! Topology: feedback cycles, pruning and rates.
 
-use super::{CheckedNode, Edge, Pruned, Sink};
-use crate::graph::Graph;
+use super::{rate_hint, CheckedNode, Edge, Pruned, Sink};
+use crate::graph::{Endpoint, Graph};
 use crate::rate::Ratio;
 use crate::spec::{Direction, RateSpec, Role};
 use petgraph::algo::{kosaraju_scc, toposort};
@@ -160,23 +160,24 @@ fn resolve_rates(graph: &Graph, nodes: &mut [CheckedNode], edges: &[Edge], topo:
             continue;
         }
         if inp.ratio != out {
-            let c = graph.connections.iter().find(|c| {
-                c.from.node == nodes[e.from.0].name && c.to.node == nodes[e.to.0].name && c.to.port == inp.name
-            });
-            let loc = c.map(|c| c.loc).unwrap_or(nodes[e.to.0].loc);
+            let (producer, consumer) = (&nodes[e.from.0], &nodes[e.to.0]);
+            let from = Endpoint { node: producer.name.clone(), port: producer.ports[e.from.1].name.clone() };
+            let to = Endpoint { node: consumer.name.clone(), port: inp.name.clone() };
+            let c = graph.connections.iter().find(|c| c.from == from && c.to == to);
+            let loc = c.map(|c| c.loc).unwrap_or(consumer.loc);
             sink.err(
                 loc,
-                Some(&nodes[e.to.0].name),
+                Some(&consumer.name),
                 format!(
                     "rate mismatch: `{}.{}` runs at {} Hz but `{}.{}` at {} Hz",
-                    nodes[e.from.0].name,
-                    nodes[e.from.0].ports[e.from.1].name,
+                    from.node,
+                    from.port,
                     out.hz(base),
-                    nodes[e.to.0].name,
-                    inp.name,
+                    to.node,
+                    to.port,
                     inp.ratio.hz(base)
                 ),
-                Some("insert a rate node between them (`hold` to raise a rate, `decimate` to lower it, `resample` for other ratios)".into()),
+                Some(rate_hint::help(graph, &from, &to, out, inp.ratio)),
             );
         }
     }

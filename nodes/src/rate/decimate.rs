@@ -28,8 +28,9 @@ from 500 Hz) takes 661 taps and delays every frequency by 330 input samples = 33
 = 33 ms; 1 kHz → 250 Hz (M = 4) takes 265 taps, a delay of 132 input = 33 output samples = \
 132 ms. The \
 group delay N/2 is always a whole number N/(2M) of output samples, so a `delay` node of that \
-many samples aligns another stream with it exactly. Lower `passband` for less delay (it scales as \
-1/(1 − passband)); the cost is N + 1 multiply-adds per output sample.\n\n\
+many samples aligns another stream with it exactly; at the defaults it is 33 output samples \
+whatever the factor. Lower `passband` or `attenuation` for less delay (passband 0.5: 16 output \
+samples; 60 dB: 19); the cost is N + 1 multiply-adds per output sample.\n\n\
 Why an FIR and not a Butterworth: a Butterworth low-pass with its −3 dB point at 0.8·f_N reaches \
 only about 16 dB at f_N at order 8 (`|H|² = 1/(1 + (f_N/f_c)^16)`, f_N/f_c ≈ 1.25) and would need \
 order 51 for 100 dB; \

@@ -50,6 +50,18 @@ fn the_documented_designs() {
     assert!(d.response.attenuation_db() >= 100.0, "{:?}", d.response);
     let d = design(4, 0.8, 100.0).unwrap();
     assert_eq!((d.taps.len(), d.delay_in(), d.delay_out()), (265, 132, 33));
+    // docs/rates.md's table: (M, passband, attenuation) → (taps, delay in output samples).
+    for (m, pass, a, taps, delay) in [
+        (2, 0.8, 100.0, 133, 33),
+        (10, 0.5, 100.0, 321, 16),
+        (10, 0.8, 60.0, 381, 19),
+        (25, 0.8, 100.0, 1651, 33),
+        (100, 0.8, 100.0, 6601, 33),
+    ] {
+        let d = design(m, pass, a).unwrap();
+        assert_eq!((d.taps.len(), d.delay_out()), (taps, delay), "M = {m}, passband {pass}, {a} dB");
+        assert!(d.response.attenuation_db() >= a && d.response.pass_deviation <= 10f64.powf(-a / 20.0));
+    }
 }
 
 /// 10 kHz → 1 kHz: tones below 400 Hz come out as sin(2πf(t − 33 ms)) to

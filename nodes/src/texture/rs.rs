@@ -8,10 +8,12 @@
 //! (`docs/texture.md` has the table): rubato's asynchronous sinc resampler
 //! at a chosen sinc length, rubato's polynomial resampler, rubato's
 //! synchronous FFT resampler (p/q must then be a ratio of small integers),
-//! and the table-driven windowed sinc of [`SincKernel`] that `interp` runs
-//! live.
+//! the table-driven windowed sinc of [`SincKernel`] that `interp` runs
+//! live, and the streaming resampler of the `resample` node at each of its
+//! qualities ([`crate::rate::resampler`]).
 
 use super::kernel::SincKernel;
+use crate::rate::resampler::{Quality, ResampleError, Stream};
 use rubato::audioadapter_buffers::direct::SequentialSlice;
 use rubato::{
     Async, Fft, FixedAsync, FixedSync, PolynomialDegree, Resampler, SincInterpolationParameters, SincInterpolationType,
@@ -30,6 +32,9 @@ pub enum RsMethod {
     RubatoFft,
     /// The Kaiser-windowed sinc table of [`SincKernel`] with this half-width.
     Kernel(usize),
+    /// The `resample` node's streaming resampler at this quality, its
+    /// stated latency removed to the nearest output sample.
+    Node(Quality),
 }
 
 impl RsMethod {
@@ -40,6 +45,7 @@ impl RsMethod {
             RsMethod::RubatoPoly(d) => format!("rubato poly {d:?}").to_lowercase(),
             RsMethod::RubatoFft => "rubato fft".into(),
             RsMethod::Kernel(w) => format!("kaiser sinc W={w}"),
+            RsMethod::Node(q) => format!("resample node {}", q.name()),
         }
     }
 }
@@ -66,6 +72,9 @@ pub enum RsError {
     /// rubato refused.
     #[error("rubato: {0}")]
     Rubato(String),
+    /// The `resample` node's stream refused.
+    #[error("resample: {0}")]
+    Stream(#[from] ResampleError),
 }
 
 /// p/q as a reduced fraction of integers below 100 000, if one matches to
@@ -100,7 +109,8 @@ pub fn rational(p: f64, q: f64) -> Option<(usize, usize)> {
 /// 𝓡𝓢(y, p, q): `y` re-sampled at p/q times its rate, ⌊len·p/q⌋ samples,
 /// aligned so that output sample k is y at input position k·q/p (within
 /// one output sample for the rubato resamplers, whose delay is trimmed in
-/// whole output samples; exactly for [`RsMethod::Kernel`]).
+/// whole output samples, and within half of one for [`RsMethod::Node`];
+/// exactly for [`RsMethod::Kernel`]).
 pub fn rs(y: &[f64], p: f64, q: f64, method: RsMethod) -> Result<Vec<f64>, RsError> {
     if !(p.is_finite() && q.is_finite() && p > 0.0 && q > 0.0) {
         return Err(RsError::Ratio { p, q });
@@ -115,6 +125,13 @@ pub fn rs(y: &[f64], p: f64, q: f64, method: RsMethod) -> Result<Vec<f64>, RsErr
         RsMethod::Kernel(w) => {
             let k = SincKernel::for_interp(w);
             return Ok(k.resample(y, 0.0, 1.0 / ratio, len_out));
+        }
+        RsMethod::Node(quality) => {
+            let mut stream = Stream::new(ratio, quality)?;
+            let shift = stream.latency().round() as usize;
+            let mut v = stream.run(y, len_out + shift)?;
+            v.drain(..shift);
+            return Ok(v);
         }
         RsMethod::RubatoSinc(len) => {
             let params = SincInterpolationParameters::new(len.max(8), WindowFunction::BlackmanHarris2)
@@ -162,6 +179,9 @@ mod tests {
             RsMethod::RubatoPoly(PolynomialDegree::Cubic),
             RsMethod::RubatoFft,
             RsMethod::Kernel(16),
+            RsMethod::Node(Quality::Fast),
+            RsMethod::Node(Quality::Balanced),
+            RsMethod::Node(Quality::Best),
         ] {
             let r = rs(&y, 10.0, 15.0, m).unwrap();
             assert_eq!(r.len(), 2666, "{m:?}");

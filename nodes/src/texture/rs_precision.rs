@@ -110,6 +110,7 @@ pub fn score(out: &[f64], tones: &[(f64, f64, f64)], step: f64) -> (f64, f64) {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::rate::resampler::Quality;
     use rubato::PolynomialDegree;
 
     #[test]
@@ -125,6 +126,21 @@ mod tests {
         assert!(s256.error < s32.error, "{s32:?} {s256:?}");
         let lin = measure(&t, 4000, 3.0, 4.0, RsMethod::RubatoPoly(PolynomialDegree::Linear), 1).unwrap();
         assert!(lin.error > s256.error, "{lin:?} {s256:?}");
+    }
+
+    #[test]
+    fn the_resample_node_s_sincs_are_accurate_and_its_cubic_is_not() {
+        // Content to 0.22 f_s at 3/4 (new Nyquist 0.375 f_s): inside both
+        // sincs' passbands (measured 5e-11, 8e-11); the cubic leaves 3e-2.
+        let t = tones(8, 0.22, 7);
+        let m = |q| measure(&t, 4000, 3.0, 4.0, RsMethod::Node(q), 1).unwrap();
+        let (fast, balanced, best) = (m(Quality::Fast), m(Quality::Balanced), m(Quality::Best));
+        assert!(balanced.error < 1e-9 && best.error < 1e-9, "{balanced:?} {best:?}");
+        assert!(fast.error > 1e-3 && fast.error < 0.1, "{fast:?}");
+        // Its latency is removed to the nearest output sample.
+        for p in [fast, balanced, best] {
+            assert!(p.delay.abs() <= 0.5 + 1e-3, "{p:?}");
+        }
     }
 
     #[test]

@@ -1,10 +1,12 @@
 //! `evflow report resample`: error against run time of the re-sampling
 //! methods the texture chain can use for 𝓡𝓢 (§6.2) — rubato's sinc
-//! resampler at several lengths, its polynomial and FFT resamplers, and
-//! the windowed-sinc kernel `interp` runs live — on a band-limited
-//! multi-tone signal whose re-sampled version is known exactly.
+//! resampler at several lengths, its polynomial and FFT resamplers, the
+//! windowed-sinc kernel `interp` runs live, and the `resample` node's
+//! streaming resampler at each `quality` — on a band-limited multi-tone
+//! signal whose re-sampled version is known exactly.
 
 use anyhow::{Context, Result};
+use evflow_nodes::rate::resampler::Quality;
 use evflow_nodes::texture::rs::RsMethod;
 use evflow_nodes::texture::rs_precision::{measure, tones};
 use evflow_tools::plot::{Plot, Series};
@@ -39,6 +41,9 @@ fn methods() -> Vec<(&'static str, RsMethod)> {
     v.push(("rubato FFT", RsMethod::RubatoFft));
     for w in [4, 8, 16, 32] {
         v.push(("interp kernel (live)", RsMethod::Kernel(w)));
+    }
+    for q in Quality::ALL {
+        v.push(("resample node (streaming)", RsMethod::Node(q)));
     }
     v
 }

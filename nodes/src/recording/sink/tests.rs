@@ -229,8 +229,20 @@ fn refuses_bad_parameters() {
     let err = run(dir.path(), &doc, 8).unwrap_err();
     assert!(err.contains("parameter `units`: 1 units for 2 channels"), "{err}");
 
-    let doc = graph(1000.0, &[("a", &[1.0])], "path = \"no/such/folder/o.wav\"");
+    // A folder that cannot be made (a file is in the way) is an error
+    // naming the path; nothing is written.
+    std::fs::write(dir.path().join("blocker"), "").unwrap();
+    let doc = graph(1000.0, &[("a", &[1.0])], "path = \"blocker/o.wav\"");
     let err = run(dir.path(), &doc, 8).unwrap_err();
-    assert!(err.contains("o.wav.tmp"), "{err}");
-    assert!(files(dir.path()).is_empty());
+    assert!(err.contains("blocker"), "{err}");
+    assert_eq!(files(dir.path()), ["blocker"]);
+}
+
+#[test]
+fn a_missing_folder_is_created() {
+    let dir = tempfile::tempdir().unwrap();
+    let doc = graph(1000.0, &[("a", &[1.0, 2.0])], "path = \"no/such/folder/o.wav\"");
+    run(dir.path(), &doc, 8).unwrap();
+    let rec = Recording::open(&dir.path().join("no/such/folder/o.wav")).unwrap();
+    assert_eq!(rec.channel("a").unwrap(), &[1.0, 2.0][..]);
 }

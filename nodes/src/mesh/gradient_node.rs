@@ -41,7 +41,7 @@ so neighbouring triangles share edges, within `weld`), or a generated §4.2 scen
 is turned so that it becomes height z. `fit = \"footprint\"` centres the mesh's x–y bounds on \
 (`offset_x`, `offset_y`) and scales the mesh uniformly (heights too, so slopes keep their values) so that \
 the larger side spans `fit_size` metres — whatever its units (mm, m) or however far from the origin it \
-was modelled; the default `fit = \"none\"` keeps `unit` and the origin at `offset_x/y`. Each entry of \
+was modelled — and reports heights `z` from its lowest point; the default `fit = \"none\"` keeps `unit` and the origin at `offset_x/y`. Each entry of \
 `scenes` is turned and fitted on its own. The BVH (obvhs CWBVH) is built when the node is constructed — never for a pruned \
 node. The hit test is f64 and watertight: rays through vertices and edges hit whatever the winding.\n\n\
 **Scenes.** `scenes` lists several meshes (generated-scene configs such as \"4B0H\", or OBJ files); all \
@@ -226,7 +226,7 @@ impl MeshGradient {
             None => self.misses += 1,
         }
         let i = intensity(e.fsq, self.range.f_min, self.range.f_max, self.i_hi, self.i_lo);
-        let z = e.z * self.placed.unit;
+        let z = (e.z - self.placed.z0) * self.placed.unit;
         [i, e.fsq, e.slope, if z.is_finite() { z } else { 0.0 }, e.hit.map_or(-1.0, |h| h.tri as f64)]
     }
 }

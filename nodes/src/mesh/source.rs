@@ -64,7 +64,8 @@ pub const FIT: ParamSpec = ParamSpec::choice(
     &["none", "footprint"],
     "none",
     "none: mesh units × `unit`, mesh origin at `offset_x/y`; footprint: the x–y bounds (after `up`) centred \
-     at `offset_x/y` and scaled uniformly, heights too, so the larger side is `fit_size`",
+     at `offset_x/y` and scaled uniformly, heights too, so the larger side is `fit_size`, the lowest point at \
+     height 0",
 );
 /// `fit_size`: the fitted footprint's larger side.
 pub const FIT_SIZE: ParamSpec = ParamSpec::float(
@@ -104,6 +105,12 @@ pub struct Placed {
     /// Height of the screen plane in mesh units: 0 for scenes (objects
     /// stand on the screen), the lowest vertex for a file.
     pub floor: f64,
+    /// Height (mesh units) at the screen surface, subtracted from the
+    /// hit's z before it is reported in metres: 0 (the mesh's own z) with
+    /// fit = "none", the floor with fit = "footprint" (the fitted mesh
+    /// stands on the screen, so its heights stay small whatever its
+    /// coordinates).
+    pub z0: f64,
     /// Metres per mesh unit.
     pub unit: f64,
     /// Touch coordinates of the mesh origin, m.
@@ -163,7 +170,7 @@ pub fn load_scenes(p: &Params, ctx: &BuildContext) -> Result<Vec<Placed>, NodeEr
 fn load_entry(p: &Params, ctx: &BuildContext, entry: &str) -> Result<Placed, NodeError> {
     let (mesh, floor, name, up) = load_mesh(p, ctx, entry)?;
     let mut placed =
-        Placed { mesh, up, floor, unit: p.f64("unit"), offset: [p.f64("offset_x"), p.f64("offset_y")], name };
+        Placed { mesh, up, floor, z0: 0.0, unit: p.f64("unit"), offset: [p.f64("offset_x"), p.f64("offset_y")], name };
     if p.str("fit") == "footprint" {
         let footprint = place::footprint(&placed.mesh)
             .ok_or_else(|| NodeError::param("fit", format!("{}: the mesh has no triangles", placed.name)))?;
@@ -171,6 +178,7 @@ fn load_entry(p: &Params, ctx: &BuildContext, entry: &str) -> Result<Placed, Nod
             .map_err(|e| NodeError::param("fit", format!("{}: {e}", placed.name)))?;
         placed.unit = fitted.unit;
         placed.offset = fitted.offset;
+        placed.z0 = placed.floor;
     }
     Ok(placed)
 }
@@ -221,7 +229,7 @@ mod tests {
     use std::path::Path;
 
     /// A height field h(x, y) on an n × m grid of unit cells, each point
-    /// `(x·scale + off, y·scale + off, h·scale)` written through `write`
+    /// `(x·scale + off, y·scale + off, h·scale + off)` written through `write`
     /// (which puts the three coordinates in the file's axis order).
     fn grid_obj(n: usize, m: usize, scale: f64, off: f64, write: impl Fn([f64; 3]) -> [f64; 3]) -> String {
         let h = |x: f64, y: f64| 0.5 * (0.8 * x).sin() + 0.1 * y + 1.0;
@@ -229,7 +237,7 @@ mod tests {
         for j in 0..=m {
             for i in 0..=n {
                 let (x, y) = (i as f64, j as f64);
-                let p = write([x * scale + off, y * scale + off, h(x, y) * scale]);
+                let p = write([x * scale + off, y * scale + off, h(x, y) * scale + off]);
                 writeln!(s, "v {} {} {}", p[0], p[1], p[2]).unwrap();
             }
         }
@@ -294,8 +302,8 @@ mod tests {
     #[test]
     fn fit_centres_the_footprint_and_scales_its_larger_side() {
         let dir = tempfile::tempdir().unwrap();
-        // A flat plate 1 unit high over x ∈ [10, 14], y ∈ [−3, −1]: 4 × 2 units.
-        let plate = "v 10 -3 1\nv 14 -3 1\nv 14 -1 1\nv 10 -1 1\nf 1 2 3 4\n";
+        // A ramp from z = 1 to 3 over x ∈ [10, 14], y ∈ [−3, −1]: 4 × 2 units.
+        let plate = "v 10 -3 1\nv 14 -3 3\nv 14 -1 3\nv 10 -1 1\nf 1 2 3 4\n";
         std::fs::write(dir.path().join("plate.obj"), plate).unwrap();
         let p =
             "file = \"plate.obj\"\nup = \"+z\"\nfit = \"footprint\"\nfit_size = 0.1\noffset_x = 0.02\noffset_y = -0.01";
@@ -311,14 +319,14 @@ mod tests {
         let on: Vec<bool> = out[4].iter().map(|&t| t >= 0.0).collect();
         let expect = [true, true, false, false, true, false, false, true, false, false, true, false, false];
         assert_eq!(on, expect);
-        // The height scales with the footprint: 1 unit = 0.025 m.
+        // Heights scale with the footprint, from the lowest point: 1 unit (at the centre) = 0.025 m.
         assert!((out[3][0] - 0.025).abs() < 1e-15, "{}", out[3][0]);
     }
 
     #[test]
     fn meshes_far_away_or_in_mm_or_m_fit_to_the_same_surface() {
         let dir = tempfile::tempdir().unwrap();
-        // One surface, 8 × 6 cells: in cm at the origin, in mm 10⁶ mm away, in m.
+        // One surface, 8 × 6 cells: in cm at the origin, in mm 10⁶ mm away (up too), in m.
         let files = [("cm.obj", 1.0, 0.0), ("mm-far.obj", 10.0, 1e6), ("m.obj", 0.01, 0.0)];
         for (name, scale, off) in files {
             std::fs::write(dir.path().join(name), grid_obj(8, 6, scale, off, |p| p)).unwrap();
@@ -336,7 +344,8 @@ mod tests {
             for (a, b) in cm[2].iter().zip(&out[2]) {
                 assert!((a - b).abs() < 1e-6, "slope {a} vs {b}");
             }
-            // Heights in m: 1 cm of the grid is 0.1/8 m on the screen.
+            // Heights in m from the lowest point: 1 cm of the grid is 0.1/8 m on the screen.
+            assert!(out[3].iter().all(|z| (0.0..0.03).contains(z)));
             for (a, b) in cm[3].iter().zip(&out[3]) {
                 assert!((a - b).abs() < 1e-12, "height {a} vs {b}");
             }

@@ -6,7 +6,8 @@ use evflow_nodes::mesh::{edges_node, gradient_node};
 use std::fmt::Write;
 use std::path::Path;
 
-/// OBJ text of a height field on an n × n grid of unit cells (cm).
+/// OBJ text of a height field on an n × n grid of unit cells (cm), z up:
+/// every file here is read with `up = "+z"` (OBJ's default is +y).
 fn grid_obj(n: usize, off: f64, f: impl Fn(f64, f64) -> f64) -> String {
     let mut s = String::new();
     for j in 0..=n {
@@ -84,7 +85,7 @@ fn vertical_walls_outside_and_degenerate_triangles() {
     s += "v 1 1 1\nv 2 2 1\nv 3 3 1\nf 13 14 15\nv 1 9 0.5\nv 9 9 0.5\nv 5 9.0000000001 0.5\nf 16 17 18\n";
     std::fs::write(dir.path().join("box.obj"), s).unwrap();
     let (x, y) = scan(-0.01, 0.11, 0.05);
-    let r = gradient(dir.path(), "file = \"box.obj\"", x.clone(), y).unwrap();
+    let r = gradient(dir.path(), "file = \"box.obj\"\nup = \"+z\"", x.clone(), y).unwrap();
     sane(&r);
     // The finger climbs the wall (resist, I = 1), rides the top, drops (assist, I = 0.3).
     let on_top = x.iter().position(|&v| v > 0.045).unwrap();
@@ -96,7 +97,8 @@ fn vertical_walls_outside_and_degenerate_triangles() {
     assert_eq!(r.out[3][0], 0.0);
     // Far outside, and NaN touch points.
     // (Non-finite touch points are held; the unit tests of `gradient` cover them.)
-    let r = gradient(dir.path(), "file = \"box.obj\"", vec![1e3, 1e300, -1e3], vec![1e3, 0.0, -1e300]).unwrap();
+    let r = gradient(dir.path(), "file = \"box.obj\"\nup = \"+z\"", vec![1e3, 1e300, -1e3], vec![1e3, 0.0, -1e300])
+        .unwrap();
     sane(&r);
 }
 
@@ -109,12 +111,12 @@ fn open_and_non_manifold_meshes() {
     std::fs::write(dir.path().join("open.obj"), s).unwrap();
     for slope in ["secant", "normal"] {
         let (x, y) = scan(-0.01, 0.07, 0.031);
-        let p = format!("file = \"open.obj\"\nslope = \"{slope}\"");
+        let p = format!("file = \"open.obj\"\nup = \"+z\"\nslope = \"{slope}\"");
         let r = gradient(dir.path(), &p, x.clone(), y.clone()).unwrap();
         sane(&r);
         let edges = Single {
             spec: &edges_node::SPEC,
-            params: "file = \"open.obj\"",
+            params: "file = \"open.obj\"\nup = \"+z\"",
             inputs: vec![("x", x, 1000.0), ("y", y, 1000.0), ("tri", r.out[4].clone(), 1000.0)],
             outputs: vec!["intensity", "sharpness", "angle"],
             base_rate: 1000.0,
@@ -137,7 +139,7 @@ fn a_flat_mesh_has_f_min_equal_f_max_and_renders_full_intensity() {
     let (x, y) = scan(0.0, 0.04, 0.02);
     let s = Single {
         spec: &gradient_node::SPEC,
-        params: "file = \"flat.obj\"",
+        params: "file = \"flat.obj\"\nup = \"+z\"",
         inputs: vec![("x", x.clone(), 1000.0), ("y", y.clone(), 1000.0)],
         outputs: vec!["intensity"],
         base_rate: 1000.0,
@@ -152,7 +154,7 @@ fn a_flat_mesh_has_f_min_equal_f_max_and_renders_full_intensity() {
 
 fn edges_summary(dir: &Path, file: &str, y: f64) -> evflow_engine::Summary {
     let (x, yv) = scan(-0.01, 0.13, y);
-    let p = format!("file = \"{file}\"");
+    let p = format!("file = \"{file}\"\nup = \"+z\"");
     let tri = gradient(dir, &p, x.clone(), yv.clone()).unwrap().out[4].clone();
     Single {
         spec: &edges_node::SPEC,
@@ -196,12 +198,18 @@ fn coordinates_of_a_million_render_like_the_origin() {
     std::fs::write(dir.path().join("far.obj"), grid_obj(8, 1e6, f)).unwrap();
     let (x, y) = scan(0.0, 0.08, 0.037);
     // Every tick's secant (min_step = 0), so both runs difference the same pairs of points.
-    let near =
-        gradient(dir.path(), "file = \"near.obj\"\nrange = \"fixed\"\nmin_step = 0.0", x.clone(), y.clone()).unwrap();
+    let near = gradient(
+        dir.path(),
+        "file = \"near.obj\"\nup = \"+z\"\nrange = \"fixed\"\nmin_step = 0.0",
+        x.clone(),
+        y.clone(),
+    )
+    .unwrap();
     // 10⁶ cm = 10⁴ m: the mesh sits there, and so does the finger.
     let xf: Vec<f64> = x.iter().map(|v| v + 1e4).collect();
     let yf: Vec<f64> = y.iter().map(|v| v + 1e4).collect();
-    let far = gradient(dir.path(), "file = \"far.obj\"\nrange = \"fixed\"\nmin_step = 0.0", xf, yf).unwrap();
+    let far =
+        gradient(dir.path(), "file = \"far.obj\"\nup = \"+z\"\nrange = \"fixed\"\nmin_step = 0.0", xf, yf).unwrap();
     sane(&far);
     // Points on shared edges may pick the neighbouring triangle after rounding; the surface is the same.
     assert!(far.out[4].iter().all(|&t| t >= 0.0));
@@ -238,7 +246,7 @@ fn touch_points_exactly_on_vertices_and_edges_never_miss() {
             y.push(j as f64 * 0.0025);
         }
     }
-    let r = gradient(dir.path(), "file = \"grid.obj\"\nrange = \"fixed\"", x, y).unwrap();
+    let r = gradient(dir.path(), "file = \"grid.obj\"\nup = \"+z\"\nrange = \"fixed\"", x, y).unwrap();
     sane(&r);
     assert_eq!(r.out[4].iter().filter(|&&t| t < 0.0).count(), 0, "misses");
 }

@@ -25,7 +25,7 @@ sharpest convex edge of the whole mesh, computed once when the node is built ove
 welded mesh (pairs of faces around non-manifold edges, walls, and open boundaries above the screen \
 plane as cliffs); a mesh without one has θ_min = 180° and never ticks. Output I_e = 0.7·S + 0.3 \
 (Eq. 4.9) on the tick of the crossing, 0 otherwise — feed it to a `grain` edge input.\n\n\
-The mesh parameters must name the same mesh as the `mesh.gradient` node that feeds `tri` (a graph \
+The mesh parameters (with `up` and `fit`) must name the same mesh as the `mesh.gradient` node that feeds `tri` (a graph \
 variable keeps them together); only the triangles and normals are loaded, no BVH. A scene without \
 sharp edges leaves this node out, and pruning never constructs it. A `tri` that is not an index of \
 this mesh, or whose triangle does not hold the point, counts as off the mesh.\n\n\
@@ -55,6 +55,9 @@ boundary and non-manifold cases (unit tests); fandisk's dihedral angles in the f
     source::UNIT,
     source::OFFSET_X,
     source::OFFSET_Y,
+    source::UP,
+    source::FIT,
+    source::FIT_SIZE,
     source::WELD,
     source::SCENES,
     source::SCENE,

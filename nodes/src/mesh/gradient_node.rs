@@ -36,7 +36,13 @@ $XDG_CACHE_HOME/evflow, else ~/.cache/evflow), or nowhere with `cache = \"none\"
 (the formative study's ±1). A flat mesh has F_min = F_max = 0 and renders I = `i_max`.\n\n\
 **Mesh.** `file` (OBJ via tobj; quads and n-gons triangulated; normals recomputed; vertices welded \
 so neighbouring triangles share edges, within `weld`), or a generated §4.2 scene (`shape`, `config`, \
-`resolution`; cm). The BVH (obvhs CWBVH) is built when the node is constructed — never for a pruned \
+`resolution`; cm). **Orientation and fit:** `up` names the mesh axis that points out of the screen \
+(default `auto`: +y for OBJ files, as OBJ models conventionally are, +z for generated scenes); the mesh \
+is turned so that it becomes height z. `fit = \"footprint\"` centres the mesh's x–y bounds on \
+(`offset_x`, `offset_y`) and scales the mesh uniformly (heights too, so slopes keep their values) so that \
+the larger side spans `fit_size` metres — whatever its units (mm, m) or however far from the origin it \
+was modelled — and reports heights `z` from its lowest point; the default `fit = \"none\"` keeps `unit` and the origin at `offset_x/y`. Each entry of \
+`scenes` is turned and fitted on its own. The BVH (obvhs CWBVH) is built when the node is constructed — never for a pruned \
 node. The hit test is f64 and watertight: rays through vertices and edges hit whatever the winding.\n\n\
 **Scenes.** `scenes` lists several meshes (generated-scene configs such as \"4B0H\", or OBJ files); all \
 are loaded, ray-cast structures built and calibrated when the node is built, and the live parameter \
@@ -68,6 +74,9 @@ gradient of the Gaussian scene (fidelity report), and the robustness cases of `d
     source::UNIT,
     source::OFFSET_X,
     source::OFFSET_Y,
+    source::UP,
+    source::FIT,
+    source::FIT_SIZE,
     source::WELD,
     source::SCENES,
     source::SCENE,
@@ -217,7 +226,7 @@ impl MeshGradient {
             None => self.misses += 1,
         }
         let i = intensity(e.fsq, self.range.f_min, self.range.f_max, self.i_hi, self.i_lo);
-        let z = e.z * self.placed.unit;
+        let z = (e.z - self.placed.z0) * self.placed.unit;
         [i, e.fsq, e.slope, if z.is_finite() { z } else { 0.0 }, e.hit.map_or(-1.0, |h| h.tri as f64)]
     }
 }

@@ -20,6 +20,7 @@ pub mod edges_node;
 pub mod gradient_node;
 pub mod grain;
 pub mod path;
+pub mod place;
 pub mod profile1d;
 pub mod source;
 

@@ -1,9 +1,12 @@
 //! Where a mesh node's mesh comes from — an OBJ file or a generated §4.2
-//! scene — and how touch coordinates (metres on the screen) map to mesh
-//! units. The parameters are shared by `mesh.gradient` and `mesh.edges` so
-//! both see the same triangles in the same order.
+//! scene — which of its axes is up, and how touch coordinates (metres on
+//! the screen) map to mesh units (`unit` and `offset_x/y`, or `fit`). The
+//! parameters are declared here once and shared by `mesh.gradient` and
+//! `mesh.edges`, so both see the same triangles in the same order at the
+//! same place.
 
 use super::obj::load_obj;
+use super::place::{self, Up};
 use super::scenes::{scene, Shape, CONFIGS};
 use super::trimesh::Mesh;
 use evflow_engine::{BuildContext, NodeError, ParamSpec, Params};
@@ -21,12 +24,58 @@ pub const CONFIG: ParamSpec =
 pub const RESOLUTION: ParamSpec =
     ParamSpec::int("resolution", 2, 4096, 48, "1", "generated Gaussian scene: grid cells per 6 cm object side");
 /// `unit`: metres per mesh unit.
-pub const UNIT: ParamSpec =
-    ParamSpec::float("unit", 1e-9, 1e3, 0.01, "m", "length of one mesh unit (0.01: the mesh is in cm)");
-/// `offset_x`: screen position of the mesh origin.
-pub const OFFSET_X: ParamSpec = ParamSpec::float("offset_x", -1e6, 1e6, 0.0, "m", "touch x of the mesh's origin");
-/// `offset_y`: screen position of the mesh origin.
-pub const OFFSET_Y: ParamSpec = ParamSpec::float("offset_y", -1e6, 1e6, 0.0, "m", "touch y of the mesh's origin");
+pub const UNIT: ParamSpec = ParamSpec::float(
+    "unit",
+    1e-9,
+    1e3,
+    0.01,
+    "m",
+    "length of one mesh unit (0.01: the mesh is in cm); with fit = \"footprint\" the fit's scale replaces it",
+);
+/// `offset_x`: screen position of the mesh origin (or, fitted, of its footprint's centre).
+pub const OFFSET_X: ParamSpec = ParamSpec::float(
+    "offset_x",
+    -1e6,
+    1e6,
+    0.0,
+    "m",
+    "touch x of the mesh's origin; with fit = \"footprint\", of the footprint's centre",
+);
+/// `offset_y`: screen position of the mesh origin (or, fitted, of its footprint's centre).
+pub const OFFSET_Y: ParamSpec = ParamSpec::float(
+    "offset_y",
+    -1e6,
+    1e6,
+    0.0,
+    "m",
+    "touch y of the mesh's origin; with fit = \"footprint\", of the footprint's centre",
+);
+/// `up`: the mesh axis that points out of the screen.
+pub const UP: ParamSpec = ParamSpec::choice(
+    "up",
+    &["auto", "+x", "-x", "+y", "-y", "+z", "-z"],
+    "auto",
+    "mesh axis pointing up, out of the screen (turned to height z by a rotation, never a mirror); \
+     auto: +y for OBJ files (the format's convention), +z for generated scenes",
+);
+/// `fit`: how the mesh's footprint is placed on the screen.
+pub const FIT: ParamSpec = ParamSpec::choice(
+    "fit",
+    &["none", "footprint"],
+    "none",
+    "none: mesh units × `unit`, mesh origin at `offset_x/y`; footprint: the x–y bounds (after `up`) centred \
+     at `offset_x/y` and scaled uniformly, heights too, so the larger side is `fit_size`, the lowest point at \
+     height 0",
+);
+/// `fit_size`: the fitted footprint's larger side.
+pub const FIT_SIZE: ParamSpec = ParamSpec::float(
+    "fit_size",
+    1e-6,
+    1e3,
+    0.1,
+    "m",
+    "with fit = \"footprint\": length on the screen of the footprint's larger side",
+);
 /// `scenes`: the meshes a session can switch between.
 pub const SCENES: ParamSpec = ParamSpec::text_list(
     "scenes",
@@ -49,11 +98,19 @@ pub const WELD: ParamSpec = ParamSpec::float(
 /// A loaded mesh with its placement.
 #[derive(Debug, Clone)]
 pub struct Placed {
-    /// The mesh.
+    /// The mesh, turned so that `up` is +z.
     pub mesh: Mesh,
+    /// The file's axis that was turned to +z.
+    pub up: Up,
     /// Height of the screen plane in mesh units: 0 for scenes (objects
     /// stand on the screen), the lowest vertex for a file.
     pub floor: f64,
+    /// Height (mesh units) at the screen surface, subtracted from the
+    /// hit's z before it is reported in metres: 0 (the mesh's own z) with
+    /// fit = "none", the floor with fit = "footprint" (the fitted mesh
+    /// stands on the screen, so its heights stay small whatever its
+    /// coordinates).
+    pub z0: f64,
     /// Metres per mesh unit.
     pub unit: f64,
     /// Touch coordinates of the mesh origin, m.
@@ -109,15 +166,38 @@ pub fn load_scenes(p: &Params, ctx: &BuildContext) -> Result<Vec<Placed>, NodeEr
 }
 
 /// One mesh: an OBJ file (a name ending in `.obj`) or a generated scene's
-/// config word.
+/// config word, turned by `up` and placed by `unit`/`offset_x/y` or `fit`.
 fn load_entry(p: &Params, ctx: &BuildContext, entry: &str) -> Result<Placed, NodeError> {
-    let unit = p.f64("unit");
-    let offset = [p.f64("offset_x"), p.f64("offset_y")];
-    if entry.to_ascii_lowercase().ends_with(".obj") {
+    let (mesh, floor, name, up) = load_mesh(p, ctx, entry)?;
+    let mut placed =
+        Placed { mesh, up, floor, z0: 0.0, unit: p.f64("unit"), offset: [p.f64("offset_x"), p.f64("offset_y")], name };
+    if p.str("fit") == "footprint" {
+        let footprint = place::footprint(&placed.mesh)
+            .ok_or_else(|| NodeError::param("fit", format!("{}: the mesh has no triangles", placed.name)))?;
+        let fitted = place::fit(footprint, p.f64("fit_size"), placed.offset)
+            .map_err(|e| NodeError::param("fit", format!("{}: {e}", placed.name)))?;
+        placed.unit = fitted.unit;
+        placed.offset = fitted.offset;
+        placed.z0 = placed.floor;
+    }
+    Ok(placed)
+}
+
+/// The mesh of one entry turned so that its up axis is +z, with its floor
+/// (mesh units), name and the axis turned.
+fn load_mesh(p: &Params, ctx: &BuildContext, entry: &str) -> Result<(Mesh, f64, String, Up), NodeError> {
+    let is_file = entry.to_ascii_lowercase().ends_with(".obj");
+    let up = match p.str("up") {
+        "auto" if is_file => Up::PlusY,
+        "auto" => Up::PlusZ,
+        w => Up::parse(w).ok_or_else(|| NodeError::param("up", format!("unknown axis `{w}`")))?,
+    };
+    if is_file {
         let path = ctx.path(entry);
         let mesh = load_obj(&path, p.f64("weld")).map_err(|e| NodeError::Other(e.to_string()))?;
+        let mesh = place::reorient(mesh, up);
         let floor = mesh.bounds().min[2];
-        return Ok(Placed { mesh, floor, unit, offset, name: path.display().to_string() });
+        return Ok((mesh, floor, path.display().to_string(), up));
     }
     let shape = if p.str("shape") == "frustum" { Shape::Frustum } else { Shape::Gaussian };
     if !CONFIGS.contains(&entry) {
@@ -128,5 +208,150 @@ fn load_entry(p: &Params, ctx: &BuildContext, entry: &str) -> Result<Placed, Nod
         ));
     }
     let mesh = scene(shape, entry, p.usize("resolution")).map_err(|e| NodeError::param("config", e.to_string()))?;
-    Ok(Placed { mesh, floor: 0.0, unit, offset, name: format!("{} {entry}", p.str("shape")) })
+    // Scenes stand on the screen plane z = 0; turned, on their lowest point.
+    let (mesh, floor) = match up {
+        Up::PlusZ => (mesh, 0.0),
+        _ => {
+            let mesh = place::reorient(mesh, up);
+            let floor = mesh.bounds().min[2];
+            (mesh, floor)
+        }
+    };
+    Ok((mesh, floor, format!("{} {entry}", p.str("shape")), up))
+}
+
+#[cfg(test)]
+mod tests {
+    use crate::mesh::gradient_node;
+    use crate::mesh::place::{Up, UP_WORDS};
+    use evflow_engine::harness::Single;
+    use std::fmt::Write;
+    use std::path::Path;
+
+    /// A height field h(x, y) on an n × m grid of unit cells, each point
+    /// `(x·scale + off, y·scale + off, h·scale + off)` written through `write`
+    /// (which puts the three coordinates in the file's axis order).
+    fn grid_obj(n: usize, m: usize, scale: f64, off: f64, write: impl Fn([f64; 3]) -> [f64; 3]) -> String {
+        let h = |x: f64, y: f64| 0.5 * (0.8 * x).sin() + 0.1 * y + 1.0;
+        let mut s = String::new();
+        for j in 0..=m {
+            for i in 0..=n {
+                let (x, y) = (i as f64, j as f64);
+                let p = write([x * scale + off, y * scale + off, h(x, y) * scale + off]);
+                writeln!(s, "v {} {} {}", p[0], p[1], p[2]).unwrap();
+            }
+        }
+        let id = |i: usize, j: usize| j * (n + 1) + i + 1;
+        for j in 0..m {
+            for i in 0..n {
+                writeln!(s, "f {} {} {} {}", id(i, j), id(i + 1, j), id(i + 1, j + 1), id(i, j + 1)).unwrap();
+            }
+        }
+        s
+    }
+
+    /// `mesh.gradient` (fixed range, every tick's secant) over the touch
+    /// points: outputs intensity, fsq, slope, z, tri.
+    fn run(dir: &Path, params: &str, x: Vec<f64>, y: Vec<f64>) -> Vec<Vec<f64>> {
+        let n = x.len() as u64;
+        let params = format!("{params}\nrange = \"fixed\"\nmin_step = 0.0");
+        Single {
+            spec: &gradient_node::SPEC,
+            params: &params,
+            inputs: vec![("x", x, 1000.0), ("y", y, 1000.0)],
+            outputs: vec!["intensity", "fsq", "slope", "z", "tri"],
+            base_rate: 1000.0,
+            ticks: n,
+            block: 64,
+            base_dir: dir,
+        }
+        .run()
+        .unwrap()
+    }
+
+    /// A diagonal scan from a to b (m), 1 kHz.
+    fn scan(a: [f64; 2], b: [f64; 2], n: usize) -> (Vec<f64>, Vec<f64>) {
+        let at = |k: usize, i: usize| a[k] + (b[k] - a[k]) * i as f64 / n as f64;
+        ((0..n).map(|i| at(0, i)).collect(), (0..n).map(|i| at(1, i)).collect())
+    }
+
+    #[test]
+    fn a_file_written_with_any_up_axis_renders_like_z_up_once_up_is_set() {
+        let dir = tempfile::tempdir().unwrap();
+        std::fs::write(dir.path().join("z.obj"), grid_obj(8, 8, 1.0, 0.0, |p| p)).unwrap();
+        let (x, y) = scan([0.001, 0.002], [0.079, 0.071], 1500);
+        let reference = run(dir.path(), "file = \"z.obj\"\nup = \"+z\"", x.clone(), y.clone());
+        assert!(reference[4].iter().all(|&t| t >= 0.0));
+        for (word, up) in UP_WORDS {
+            // The file's coordinates: the inverse rotation (its transpose) of the z-up point.
+            let cols = [[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]].map(|e| up.to_z_up(e));
+            let file = |q: [f64; 3]| cols.map(|c| c[0] * q[0] + c[1] * q[1] + c[2] * q[2]);
+            let name = format!("up-{}{}.obj", if word.starts_with('+') { "plus" } else { "minus" }, &word[1..]);
+            std::fs::write(dir.path().join(&name), grid_obj(8, 8, 1.0, 0.0, file)).unwrap();
+            let out = run(dir.path(), &format!("file = \"{name}\"\nup = \"{word}\""), x.clone(), y.clone());
+            assert_eq!(out, reference, "up = {word}");
+            if up == Up::PlusY {
+                // OBJ's convention is the default.
+                assert_eq!(run(dir.path(), &format!("file = \"{name}\""), x.clone(), y.clone()), reference);
+            }
+        }
+        // A z-up file read with the OBJ default (+y) stands on its side: another surface.
+        assert_ne!(run(dir.path(), "file = \"z.obj\"", x.clone(), y.clone())[3], reference[3]);
+    }
+
+    #[test]
+    fn fit_centres_the_footprint_and_scales_its_larger_side() {
+        let dir = tempfile::tempdir().unwrap();
+        // A ramp from z = 1 to 3 over x ∈ [10, 14], y ∈ [−3, −1]: 4 × 2 units.
+        let plate = "v 10 -3 1\nv 14 -3 3\nv 14 -1 3\nv 10 -1 1\nf 1 2 3 4\n";
+        std::fs::write(dir.path().join("plate.obj"), plate).unwrap();
+        let p =
+            "file = \"plate.obj\"\nup = \"+z\"\nfit = \"footprint\"\nfit_size = 0.1\noffset_x = 0.02\noffset_y = -0.01";
+        // 0.1 m / 4 units: 0.025 m per unit, so 0.1 × 0.05 m centred at (0.02, −0.01).
+        let (e, d) = (1e-6, [0.05, 0.025]);
+        let mut x = vec![0.02];
+        let mut y = vec![-0.01];
+        for (sx, sy) in [(-1.0, -1.0), (1.0, -1.0), (1.0, 1.0), (-1.0, 1.0)] {
+            x.extend([0.02 + sx * (d[0] - e), 0.02 + sx * (d[0] + e), 0.02]);
+            y.extend([-0.01 + sy * (d[1] - e), -0.01, -0.01 + sy * (d[1] + e)]);
+        }
+        let out = run(dir.path(), p, x, y);
+        let on: Vec<bool> = out[4].iter().map(|&t| t >= 0.0).collect();
+        let expect = [true, true, false, false, true, false, false, true, false, false, true, false, false];
+        assert_eq!(on, expect);
+        // Heights scale with the footprint, from the lowest point: 1 unit (at the centre) = 0.025 m.
+        assert!((out[3][0] - 0.025).abs() < 1e-15, "{}", out[3][0]);
+    }
+
+    #[test]
+    fn meshes_far_away_or_in_mm_or_m_fit_to_the_same_surface() {
+        let dir = tempfile::tempdir().unwrap();
+        // One surface, 8 × 6 cells: in cm at the origin, in mm 10⁶ mm away (up too), in m.
+        let files = [("cm.obj", 1.0, 0.0), ("mm-far.obj", 10.0, 1e6), ("m.obj", 0.01, 0.0)];
+        for (name, scale, off) in files {
+            std::fs::write(dir.path().join(name), grid_obj(8, 6, scale, off, |p| p)).unwrap();
+        }
+        let (x, y) = scan([-0.049, -0.036], [0.049, 0.036], 2000);
+        let fitted = |name: &str| {
+            let p = format!("file = \"{name}\"\nup = \"+z\"\nfit = \"footprint\"\nfit_size = 0.1");
+            run(dir.path(), &p, x.clone(), y.clone())
+        };
+        let cm = fitted("cm.obj");
+        for out in [&cm, &fitted("mm-far.obj"), &fitted("m.obj")] {
+            assert!(out.iter().flatten().all(|v| v.is_finite()));
+            // Inside the footprint (0.1 × 0.075 m, centred on the origin) every tick hits.
+            assert!(out[4].iter().all(|&t| t >= 0.0));
+            for (a, b) in cm[2].iter().zip(&out[2]) {
+                assert!((a - b).abs() < 1e-6, "slope {a} vs {b}");
+            }
+            // Heights in m from the lowest point: 1 cm of the grid is 0.1/8 m on the screen.
+            assert!(out[3].iter().all(|z| (0.0..0.03).contains(z)));
+            for (a, b) in cm[3].iter().zip(&out[3]) {
+                assert!((a - b).abs() < 1e-12, "height {a} vs {b}");
+            }
+        }
+        // Unfitted, the millimetre mesh would lie 10 km away and the finger would miss it.
+        let far = run(dir.path(), "file = \"mm-far.obj\"\nup = \"+z\"", x.clone(), y.clone());
+        assert!(far[4].iter().all(|&t| t < 0.0) && far.iter().flatten().all(|v| v.is_finite()));
+    }
 }

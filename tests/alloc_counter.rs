@@ -3,7 +3,10 @@
 //! every allocation, reallocation and free. A test binary installs it with
 //! `#[global_allocator] static GLOBAL: evflow_tests::alloc_counter::Counting
 //! = evflow_tests::alloc_counter::Counting;` and arms it from the live
-//! runner's per-tick hook.
+//! runner's per-tick hook. Tests that measure a stretch of code on their own
+//! thread (the nodes crate's allocation tests include this file with
+//! `#[path]`) read [`thread_allocations`], which parallel tests in the same
+//! binary do not disturb.
 
 use std::alloc::{GlobalAlloc, Layout, System};
 use std::cell::Cell;
@@ -14,6 +17,8 @@ pub struct Counting;
 
 thread_local! {
     static ARMED: Cell<bool> = const { Cell::new(false) };
+    /// Allocations and frees counted on this thread while armed.
+    static MINE: Cell<u64> = const { Cell::new(0) };
 }
 static ALLOCS: AtomicU64 = AtomicU64::new(0);
 static ARMINGS: AtomicU64 = AtomicU64::new(0);
@@ -25,6 +30,7 @@ fn armed() -> bool {
 fn count() {
     if armed() {
         ALLOCS.fetch_add(1, Ordering::SeqCst);
+        let _ = MINE.try_with(|m| m.set(m.get() + 1));
     }
 }
 
@@ -59,6 +65,11 @@ pub fn arm(on: bool) {
 /// Allocations and frees counted so far, on every armed thread.
 pub fn allocations() -> u64 {
     ALLOCS.load(Ordering::SeqCst)
+}
+
+/// Allocations and frees counted so far on the calling thread.
+pub fn thread_allocations() -> u64 {
+    MINE.with(|m| m.get())
 }
 
 /// Times any thread armed the counter.

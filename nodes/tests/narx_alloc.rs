@@ -5,52 +5,23 @@ use evflow_nodes::narx::closed_loop::ClosedLoop;
 use evflow_nodes::narx::mapminmax::MapMinMax;
 use evflow_nodes::narx::net::Mlp;
 use evflow_nodes::narx::taps::Taps;
-use std::alloc::{GlobalAlloc, Layout, System};
-use std::cell::Cell;
 
-struct Counting;
+#[path = "../../tests/alloc_counter.rs"]
+#[allow(dead_code)] // the live tests' parts of the shared counter are not used here
+mod alloc_counter;
 
-thread_local! {
-    /// Counting is on only on the thread under test (libtest's own threads allocate meanwhile).
-    static WATCHED: Cell<bool> = const { Cell::new(false) };
-    /// Allocations of this thread while watched.
-    static ALLOCATIONS: Cell<usize> = const { Cell::new(0) };
-}
-
-fn count() {
-    if WATCHED.with(|w| w.get()) {
-        ALLOCATIONS.with(|a| a.set(a.get() + 1));
-    }
-}
-
-fn allocations() -> usize {
-    ALLOCATIONS.with(|a| a.get())
-}
-
-unsafe impl GlobalAlloc for Counting {
-    unsafe fn alloc(&self, layout: Layout) -> *mut u8 {
-        count();
-        unsafe { System.alloc(layout) }
-    }
-    unsafe fn dealloc(&self, ptr: *mut u8, layout: Layout) {
-        unsafe { System.dealloc(ptr, layout) }
-    }
-    unsafe fn realloc(&self, ptr: *mut u8, layout: Layout, new_size: usize) -> *mut u8 {
-        count();
-        unsafe { System.realloc(ptr, layout, new_size) }
-    }
-}
+use alloc_counter::{arm, thread_allocations as allocations, Counting};
 
 #[global_allocator]
 static GLOBAL: Counting = Counting;
 
 #[test]
 fn the_counter_sees_an_allocation() {
-    WATCHED.with(|w| w.set(true));
+    arm(true);
     let before = allocations();
     let v: Vec<f64> = std::hint::black_box(vec![1.0; 100]);
     let after = allocations();
-    WATCHED.with(|w| w.set(false));
+    arm(false);
     assert!(after > before && v.len() == 100);
 }
 
@@ -68,13 +39,13 @@ fn the_closed_loop_does_not_allocate_per_sample() {
         let force: Vec<f64> =
             (0..5000).map(|i| (i as f64 * 0.1).sin() * if i % 97 == 0 { f64::NAN } else { 1.0 }).collect();
         let before = allocations();
-        WATCHED.with(|w| w.set(true));
+        arm(true);
         let mut acc = 0.0;
         for &f in &force {
             acc += cl.step(f);
         }
         cl.reset();
-        WATCHED.with(|w| w.set(false));
+        arm(false);
         let after = allocations();
         assert!(acc.is_finite());
         assert_eq!(after, before, "{taps:?}: {} allocations in 5000 steps", after - before);

@@ -5,66 +5,35 @@
 
 use evflow_engine::harness::Single;
 use evflow_nodes::rate::{decimate, resample};
-use std::alloc::{GlobalAlloc, Layout, System};
-use std::cell::Cell;
 use std::path::Path;
 
-struct Counting;
+#[path = "../../tests/alloc_counter.rs"]
+#[allow(dead_code)] // the live tests' parts of the shared counter are not used here
+mod alloc_counter;
 
-thread_local! {
-    /// Counting is on only on the thread under test (libtest's own threads allocate meanwhile).
-    static WATCHED: Cell<bool> = const { Cell::new(false) };
-    /// Allocations of this thread while watched.
-    static ALLOCATIONS: Cell<usize> = const { Cell::new(0) };
-}
-
-fn count() {
-    if WATCHED.with(|w| w.get()) {
-        ALLOCATIONS.with(|a| a.set(a.get() + 1));
-    }
-}
-
-fn allocations() -> usize {
-    ALLOCATIONS.with(|a| a.get())
-}
-
-// SAFETY: forwards to the system allocator; counting has no effect on memory.
-unsafe impl GlobalAlloc for Counting {
-    unsafe fn alloc(&self, layout: Layout) -> *mut u8 {
-        count();
-        unsafe { System.alloc(layout) }
-    }
-    unsafe fn dealloc(&self, ptr: *mut u8, layout: Layout) {
-        count();
-        unsafe { System.dealloc(ptr, layout) }
-    }
-    unsafe fn realloc(&self, ptr: *mut u8, layout: Layout, new_size: usize) -> *mut u8 {
-        count();
-        unsafe { System.realloc(ptr, layout, new_size) }
-    }
-}
+use alloc_counter::{arm, thread_allocations as allocations, Counting};
 
 #[global_allocator]
 static GLOBAL: Counting = Counting;
 
 #[test]
 fn the_counter_sees_an_allocation() {
-    WATCHED.with(|w| w.set(true));
+    arm(true);
     let before = allocations();
     let v: Vec<f64> = std::hint::black_box(vec![1.0; 100]);
     let after = allocations();
-    WATCHED.with(|w| w.set(false));
+    arm(false);
     assert!(after > before && v.len() == 100);
 }
 
 /// Steps the plan of `single` to its end with counting on; returns the
 /// allocations counted and the samples of the node's output.
-fn count_steps(single: &Single<'_>) -> (usize, usize) {
+fn count_steps(single: &Single<'_>) -> (u64, usize) {
     let (mut plan, _) = single.plan().unwrap();
     let mut samples = 0;
     let mut done = 0u64;
     let before = allocations();
-    WATCHED.with(|w| w.set(true));
+    arm(true);
     while done < single.ticks {
         let n = (plan.max_block() as u64).min(single.ticks - done);
         plan.step(n as usize).unwrap();
@@ -72,7 +41,7 @@ fn count_steps(single: &Single<'_>) -> (usize, usize) {
         done += n;
     }
     plan.reset();
-    WATCHED.with(|w| w.set(false));
+    arm(false);
     (allocations() - before, samples)
 }
 

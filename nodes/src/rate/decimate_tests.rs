@@ -3,42 +3,18 @@
 
 use super::*;
 use crate::rate::decimator::design;
-use evflow_engine::harness::Single;
+use crate::rate::testing::{noise, run_node};
 use std::f64::consts::TAU;
-use std::path::Path;
 
 /// Runs `decimate` with `params` on `x` at `fs_in` Hz, the base rate being
 /// the input's, in blocks of `block` input samples.
 fn run(params: &str, x: &[f64], fs_in: f64, block: usize) -> Result<Vec<f64>, String> {
-    Single {
-        spec: &SPEC,
-        params,
-        inputs: vec![("in", x.to_vec(), fs_in)],
-        outputs: vec!["out"],
-        base_rate: fs_in,
-        ticks: x.len() as u64,
-        block,
-        base_dir: Path::new("."),
-    }
-    .run()
-    .map(|mut o| o.remove(0))
+    run_node(&SPEC, params, x, fs_in, fs_in, x.len() as u64, block)
 }
 
 /// sin(2πft + 0.7): the phase keeps a tone at the new Nyquist frequency off its zeros.
 fn tone(f: f64, fs: f64, n: usize) -> Vec<f64> {
     (0..n).map(|i| (TAU * f / fs * i as f64 + 0.7).sin()).collect()
-}
-
-fn noise(len: usize, seed: u64) -> Vec<f64> {
-    let mut s = seed | 1;
-    (0..len)
-        .map(|_| {
-            s ^= s << 13;
-            s ^= s >> 7;
-            s ^= s << 17;
-            (s >> 11) as f64 / (1u64 << 53) as f64 - 0.5
-        })
-        .collect()
 }
 
 /// The figures the node's doc states.
@@ -126,18 +102,7 @@ fn any_block_size_gives_the_same_samples() {
 }
 
 fn run_at(params: &str, x: &[f64], fs_in: f64, base: f64, ticks: u64, block: usize) -> Result<Vec<f64>, String> {
-    Single {
-        spec: &SPEC,
-        params,
-        inputs: vec![("in", x.to_vec(), fs_in)],
-        outputs: vec!["out"],
-        base_rate: base,
-        ticks,
-        block,
-        base_dir: Path::new("."),
-    }
-    .run()
-    .map(|mut o| o.remove(0))
+    run_node(&SPEC, params, x, fs_in, base, ticks, block)
 }
 
 #[test]

@@ -201,6 +201,7 @@ fn dot(a: &[f64], b: &[f64]) -> f64 {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::rate::testing::noise;
 
     /// The textbook definition: y[l] = Σ_k h[k]·x[Ml − k], x[n < 0] = 0.
     fn reference(h: &[f64], x: &[f64], m: usize) -> Vec<f64> {
@@ -208,18 +209,6 @@ mod tests {
             .map(|l| {
                 let n = l * m;
                 (0..h.len()).filter(|&k| k <= n).map(|k| h[k] * x[n - k]).sum()
-            })
-            .collect()
-    }
-
-    fn noise(len: usize, seed: u64) -> Vec<f64> {
-        let mut s = seed | 1;
-        (0..len)
-            .map(|_| {
-                s ^= s << 13;
-                s ^= s >> 7;
-                s ^= s << 17;
-                (s >> 11) as f64 / (1u64 << 53) as f64 - 0.5
             })
             .collect()
     }

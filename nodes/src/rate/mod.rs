@@ -17,3 +17,43 @@ use evflow_engine::NodeSpec;
 
 /// The node types of this family.
 pub static SPECS: &[&NodeSpec] = &[&hold::SPEC, &decimate::SPEC, &resample::SPEC];
+
+/// Test helpers shared by the rate nodes' tests.
+#[cfg(test)]
+pub(crate) mod testing {
+    use evflow_engine::harness::Single;
+    use evflow_engine::NodeSpec;
+    use std::path::Path;
+
+    /// Runs the node `spec` with `params` on `x` at `fs_in` Hz in a graph of
+    /// base rate `base`, for `ticks` base ticks in blocks of `block` ticks;
+    /// returns its output `out`.
+    pub fn run_node(
+        spec: &'static NodeSpec,
+        params: &str,
+        x: &[f64],
+        fs_in: f64,
+        base: f64,
+        ticks: u64,
+        block: usize,
+    ) -> Result<Vec<f64>, String> {
+        Single {
+            spec,
+            params,
+            inputs: vec![("in", x.to_vec(), fs_in)],
+            outputs: vec!["out"],
+            base_rate: base,
+            ticks,
+            block,
+            base_dir: Path::new("."),
+        }
+        .run()
+        .map(|mut o| o.remove(0))
+    }
+
+    /// `len` samples uniform in [−0.5, 0.5) from the lab's generator.
+    pub fn noise(len: usize, seed: u64) -> Vec<f64> {
+        let mut r = crate::lab::rng::Rng::new(seed);
+        (0..len).map(|_| r.uniform() - 0.5).collect()
+    }
+}

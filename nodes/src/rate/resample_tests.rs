@@ -4,25 +4,13 @@
 
 use super::*;
 use crate::rate::resampler::{Quality, Stream};
-use evflow_engine::harness::Single;
+use crate::rate::testing::run_node;
 use std::f64::consts::TAU;
-use std::path::Path;
 
 /// Runs `resample` with `params` on `x` at `fs_in` Hz in a graph of base
 /// rate `base`, for `ticks` base ticks in blocks of `block` ticks.
 fn run(params: &str, x: &[f64], fs_in: f64, base: f64, ticks: u64, block: usize) -> Result<Vec<f64>, String> {
-    Single {
-        spec: &SPEC,
-        params,
-        inputs: vec![("in", x.to_vec(), fs_in)],
-        outputs: vec!["out"],
-        base_rate: base,
-        ticks,
-        block,
-        base_dir: Path::new("."),
-    }
-    .run()
-    .map(|mut o| o.remove(0))
+    run_node(&SPEC, params, x, fs_in, base, ticks, block)
 }
 
 fn latency(fs_in: f64, fs_out: f64, q: Quality) -> f64 {

@@ -14,17 +14,10 @@ use std::path::Path;
 pub fn sweep_fields(path: &Path) -> Result<Vec<(String, Value)>, String> {
     let rec = Recording::open_channels(path, &[] as &[&str]).map_err(|e| e.to_string())?;
     let meta = rec.meta();
-    let c = &meta.condition;
     let mut out = vec![("rate".to_string(), Value::Float(meta.rate))];
-    for (k, v) in [("load_g", c.load_g), ("velocity_cm_s", c.velocity_cm_s), ("gain", c.gain)] {
-        if let Some(x) = v {
-            out.push((k.to_string(), Value::Float(x)));
-        }
-    }
-    if let Some(m) = &c.material {
-        out.push(("material".to_string(), Value::Text(m.clone())));
-    }
-    for (k, v) in &c.extra {
+    // The condition as its sidecar writes it: known keys, then the others.
+    let condition = serde_json::to_value(&meta.condition).map_err(|e| e.to_string())?;
+    for (k, v) in condition.as_object().into_iter().flatten() {
         let value = match v {
             serde_json::Value::Number(n) => n.as_f64().map(Value::Float),
             serde_json::Value::String(s) => Some(Value::Text(s.clone())),

@@ -26,8 +26,8 @@ pub fn train(
     let p = net.n_params();
     let n = train.len();
     let mut ws = net.workspace();
-    let mut perf = mse(net, train, &mut ws);
-    let mut stop = EarlyStop::new(net.weights(), mse(net, val, &mut ws), perf, opts.max_fail);
+    let mut perf = mse(net, train);
+    let mut stop = EarlyStop::new(net.weights(), mse(net, val), perf, opts.max_fail);
     let (mut m, mut v, mut g, mut row) = (vec![0.0; p], vec![0.0; p], vec![0.0; p], vec![0.0; p]);
     let mut order: Vec<usize> = (0..n).collect();
     let mut rng = Rng::new(opts.seed);
@@ -67,8 +67,8 @@ pub fn train(
                 *w -= opts.learning_rate * (m[k] / c1) / ((v[k] / c2).sqrt() + EPS);
             }
         }
-        perf = mse(net, train, &mut ws);
-        let vperf = mse(net, val, &mut ws);
+        perf = mse(net, train);
+        let vperf = mse(net, val);
         epochs = epoch;
         progress(&Epoch {
             epoch,
@@ -115,8 +115,7 @@ mod tests {
         let v = Data::new(x.slice(ndarray::s![300.., ..]), t.slice(ndarray::s![300..])).unwrap();
         let mut net = Mlp::new(2, &[8]).unwrap();
         net.init_nguyen_widrow(&mut Rng::new(5));
-        let mut ws = net.workspace();
-        let before = mse(&net, &d, &mut ws);
+        let before = mse(&net, &d);
         let opts = Options { max_epochs: 300, learning_rate: 0.01, batch: 16, max_fail: 1000, ..Options::default() };
         let rep = train(&mut net, &d, &v, &opts, &mut |_| {});
         assert!(rep.train_mse < before / 20.0 && rep.train_mse < 2e-3, "{rep:?} (before {before})");

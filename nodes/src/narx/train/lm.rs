@@ -47,8 +47,8 @@ pub fn train(
     let p = net.n_params();
     let n = train.len();
     let mut ws = net.workspace();
-    let mut perf = mse(net, train, &mut ws);
-    let mut stop = EarlyStop::new(net.weights(), mse(net, val, &mut ws), perf, opts.max_fail);
+    let mut perf = mse(net, train);
+    let mut stop = EarlyStop::new(net.weights(), mse(net, val), perf, opts.max_fail);
     let mut mu = opts.mu;
     // JᵀJ: only its lower triangle is formed and read (Cholesky of the lower half).
     let mut jtj = Mat::<f64>::zeros(p, p);
@@ -119,7 +119,7 @@ pub fn train(
                     }
                     let saved: Vec<f64> = w.to_vec();
                     net.weights_mut().copy_from_slice(&trial);
-                    let perf2 = mse(net, train, &mut ws);
+                    let perf2 = mse(net, train);
                     if perf2 < perf {
                         perf = perf2;
                         mu *= opts.mu_dec;
@@ -132,7 +132,7 @@ pub fn train(
             mu *= opts.mu_inc;
         }
         epochs = epoch;
-        let vperf = mse(net, val, &mut ws);
+        let vperf = mse(net, val);
         progress(&Epoch {
             epoch,
             train_mse: perf,
@@ -180,8 +180,7 @@ mod tests {
         let (d, v) = (Data::new(x.view(), t.view()).unwrap(), Data::new(xv.view(), tv.view()).unwrap());
         let mut net = Mlp::new(2, &[8]).unwrap();
         net.init_nguyen_widrow(&mut Rng::new(5));
-        let mut ws = net.workspace();
-        let before = mse(&net, &d, &mut ws);
+        let before = mse(&net, &d);
         let mut seen = Vec::new();
         let opts = Options { max_epochs: 200, ..Options::default() };
         let r = train(&mut net, &d, &v, &opts, &mut |e| seen.push(*e));
@@ -190,7 +189,7 @@ mod tests {
         for w in seen.windows(2) {
             assert!(w[1].train_mse <= w[0].train_mse, "{:?}", w);
         }
-        assert_eq!(r.train_mse, mse(&net, &d, &mut ws));
+        assert_eq!(r.train_mse, mse(&net, &d));
     }
 
     #[test]
@@ -225,8 +224,7 @@ mod tests {
         let rep = train(&mut net, &d, &v, &Options::default(), &mut |e| seen.push(*e));
         assert_eq!(rep.stop, StopReason::ValidationStop, "{rep:?}");
         let best = seen.iter().map(|e| e.val_mse).fold(f64::INFINITY, f64::min);
-        let mut ws = net.workspace();
-        assert!(rep.val_mse <= best && (mse(&net, &v, &mut ws) - rep.val_mse).abs() < 1e-12);
+        assert!(rep.val_mse <= best && (mse(&net, &v) - rep.val_mse).abs() < 1e-12);
         assert!(rep.epochs >= rep.best_epoch + 6 && rep.epochs < 1000);
     }
 }

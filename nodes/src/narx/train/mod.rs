@@ -7,7 +7,7 @@
 pub mod adam;
 pub mod lm;
 
-use super::net::{Mlp, Workspace};
+use super::net::Mlp;
 use super::packed::{PackedMlp, Tanh};
 use ndarray::{ArrayView1, ArrayView2};
 use serde::{Deserialize, Serialize};
@@ -169,7 +169,7 @@ pub struct Report {
 /// layout ([`PackedMlp`], exact tanh: each output equal to
 /// [`Mlp::forward`]'s bit for bit, so the same value as a row-by-row pass
 /// of the network, in about 0.6 of its time).
-pub fn mse(net: &Mlp, data: &Data<'_>, _ws: &mut Workspace) -> f64 {
+pub fn mse(net: &Mlp, data: &Data<'_>) -> f64 {
     if data.is_empty() {
         return f64::NAN;
     }

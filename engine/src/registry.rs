@@ -7,6 +7,8 @@ use crate::spec::NodeSpec;
 #[derive(Debug, Clone, Default)]
 pub struct Registry {
     specs: Vec<&'static NodeSpec>,
+    /// Node types this build left out, with the cargo feature that has them.
+    absent: Vec<(&'static str, &'static str)>,
 }
 
 impl Registry {
@@ -28,6 +30,17 @@ impl Registry {
     /// All node types, in registration order.
     pub fn specs(&self) -> impl Iterator<Item = &'static NodeSpec> + Clone + '_ {
         self.specs.iter().copied()
+    }
+    /// Records that node type `name` exists but this build left it out;
+    /// `feature` is the cargo feature that brings it in.
+    pub fn add_absent(&mut self, name: &'static str, feature: &'static str) -> &mut Self {
+        self.absent.push((name, feature));
+        self
+    }
+    /// The cargo feature that would bring in node type `name`, when this
+    /// build left it out.
+    pub fn absent(&self, name: &str) -> Option<&'static str> {
+        self.absent.iter().find(|(n, _)| *n == name).map(|(_, f)| *f)
     }
     /// All type names.
     pub fn names(&self) -> impl Iterator<Item = &'static str> + Clone + '_ {

@@ -18,7 +18,7 @@ use std::hint::black_box;
 
 fn network(taps: Taps, hidden: &[usize]) -> Mlp {
     let mut net = Mlp::new(taps.n_inputs(), hidden).unwrap();
-    net.init_nguyen_widrow(&mut evflow_nodes::lab::rng::Rng::new(1));
+    net.init_nguyen_widrow(&mut evflow_nodes::rng::Rng::new(1));
     net
 }
 
@@ -100,7 +100,7 @@ fn closed_loop(c: &mut Criterion) {
 fn forward(c: &mut Criterion) {
     let taps = Taps { feedback: 1, input: 10, lookahead: 3 };
     let net = network(taps, &[15, 10, 5]);
-    let mut r = evflow_nodes::lab::rng::Rng::new(3);
+    let mut r = evflow_nodes::rng::Rng::new(3);
     let rows: Vec<f64> = (0..1024 * 15).map(|_| 2.0 * r.uniform() - 1.0).collect();
     let mut g = c.benchmark_group("forward_sample/15-10-5, 15 inputs");
     let mut ws = net.workspace();
@@ -158,7 +158,7 @@ fn tanh(c: &mut Criterion) {
 fn lm_epoch(c: &mut Criterion) {
     let taps = Taps { feedback: 1, input: 10, lookahead: 3 };
     let n = 3000;
-    let mut r = evflow_nodes::lab::rng::Rng::new(2);
+    let mut r = evflow_nodes::rng::Rng::new(2);
     let x = ndarray::Array2::from_shape_fn((n, taps.n_inputs()), |_| 2.0 * r.uniform() - 1.0);
     let t = ndarray::Array1::from_shape_fn(n, |i| x[(i, 0)] * x[(i, 3)].tanh());
     let data = Data::new(x.view(), t.view()).unwrap();

@@ -5,7 +5,7 @@
 //! `cargo bench -p evflow-nodes --bench volterra`
 
 use criterion::{criterion_group, criterion_main, Criterion, Throughput};
-use evflow_nodes::lab::rng::Rng;
+use evflow_nodes::rng::Rng;
 use evflow_nodes::synth::volterra::Volterra;
 use std::hint::black_box;
 

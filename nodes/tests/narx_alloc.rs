@@ -33,7 +33,7 @@ fn the_closed_loop_does_not_allocate_per_sample() {
         Taps { feedback: 0, input: 0, lookahead: 0 },
     ] {
         let mut net = Mlp::new(taps.n_inputs(), &[15, 10, 5]).unwrap();
-        net.init_nguyen_widrow(&mut evflow_nodes::lab::rng::Rng::new(1));
+        net.init_nguyen_widrow(&mut evflow_nodes::rng::Rng::new(1));
         let map = MapMinMax { min: -0.5, max: 0.5 };
         let mut cl = ClosedLoop::new(net, taps, map, MapMinMax { min: -1.0, max: 1.0 });
         let force: Vec<f64> =

@@ -81,7 +81,7 @@ fn closed_loop(m: &Model, u: &[f64], noise_force: bool) -> ClosedLoopScore {
     let mut x = Lab { seed: 99, ..Lab::default() }.force(u);
     if noise_force {
         let rms = (x.iter().map(|v| v * v).sum::<f64>() / x.len() as f64).sqrt();
-        let mut g = evflow_nodes::lab::rng::Rng::new(5);
+        let mut g = evflow_nodes::rng::Rng::new(5);
         for v in x.iter_mut().skip(KNOWN) {
             *v = rms * g.gaussian();
         }

@@ -111,7 +111,7 @@ enum Command {
     /// Example, damaging 5 % of the frames and logging for a minute:
     ///
     ///   evflow devsim --corrupt 0.05 --log devsim-log --duration 60
-    #[cfg(feature = "serial")]
+    #[cfg(all(feature = "serial", feature = "lab"))]
     Devsim(cli::devsim::Args),
 }
 
@@ -127,7 +127,7 @@ fn main() -> ExitCode {
         Command::Replay(a) => cli::replay::main(a),
         Command::Report(a) => cli::report::main(a),
         Command::Bench(a) => cli::bench::main(a),
-        #[cfg(feature = "serial")]
+        #[cfg(all(feature = "serial", feature = "lab"))]
         Command::Devsim(a) => cli::devsim::main(a),
     };
     match result {

@@ -207,7 +207,17 @@ pub fn check(graph: &Graph, registry: &Registry, overrides: &[Override]) -> Resu
     let mut nodes: Vec<Option<CheckedNode>> = Vec::with_capacity(graph.nodes.len());
     for decl in &graph.nodes {
         let Some(spec) = registry.get(&decl.kind) else {
-            if !decl.kind.is_empty() {
+            if let Some(feature) = registry.absent(&decl.kind) {
+                let help = format!(
+                    "rebuild evflow with its cargo feature `{feature}` (on by default; e.g. `cargo build --release -p evflow --features {feature}`)"
+                );
+                sink.err(
+                    decl.kind_loc,
+                    Some(&decl.name),
+                    format!("node type `{}` is not in this build of evflow", decl.kind),
+                    Some(help),
+                );
+            } else if !decl.kind.is_empty() {
                 let help = suggest::help(&decl.kind, registry.names());
                 sink.err(decl.kind_loc, Some(&decl.name), format!("unknown node type `{}`", decl.kind), Some(help));
             }

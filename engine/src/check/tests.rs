@@ -100,6 +100,19 @@ fn one_error(text: &str) -> Diagnostic {
 }
 
 #[test]
+fn a_type_this_build_left_out_names_its_feature() {
+    let text = GOOD.replace("type = \"filt\"", "type = \"sim.display\"");
+    let g = parse_graph(Path::new("g.toml"), &text).unwrap();
+    let mut reg = registry();
+    reg.add_absent("sim.display", "lab");
+    let d = check(&g, &reg, &[]).unwrap_err().0;
+    assert_eq!(d.len(), 1, "{d:#?}");
+    assert!(d[0].message.contains("node type `sim.display` is not in this build"), "{}", d[0]);
+    assert!(d[0].help.as_deref().unwrap().contains("cargo feature `lab`"), "{}", d[0]);
+    assert_eq!(d[0].loc.line, 18);
+}
+
+#[test]
 fn good_graph_checks() {
     assert!(errors(GOOD).is_empty());
 }

@@ -32,7 +32,7 @@ use super::electrical::{self, Circuit};
 use super::integrator::{decay, CoulombLti, Lti, Method, Plant};
 use super::noise::Ou;
 use super::profile::LabProfile;
-use super::rng::Rng;
+use crate::rng::Rng;
 
 /// Force beyond which the model counts as diverged (only explicit methods reach it), N.
 pub const GUARD_N: f64 = 1e3;

@@ -13,7 +13,6 @@ pub mod integrator;
 pub mod noise;
 pub mod profile;
 pub mod profile_load;
-pub mod rng;
 pub mod sensor_model;
 pub mod texture;
 pub mod tribometer;

@@ -3,7 +3,7 @@
 //! σ² at every step size (Gillespie, "Exact numerical simulation of the
 //! Ornstein–Uhlenbeck process and its integral", Phys. Rev. E 54, 1996).
 
-use super::rng::Rng;
+use crate::rng::Rng;
 
 /// A stationary Ornstein–Uhlenbeck process with its own random stream.
 #[derive(Debug, Clone)]

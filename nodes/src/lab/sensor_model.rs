@@ -12,7 +12,7 @@
 use super::integrator::{Lti, Method};
 use super::noise::Ou;
 use super::profile::LabProfile;
-use super::rng::Rng;
+use crate::rng::Rng;
 
 /// Speed above which the sensor counts as moving in a direction, m/s.
 pub const V_DIR: f64 = 1e-4;

@@ -214,7 +214,7 @@ impl ClosedLoop {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::lab::rng::Rng;
+    use crate::rng::Rng;
 
     fn map(min: f64, max: f64) -> MapMinMax {
         MapMinMax { min, max }

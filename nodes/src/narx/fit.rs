@@ -10,7 +10,7 @@ use super::model::{self, Architecture, ClosedLoopScore, Condition, Model, Normal
 use super::net::Mlp;
 use super::taps::{self, Taps};
 use super::train::{self, Data, Epoch, Options};
-use crate::lab::rng::Rng;
+use crate::rng::Rng;
 use serde::{Deserialize, Serialize};
 
 /// The training algorithm.

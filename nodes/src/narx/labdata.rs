@@ -9,9 +9,9 @@ use crate::filters::butterworth::sos::Cascade;
 use crate::lab::display_model::DisplayModel;
 use crate::lab::integrator::Method;
 use crate::lab::profile::G;
-use crate::lab::rng::Rng;
 use crate::lab::sensor_model::SensorModel;
 use crate::lab::LabProfile;
+use crate::rng::Rng;
 use evflow_engine::harness::Single;
 use std::path::Path;
 

@@ -9,6 +9,7 @@ pub mod fast_tanh;
 pub mod fast_tanh_avx2;
 pub mod fit;
 pub mod grid_node;
+#[cfg(feature = "lab")]
 pub mod labdata;
 pub mod mapminmax;
 pub mod model;

@@ -9,7 +9,7 @@
 //! central finite differences in the tests.
 
 use super::error::NarxError;
-use crate::lab::rng::Rng;
+use crate::rng::Rng;
 
 /// A tanh-hidden, linear-output network with one output.
 #[derive(Debug, Clone, PartialEq)]

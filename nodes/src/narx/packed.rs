@@ -300,7 +300,7 @@ fn group<const B: usize, const FUSED: bool>(
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::lab::rng::Rng;
+    use crate::rng::Rng;
 
     fn net(inputs: usize, hidden: &[usize], seed: u64) -> Mlp {
         let mut m = Mlp::new(inputs, hidden).unwrap();

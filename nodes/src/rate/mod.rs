@@ -53,7 +53,7 @@ pub(crate) mod testing {
 
     /// `len` samples uniform in [−0.5, 0.5) from the lab's generator.
     pub fn noise(len: usize, seed: u64) -> Vec<f64> {
-        let mut r = crate::lab::rng::Rng::new(seed);
+        let mut r = crate::rng::Rng::new(seed);
         (0..len).map(|_| r.uniform() - 0.5).collect()
     }
 }

@@ -2,7 +2,7 @@
 //! sequence over GF(q), or a random q-level sequence of the same length.
 
 use super::prms_field::{self, Recurrence};
-use crate::lab::rng::Rng;
+use crate::rng::Rng;
 use evflow_engine::{BuildContext, Io, Node, NodeError, NodeSpec, ParamSpec, Params, PortSpec, Role};
 
 /// Declaration of `prms`.

@@ -279,7 +279,7 @@ mod tests {
     #[test]
     fn never_leaves_the_box_and_never_raises_the_objective() {
         // A coupled, badly scaled quartic in 40 variables, from many starts.
-        let mut r = crate::lab::rng::Rng::new(3);
+        let mut r = crate::rng::Rng::new(3);
         let n = 40;
         let w: Vec<f64> = (0..n).map(|_| 0.1 + 10.0 * r.uniform()).collect();
         let mut f = |x: &[f64], g: &mut [f64]| {

@@ -160,9 +160,9 @@ impl<'a> Objective<'a> {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::lab::rng::Rng;
     use crate::metric::spectral_error::Band;
     use crate::metric::spectrum::{SpectrumConfig, Window};
+    use crate::rng::Rng;
 
     fn check_gradient(make: &dyn Fn() -> Loss) {
         let mut r = Rng::new(7);

@@ -84,7 +84,7 @@ impl OutputFilter {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::lab::rng::Rng;
+    use crate::rng::Rng;
 
     #[test]
     fn the_adjoint_satisfies_the_inner_product_identity() {

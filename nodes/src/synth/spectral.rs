@@ -264,9 +264,9 @@ impl SpectralTarget {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::lab::rng::Rng;
     use crate::metric::spectral_error::spectral_rms_error;
     use crate::metric::spectrum::Window;
+    use crate::rng::Rng;
 
     fn series(n: usize, seed: u64) -> Vec<f64> {
         let mut r = Rng::new(seed);

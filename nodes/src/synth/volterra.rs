@@ -278,7 +278,7 @@ pub fn upper_index(m: usize, i: usize, j: usize) -> usize {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::lab::rng::Rng;
+    use crate::rng::Rng;
 
     fn random(m: usize, seed: u64) -> Volterra {
         let mut r = Rng::new(seed);

@@ -360,7 +360,7 @@ pub fn noise_spectrum(r: &[f64], u: &[f64], rate: f64) -> Option<NoiseSpectrum> 
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::lab::rng::Rng;
+    use crate::rng::Rng;
 
     /// A square-law "display": v = g * u (FIR), y = v² + 0.1·v + 0.02, then
     /// the output filter. Its exact Volterra kernel is H = g gᵀ, l = 0.1 g.

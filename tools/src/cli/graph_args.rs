@@ -16,6 +16,7 @@ pub fn load_with(file: &Path, sets: &[impl AsRef<str>]) -> Result<Checked> {
 
 /// Loads `file` with `sets` and runs it offline to its end, its outputs
 /// written under `out`: what the reports do with the shipped graphs.
+#[cfg_attr(not(feature = "synth"), allow(dead_code))]
 pub fn run_with(file: &Path, sets: &[impl AsRef<str>], out: &Path) -> Result<RunReport> {
     let checked = load_with(file, sets)?;
     let opts = PlanOptions {

@@ -2,7 +2,7 @@
 
 pub mod bench;
 pub mod check;
-#[cfg(feature = "serial")]
+#[cfg(all(feature = "serial", feature = "lab"))]
 pub mod devsim;
 pub mod dot;
 pub mod graph_args;

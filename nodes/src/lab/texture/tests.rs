@@ -3,10 +3,10 @@
 
 use super::samples::{is_soft, sample, NAMES};
 use super::surface::Surface;
-use crate::lab::rng::Rng;
 use crate::lab::testutil::{linear_fit, mean, tone};
 use crate::metric::spectral_error::{spectral_rms_error, Band};
 use crate::metric::spectrum::{averaged_spectrum, SpectrumConfig, Window};
+use crate::rng::Rng;
 
 const RATE: f64 = 1000.0;
 const G: f64 = 9.806_65;

@@ -12,7 +12,7 @@
 //! A speed range of 0 leaves the finger at rest at the left end.
 
 use crate::lab::noise::Ou;
-use crate::lab::rng::Rng;
+use crate::rng::Rng;
 
 /// Standard gravity, m/s² (mass in g → load in N).
 pub const G: f64 = 9.806_65;

@@ -4,8 +4,8 @@
 
 pub mod finger;
 
-use crate::lab::rng::Rng;
 use crate::rate::clock::Clock;
+use crate::rng::Rng;
 use evflow_engine::{
     BuildContext, Io, Node, NodeError, NodeSpec, ParamSpec, Params, PortSpec, RateSpec, Role, Summary,
 };

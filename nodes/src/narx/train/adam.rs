@@ -6,8 +6,8 @@
 //! stopping on the validation block as for LM.
 
 use super::{mse, Data, EarlyStop, Epoch, Options, Report, StopReason};
-use crate::lab::rng::Rng;
 use crate::narx::net::Mlp;
+use crate::rng::Rng;
 use std::time::Instant;
 
 const BETA1: f64 = 0.9;

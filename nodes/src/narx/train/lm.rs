@@ -156,7 +156,7 @@ pub fn train(
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::lab::rng::Rng;
+    use crate::rng::Rng;
     use ndarray::{Array1, Array2};
 
     /// Samples of a smooth nonlinear function of two inputs.

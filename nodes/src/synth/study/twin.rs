@@ -422,7 +422,7 @@ mod tests {
     }
 
     fn actuation(n: usize) -> Vec<f64> {
-        let mut r = crate::lab::rng::Rng::new(4);
+        let mut r = crate::rng::Rng::new(4);
         (0..n).map(|k| if k % 2 == 0 { 0.6 } else { -0.6 } * (1.0 + 0.4 * (2.0 * r.uniform() - 1.0))).collect()
     }
 
@@ -460,7 +460,7 @@ mod tests {
             let (load, vel) = (&load[..n], &vel[..n]);
             let u = actuation(n);
             let twin = DisplayTwin::new(&profile, 1000.0, 4).unwrap();
-            let mut r = crate::lab::rng::Rng::new(8);
+            let mut r = crate::rng::Rng::new(8);
             let fbar: Vec<f64> = (0..n).map(|_| r.gaussian()).collect();
             let mut tape = Tape::default();
             twin.forward(&u, load, vel, &mut tape);
@@ -485,7 +485,7 @@ mod tests {
     fn the_sensor_adjoint_satisfies_the_inner_product_identity() {
         let profile = LabProfile::default();
         let s = SensorTwin::new(&profile, 1000.0, 4).unwrap();
-        let mut r = crate::lab::rng::Rng::new(2);
+        let mut r = crate::rng::Rng::new(2);
         let n = 500;
         let f: Vec<f64> = (0..n).map(|_| 0.01 * r.gaussian()).collect();
         let ybar: Vec<f64> = (0..n).map(|_| r.gaussian()).collect();

@@ -3,10 +3,15 @@
 //! figures of `docs/benchmarks.md`. Throughput of whole graphs is
 //! `evflow run`'s timing; micro-benchmarks are criterion benches.
 
+#[cfg(feature = "mesh")]
 pub mod mesh;
+#[cfg(feature = "narx")]
 pub mod narx;
+#[cfg(feature = "narx")]
 pub mod narx_export;
+#[cfg(any(feature = "mesh", feature = "texture"))]
 pub mod stats;
+#[cfg(feature = "texture")]
 pub mod texture;
 
 /// Arguments of `evflow bench`.
@@ -24,6 +29,7 @@ enum Which {
     /// 1 M triangles. Build with --release.
     ///
     /// Example: cargo run --release -p evflow -- bench mesh
+    #[cfg(feature = "mesh")]
     Mesh(mesh::Args),
     /// The inverse NARX model (chapter 5): training time of the default
     /// network (15-10-5, LM) on 3066 lab samples, its closed-loop error on a
@@ -32,15 +38,18 @@ enum Which {
     /// --release.
     ///
     /// Example: cargo run --release -p evflow -- bench narx --curve
+    #[cfg(feature = "narx")]
     Narx(narx::Args),
     /// The texture chain (chapter 6): per-tick compute time of
     /// graphs/texture-live.toml, the ticks that start a 10 Hz table update
     /// apart from the others. Build with --release.
     ///
     /// Example: cargo run --release -p evflow -- bench texture
+    #[cfg(feature = "texture")]
     Texture(texture::Args),
 }
 
+#[cfg(any(feature = "mesh", feature = "texture"))]
 /// A plan built tick by tick, as the live runner steps it, but offline (a
 /// bench never opens a device), without per-node timing.
 pub(crate) fn tick_plan(checked: &evflow_engine::Checked) -> anyhow::Result<evflow_engine::Plan> {
@@ -51,8 +60,11 @@ pub(crate) fn tick_plan(checked: &evflow_engine::Checked) -> anyhow::Result<evfl
 /// Runs the chosen benchmark.
 pub fn main(a: BenchArgs) -> anyhow::Result<()> {
     match a.which {
+        #[cfg(feature = "mesh")]
         Which::Mesh(m) => mesh::main(m),
+        #[cfg(feature = "narx")]
         Which::Narx(n) => narx::main(n),
+        #[cfg(feature = "texture")]
         Which::Texture(t) => texture::main(t),
     }
 }

@@ -16,10 +16,10 @@
 
 use super::narx::{Excitation, Measured, KNOWN};
 use anyhow::{Context, Result};
-use evflow_nodes::lab::rng::Rng;
 use evflow_nodes::narx::fit::FitConfig;
 use evflow_nodes::narx::model::ClosedLoopScore;
 use evflow_nodes::narx::net::Mlp;
+use evflow_nodes::rng::Rng;
 use serde_json::json;
 use std::fmt::Write as _;
 use std::path::Path;

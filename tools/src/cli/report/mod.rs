@@ -2,15 +2,25 @@
 //! to its run time, as tables and PNG figures.
 
 pub mod foaw;
+#[cfg(feature = "synth")]
 pub mod freqvel;
+#[cfg(feature = "synth")]
 pub mod interp;
+#[cfg(feature = "synth")]
 pub mod interp_cells;
+#[cfg(feature = "synth")]
 pub mod interp_cells_table;
+#[cfg(feature = "synth")]
 pub mod lab_recording;
+#[cfg(feature = "mesh")]
 pub mod mesh;
+#[cfg(feature = "synth")]
 pub mod narx;
+#[cfg(feature = "texture")]
 pub mod resample;
+#[cfg(feature = "synth")]
 pub mod textures;
+#[cfg(feature = "synth")]
 pub mod textures_table;
 
 /// Arguments of `evflow report`.
@@ -27,6 +37,7 @@ enum Which {
     /// dihedral ground truth.
     ///
     /// Example: evflow report mesh --out report
+    #[cfg(feature = "mesh")]
     Mesh(mesh::Args),
     /// Velocity from IR-frame positions (§6.5.1): FOAW against finite
     /// differences and moving averages on known trajectories sampled at
@@ -39,6 +50,7 @@ enum Which {
     /// spectral component against speed with a linear fit and R².
     ///
     /// Example: cargo run --release -p evflow -- report freqvel --out report
+    #[cfg(feature = "synth")]
     Freqvel(freqvel::Args),
     /// Interpolation over the (load, velocity) grid (Fig. 5.6, 5.9, 6.8):
     /// the basic (§5.3.3) and improved (Eq. 6.4) schemes against the
@@ -50,12 +62,14 @@ enum Which {
     /// synthesize with the nearest trained condition's model).
     ///
     /// Example: cargo run --release -p evflow -- report interp --cells optimized --out report
+    #[cfg(feature = "synth")]
     Interp(interp::Args),
     /// Re-sampling for the texture chain (§6.2): error against run time
     /// of rubato's sinc, polynomial and FFT resamplers and the live
     /// kernel of `interp`, a table and a work-precision PNG.
     ///
     /// Example: cargo run --release -p evflow -- report resample --out report
+    #[cfg(feature = "texture")]
     Resample(resample::Args),
     /// Virtual against real textures (Fig. 5.7/5.8, Table 5.1), on the
     /// texture study: every method (inverse NARX on binary and multilevel
@@ -66,6 +80,7 @@ enum Which {
     /// `--grid` writes each method's cells for the live grids.
     ///
     /// Example: cargo run --release -p evflow -- report textures --out report
+    #[cfg(feature = "synth")]
     Textures(textures::Args),
     /// Error against run time of the inverse NARX model (issue 6, point
     /// 10): several network sizes, tap delays and both trainers, each
@@ -75,6 +90,7 @@ enum Which {
     /// with the Pareto front and a PNG.
     ///
     /// Example: cargo run --release -p evflow -- report narx --out report
+    #[cfg(feature = "synth")]
     Narx(narx::Args),
 }
 
@@ -87,6 +103,7 @@ fn save_png(plot: &evflow_tools::plot::Plot, path: &std::path::Path) {
     }
 }
 
+#[cfg(feature = "synth")]
 /// Writes a report's Markdown `text` to `path` (through a temporary file,
 /// so an interrupted run leaves no half table) and says so.
 fn save_markdown(path: &std::path::Path, text: &str) -> anyhow::Result<()> {
@@ -102,12 +119,18 @@ fn save_markdown(path: &std::path::Path, text: &str) -> anyhow::Result<()> {
 /// Runs the chosen report.
 pub fn main(a: ReportArgs) -> anyhow::Result<()> {
     match a.which {
+        #[cfg(feature = "mesh")]
         Which::Mesh(m) => mesh::main(m),
         Which::Foaw(f) => foaw::main(f),
+        #[cfg(feature = "synth")]
         Which::Freqvel(f) => freqvel::main(f),
+        #[cfg(feature = "synth")]
         Which::Interp(i) => interp::main(i),
+        #[cfg(feature = "texture")]
         Which::Resample(r) => resample::main(r),
+        #[cfg(feature = "synth")]
         Which::Textures(t) => textures::main(t),
+        #[cfg(feature = "synth")]
         Which::Narx(n) => narx::main(n),
     }
 }

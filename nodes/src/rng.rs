@@ -1,4 +1,5 @@
-//! Seeded random numbers for the simulated lab: SplitMix64 (seeding),
+//! Seeded random numbers for every noisy node (sources, the simulated lab, NARX
+//! initialisation): SplitMix64 (seeding),
 //! xoshiro256++ (the stream) and Gaussian deviates by Marsaglia's polar method.
 //!
 //! References: S. Vigna, "Further scramblings of Marsaglia's xorshift

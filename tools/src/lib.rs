@@ -4,3 +4,5 @@
 
 pub mod fit;
 pub mod plot;
+#[cfg(feature = "studio")]
+pub mod studio;

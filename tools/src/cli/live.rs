@@ -73,6 +73,27 @@ pub struct Args {
     /// Also write the final report as JSON to this file.
     #[arg(long, value_name = "FILE")]
     json: Option<PathBuf>,
+    /// Serve the studio: a web page showing the session as it runs and
+    /// steering its live parameters (docs/studio.md). ADDR is `PORT` or
+    /// `HOST:PORT` (default 127.0.0.1:8737; port 0 picks a free one).
+    #[cfg(feature = "studio")]
+    #[arg(long, value_name = "ADDR", num_args = 0..=1, default_missing_value = "127.0.0.1:8737")]
+    studio: Option<String>,
+    /// Let the studio listen on a non-loopback address; the page then needs
+    /// the one-time token printed at start.
+    #[cfg(feature = "studio")]
+    #[arg(long, requires = "studio")]
+    studio_public: bool,
+}
+
+#[cfg(feature = "studio")]
+impl recorder::Tee for evflow_tools::studio::Ingest {
+    fn samples(&mut self, tap: usize, samples: &[f64]) {
+        evflow_tools::studio::Ingest::samples(self, tap, samples);
+    }
+    fn event(&mut self, e: &evflow_engine::live::Event) {
+        evflow_tools::studio::Ingest::event(self, e);
+    }
 }
 
 /// Runs `evflow live`.
@@ -94,7 +115,16 @@ pub fn main(a: Args) -> Result<()> {
         mode: evflow_engine::RunMode::Live,
     };
     let plan = Plan::build(&checked, &opts).map_err(|e| anyhow!("{e}"))?;
-    let (taps, n_inputs) = taps_of(&plan, &a.taps)?;
+    #[allow(unused_mut)]
+    let mut extra = a.taps.clone();
+    #[cfg(feature = "studio")]
+    if a.studio.is_some() {
+        // What the page shows by default is recorded too.
+        extra.extend(
+            evflow_tools::studio::default_taps(&checked, &plan).into_iter().map(|t| format!("{}.{}", t.node, t.port)),
+        );
+    }
+    let (taps, n_inputs) = taps_of(&plan, &extra)?;
     let lp = LivePlan::new(plan, &taps).map_err(|e| anyhow!("{}: {e}", a.graph.file.display()))?;
     let (inputs, outputs) = session::files(lp.taps(), n_inputs)?;
 
@@ -133,8 +163,10 @@ pub fn main(a: Args) -> Result<()> {
         miss_streak: a.miss_streak,
         ..LiveConfig::default()
     };
-    let mut session = live::start(lp, &cfg).map_err(|e| anyhow!("{e}"))?;
     let vars = live::live_vars(&checked);
+    #[cfg(feature = "studio")]
+    let description = a.studio.is_some().then(|| evflow_tools::studio::Description::live(&checked, &lp, &vars));
+    let mut session = live::start(lp, &cfg).map_err(|e| anyhow!("{e}"))?;
     let vars_line = vars
         .iter()
         .map(|v| {
@@ -156,6 +188,21 @@ pub fn main(a: Args) -> Result<()> {
     let names = session.node_names.clone();
     let parts = session.into_parts();
     let shared = parts.shared.clone();
+    // The console and the studio queue changes through the same control.
+    let control = Arc::new(std::sync::Mutex::new(parts.control));
+    #[cfg(feature = "studio")]
+    let studio = match (&a.studio, description) {
+        (Some(addr), Some(d)) => {
+            let cfg = evflow_tools::studio::StudioConfig { addr: studio_addr(addr)?, public: a.studio_public };
+            let (studio, ingest) = evflow_tools::studio::Studio::start_live(&cfg, &d, control.clone(), shared.clone())?;
+            eprintln!("studio: {}", studio.url());
+            if studio.token().is_some() {
+                eprintln!("studio: serving beyond this machine; the address above holds its one-time token");
+            }
+            Some((studio, ingest))
+        }
+        _ => None,
+    };
 
     // Ctrl-C: the first stops (the limiters fade out), a second quits at once.
     let presses = Arc::new(AtomicU32::new(0));
@@ -175,6 +222,11 @@ pub fn main(a: Args) -> Result<()> {
     // Recorder, metrics display and console: ordinary threads.
     let done = Arc::new(AtomicBool::new(false));
     let recorder = Recorder::create(&dir, &[inputs, outputs].concat(), parts.taps, parts.events, names, "evflow live")?;
+    #[cfg(feature = "studio")]
+    let recorder = match &studio {
+        Some((_, ingest)) => recorder.tee(Box::new(ingest.clone())),
+        None => recorder,
+    };
     let rec_thread = {
         let done = done.clone();
         std::thread::Builder::new()
@@ -186,6 +238,10 @@ pub fn main(a: Args) -> Result<()> {
         let done = done.clone();
         let shared = shared.clone();
         let mut stats = parts.stats;
+        #[cfg(feature = "studio")]
+        let ingest = studio.as_ref().map(|(_, i)| i.clone());
+        #[cfg(not(feature = "studio"))]
+        let ingest: Option<()> = None;
         std::thread::Builder::new().name("evflow-metrics".into()).spawn(move || {
             let mut m = Metrics::new();
             let mut shown = Instant::now();
@@ -193,6 +249,13 @@ pub fn main(a: Args) -> Result<()> {
             let steal0 = steal::steal_seconds();
             while !done.load(Ordering::Acquire) {
                 std::thread::sleep(Duration::from_millis(50));
+                #[cfg(feature = "studio")]
+                if let Some(i) = &ingest {
+                    drain_to_studio(&mut m, &mut stats, i);
+                    i.steal(steal::steal_seconds().zip(steal0).map(|(b, a)| (b - a).max(0.0)));
+                }
+                #[cfg(not(feature = "studio"))]
+                let _ = &ingest;
                 m.drain(&mut stats);
                 if show && shown.elapsed() >= Duration::from_secs(1) {
                     let mut line = m.summary(&shared, base_rate).line();
@@ -215,7 +278,6 @@ pub fn main(a: Args) -> Result<()> {
             m
         })?
     };
-    let mut control = parts.control;
     if show {
         eprintln!(
             "live: `{}` at {base_rate} Hz{}; recording to {}",
@@ -235,13 +297,13 @@ pub fn main(a: Args) -> Result<()> {
             let line = line.trim();
             match line {
                 "" => {}
-                "stop" | "q" | "quit" => control.stop(),
-                _ => match control.set_text(line, None) {
+                "stop" | "q" | "quit" => control.lock().unwrap_or_else(|e| e.into_inner()).stop(),
+                _ => match control.lock().unwrap_or_else(|e| e.into_inner()).set_text(line, None) {
                     Ok(()) => eprintln!("queued {line}"),
                     Err(e) => eprintln!("{e}"),
                 },
             }
-            control.collect_retired();
+            control.lock().unwrap_or_else(|e| e.into_inner()).collect_retired();
         }
     })?;
 
@@ -253,6 +315,18 @@ pub fn main(a: Args) -> Result<()> {
     done.store(true, Ordering::Release);
     let rec = rec_thread.join().map_err(|_| anyhow!("the recorder thread panicked"))?;
     let metrics = metrics_thread.join().map_err(|_| anyhow!("the metrics thread panicked"))?;
+    #[cfg(feature = "studio")]
+    if let Some((studio, _)) = studio {
+        // The last frames reach the page before it is told the session ended.
+        std::thread::sleep(Duration::from_millis(150));
+        if studio.frames_dropped() > 0 {
+            eprintln!(
+                "studio: browsers lost {} frames (slow to read; the session was not delayed)",
+                studio.frames_dropped()
+            );
+        }
+        studio.close();
+    }
     let summary = metrics.summary(&shared, base_rate);
     let mut exit = exit;
     let sums = exit.plan.plan_mut().finish().map_err(|e| anyhow!("{e}"))?;
@@ -326,6 +400,38 @@ pub fn main(a: Args) -> Result<()> {
         None if exit.reason.is_some_and(|r| r.is_fault()) => Err(anyhow!("session stopped by a fault: {reason}")),
         None => Ok(()),
     }
+}
+
+/// Hands the tick timings to the studio as well, then counts them.
+#[cfg(feature = "studio")]
+fn drain_to_studio(
+    m: &mut Metrics,
+    ring: &mut evflow_engine::live::rtrb::Consumer<evflow_engine::live::TickStat>,
+    studio: &evflow_tools::studio::Ingest,
+) {
+    let n = ring.slots();
+    if let Ok(chunk) = ring.read_chunk(n) {
+        let (a, b) = chunk.as_slices();
+        studio.stats(a);
+        studio.stats(b);
+        for s in a.iter().chain(b) {
+            m.absorb(s);
+        }
+        chunk.commit_all();
+    }
+}
+
+/// The studio's address from `--studio`: `PORT`, `HOST:PORT` or `IP:PORT`.
+#[cfg(feature = "studio")]
+fn studio_addr(text: &str) -> Result<std::net::SocketAddr> {
+    use std::net::ToSocketAddrs;
+    let t = text.trim();
+    let with_host = if t.parse::<u16>().is_ok() { format!("127.0.0.1:{t}") } else { t.to_string() };
+    with_host
+        .to_socket_addrs()
+        .ok()
+        .and_then(|mut a| a.next())
+        .ok_or_else(|| anyhow!("--studio {text}: expected PORT or HOST:PORT (e.g. 127.0.0.1:8737)"))
 }
 
 /// ` unit`, or nothing for dimensionless values.

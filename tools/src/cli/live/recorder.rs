@@ -35,8 +35,21 @@ pub struct RecorderReport {
     pub event_error: Option<String>,
 }
 
+/// A second, non-real-time reader of what the recorder drains (the
+/// studio): it sees each tap's samples, in order, right after they leave
+/// their ring, and every event. It runs on the recorder's thread, so it
+/// must be quick and never block.
+pub trait Tee: Send {
+    /// Samples of tap `tap` (index in tap order), oldest first; zeros for
+    /// samples lost to a full ring.
+    fn samples(&mut self, tap: usize, samples: &[f64]);
+    /// An event, in order.
+    fn event(&mut self, e: &Event);
+}
+
 /// Owns the consumer ends of the rings and the session's files.
 pub struct Recorder {
+    tee: Option<Box<dyn Tee>>,
     sinks: Vec<Sink>,
     rings: Vec<rtrb::Consumer<f64>>,
     events: rtrb::Consumer<Event>,
@@ -93,6 +106,7 @@ impl Recorder {
         }
         let log = File::create(dir.join("events.jsonl"))?;
         Ok(Self {
+            tee: None,
             sinks,
             rings,
             events,
@@ -101,6 +115,13 @@ impl Recorder {
             report: RecorderReport::default(),
             scratch: Vec::new(),
         })
+    }
+
+    /// Hands every drained sample and event to `tee` as well.
+    #[cfg_attr(not(feature = "studio"), allow(dead_code))]
+    pub fn tee(mut self, tee: Box<dyn Tee>) -> Self {
+        self.tee = Some(tee);
+        self
     }
 
     /// Moves up to `limit` frames (all available when `None`) of a sink
@@ -118,6 +139,10 @@ impl Recorder {
         for (c, &r) in sink.rings.iter().enumerate() {
             if let Ok(chunk) = self.rings[r].read_chunk(n) {
                 let (a, b) = chunk.as_slices();
+                if let Some(t) = self.tee.as_mut() {
+                    t.samples(r, a);
+                    t.samples(r, b);
+                }
                 for (i, x) in a.iter().chain(b).enumerate() {
                     self.scratch[i * ch + c] = *x;
                 }
@@ -148,10 +173,18 @@ impl Recorder {
                 for sink in &mut self.sinks {
                     let missing = Self::due(&sink.spec, e.tick + ticks) - Self::due(&sink.spec, e.tick);
                     let zeros = vec![0.0; (missing as usize) * sink.rings.len()];
+                    if let Some(t) = self.tee.as_mut() {
+                        for &r in &sink.rings {
+                            t.samples(r, &zeros[..missing as usize]);
+                        }
+                    }
                     sink.frames += missing;
                     sink.gap_frames += missing;
                     write(sink, &zeros);
                 }
+            }
+            if let Some(t) = self.tee.as_mut() {
+                t.event(&e);
             }
             self.log_event(&e);
         }

@@ -1,0 +1,268 @@
+// The studio page: one WebSocket; a `hello` describes the session, then
+// `frame`s bring decimated traces, timing, limiter states and events;
+// changes go back as `set` messages and come back as `reply`s.
+"use strict";
+const $ = id => document.getElementById(id);
+const S = {
+  hello: null, taps: [], series: [], frames: 0, t: 0, tick: 0, windowS: 10, keepS: 120,
+  replies: [], events: [], limiters: {}, compute: { t: [], lo: [], hi: [] }, nextId: 1, ended: false,
+  recorded: false, view: null,
+};
+window.studio = S;
+const COLORS = ["#3566c4", "#c0162b", "#1c8a3a", "#d98200", "#7b3fb8", "#0f8a8a", "#a0522d", "#444"];
+const token = new URLSearchParams(location.search).get("token");
+const ws = new WebSocket(`ws://${location.host}/ws${token ? "?token=" + encodeURIComponent(token) : ""}`);
+ws.onopen = () => status("connected", "ok");
+ws.onclose = () => status(S.recorded ? "recorded session (loaded)" : (S.ended ? "session ended" : "disconnected"), S.recorded || S.ended ? "ended" : "bad");
+ws.onmessage = m => {
+  const msg = JSON.parse(m.data);
+  if (msg.type === "hello") hello(msg);
+  else if (msg.type === "frame") frame(msg);
+  else if (msg.type === "reply") reply(msg);
+  else if (msg.type === "drops") $("drops").textContent = msg.frames;
+  else if (msg.type === "error") status(msg.message, "bad");
+};
+function status(text, cls) { const s = $("status"); s.textContent = text; s.className = "status " + cls; }
+function el(tag, attrs, ...kids) {
+  const e = document.createElement(tag);
+  for (const [k, v] of Object.entries(attrs || {})) if (k === "class") e.className = v; else if (k.startsWith("on")) e[k] = v; else e.setAttribute(k, v);
+  for (const k of kids) e.append(k);
+  return e;
+}
+const tapName = t => `${t.node}.${t.port}`;
+
+function hello(h) {
+  S.hello = h;
+  S.recorded = h.mode === "recorded";
+  $("graph-name").textContent = h.graph.name + (S.recorded ? " (recorded)" : "");
+  S.taps = h.taps;
+  S.series = h.taps.map(() => ({ t: [], lo: [], hi: [], last: null }));
+  const picks = $("tap-picks"), traces = $("traces");
+  picks.textContent = "show: "; traces.textContent = "";
+  h.taps.forEach((t, i) => {
+    const box = el("input", { type: "checkbox", id: "show-" + i });
+    box.checked = !!t.shown;
+    box.onchange = () => { $("trace-" + i).style.display = box.checked ? "" : "none"; };
+    picks.append(el("label", {}, box, tapName(t) + ` (${plot.fmt(t.rate)} Hz) `));
+    const row = el("div", { class: "trace", id: "trace-" + i }, el("div", { class: "label" }, tapName(t), el("br"), el("span", { id: "last-" + i, class: "small" })), el("canvas", { id: "canvas-" + i }));
+    row.style.display = t.shown ? "" : "none";
+    traces.append(row);
+  });
+  limitersInit(h.limiters);
+  steerInit(h);
+  graphDraw(h.graph);
+  if (S.recorded) recordedInit(h);
+}
+
+function frame(f) {
+  S.frames++;
+  S.t = f.t; S.tick = f.tick;
+  $("session-time").textContent = f.t.toFixed(1);
+  $("session-tick").textContent = f.tick;
+  for (const d of f.taps) {
+    const s = S.series[d.i];
+    for (let k = 0; k < d.lo.length; k++) { s.t.push(d.t0 + k * d.dt); s.lo.push(d.lo[k]); s.hi.push(d.hi[k]); }
+    s.last = d.last;
+    const cut = s.t.findIndex(x => x >= s.t[s.t.length - 1] - S.keepS);
+    if (cut > 0) { s.t.splice(0, cut); s.lo.splice(0, cut); s.hi.splice(0, cut); }
+  }
+  for (const l of f.limiters) limiterShow(l);
+  for (const e of f.events) eventShow(e);
+  if (f.timing) timingShow(f);
+  if (f.studio) { $("drops-all").textContent = f.studio.frames_dropped; $("browsers").textContent = f.studio.browsers; }
+  if (!S.recorded) requestDraw();
+}
+
+let drawPending = false;
+function requestDraw() { if (!drawPending) { drawPending = true; requestAnimationFrame(draw); } }
+function draw() {
+  drawPending = false;
+  let t0, t1;
+  if (S.view) [t0, t1] = S.view; else { t1 = Math.max(S.t, S.windowS); t0 = t1 - S.windowS; }
+  S.taps.forEach((t, i) => {
+    if ($("trace-" + i).style.display === "none") return;
+    plot.band($("canvas-" + i), S.series[i], t0, t1, COLORS[i % COLORS.length]);
+    const last = S.series[i].last;
+    $("last-" + i).textContent = last === null ? "" : plot.fmt(last);
+  });
+  plot.band($("compute"), S.compute, t0, t1, "#7b3fb8");
+  sceneDraw(t0, t1);
+}
+
+// --- limiters ---
+function limitersInit(ls) {
+  const box = $("limiters"); box.textContent = "";
+  if (!ls.length) box.append(el("p", { class: "small" }, "this graph has no safety limiter"));
+  for (const l of ls) {
+    const arm = el("button", { id: `rearm-${l.node}`, onclick: () => send(`${l.node}.enable`, "true") }, "re-arm");
+    const off = el("button", { id: `disable-${l.node}`, onclick: () => send(`${l.node}.enable`, "false") }, "fade out");
+    if (S.recorded) { arm.disabled = true; off.disabled = true; }
+    box.append(el("div", { class: "limiter" }, el("div", { class: "badge armed", id: `limiter-${l.node}` }, "ARMED"),
+      el("div", {}, el("b", {}, l.node), ` |out| ≤ ${l.amplitude}`, el("br"), el("span", { class: "small", id: `limiter-info-${l.node}` })), arm, off));
+  }
+}
+function limiterShow(l) {
+  const b = $(`limiter-${l.node}`);
+  if (!b) return;
+  S.limiters[l.node] = l;
+  b.className = "badge " + l.state;
+  b.textContent = l.state.toUpperCase();
+  $(`limiter-info-${l.node}`).textContent = `enable ${l.enable} · peak in ${plot.fmt(l.in_peak)} out ${plot.fmt(l.out_peak)} · clamped ${l.clamped_samples} samples · non-finite inputs ${l.non_finite_inputs}` + (l.watching_input ? "" : " · (input not tapped: clamping not seen)");
+}
+
+// --- steering ---
+function steerInit(h) {
+  const vars = $("vars"); vars.textContent = "";
+  const sel = $("param-select"); sel.textContent = "";
+  for (const v of h.vars) {
+    const p = v.param || {};
+    const input = el("input", { id: "var-" + v.name, size: 8, value: p.value === null || p.value === undefined ? "" : String(p.value) });
+    const btn = el("button", { id: "set-" + v.name, onclick: () => send(v.name, input.value) }, "set");
+    if (S.recorded) btn.disabled = true;
+    vars.append(el("div", { class: "row" }, el("b", {}, v.name), input, btn, el("span", { class: "small" }, `${p.limits || ""} → ${v.uses.join(", ")}`)));
+  }
+  for (const p of h.params) sel.append(el("option", { value: `${p.node}.${p.param}` }, `${p.node}.${p.param}`));
+  const show = () => { const p = h.params.find(q => `${q.node}.${q.param}` === sel.value); $("param-limits").textContent = p ? `${p.limits} ${p.unit || ""} — ${p.doc}` : ""; };
+  sel.onchange = show; show();
+  $("param-set").onclick = () => send(sel.value, $("param-value").value);
+  if (S.recorded) $("param-set").disabled = true;
+}
+function send(target, value) {
+  const id = S.nextId++;
+  ws.send(JSON.stringify({ type: "set", id, target, value }));
+  logLine($("steer-log"), `→ ${target} = ${value}`, "");
+}
+function reply(r) {
+  S.replies.push(r);
+  logLine($("steer-log"), (r.ok ? "✓ " : "✗ refused: ") + r.message, r.ok ? "ok" : "err");
+}
+function logLine(list, text, cls) {
+  list.append(el("li", { class: cls }, text));
+  while (list.children.length > 200) list.firstChild.remove();
+  list.scrollTop = list.scrollHeight;
+}
+
+// --- timing ---
+function timingShow(f) {
+  const m = f.timing, o = m.overruns || {};
+  const rows = [
+    ["wake-up jitter µs", `p50 ${m.jitter_us.p50.toFixed(0)} · p99 ${m.jitter_us.p99.toFixed(0)} · p99.9 ${m.jitter_us.p99_9.toFixed(0)} · max ${m.jitter_us.max.toFixed(0)}`, false],
+    ["compute µs", `p50 ${m.compute_us.p50.toFixed(0)} · p99.9 ${m.compute_us.p99_9.toFixed(0)} · max ${m.compute_us.max.toFixed(0)}`, false],
+    ["deadline misses", `${m.misses} (longest streak ${m.longest_miss_streak})`, m.misses > 0],
+    ["ring overruns", `taps ${o.taps ?? "–"} · events ${o.events ?? "–"} · timings ${o.measurements ?? "–"} · commands ${o.commands ?? "–"}`, (o.taps || 0) + (o.events || 0) > 0],
+    ["host steal", m.host_steal_ms === null || m.host_steal_ms === undefined ? "n/a" : `${m.host_steal_ms.toFixed(0)} ms`, m.host_steal_ms > 0],
+  ];
+  const tb = $("timing"); tb.textContent = "";
+  for (const [k, v, warn] of rows) tb.append(el("tr", {}, el("td", {}, k), el("td", { class: warn ? "warn" : "" }, v)));
+  const e = m.jitter_hist.edges_us, labels = e.map(x => "<" + (x >= 1000 ? x / 1000 + "ms" : x + "µs")).concat([">" + e[e.length - 1] / 1000 + "ms"]);
+  plot.bars($("jitter-hist"), labels, m.jitter_hist.counts, "wake-up jitter (ticks, log)");
+  if (m.window) { S.compute.t.push(f.t); S.compute.lo.push(0); S.compute.hi.push(m.window.compute_max_us); }
+}
+
+// --- finger over the scene ---
+function findTap(pred) { return S.taps.findIndex(pred); }
+function sceneDraw(t0, t1) {
+  const c = $("scene");
+  let xi = findTap(t => t.port === "x" && S.hello.graph.nodes.some(n => n.name === t.node && n.type.startsWith("sim.user")));
+  let yi = findTap(t => t.port === "y" && t.node === (S.taps[xi] || {}).node);
+  let ci = findTap(t => t.port === "intensity");
+  let xl = "x (m)", yl = "y (m)";
+  if (xi < 0 || yi < 0) { // texture chains: the interpolator's (load, velocity) point
+    const ed = S.hello.graph.edges;
+    const src = inp => { const e = ed.find(e => S.hello.graph.nodes.some(n => n.name === e.to && n.type === "interp") && e.in === inp); return e ? findTap(t => t.node === e.from && t.port === e.out) : -1; };
+    xi = src("velocity"); yi = src("load"); ci = findTap(t => t.port === "force"); xl = "velocity (cm/s)"; yl = "load (g)";
+  }
+  if (xi < 0 || yi < 0) { $("scene-note").textContent = "no finger position is tapped in this graph"; return; }
+  const sx = S.series[xi], sy = S.series[yi], sc = ci >= 0 ? S.series[ci] : null;
+  const pts = [];
+  let xr = [Infinity, -Infinity], yr = [Infinity, -Infinity], cr = [Infinity, -Infinity];
+  const at = (s, t) => { let lo = 0, hi = s.t.length - 1; if (hi < 0) return null; while (lo < hi) { const m = (lo + hi + 1) >> 1; if (s.t[m] <= t) lo = m; else hi = m - 1; } return s.hi[lo] === null ? null : (s.lo[lo] + s.hi[lo]) / 2; };
+  const n = 150;
+  for (let k = 0; k <= n; k++) {
+    const t = t0 + (t1 - t0) * k / n;
+    if (t > S.t && !S.view) break;
+    const x = at(sx, t), y = at(sy, t), cv = sc ? at(sc, t) : 0;
+    if (x === null || y === null) continue;
+    pts.push([x, y, cv ?? 0]);
+    xr = [Math.min(xr[0], x), Math.max(xr[1], x)]; yr = [Math.min(yr[0], y), Math.max(yr[1], y)]; cr = [Math.min(cr[0], cv ?? 0), Math.max(cr[1], cv ?? 0)];
+  }
+  if (!pts.length) return;
+  const span = cr[1] - cr[0] || 1;
+  for (const p of pts) p[2] = (p[2] - cr[0]) / span;
+  plot.trail(c, pts, plot.range(xr[0], xr[1]), plot.range(yr[0], yr[1]), xl, yl);
+  $("scene-note").textContent = `${tapName(S.taps[xi])} × ${tapName(S.taps[yi])}` + (sc ? `, colour: ${tapName(S.taps[ci])} (blue low → red high)` : "") + "; the large dot is now";
+}
+
+// --- graph ---
+function graphDraw(g) {
+  const depth = {};
+  g.nodes.forEach(n => depth[n.name] = 0);
+  for (let pass = 0; pass < g.nodes.length; pass++)
+    for (const e of g.edges) if (depth[e.to] < depth[e.from] + 1 && pass < g.nodes.length - 1) depth[e.to] = Math.min(depth[e.from] + 1, g.nodes.length);
+  const cols = {}; g.nodes.forEach(n => (cols[depth[n.name]] = cols[depth[n.name]] || []).push(n));
+  const W = 150, H = 46, pos = {};
+  let maxRow = 0;
+  for (const [d, ns] of Object.entries(cols)) ns.forEach((n, r) => { pos[n.name] = [10 + d * (W + 40), 10 + r * (H + 18)]; maxRow = Math.max(maxRow, r); });
+  const width = 20 + (Math.max(...Object.keys(cols).map(Number)) + 1) * (W + 40), height = 20 + (maxRow + 1) * (H + 18);
+  let svg = `<svg viewBox="0 0 ${width} ${height}" height="${height}">`;
+  for (const e of g.edges) {
+    const [x1, y1] = pos[e.from], [x2, y2] = pos[e.to];
+    const a = [x1 + W, y1 + H / 2], b = [x2, y2 + H / 2];
+    svg += `<path class="edge" d="M${a[0]},${a[1]} C${a[0] + 25},${a[1]} ${b[0] - 25},${b[1]} ${b[0]},${b[1]}"><title>${e.from}.${e.out} → ${e.to}.${e.in} (${e.rate} Hz)</title></path>`;
+    svg += `<text class="edge-label" x="${(a[0] + b[0]) / 2 - 10}" y="${(a[1] + b[1]) / 2 - 2}">${plot.fmt(e.rate)}</text>`;
+  }
+  for (const n of g.nodes) {
+    const [x, y] = pos[n.name];
+    const why = (g.pruned.find(p => p.node === n.name) || {}).reason;
+    svg += `<g class="node${n.in_plan ? "" : " pruned"}${n.guard ? " guard" : ""}"><rect x="${x}" y="${y}" width="${W}" height="${H}" rx="5"/><title>${n.type}${why ? " — left out: " + why : ""}</title>` +
+      `<text x="${x + 6}" y="${y + 15}"><tspan font-weight="700">${n.name}</tspan></text><text x="${x + 6}" y="${y + 29}">${n.type}</text><text x="${x + 6}" y="${y + 41}">${plot.fmt(n.rate)} Hz${n.in_plan ? "" : " · left out"}</text></g>`;
+  }
+  $("graph").innerHTML = svg + "</svg>";
+  const pr = $("pruned"); pr.textContent = "";
+  if (!g.pruned.length) pr.append(el("li", {}, "the plan left nothing out"));
+  for (const p of g.pruned) pr.append(el("li", {}, `left out: ${p.node} — ${p.reason}`));
+}
+
+// --- events ---
+function eventShow(e) {
+  S.events.push(e);
+  let text = `${e.t.toFixed(3)} s (tick ${e.tick}) `;
+  if (e.event === "set") text += `${e.node}.${e.param} = ${e.value}`;
+  else if (e.event === "refused") text += `REFUSED by the node: ${e.node}.${e.param} = ${e.value}`;
+  else if (e.event === "stop") { text += `stop: ${e.reason}`; S.ended = true; }
+  else if (e.event === "gap") text += `gap: ${e.ticks} ticks of samples lost`;
+  else text += e.event;
+  logLine($("events"), text, e.event === "refused" || e.event === "gap" ? "err" : "");
+}
+
+// --- recorded sessions ---
+function recordedInit(h) {
+  const r = h.recording;
+  $("window-s").textContent = "scrub";
+  const from = el("input", { type: "range", id: "scrub-from", min: 0, max: r.seconds, step: r.seconds / 1000, value: 0 });
+  const span = el("input", { type: "range", id: "scrub-span", min: Math.min(0.05, r.seconds), max: r.seconds, step: r.seconds / 1000, value: r.seconds });
+  const upd = () => { const a = +from.value, w = +span.value; S.view = [a, Math.min(a + w, Math.max(r.seconds, a + 0.01))]; draw(); markers(); };
+  from.oninput = upd; span.oninput = upd;
+  $("traces-panel").insertBefore(el("div", { class: "row" }, "from", from, "span", span,
+    el("span", { class: "small" }, `${r.seconds.toFixed(3)} s · stopped: ${r.stopped} · replay check: `),
+    el("b", { id: "replay-check" }, r.replay.ok ? "✓ " + r.replay.summary : "✗ " + r.replay.summary)), $("traces"));
+  S.view = [0, r.seconds];
+  setTimeout(() => { draw(); markers(); }, 0);
+}
+function markers() {
+  // Events on the time axis of every trace.
+  if (!S.view) return;
+  const [t0, t1] = S.view;
+  S.taps.forEach((t, i) => {
+    const c = $("canvas-" + i);
+    if (!c || $("trace-" + i).style.display === "none") return;
+    const g = c.getContext("2d");
+    for (const e of S.events) {
+      if (e.t < t0 || e.t > t1) continue;
+      const x = (e.t - t0) / (t1 - t0) * c.width;
+      g.strokeStyle = e.event === "set" ? "#1c8a3a" : "#c0162b";
+      g.beginPath(); g.moveTo(x, 0); g.lineTo(x, c.height); g.stroke();
+    }
+  });
+}
+window.addEventListener("resize", requestDraw);

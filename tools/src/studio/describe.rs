@@ -1,0 +1,187 @@
+//! What the page is told once, when it connects: the graph (nodes,
+//! connections, rates, what the plan left out and why), the tapped
+//! streams, the live parameters with their declared limits, the graph
+//! variables bound to them, and the safety limiters to watch.
+
+use evflow_engine::live::{LivePlan, LiveVar, Tap, TapInfo};
+use evflow_engine::params::Value as PValue;
+use evflow_engine::spec::{ParamKind, ParamSpec};
+use evflow_engine::{Checked, Direction};
+use serde_json::{json, Value};
+
+/// A safety limiter (`limit`) whose state the studio infers from its
+/// input and output taps and its `enable` changes.
+#[derive(Debug, Clone)]
+pub(crate) struct LimiterSpec {
+    /// Node name.
+    pub node: String,
+    /// Plan index (events name nodes by it).
+    pub index: u32,
+    /// Its `amplitude` parameter: |in| above it is clamped.
+    pub amplitude: f64,
+    /// Tap carrying what feeds its `in`, if tapped.
+    pub input: Option<usize>,
+    /// Tap of its `out`, if tapped.
+    pub output: Option<usize>,
+    /// `enable` as the graph sets it.
+    pub enabled: bool,
+}
+
+/// Everything the studio knows about the session it shows.
+#[derive(Debug, Clone)]
+pub struct Description {
+    pub(crate) hello: Value,
+    pub(crate) taps: Vec<TapInfo>,
+    pub(crate) names: Vec<String>,
+    pub(crate) limiters: Vec<LimiterSpec>,
+    pub(crate) base_rate: f64,
+}
+
+/// Streams worth seeing by default on top of the sources and guards the
+/// session records anyway: the display's force, the mesh intensities, what
+/// feeds each limiter (so clamping shows), and the (load, velocity) point of
+/// each texture interpolator. Only nodes the plan kept.
+pub fn default_taps(checked: &Checked, plan: &evflow_engine::Plan) -> Vec<Tap> {
+    let mut taps = Vec::new();
+    let mut add = |node: &str, port: &str| {
+        let t = Tap::new(node, port);
+        if plan.index(node).is_some() && !taps.contains(&t) {
+            taps.push(t);
+        }
+    };
+    for n in &checked.nodes {
+        match n.spec.name {
+            "sim.display" => add(&n.name, "force"),
+            "mesh.gradient" | "mesh.edges" => add(&n.name, "intensity"),
+            _ => {}
+        }
+    }
+    for e in &checked.edges {
+        let to = &checked.nodes[e.to.0];
+        let port = &to.ports[e.to.1].name;
+        let wanted =
+            matches!((to.spec.name, port.as_str()), ("limit", "in") | ("interp", "load") | ("interp", "velocity"));
+        if wanted {
+            let from = &checked.nodes[e.from.0];
+            add(&from.name, &from.ports[e.from.1].name);
+        }
+    }
+    taps
+}
+
+fn param_json(node: &str, p: &ParamSpec, current: Option<&PValue>) -> Value {
+    let (kind, min, max, choices) = match p.kind {
+        ParamKind::Float { min, max } => ("float", json!(min), json!(max), json!(null)),
+        ParamKind::Int { min, max } => ("int", json!(min), json!(max), json!(null)),
+        ParamKind::Bool => ("bool", json!(null), json!(null), json!(null)),
+        ParamKind::Choice(w) => ("choice", json!(null), json!(null), json!(w)),
+        _ => ("other", json!(null), json!(null), json!(null)),
+    };
+    let value = match current {
+        Some(PValue::Float(x)) => json!(x),
+        Some(PValue::Int(i)) => json!(i),
+        Some(PValue::Bool(b)) => json!(b),
+        Some(PValue::Text(t)) => json!(t),
+        _ => json!(null),
+    };
+    json!({
+        "node": node, "param": p.name, "kind": kind, "min": min, "max": max, "choices": choices,
+        "limits": p.kind.limits(), "unit": p.unit, "doc": p.doc, "value": value,
+    })
+}
+
+impl Description {
+    /// Describes a live session about to run `plan` (built from `checked`),
+    /// with the graph variables bound to its live parameters.
+    pub fn live(checked: &Checked, plan: &LivePlan, vars: &[LiveVar]) -> Self {
+        let p = plan.plan();
+        let base = p.base_rate();
+        let taps = plan.taps().to_vec();
+        let names: Vec<String> = (0..p.len()).map(|k| p.node_name(k).to_string()).collect();
+        let nodes: Vec<Value> = checked
+            .nodes
+            .iter()
+            .map(|n| {
+                let in_plan = p.index(&n.name).is_some();
+                json!({
+                    "name": n.name, "type": n.spec.name, "rate": n.ratio.hz(base), "in_plan": in_plan,
+                    "guard": n.spec.safety_guard,
+                    "inputs": n.ports.iter().filter(|q| q.dir == Direction::In).map(|q| &q.name).collect::<Vec<_>>(),
+                    "outputs": n.ports.iter().filter(|q| q.dir == Direction::Out).map(|q| &q.name).collect::<Vec<_>>(),
+                })
+            })
+            .collect();
+        let edges: Vec<Value> = checked
+            .edges
+            .iter()
+            .map(|e| {
+                let (f, t) = (&checked.nodes[e.from.0], &checked.nodes[e.to.0]);
+                let fp = &f.ports[e.from.1];
+                json!({ "from": f.name, "out": fp.name, "to": t.name, "in": t.ports[e.to.1].name, "rate": fp.ratio.hz(base) })
+            })
+            .collect();
+        let pruned: Vec<Value> = p.pruned().iter().map(|x| json!({ "node": x.node, "reason": x.reason })).collect();
+        let params: Vec<Value> = checked
+            .nodes
+            .iter()
+            .filter(|n| p.index(&n.name).is_some())
+            .flat_map(|n| n.spec.params.iter().filter(|q| q.live).map(|q| param_json(&n.name, q, n.params.get(q.name))))
+            .collect();
+        let vars_json: Vec<Value> = vars
+            .iter()
+            .map(|v| {
+                let first = v.uses.first().and_then(|(node, param)| {
+                    let n = checked.nodes.iter().find(|n| &n.name == node)?;
+                    Some(param_json(node, n.spec.param(param)?, n.params.get(param)))
+                });
+                let uses: Vec<String> = v.uses.iter().map(|(n, q)| format!("{n}.{q}")).collect();
+                json!({ "name": v.name, "uses": uses, "param": first })
+            })
+            .collect();
+        let tap_of = |node: &str, port: &str| taps.iter().position(|t| t.node == node && t.port == port);
+        let mut limiters = Vec::new();
+        for n in checked.nodes.iter().filter(|n| n.spec.name == "limit") {
+            let Some(index) = p.index(&n.name) else { continue };
+            let input = checked
+                .edges
+                .iter()
+                .find(|e| e.to.0 == checked.index(&n.name).unwrap_or(usize::MAX) && n.ports[e.to.1].name == "in")
+                .and_then(|e| {
+                    let f = &checked.nodes[e.from.0];
+                    tap_of(&f.name, &f.ports[e.from.1].name)
+                });
+            limiters.push(LimiterSpec {
+                node: n.name.clone(),
+                index: index as u32,
+                amplitude: n.params.f64("amplitude"),
+                input,
+                output: tap_of(&n.name, "out"),
+                enabled: n.params.bool("enable"),
+            });
+        }
+        let defaults = default_taps(checked, p);
+        let taps_json: Vec<Value> = taps
+            .iter()
+            .enumerate()
+            .map(|(i, t)| {
+                let shown = defaults.iter().any(|d| d.node == t.node && d.port == t.port)
+                    || limiters.iter().any(|l| l.output == Some(i))
+                    || t.port == "velocity";
+                json!({ "i": i, "node": t.node, "port": t.port, "rate": t.rate, "shown": shown })
+            })
+            .collect();
+        let hello = json!({
+            "type": "hello",
+            "mode": "live",
+            "graph": {
+                "name": checked.graph.name, "description": checked.graph.description, "base_rate": base,
+                "nodes": nodes, "edges": edges, "pruned": pruned,
+            },
+            "taps": taps_json,
+            "params": params,
+            "vars": vars_json,
+            "limiters": limiters.iter().map(|l| json!({ "node": l.node, "amplitude": l.amplitude })).collect::<Vec<_>>(),
+        });
+        Self { hello, taps, names, limiters, base_rate: base }
+    }
+}

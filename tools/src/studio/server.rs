@@ -60,6 +60,26 @@ const FRAME_PERIOD: Duration = Duration::from_millis(50);
 const MAX_CONNECTIONS: usize = 32;
 /// Largest request head accepted.
 const MAX_HEAD: usize = 8192;
+/// The kernel's send buffer per browser (about a second of frames): a
+/// browser that stops reading is found out within seconds, not after
+/// megabytes of stale frames, and then loses frames in its queue.
+const SEND_BUFFER: libc::c_int = 64 * 1024;
+
+/// Bounds the kernel's send buffer of `s` (best effort).
+fn bound_send_buffer(s: &TcpStream) {
+    use std::os::fd::AsRawFd;
+    let size = SEND_BUFFER;
+    // SAFETY: setsockopt on an open socket with a pointer to a c_int of the given size.
+    unsafe {
+        libc::setsockopt(
+            s.as_raw_fd(),
+            libc::SOL_SOCKET,
+            libc::SO_SNDBUF,
+            &size as *const libc::c_int as *const libc::c_void,
+            std::mem::size_of::<libc::c_int>() as libc::socklen_t,
+        );
+    }
+}
 
 struct Ctx {
     hub: Arc<Hub>,
@@ -294,6 +314,7 @@ fn connection(mut s: TcpStream, ctx: &Ctx) {
 }
 
 fn websocket(s: TcpStream, ctx: &Ctx) {
+    bound_send_buffer(&s);
     let Ok(mut ws) = tungstenite::accept(s) else { return };
     let Some((rx, drops)) = ctx.hub.join() else {
         let _ = ws.send(Message::text(r#"{"type":"error","message":"too many browsers are connected"}"#));

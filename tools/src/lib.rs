@@ -2,5 +2,6 @@
 //! tests and benchmarks — plots for reports.
 #![deny(missing_docs)]
 
+pub mod batch;
 pub mod fit;
 pub mod plot;

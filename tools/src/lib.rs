@@ -2,6 +2,7 @@
 //! tests and benchmarks — plots for reports.
 #![deny(missing_docs)]
 
+pub mod batch;
 pub mod fit;
 pub mod plot;
 #[cfg(feature = "studio")]

@@ -32,6 +32,15 @@ enum Command {
     ///   evflow run graphs/excitation.toml --sweep mass=60,85,110 --sweep speed=3,4,5 --csv grid.csv
     #[command(visible_alias = "sweep")]
     Run(cli::run::Args),
+    /// Join the outputs of the shards of a sweep (`run --shard K/N`) into
+    /// what one run would have written: the files the graphs wrote, and
+    /// the --csv / --json tables in sweep order. Checks that the folders
+    /// are every K of N of one sweep; lists the shards' failed runs.
+    ///
+    /// Example (docs/scale.md):
+    ///   for k in 1 2 3; do evflow run graphs/excitation.toml --shard $k/3 --out part$k --csv part$k/grid.csv; done
+    ///   evflow merge grid part1 part2 part3
+    Merge(cli::merge::Args),
     /// Validate a graph and print its plan: execution order, rates, buffer
     /// block size, and which nodes were left out and why.
     ///
@@ -125,6 +134,7 @@ fn main() -> ExitCode {
         Command::Import(a) => cli::import::main(a),
         Command::Live(a) => cli::live::main(a),
         Command::Replay(a) => cli::replay::main(a),
+        Command::Merge(a) => cli::merge::main(a),
         Command::Report(a) => cli::report::main(a),
         Command::Bench(a) => cli::bench::main(a),
         #[cfg(all(feature = "serial", feature = "lab"))]

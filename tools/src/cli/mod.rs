@@ -8,6 +8,7 @@ pub mod dot;
 pub mod graph_args;
 pub mod import;
 pub mod live;
+pub mod merge;
 pub mod nodes;
 pub mod replay;
 pub mod report;

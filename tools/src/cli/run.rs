@@ -1,11 +1,14 @@
 //! `evflow run FILE`: the offline driver from the command line, for one run
-//! or a sweep over graph variables.
+//! or a sweep over graph variables — a sweep's runs on `--jobs` threads
+//! (through `evflow_engine::batch`), printed and written in sweep order.
 
 use super::graph_args::GraphArgs;
-use super::run_report::{print_report, report_json, sweep_csv, sweep_table};
+use super::run_report::{print_report, report_json, sweep_csv, sweep_table, Timings};
 use anyhow::{anyhow, bail, Result};
+use evflow_engine::batch::{for_each_ordered, Failures};
 use evflow_engine::sweep::{parse_axis, points, Point};
 use evflow_engine::{check, read_graph, run_offline, Checked, Plan, PlanOptions, RunOptions, RunReport};
+use evflow_tools::batch::{progress_bar, BatchArgs};
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::Arc;
@@ -22,6 +25,8 @@ pub struct Args {
     /// variable instead.
     #[arg(long = "sweep", value_name = "NAME=V1,V2,…")]
     sweep: Vec<String>,
+    #[command(flatten)]
+    batch: BatchArgs,
     /// Seed for every random stream (overrides the graph's `seed`).
     #[arg(long)]
     seed: Option<u64>,
@@ -39,6 +44,10 @@ pub struct Args {
     /// Print only what the sinks report.
     #[arg(long, short)]
     quiet: bool,
+    /// Leave run times out of the printed table, --json and --csv, so that
+    /// they are the same from run to run (and comparable byte for byte).
+    #[arg(long)]
+    no_times: bool,
     /// Also write the results (summaries and timings; one entry per run of a
     /// sweep) as JSON to this file.
     #[arg(long, value_name = "FILE")]
@@ -63,23 +72,40 @@ pub fn main(a: Args) -> Result<()> {
     }
 
     // Validate every run of the sweep before anything is built or written.
+    // A run that does not validate is a failure of that run only; when none
+    // validates, nothing is written.
     let sweep =
         evflow_engine::sweep_files::expand(&graph, &overrides, &evflow_nodes::recording::sweep_fields::sweep_fields)
             .map_err(|e| anyhow!("{}: {e}", graph.file.display()))?;
-    let runs = points(&sweep, &axes, &overrides);
-    let mut checked: Vec<(Point, Checked)> = Vec::with_capacity(runs.len());
-    for p in runs {
+    let all = points(&sweep, &axes, &overrides);
+    let total = all.len();
+    let shard = a.batch.shard();
+    let slice = shard.range(total);
+    let is_sweep = total > 1;
+    let mut items: Vec<(usize, Point, Result<Checked, String>)> = Vec::with_capacity(slice.len());
+    for (i, p) in all.into_iter().enumerate().skip(slice.start).take(slice.len()) {
         let mut o = overrides.clone();
         o.extend(p.overrides());
         match check(&graph, &registry, &o) {
-            Ok(c) => checked.push((p, c)),
-            Err(e) if p.values.is_empty() => bail!("{e}"),
-            Err(e) => bail!("sweep run {}: {e}", p.label()),
+            Ok(c) => items.push((i, p, Ok(c))),
+            Err(e) if !is_sweep => bail!("{e}"),
+            Err(e) => items.push((i, p, Err(e.to_string()))),
         }
     }
+    if is_sweep && !items.iter().any(|(_, _, c)| c.is_ok()) {
+        let mut f = Failures::new();
+        for (_, p, c) in &items {
+            if let Err(e) = c {
+                f.push(p.label(), e);
+            }
+        }
+        bail!("nothing was run: {}", f.summary(items.len(), "sweep runs").trim_end());
+    }
     if !a.quiet {
-        for p in &checked[0].1.pruned {
-            eprintln!("left out `{}`: {}", p.node, p.reason);
+        if let Some((_, _, Ok(c))) = items.iter().find(|(_, _, c)| c.is_ok()) {
+            for p in &c.pruned {
+                eprintln!("left out `{}`: {}", p.node, p.reason);
+            }
         }
     }
     std::fs::create_dir_all(&a.out).map_err(|e| anyhow!("{}: cannot create output folder: {e}", a.out.display()))?;
@@ -90,30 +116,58 @@ pub fn main(a: Args) -> Result<()> {
         // A second Ctrl-C (or a failure to install the handler) falls back to the default.
         let _ = ctrlc::set_handler(move || stop.store(true, Ordering::SeqCst));
     }
-    let sweep = checked.len() > 1;
-    let mut reports: Vec<(Point, RunReport)> = Vec::new();
-    let n = checked.len();
-    for (k, (point, c)) in checked.into_iter().enumerate() {
-        if stop.load(Ordering::Relaxed) {
-            bail!("interrupted after {k} of {n} runs");
-        }
-        if sweep && !a.quiet {
-            println!("── run {}/{n}: {} ──", k + 1, point.label());
-        }
-        let report =
-            run_one(&c, &a, &stop).map_err(|e| if sweep { anyhow!("sweep run {}: {e}", point.label()) } else { e })?;
-        print_report(&report, a.quiet);
-        if sweep && !a.quiet {
-            println!();
-        }
+    let timings = if a.no_times { Timings::Leave } else { Timings::Show };
+    let n = items.len();
+    let mut reports: Vec<(Point, RunReport)> = Vec::with_capacity(n);
+    // The sweep index of each report, for a shard's record.
+    let mut indices: Vec<usize> = Vec::with_capacity(n);
+    let mut failures = Failures::new();
+    let labels: Vec<(usize, Point)> = items.iter().map(|(i, p, _)| (*i, p.clone())).collect();
+    let received = if is_sweep {
+        let bar = progress_bar(n, "runs", a.quiet);
+        let work = |_: usize, (_, _, c): (usize, Point, Result<Checked, String>)| -> Result<RunReport, String> {
+            let report = run_one(&c?, &a, &stop, false).map_err(|e| format!("{e:#}"));
+            bar.inc(1);
+            report
+        };
+        let received = for_each_ordered(items, a.batch.jobs(), &stop, work, |k, outcome| {
+            let (i, point) = &labels[k];
+            if !a.quiet {
+                println!("── run {}/{total}: {} ──", i + 1, point.label());
+            }
+            match outcome.and_then(|r| r) {
+                Ok(report) => {
+                    print_report(&report, a.quiet, timings);
+                    reports.push((point.clone(), report));
+                    indices.push(*i);
+                }
+                Err(e) => {
+                    println!("run {} failed: {}", point.label(), e.lines().next().unwrap_or(""));
+                    failures.push(point.label(), e);
+                }
+            }
+            if !a.quiet {
+                println!();
+            }
+        });
+        bar.finish_and_clear();
+        received
+    } else {
+        let (_, point, c) = items.pop().expect("one run");
+        let report = run_one(&c.map_err(|e| anyhow!(e))?, &a, &stop, true)?;
+        print_report(&report, a.quiet, timings);
         reports.push((point, report));
+        indices.push(0);
+        1
+    };
+    if received < n {
+        bail!("interrupted after {received} of {n} runs");
     }
-    if sweep {
-        print!("{}", sweep_table(&reports));
+    if is_sweep {
+        print!("{}", sweep_table(&reports, timings));
     }
     if let Some(path) = &a.json {
-        std::fs::write(path, report_json(&reports, sweep))
-            .map_err(|e| anyhow!("{}: cannot write results: {e}", path.display()))?;
+        write(path, &report_json(&reports, is_sweep, timings), "results")?;
     }
     let (lines, errors) = super::run_plots::draw_plots(&graph, &reports, &overrides, &a.out);
     for l in lines {
@@ -124,14 +178,44 @@ pub fn main(a: Args) -> Result<()> {
         eprintln!("warning: {e}");
     }
     if let Some(path) = &a.csv {
-        std::fs::write(path, sweep_csv(&reports))
-            .map_err(|e| anyhow!("{}: cannot write table: {e}", path.display()))?;
+        write(path, &sweep_csv(&reports, timings), "table")?;
+    }
+    if a.batch.shard.is_some() {
+        let record = super::merge::ShardRecord {
+            graph: graph.file.display().to_string(),
+            shard,
+            total,
+            range: slice.clone(),
+            indices,
+            runs: reports,
+            failures: failures.list.clone(),
+            sweep: is_sweep,
+            timings,
+            csv: a.csv.as_deref().map(|p| super::merge::relative_to(p, &a.out)),
+            json: a.json.as_deref().map(|p| super::merge::relative_to(p, &a.out)),
+        };
+        record.write(&a.out)?;
+    }
+    if !failures.is_empty() {
+        bail!("{}", failures.summary(n, "sweep runs").trim_end());
     }
     Ok(())
 }
 
-/// Builds and runs one checked graph; returns its report.
-fn run_one(checked: &Checked, a: &Args, stop: &AtomicBool) -> Result<RunReport> {
+/// Writes `text` to `path` through a temporary file beside it (an
+/// interrupted write leaves no half file).
+fn write(path: &std::path::Path, text: &str, what: &str) -> Result<()> {
+    let name = path.file_name().map(|n| n.to_string_lossy().into_owned()).unwrap_or_default();
+    let tmp = path.with_file_name(format!(".{name}.tmp"));
+    std::fs::write(&tmp, text)
+        .and_then(|_| std::fs::rename(&tmp, path))
+        .map_err(|e| anyhow!("{}: cannot write {what}: {e}", path.display()))
+}
+
+/// Builds and runs one checked graph; returns its report. With `show_ticks`,
+/// a progress bar over the run's ticks appears when it lasts over a second
+/// (a sweep shows one bar over its runs instead).
+fn run_one(checked: &Checked, a: &Args, stop: &AtomicBool, show_ticks: bool) -> Result<RunReport> {
     let opts = PlanOptions {
         max_block: a.block.max(1),
         seed: a.seed,
@@ -149,12 +233,14 @@ fn run_one(checked: &Checked, a: &Args, stop: &AtomicBool) -> Result<RunReport> 
     let started = Instant::now();
     let mut shown = false;
     let mut progress = |done: u64, total: u64| {
-        if !shown && !a.quiet && started.elapsed() > Duration::from_secs(1) {
-            bar.set_draw_target(ProgressDrawTarget::stderr());
-            shown = true;
+        if show_ticks {
+            if !shown && !a.quiet && started.elapsed() > Duration::from_secs(1) {
+                bar.set_draw_target(ProgressDrawTarget::stderr());
+                shown = true;
+            }
+            bar.set_length(total);
+            bar.set_position(done);
         }
-        bar.set_length(total);
-        bar.set_position(done);
         !stop.load(Ordering::Relaxed)
     };
     let result = run_offline(&mut plan, RunOptions { duration: a.duration, progress: Some(&mut progress) });

@@ -16,7 +16,19 @@ pub fn number(v: f64) -> String {
     }
 }
 
-pub fn print_report(r: &RunReport, quiet: bool) {
+/// Whether run times appear in what is printed and written: they differ
+/// from run to run, so `--no-times` leaves them out for output that can be
+/// compared byte for byte.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Timings {
+    /// Run times shown.
+    Show,
+    /// Run times left out.
+    Leave,
+}
+
+/// Prints what the sinks report and, unless `quiet`, the run's times.
+pub fn print_report(r: &RunReport, quiet: bool, timings: Timings) {
     let base_rate = r.base_rate;
     for (node, s) in &r.summaries {
         for l in &s.lines {
@@ -27,7 +39,7 @@ pub fn print_report(r: &RunReport, quiet: bool) {
             println!("{node}: {k} = {}{unit}", number(*v));
         }
     }
-    if quiet {
+    if quiet || timings == Timings::Leave {
         return;
     }
     let secs = r.elapsed.as_secs_f64();
@@ -48,7 +60,7 @@ pub fn print_report(r: &RunReport, quiet: bool) {
 }
 
 /// One run as JSON.
-fn run_json(r: &RunReport) -> serde_json::Value {
+fn run_json(r: &RunReport, timings: Timings) -> serde_json::Value {
     let summaries: serde_json::Map<String, serde_json::Value> = r
         .summaries
         .iter()
@@ -63,30 +75,33 @@ fn run_json(r: &RunReport) -> serde_json::Value {
         .iter()
         .map(|t| serde_json::json!({ "node": t.node, "type": t.kind, "seconds": t.elapsed.as_secs_f64() }))
         .collect();
-    serde_json::json!({
-        "ticks": r.ticks,
-        "base_rate": r.base_rate,
-        "seconds": r.elapsed.as_secs_f64(),
-        "summaries": summaries,
-        "times": times,
-    })
+    match timings {
+        Timings::Show => serde_json::json!({
+            "ticks": r.ticks,
+            "base_rate": r.base_rate,
+            "seconds": r.elapsed.as_secs_f64(),
+            "summaries": summaries,
+            "times": times,
+        }),
+        Timings::Leave => serde_json::json!({ "ticks": r.ticks, "base_rate": r.base_rate, "summaries": summaries }),
+    }
 }
 
 /// The results as JSON: one run's object, or for a sweep a list of
 /// `{ "vars": {…}, "run": {…} }`.
-pub fn report_json(runs: &[(Point, RunReport)], sweep: bool) -> String {
+pub fn report_json(runs: &[(Point, RunReport)], sweep: bool, timings: Timings) -> String {
     let v = if sweep {
         serde_json::Value::Array(
             runs.iter()
                 .map(|(p, r)| {
                     let vars: serde_json::Map<String, serde_json::Value> =
                         p.values.iter().map(|(k, v)| (k.clone(), serde_json::json!(text_of(v)))).collect();
-                    serde_json::json!({ "vars": vars, "run": run_json(r) })
+                    serde_json::json!({ "vars": vars, "run": run_json(r, timings) })
                 })
                 .collect(),
         )
     } else {
-        runs.first().map(|(_, r)| run_json(r)).unwrap_or(serde_json::Value::Null)
+        runs.first().map(|(_, r)| run_json(r, timings)).unwrap_or(serde_json::Value::Null)
     };
     serde_json::to_string_pretty(&v).unwrap_or_default()
 }
@@ -107,18 +122,22 @@ fn columns(runs: &[(Point, RunReport)]) -> Vec<(String, String)> {
 }
 
 /// A sweep as an aligned text table: the swept variables, then every
-/// reported value, then the run time.
-pub fn sweep_table(runs: &[(Point, RunReport)]) -> String {
+/// reported value, then the run time (with [`Timings::Show`]).
+pub fn sweep_table(runs: &[(Point, RunReport)], timings: Timings) -> String {
     let cols = columns(runs);
     let mut head: Vec<String> =
         runs.first().map(|(p, _)| p.values.iter().map(|(k, _)| k.clone()).collect()).unwrap_or_default();
     head.extend(cols.iter().map(|(n, c)| format!("{n}.{c}")));
-    head.push("seconds".into());
+    if timings == Timings::Show {
+        head.push("seconds".into());
+    }
     let mut rows = vec![head];
     for (p, r) in runs {
         let mut row: Vec<String> = p.values.iter().map(|(_, v)| text_of(v)).collect();
         row.extend(cols.iter().map(|(n, c)| r.value(n, c).map(number).unwrap_or_else(|| "-".into())));
-        row.push(format!("{:.3}", r.elapsed.as_secs_f64()));
+        if timings == Timings::Show {
+            row.push(format!("{:.3}", r.elapsed.as_secs_f64()));
+        }
         rows.push(row);
     }
     let widths: Vec<usize> =
@@ -136,25 +155,32 @@ pub fn sweep_table(runs: &[(Point, RunReport)]) -> String {
     s
 }
 
-/// A sweep as CSV (full precision), with every node's run time in seconds
-/// (`NODE.time` columns) after the reported values.
-pub fn sweep_csv(runs: &[(Point, RunReport)]) -> String {
+/// A sweep as CSV (full precision), with (for [`Timings::Show`]) the run
+/// time and every node's run time in seconds (`NODE.time` columns) after
+/// the reported values.
+pub fn sweep_csv(runs: &[(Point, RunReport)], timings: Timings) -> String {
     let cols = columns(runs);
     let quote =
         |t: &str| if t.contains([',', '"', '\n']) { format!("\"{}\"", t.replace('"', "\"\"")) } else { t.to_string() };
     let mut head: Vec<String> =
         runs.first().map(|(p, _)| p.values.iter().map(|(k, _)| quote(k)).collect()).unwrap_or_default();
     head.extend(cols.iter().map(|(n, c)| quote(&format!("{n}.{c}"))));
-    head.push("seconds".into());
     // Run time of every node, for work-precision tables.
-    let nodes: Vec<String> =
-        runs.first().map(|(_, r)| r.times.iter().map(|t| t.node.clone()).collect()).unwrap_or_default();
+    let nodes: Vec<String> = match timings {
+        Timings::Show => {
+            head.push("seconds".into());
+            runs.first().map(|(_, r)| r.times.iter().map(|t| t.node.clone()).collect()).unwrap_or_default()
+        }
+        Timings::Leave => Vec::new(),
+    };
     head.extend(nodes.iter().map(|n| quote(&format!("{n}.time"))));
     let mut s = head.join(",") + "\n";
     for (p, r) in runs {
         let mut row: Vec<String> = p.values.iter().map(|(_, v)| quote(&text_of(v))).collect();
         row.extend(cols.iter().map(|(n, c)| r.value(n, c).map(|v| format!("{v}")).unwrap_or_default()));
-        row.push(format!("{}", r.elapsed.as_secs_f64()));
+        if timings == Timings::Show {
+            row.push(format!("{}", r.elapsed.as_secs_f64()));
+        }
         for n in &nodes {
             let t = r.times.iter().find(|t| &t.node == n).map(|t| t.elapsed.as_secs_f64());
             row.push(t.map(|t| format!("{t}")).unwrap_or_default());

@@ -1,0 +1,143 @@
+//! Batches from the command line (issue 17): a sweep on several jobs
+//! prints and writes exactly what it does on one; one bad run does not
+//! lose the others; shards merged equal one run byte for byte.
+
+use std::path::{Path, PathBuf};
+use std::process::{Command, Output};
+
+fn root() -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR")).parent().expect("workspace root").to_path_buf()
+}
+
+fn evflow(args: &[&str]) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_evflow")).args(args).current_dir(root()).output().expect("evflow runs")
+}
+
+/// Every file under `dir` (relative path, bytes), sorted.
+fn tree(dir: &Path) -> Vec<(PathBuf, Vec<u8>)> {
+    let mut out = Vec::new();
+    let mut stack = vec![dir.to_path_buf()];
+    while let Some(d) = stack.pop() {
+        for e in std::fs::read_dir(&d).unwrap() {
+            let p = e.unwrap().path();
+            if p.is_dir() {
+                stack.push(p);
+            } else {
+                out.push((p.strip_prefix(dir).unwrap().to_path_buf(), std::fs::read(&p).unwrap()));
+            }
+        }
+    }
+    out.sort();
+    out
+}
+
+/// The 3×3 grid of graphs/excitation.toml, outputs into `dir`.
+fn sweep_args(dir: &Path) -> Vec<String> {
+    let d = dir.to_str().unwrap();
+    [
+        "run",
+        "graphs/excitation.toml",
+        "--sweep",
+        "mass=60,85,110",
+        "--sweep",
+        "speed=3,4,5",
+        "--no-times",
+        "--out",
+        d,
+        "--csv",
+        &format!("{d}/grid.csv"),
+        "--json",
+        &format!("{d}/grid.json"),
+    ]
+    .iter()
+    .map(|s| s.to_string())
+    .collect()
+}
+
+fn run(args: &[String], extra: &[&str]) -> Output {
+    let mut all: Vec<&str> = args.iter().map(String::as_str).collect();
+    all.extend_from_slice(extra);
+    evflow(&all)
+}
+
+#[test]
+fn a_sweep_on_two_jobs_prints_and_writes_what_one_job_does() {
+    let (one, two) = (tempfile::tempdir().unwrap(), tempfile::tempdir().unwrap());
+    let a = run(&sweep_args(one.path()), &["--jobs", "1"]);
+    let b = run(&sweep_args(two.path()), &["--jobs", "2"]);
+    assert!(a.status.success(), "{}", String::from_utf8_lossy(&a.stderr));
+    assert!(b.status.success(), "{}", String::from_utf8_lossy(&b.stderr));
+    let out = String::from_utf8_lossy(&a.stdout);
+    // Nine runs, in sweep order, each with its own recording.
+    let heads: Vec<&str> = out.lines().filter(|l| l.starts_with("── run")).collect();
+    assert_eq!(heads.len(), 9, "{out}");
+    assert!(heads[0].contains("1/9: mass=60 speed=3") && heads[8].contains("9/9: mass=110 speed=5"), "{out}");
+    assert_eq!(a.stdout, b.stdout, "stdout differs between --jobs 1 and 2");
+    let (ta, tb) = (tree(one.path()), tree(two.path()));
+    assert_eq!(ta.len(), 9 * 2 + 2, "{:?}", ta.iter().map(|t| &t.0).collect::<Vec<_>>());
+    assert_eq!(ta, tb, "files differ between --jobs 1 and 2");
+}
+
+#[test]
+fn one_bad_run_does_not_lose_the_others_and_fails_the_batch() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path().to_str().unwrap();
+    let csv = format!("{d}/t.csv");
+    let o = evflow(&[
+        "run",
+        "graphs/excitation.toml",
+        "--sweep",
+        "mass=60,5000,110,-3",
+        "--jobs",
+        "2",
+        "--quiet",
+        "--out",
+        d,
+        "--csv",
+        &csv,
+    ]);
+    let stderr = String::from_utf8_lossy(&o.stderr);
+    assert!(!o.status.success(), "a failed run must fail the batch");
+    // The summary names every failure with its reason.
+    assert!(stderr.contains("2 of 4 sweep runs failed"), "{stderr}");
+    assert!(stderr.contains("mass=5000: ") && stderr.contains("mass=-3: "), "{stderr}");
+    assert!(stderr.contains("outside its limits"), "{stderr}");
+    // The good runs ran and were written.
+    let table = std::fs::read_to_string(&csv).unwrap();
+    let rows: Vec<&str> = table.lines().skip(1).collect();
+    assert_eq!(rows.len(), 2, "{table}");
+    assert!(rows[0].starts_with("60,") && rows[1].starts_with("110,"), "{table}");
+    let wavs: Vec<PathBuf> =
+        tree(dir.path()).into_iter().map(|(p, _)| p).filter(|p| p.extension().is_some_and(|e| e == "wav")).collect();
+    assert_eq!(wavs.len(), 2, "{wavs:?}");
+    assert!(wavs.iter().any(|p| p.to_string_lossy().starts_with("excitation-60g")), "{wavs:?}");
+    assert!(wavs.iter().any(|p| p.to_string_lossy().starts_with("excitation-110g")), "{wavs:?}");
+}
+
+#[test]
+fn shards_merged_equal_one_run_byte_for_byte() {
+    let base = tempfile::tempdir().unwrap();
+    let one = base.path().join("one");
+    let o = run(&sweep_args(&one), &["--jobs", "2"]);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    // Four shards of nine runs (3, 2, 2, 2), given to merge out of order.
+    let mut dirs = Vec::new();
+    for k in 1..=4 {
+        let d = base.path().join(format!("part{k}"));
+        let o = run(&sweep_args(&d), &["--jobs", "1", "--shard", &format!("{k}/4")]);
+        assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+        dirs.push(d.to_str().unwrap().to_string());
+    }
+    let merged = base.path().join("merged");
+    let missing = evflow(&["merge", merged.to_str().unwrap(), &dirs[0], &dirs[2], &dirs[3]]);
+    assert!(!missing.status.success());
+    assert!(String::from_utf8_lossy(&missing.stderr).contains("shards missing: 2/4"));
+    let o = evflow(&["merge", merged.to_str().unwrap(), &dirs[3], &dirs[1], &dirs[0], &dirs[2]]);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let (a, b) = (tree(&one), tree(&merged));
+    assert_eq!(a.iter().map(|t| &t.0).collect::<Vec<_>>(), b.iter().map(|t| &t.0).collect::<Vec<_>>());
+    assert_eq!(a, b, "merged shards differ from one run");
+    // The same shard twice is refused.
+    let o = evflow(&["merge", merged.to_str().unwrap(), &dirs[0], &dirs[1], &dirs[1], &dirs[2], &dirs[3]]);
+    assert!(String::from_utf8_lossy(&o.stderr).contains("both are shard 2/4"));
+}

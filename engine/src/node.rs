@@ -160,6 +160,28 @@ impl Summary {
     }
 }
 
+/// A node's output declared constant for a plan: one value per output port
+/// (in the order of the node's resolved outputs), and why, in words for
+/// `evflow check` (see `docs/pruning.md`).
+#[derive(Debug, Clone, PartialEq)]
+pub struct Constant {
+    /// The value of each output port, at every sample from t = 0.
+    pub outputs: Vec<f64>,
+    /// Why, e.g. `gain = 0`.
+    pub reason: String,
+}
+
+impl Constant {
+    /// Every one of `n` outputs at `value`.
+    pub fn all(n: usize, value: f64, reason: impl Into<String>) -> Self {
+        Self { outputs: vec![value; n], reason: reason.into() }
+    }
+    /// The given output values.
+    pub fn new(outputs: Vec<f64>, reason: impl Into<String>) -> Self {
+        Self { outputs, reason: reason.into() }
+    }
+}
+
 /// The ports of one node during one call: inputs to read, outputs to fill.
 ///
 /// Each port has its own length for this call (ports at different rates
@@ -300,5 +322,25 @@ pub trait Node: Send {
     /// new value without a click (e.g. a ramp). The default refuses.
     fn set(&mut self, param: &'static str, _value: f64) -> Result<(), Refused> {
         Err(Refused(param))
+    }
+
+    /// Asked once, right after the node is built: `Some` when what the node
+    /// loaded makes its output a constant whatever its inputs — and whatever
+    /// values its live parameters take later (e.g. `mesh.edges` on meshes
+    /// without a convex edge sharper than `max_angle`). The planner then
+    /// drops the node, holds its outputs at the constant and leaves out
+    /// what fed only it (`docs/pruning.md`). Decisions that need only the
+    /// parameters and constant inputs belong in the declaration's
+    /// [`crate::spec::NodeSpec::fold`], which the planner asks before
+    /// anything is built.
+    fn constant_output(&self) -> Option<Constant> {
+        None
+    }
+
+    /// Lines for people about what the node loaded and how it will use it
+    /// (e.g. a mesh's bounds, up axis and scale), asked right after the node
+    /// is built; `evflow check --build` prints them.
+    fn notes(&self) -> Vec<String> {
+        Vec::new()
     }
 }

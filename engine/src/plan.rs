@@ -2,6 +2,7 @@
 //! nodes and preallocated buffer slots. Both drivers (offline and live) call
 //! the same [`Plan::step`].
 
+use crate::check::prune::{Folded, Pruning};
 use crate::check::{Checked, Pruned};
 use crate::diag::Loc;
 use crate::node::{BuildContext, Io, Node, NodeError, PrepareContext, Refused, RunMode, Summary};
@@ -67,6 +68,8 @@ struct Entry {
     out_lens: Vec<usize>,
     scratch: Vec<Vec<f64>>,
     split: bool,
+    /// The output values of a node replaced by a constant (never stepped).
+    held: Option<Vec<f64>>,
     /// Time in build and prepare.
     setup: Duration,
     /// Time in process, emit and absorb.
@@ -106,14 +109,62 @@ pub struct Plan {
     max_block: usize,
     timing: bool,
     pruned: Vec<Pruned>,
+    folded: Vec<Folded>,
+    notes: Vec<(String, Vec<String>)>,
     duration: Option<f64>,
     mode: RunMode,
 }
 
+/// Whether the planner replaces nodes whose output is constant
+/// (`docs/pruning.md`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum Folding {
+    /// Replace them. Folds may read live parameters unless the plan is
+    /// live ([`RunMode::Live`]), which takes changes while it runs.
+    #[default]
+    On,
+    /// Replace them, but take live parameters as changeable although the
+    /// plan runs offline: a replay that applies a live session's changes.
+    Changes,
+    /// Leave nothing out for being constant, only what no sink needs (for
+    /// comparisons and benchmarks).
+    Off,
+}
+
+/// The stand-in of a node replaced by a constant: never stepped (its
+/// output buffers hold the value). A live change of a parameter is taken
+/// and has no effect when the constant holds for every value the plan lets
+/// it take (a live plan, or one built with [`Folding::Changes`]); otherwise
+/// it is refused.
+struct Held {
+    takes_changes: bool,
+}
+
+impl Node for Held {
+    fn process(&mut self, _io: &mut Io<'_>) -> Result<(), NodeError> {
+        Ok(())
+    }
+    fn reset(&mut self) {}
+    fn set(&mut self, param: &'static str, _value: f64) -> Result<(), Refused> {
+        if self.takes_changes {
+            Ok(())
+        } else {
+            Err(Refused(param))
+        }
+    }
+}
+
 impl Plan {
     /// Constructs the nodes that survived pruning (and only those), sizes
-    /// every buffer, and prepares every node.
+    /// every buffer, and prepares every node; nodes whose output is
+    /// constant for this plan are replaced by the constant, and what fed
+    /// only them is never built ([`Folding::On`], `docs/pruning.md`).
     pub fn build(checked: &Checked, opts: &PlanOptions) -> Result<Plan, Box<NodeFailure>> {
+        Self::build_with(checked, opts, Folding::On)
+    }
+
+    /// [`Plan::build`] with a choice of [`Folding`].
+    pub fn build_with(checked: &Checked, opts: &PlanOptions, folding: Folding) -> Result<Plan, Box<NodeFailure>> {
         let g = &checked.graph;
         let base_dir =
             opts.base_dir.clone().unwrap_or_else(|| g.file.parent().map(|p| p.to_path_buf()).unwrap_or_default());
@@ -122,32 +173,20 @@ impl Plan {
             let n = &checked.nodes[i];
             Box::new(NodeFailure { file: g.file.clone(), loc: n.loc, node: n.name.clone(), kind: n.spec.name, error })
         };
+        let takes_changes = folding == Folding::Changes || opts.mode == RunMode::Live;
+        let mut pruning =
+            Pruning::new(checked, !takes_changes, folding != Folding::Off).map_err(|(i, e)| fail(i, e))?;
 
-        // Block size: a multiple of every divided rate, within feedback delays.
-        let mut unit = 1u64;
-        for &i in &checked.order {
-            for p in &checked.nodes[i].ports {
-                unit = lcm(unit, p.ratio.div);
+        // Build, downstream first: a node that turns out constant leaves
+        // out its upstream before that is built.
+        let n_nodes = checked.nodes.len();
+        let mut built: Vec<Option<Box<dyn Node>>> = (0..n_nodes).map(|_| None).collect();
+        let mut setup_of = vec![Duration::ZERO; n_nodes];
+        let mut notes = Vec::new();
+        for &i in checked.order.iter().rev() {
+            if !pruning.needed(i) || pruning.constant(i).is_some() {
+                continue;
             }
-        }
-        let mut max_block = (opts.max_block.max(1) as u64).div_ceil(unit) * unit;
-
-        // Slots: one per output of each live node.
-        let mut slot_of = vec![Vec::new(); checked.nodes.len()];
-        let mut n_slots = 0;
-        for &i in &checked.order {
-            slot_of[i] = checked.nodes[i]
-                .outputs()
-                .map(|_| {
-                    n_slots += 1;
-                    n_slots - 1
-                })
-                .collect();
-        }
-
-        let mut entries = Vec::with_capacity(checked.order.len());
-        let mut late = Vec::new();
-        for &i in &checked.order {
             let n = &checked.nodes[i];
             let ctx = BuildContext {
                 node: n.name.clone(),
@@ -158,20 +197,73 @@ impl Plan {
                 out_dir: opts.out_dir.clone().unwrap_or_default(),
                 seed,
             };
-            let built = Instant::now();
+            let started = Instant::now();
             let node = (n.spec.build)(&n.params, &ctx).map_err(|e| fail(i, e))?;
-            let setup = if opts.timing { built.elapsed() } else { Duration::ZERO };
+            let constant = if folding == Folding::Off { None } else { node.constant_output() };
+            if opts.timing {
+                setup_of[i] = started.elapsed();
+            }
+            let lines = node.notes();
+            if !lines.is_empty() {
+                notes.push((i, lines));
+            }
+            match constant {
+                Some(k) => pruning.declare(i, k).map_err(|(j, e)| fail(j, e))?,
+                None => built[i] = Some(node),
+            }
+        }
+        let order = pruning.order();
+        notes.retain(|(i, _)| pruning.needed(*i));
+        notes.sort_by_key(|(i, _)| order.iter().position(|j| j == i));
+
+        // Block size: a multiple of every divided rate, within feedback delays.
+        let mut unit = 1u64;
+        for &i in &order {
+            for p in &checked.nodes[i].ports {
+                unit = lcm(unit, p.ratio.div);
+            }
+        }
+        let mut max_block = (opts.max_block.max(1) as u64).div_ceil(unit) * unit;
+
+        // Slots: one per output of each node in the plan.
+        let mut slot_of = vec![Vec::new(); n_nodes];
+        let mut n_slots = 0;
+        for &i in &order {
+            slot_of[i] = checked.nodes[i]
+                .outputs()
+                .map(|_| {
+                    n_slots += 1;
+                    n_slots - 1
+                })
+                .collect();
+        }
+
+        let mut entries = Vec::with_capacity(order.len());
+        let mut late = Vec::new();
+        for &i in &order {
+            let n = &checked.nodes[i];
+            let held = pruning.constant(i).map(|k| k.outputs.clone());
+            let node: Box<dyn Node> = match (&held, built[i].take()) {
+                (None, Some(node)) => node,
+                (None, None) => return Err(fail(i, NodeError::Other("the planner lost this node".into()))),
+                (Some(_), _) => Box::new(Held { takes_changes }),
+            };
             let mut in_slots = Vec::new();
             let mut in_ratios = Vec::new();
-            for p in n.inputs() {
-                let e = checked.edges.iter().find(|e| e.to == (i, p)).expect("validated: every input has a producer");
-                let out_index =
-                    checked.nodes[e.from.0].outputs().position(|q| q == e.from.1).expect("producer port is an output");
-                in_slots.push(slot_of[e.from.0][out_index]);
-                in_ratios.push(n.ports[p].ratio);
+            if held.is_none() {
+                for p in n.inputs() {
+                    let e =
+                        checked.edges.iter().find(|e| e.to == (i, p)).expect("validated: every input has a producer");
+                    let out_index = checked.nodes[e.from.0]
+                        .outputs()
+                        .position(|q| q == e.from.1)
+                        .expect("producer port is an output");
+                    in_slots.push(slot_of[e.from.0][out_index]);
+                    in_ratios.push(n.ports[p].ratio);
+                }
             }
             let out_ratios: Vec<Ratio> = n.outputs().map(|p| n.ports[p].ratio).collect();
-            let split = checked.in_cycle.contains(&i);
+            let split = held.is_none() && checked.in_cycle.contains(&i);
             if split {
                 let d = node.cycle_delay() as u64;
                 let limit = if n.ratio.div == 1 { d / n.ratio.mul } else { d * n.ratio.div };
@@ -197,7 +289,8 @@ impl Plan {
                 out_slots: slot_of[i].clone(),
                 out_ratios,
                 split,
-                setup,
+                held,
+                setup: setup_of[i],
                 elapsed: Duration::ZERO,
                 finishing: Duration::ZERO,
             });
@@ -210,17 +303,20 @@ impl Plan {
             }
         }
         for (k, e) in entries.iter_mut().enumerate() {
+            if e.held.is_some() {
+                continue;
+            }
             let largest = e.in_ratios.iter().chain(&e.out_ratios).map(cap).max().unwrap_or(cap(&e.ratio));
             let started = Instant::now();
             e.node.prepare(&PrepareContext { max_block: largest, mode: opts.mode }).map_err(|err| {
-                let i = checked.order[k];
+                let i = order[k];
                 fail(i, err)
             })?;
             if opts.timing {
                 e.setup += started.elapsed();
             }
         }
-        Ok(Plan {
+        let mut plan = Plan {
             name: g.name.clone(),
             file: g.file.clone(),
             base_rate: g.rate,
@@ -230,10 +326,25 @@ impl Plan {
             tick: 0,
             max_block: max_block as usize,
             timing: opts.timing,
-            pruned: checked.pruned.clone(),
+            pruned: pruning.pruned(),
+            folded: pruning.folded(),
+            notes: notes.into_iter().map(|(i, l)| (checked.nodes[i].name.clone(), l)).collect(),
             duration: g.duration,
             mode: opts.mode,
-        })
+        };
+        plan.hold_constants();
+        Ok(plan)
+    }
+
+    /// Fills the output buffers of the nodes replaced by constants.
+    fn hold_constants(&mut self) {
+        for e in &self.entries {
+            if let Some(values) = &e.held {
+                for (&s, &v) in e.out_slots.iter().zip(values) {
+                    self.pool[s].fill(v);
+                }
+            }
+        }
     }
 
     /// Runs `n` base ticks (`1 ≤ n ≤ max_block`). Allocation-free.
@@ -252,7 +363,7 @@ impl Plan {
                 *len = r.count(t0, n) as usize;
                 any |= *len > 0;
             }
-            if !any && e.ratio.count(t0, n) == 0 {
+            if (!any && e.ratio.count(t0, n) == 0) || e.held.is_some() {
                 continue;
             }
             for (j, &s) in e.out_slots.iter().enumerate() {
@@ -341,6 +452,7 @@ impl Plan {
         for b in &mut self.pool {
             b.fill(0.0);
         }
+        self.hold_constants();
         self.tick = 0;
     }
 
@@ -420,9 +532,20 @@ impl Plan {
         self.entries[k].node.set(param, value)
     }
 
-    /// Nodes left out, and why.
+    /// Nodes left out, and why: those no sink needs, then those that fed
+    /// only nodes replaced by constants.
     pub fn pruned(&self) -> &[Pruned] {
         &self.pruned
+    }
+    /// Nodes replaced by constants (in the plan, never stepped), with their
+    /// values and why.
+    pub fn folded(&self) -> &[Folded] {
+        &self.folded
+    }
+    /// What the built nodes said about what they loaded
+    /// ([`Node::notes`]), by node, in plan order.
+    pub fn notes(&self) -> &[(String, Vec<String>)] {
+        &self.notes
     }
     /// The graph's name.
     pub fn name(&self) -> &str {

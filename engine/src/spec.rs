@@ -4,8 +4,8 @@
 //! in a [`NodeSpec`]. The loader, the validator, `evflow nodes` and the
 //! generated node reference (`docs/nodes.md`) all read that one declaration.
 
-use crate::node::{BuildContext, Node, NodeError};
-use crate::params::Params;
+use crate::node::{BuildContext, Constant, Node, NodeError};
+use crate::params::{Params, Value};
 
 /// Which way samples flow through a port.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -260,6 +260,68 @@ pub enum Role {
 /// Called only for nodes that survive pruning.
 pub type Constructor = fn(&Params, &BuildContext) -> Result<Box<dyn Node>, NodeError>;
 
+/// What a node type's [`Fold`] sees: its parameters and which of its inputs
+/// are constant, before anything is built.
+#[derive(Debug, Clone, Copy)]
+pub struct FoldArgs<'a> {
+    spec: &'static NodeSpec,
+    params: &'a Params,
+    inputs: &'a [Option<f64>],
+    outputs: usize,
+    settled: bool,
+}
+
+impl<'a> FoldArgs<'a> {
+    /// The arguments of one fold: `inputs[i]` is `Some(v)` when input `i`
+    /// (in the order of the node's resolved inputs) holds `v` at every
+    /// sample; `outputs` is the number of output ports; `settled` is true
+    /// when the plan takes no live parameter changes (an offline run).
+    pub fn new(
+        spec: &'static NodeSpec,
+        params: &'a Params,
+        inputs: &'a [Option<f64>],
+        outputs: usize,
+        settled: bool,
+    ) -> Self {
+        Self { spec, params, inputs, outputs, settled }
+    }
+    /// The constant value of input `i`, if it is constant.
+    pub fn input(&self, i: usize) -> Option<f64> {
+        self.inputs.get(i).copied().flatten()
+    }
+    /// Every input's constant value (`None`: not constant).
+    pub fn inputs(&self) -> &[Option<f64>] {
+        self.inputs
+    }
+    /// The number of output ports.
+    pub fn outputs(&self) -> usize {
+        self.outputs
+    }
+    /// A parameter's value — `None` when it is declared live and the plan
+    /// may change it while it runs (a live session or its replay), so no
+    /// fold can rely on it there.
+    pub fn value(&self, name: &str) -> Option<&'a Value> {
+        let live = self.spec.param(name).is_some_and(|p| p.live);
+        if live && !self.settled {
+            return None;
+        }
+        self.params.get(name)
+    }
+    /// A number parameter (see [`FoldArgs::value`]).
+    pub fn f64(&self, name: &str) -> Option<f64> {
+        self.value(name).and_then(Value::as_f64)
+    }
+}
+
+/// A node type's constant folding: given its parameters and its constant
+/// inputs, `Some` when its output is a constant for this plan (e.g. `gain`
+/// with gain 0, `add` of two constants). Asked in the plan's order before
+/// any node is built, so nodes that only fed a constant are never built
+/// and never open their files (`docs/pruning.md`). It must be exact: the
+/// constant equals, sample for sample from t = 0, what the node would
+/// output given finite inputs.
+pub type Fold = fn(&FoldArgs<'_>) -> Option<Constant>;
+
 /// The one declaration of a node type.
 #[derive(Debug, Clone, Copy)]
 pub struct NodeSpec {
@@ -296,6 +358,8 @@ pub struct NodeSpec {
     pub example: &'static str,
     /// The constructor.
     pub build: Constructor,
+    /// How the node folds to a constant (see [`Fold`]); `None`: never.
+    pub fold: Option<Fold>,
 }
 
 impl NodeSpec {
@@ -322,6 +386,7 @@ impl NodeSpec {
             offline_only: None,
             example: "",
             build,
+            fold: None,
         }
     }
     /// Sets the long description.
@@ -368,6 +433,11 @@ impl NodeSpec {
     /// Sets the working example node table.
     pub const fn example(mut self, example: &'static str) -> Self {
         self.example = example;
+        self
+    }
+    /// Declares how the node folds to a constant (see [`Fold`]).
+    pub const fn fold(mut self, fold: Fold) -> Self {
+        self.fold = Some(fold);
         self
     }
     /// The declared parameter of that name.

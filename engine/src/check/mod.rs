@@ -4,6 +4,7 @@
 
 pub mod interpolate;
 mod params;
+pub mod prune;
 mod rate_hint;
 mod topology;
 

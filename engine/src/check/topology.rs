@@ -6,9 +6,6 @@ use crate::rate::Ratio;
 use crate::spec::{Direction, RateSpec, Role};
 use petgraph::algo::{kosaraju_scc, toposort};
 use petgraph::graph::{DiGraph, NodeIndex};
-use petgraph::visit::EdgeRef;
-use petgraph::Direction as PgDir;
-use std::collections::VecDeque;
 
 type Analysis = (Vec<usize>, Vec<Pruned>, Vec<usize>);
 
@@ -60,10 +57,9 @@ pub(super) fn analyse(graph: &Graph, nodes: &mut [CheckedNode], edges: &[Edge], 
 
     resolve_rates(graph, nodes, edges, &topo, sink);
 
-    // Pruning: keep what can reach a sink.
-    let mut live = vec![false; n];
-    let mut queue: VecDeque<usize> = (0..n).filter(|&i| nodes[i].spec.role == Role::Sink).collect();
-    if queue.is_empty() {
+    // Pruning: keep what can reach a sink (constants are the planner's, super::prune).
+    let is_sink = |i: usize| nodes[i].spec.role == Role::Sink;
+    if !(0..n).any(is_sink) {
         sink.err(
             graph.loc,
             None,
@@ -71,18 +67,7 @@ pub(super) fn analyse(graph: &Graph, nodes: &mut [CheckedNode], edges: &[Edge], 
             Some("add a sink such as `recording.out` or `metric`; `evflow nodes` lists them".into()),
         );
     }
-    for &i in &queue {
-        live[i] = true;
-    }
-    while let Some(i) = queue.pop_front() {
-        for e in full.edges_directed(NodeIndex::new(i), PgDir::Incoming) {
-            let j = e.source().index();
-            if !live[j] {
-                live[j] = true;
-                queue.push_back(j);
-            }
-        }
-    }
+    let live = super::prune::needed(n, edges, is_sink, |_| true);
     let pruned = (0..n)
         .filter(|&i| !live[i])
         .map(|i| Pruned { node: nodes[i].name.clone(), reason: "no sink is reachable from it".into() })

@@ -14,8 +14,8 @@ const plot = (() => {
   function fmt(v) {
     const a = Math.abs(v);
     if (a === 0) return "0";
-    if (a >= 1e4 || a < 1e-2) return v.toExponential(1);
-    return v.toPrecision(3);
+    if (a >= 1e6 || a < 1e-2) return v.toExponential(1);
+    return String(Number(v.toPrecision(a >= 1000 ? 6 : 3)));
   }
   function range(lo, hi) {
     if (!(hi > lo)) { const c = isFinite(lo) ? lo : 0; return [c - 1, c + 1]; }

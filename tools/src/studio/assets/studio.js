@@ -20,6 +20,7 @@ ws.onmessage = m => {
   else if (msg.type === "frame") frame(msg);
   else if (msg.type === "reply") reply(msg);
   else if (msg.type === "drops") $("drops").textContent = msg.frames;
+  else if (msg.type === "replay") replayShow(msg);
   else if (msg.type === "error") status(msg.message, "bad");
 };
 function status(text, cls) { const s = $("status"); s.textContent = text; s.className = "status " + cls; }
@@ -63,6 +64,7 @@ function frame(f) {
     const s = S.series[d.i];
     for (let k = 0; k < d.lo.length; k++) { s.t.push(d.t0 + k * d.dt); s.lo.push(d.lo[k]); s.hi.push(d.hi[k]); }
     s.last = d.last;
+    if (S.recorded) continue;
     const cut = s.t.findIndex(x => x >= s.t[s.t.length - 1] - S.keepS);
     if (cut > 0) { s.t.splice(0, cut); s.lo.splice(0, cut); s.hi.splice(0, cut); }
   }
@@ -70,7 +72,8 @@ function frame(f) {
   for (const e of f.events) eventShow(e);
   if (f.timing) timingShow(f);
   if (f.studio) { $("drops-all").textContent = f.studio.frames_dropped; $("browsers").textContent = f.studio.browsers; }
-  if (!S.recorded) requestDraw();
+  if (f.limiter_timelines) S.timelines = f.limiter_timelines;
+  if (S.recorded) draw(); else requestDraw();
 }
 
 let drawPending = false;
@@ -85,8 +88,9 @@ function draw() {
     const last = S.series[i].last;
     $("last-" + i).textContent = last === null ? "" : plot.fmt(last);
   });
-  plot.band($("compute"), S.compute, t0, t1, "#7b3fb8");
+  if (!S.recorded) plot.band($("compute"), S.compute, t0, t1, "#7b3fb8");
   sceneDraw(t0, t1);
+  if (S.recorded) markers();
 }
 
 // --- limiters ---
@@ -154,6 +158,7 @@ function timingShow(f) {
   ];
   const tb = $("timing"); tb.textContent = "";
   for (const [k, v, warn] of rows) tb.append(el("tr", {}, el("td", {}, k), el("td", { class: warn ? "warn" : "" }, v)));
+  if (!m.jitter_hist) return;
   const e = m.jitter_hist.edges_us, labels = e.map(x => "<" + (x >= 1000 ? x / 1000 + "ms" : x + "µs")).concat([">" + e[e.length - 1] / 1000 + "ms"]);
   plot.bars($("jitter-hist"), labels, m.jitter_hist.counts, "wake-up jitter (ticks, log)");
   if (m.window) { S.compute.t.push(f.t); S.compute.lo.push(0); S.compute.hi.push(m.window.compute_max_us); }
@@ -241,17 +246,42 @@ function recordedInit(h) {
   $("window-s").textContent = "scrub";
   const from = el("input", { type: "range", id: "scrub-from", min: 0, max: r.seconds, step: r.seconds / 1000, value: 0 });
   const span = el("input", { type: "range", id: "scrub-span", min: Math.min(0.05, r.seconds), max: r.seconds, step: r.seconds / 1000, value: r.seconds });
-  const upd = () => { const a = +from.value, w = +span.value; S.view = [a, Math.min(a + w, Math.max(r.seconds, a + 0.01))]; draw(); markers(); };
+  const upd = () => { const a = +from.value, w = +span.value; S.view = [a, Math.min(a + w, Math.max(r.seconds, a + 0.01))]; draw(); };
   from.oninput = upd; span.oninput = upd;
   $("traces-panel").insertBefore(el("div", { class: "row" }, "from", from, "span", span,
     el("span", { class: "small" }, `${r.seconds.toFixed(3)} s · stopped: ${r.stopped} · replay check: `),
-    el("b", { id: "replay-check" }, r.replay.ok ? "✓ " + r.replay.summary : "✗ " + r.replay.summary)), $("traces"));
+    el("b", { id: "replay-check" }, r.replay.summary)), $("traces"));
   S.view = [0, r.seconds];
-  setTimeout(() => { draw(); markers(); }, 0);
+  $("drops").parentElement.style.display = "none";
+  for (const l of h.limiters) $(`limiter-${l.node}`).parentElement.after(el("div", { class: "small" }, "state over the shown span:"), el("canvas", { id: `timeline-${l.node}`, class: "timeline", width: 600, height: 18 }));
+  $("compute").style.display = "none";
+}
+function replayShow(r) {
+  S.replay = r;
+  const b = $("replay-check");
+  if (b) { b.textContent = (r.ok ? "✓ reproduced: " : "✗ ") + r.summary; b.className = r.ok ? "ok" : "bad"; }
+}
+const STATE_COLORS = { armed: "#1c8a3a", clamping: "#d98200", faulted: "#c0162b", fading: "#3566c4", faded: "#6b7280" };
+function timelinesDraw() {
+  if (!S.timelines || !S.view) return;
+  const [t0, t1] = S.view;
+  for (const l of S.timelines) {
+    const c = $(`timeline-${l.node}`);
+    if (!c) continue;
+    const g = c.getContext("2d");
+    g.clearRect(0, 0, c.width, c.height);
+    for (const seg of l.segments) {
+      const a = Math.max(seg.t0, t0), b = Math.min(seg.t1, t1);
+      if (b <= a) continue;
+      g.fillStyle = STATE_COLORS[seg.state] || "#999";
+      g.fillRect((a - t0) / (t1 - t0) * c.width, 0, Math.max(1, (b - a) / (t1 - t0) * c.width), c.height);
+    }
+  }
 }
 function markers() {
   // Events on the time axis of every trace.
   if (!S.view) return;
+  timelinesDraw();
   const [t0, t1] = S.view;
   S.taps.forEach((t, i) => {
     const c = $("canvas-" + i);

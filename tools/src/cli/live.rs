@@ -165,7 +165,11 @@ pub fn main(a: Args) -> Result<()> {
     };
     let vars = live::live_vars(&checked);
     #[cfg(feature = "studio")]
-    let description = a.studio.is_some().then(|| evflow_tools::studio::Description::live(&checked, &lp, &vars));
+    let description = a.studio.is_some().then(|| {
+        let graph_dir = a.graph.file.parent().unwrap_or(Path::new("."));
+        evflow_tools::studio::Description::live(&checked, &lp, &vars)
+            .with_scene(evflow_tools::studio::scene_json(&checked, graph_dir))
+    });
     let mut session = live::start(lp, &cfg).map_err(|e| anyhow!("{e}"))?;
     let vars_line = vars
         .iter()

@@ -83,6 +83,7 @@ fn read(dir: &Path) -> Result<RecordedSession> {
             None
         }
     };
+    let scene = checked.as_ref().map(|c| evflow_tools::studio::scene_json(c, &m.base_dir)).unwrap_or(Value::Null);
     Ok(RecordedSession {
         name: m.name.clone(),
         base_rate: m.base_rate,
@@ -96,6 +97,7 @@ fn read(dir: &Path) -> Result<RecordedSession> {
         metrics: end["metrics"].clone(),
         steal_s: end["host_steal_seconds"].as_f64(),
         checked,
+        scene,
     })
 }
 

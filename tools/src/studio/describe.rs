@@ -207,4 +207,10 @@ impl Description {
         });
         Self { hello, taps, names, limiters, base_rate: base }
     }
+
+    /// Adds the finger view's background ([`super::scene_json`]).
+    pub fn with_scene(mut self, scene: Value) -> Self {
+        self.hello["scene"] = scene;
+        self
+    }
 }

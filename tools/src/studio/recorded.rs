@@ -45,6 +45,8 @@ pub struct RecordedSession {
     pub steal_s: Option<f64>,
     /// The graph as recorded, if it still loads.
     pub checked: Option<Checked>,
+    /// The finger view's background ([`super::scene_json`]), or null.
+    pub scene: Value,
 }
 
 /// Window of the limiter's state timeline, seconds.
@@ -141,6 +143,7 @@ impl RecordedSession {
             "params": [],
             "vars": [],
             "limiters": limiters,
+            "scene": self.scene,
             "recording": {
                 "seconds": seconds, "ticks": self.ticks, "stopped": self.stopped, "bucket_s": bucket,
                 "replay": { "ok": null, "summary": "running `evflow replay --check`…" },
@@ -217,6 +220,7 @@ mod tests {
             metrics: Value::Null,
             steal_s: None,
             checked: None,
+            scene: Value::Null,
         };
         let (hello, frame) = s.messages();
         let h: Value = serde_json::from_str(&hello).unwrap();

@@ -17,6 +17,10 @@ use evflow_engine::live::{self, LiveConfig, LivePlan};
 use evflow_engine::{load_file, Plan, PlanOptions};
 use evflow_tests::alloc_counter;
 use std::sync::atomic::Ordering;
+use std::sync::Mutex;
+
+/// The counters are process-wide: the tests of this file take turns.
+static TURN: Mutex<()> = Mutex::new(());
 
 #[global_allocator]
 static GLOBAL: alloc_counter::Counting = alloc_counter::Counting;
@@ -288,6 +292,7 @@ mod allocating {
 
 #[test]
 fn no_allocation_on_the_real_time_thread() {
+    let _turn = TURN.lock().unwrap_or_else(|e| e.into_inner());
     syscalls::install_handler();
     // The guard works: a node that allocates is caught.
     {
@@ -329,5 +334,120 @@ fn no_allocation_on_the_real_time_thread() {
     eprintln!("ran live without allocating: {ran:?}\nnot live-capable: {skipped:?}");
     for live in ["display-live.toml", "mesh-live.toml", "texture-live.toml"] {
         assert!(ran.iter().any(|g| g.ends_with(live)), "the shipped live graph {live} ran");
+    }
+}
+
+/// The studio attached (`evflow live --studio`): its intake fed from the
+/// tap, event and timing rings the way the recorder and metrics threads
+/// feed it, a browser connected over the WebSocket steering the texture,
+/// the gain and the limiter (the same command queue as the console) while
+/// it receives frames — and still no allocation, free or forbidden system
+/// call on the real-time thread.
+#[test]
+fn no_allocation_on_the_real_time_thread_with_the_studio_attached() {
+    use evflow_tools::studio::{default_taps, Description, Studio, StudioConfig};
+    use tungstenite::Message;
+    let _turn = TURN.lock().unwrap_or_else(|e| e.into_inner());
+    syscalls::install_handler();
+    syscalls::TRAPPED.store(0, Ordering::SeqCst);
+    syscalls::FIRST.store(-1, Ordering::SeqCst);
+    let path = evflow_tests::root().join("graphs/texture-live.toml");
+    let checked = load_file(&path, &evflow_nodes::registry(), &[]).unwrap_or_else(|e| panic!("{e}"));
+    let opts = PlanOptions { max_block: 1, mode: evflow_engine::RunMode::Live, timing: false, ..Default::default() };
+    let plan = Plan::build(&checked, &opts).unwrap_or_else(|e| panic!("{e}"));
+    let mut taps = LivePlan::source_taps(&plan);
+    taps.extend(LivePlan::guard_taps(&plan));
+    taps.extend(default_taps(&checked, &plan));
+    let lp = LivePlan::new(plan, &taps).unwrap();
+    let vars = live::live_vars(&checked);
+    let description = Description::live(&checked, &lp, &vars);
+    let cfg = LiveConfig { duration: Some(2.0), miss_streak: 0, hook: Some(hook), ..LiveConfig::default() };
+    let before = alloc_counter::allocations();
+    let armings = alloc_counter::armings();
+    let mut session = live::start(lp, &cfg).unwrap();
+    session.control.bind_vars(vars);
+    let parts = session.into_parts();
+    let control = std::sync::Arc::new(Mutex::new(parts.control));
+    let scfg = StudioConfig { addr: "127.0.0.1:0".parse().unwrap(), public: false };
+    let (studio, ingest) = Studio::start_live(&scfg, &description, control, parts.shared.clone()).unwrap();
+
+    // The recorder's and metrics thread's part: drain every ring into the studio.
+    let done = std::sync::Arc::new(std::sync::atomic::AtomicBool::new(false));
+    let drain = {
+        let (done, mut rings, mut events, mut stats) = (done.clone(), parts.taps, parts.events, parts.stats);
+        std::thread::spawn(move || loop {
+            let last = done.load(Ordering::Acquire);
+            for (i, (_, r)) in rings.iter_mut().enumerate() {
+                if let Ok(c) = r.read_chunk(r.slots()) {
+                    let (a, b) = c.as_slices();
+                    ingest.samples(i, a);
+                    ingest.samples(i, b);
+                    c.commit_all();
+                }
+            }
+            while let Ok(e) = events.pop() {
+                ingest.event(&e);
+            }
+            if let Ok(c) = stats.read_chunk(stats.slots()) {
+                let (a, b) = c.as_slices();
+                ingest.stats(a);
+                ingest.stats(b);
+                c.commit_all();
+            }
+            if last {
+                break;
+            }
+            std::thread::sleep(std::time::Duration::from_millis(20));
+        })
+    };
+
+    // A browser: reads frames, steers.
+    let (mut ws, _) = tungstenite::connect(format!("ws://{}/ws", studio.addr())).unwrap();
+    let mut frames = 0;
+    let mut replies = Vec::new();
+    let mut applied = Vec::new();
+    let sets =
+        [("texture", "2"), ("gain", "0.5"), ("limit.enable", "false"), ("limit.enable", "true"), ("gain", "9e9")];
+    let mut sent = 0;
+    while !parts.thread.is_finished() {
+        let Ok(Message::Text(t)) = ws.read() else { break };
+        let v: serde_json::Value = serde_json::from_str(t.as_str()).unwrap();
+        match v["type"].as_str() {
+            Some("frame") => {
+                frames += 1;
+                for e in v["events"].as_array().into_iter().flatten() {
+                    applied.push(format!("{}.{}={}", e["node"].as_str().unwrap_or(""), e["param"], e["value"]));
+                }
+                if frames % 4 == 0 && sent < sets.len() {
+                    let (target, value) = sets[sent];
+                    let m = serde_json::json!({ "type": "set", "id": sent, "target": target, "value": value });
+                    ws.send(Message::text(m.to_string())).unwrap();
+                    sent += 1;
+                }
+            }
+            Some("reply") => replies.push(v),
+            _ => {}
+        }
+    }
+    let exit = parts.thread.join();
+    assert!(exit.failure.is_none());
+    done.store(true, Ordering::Release);
+    drain.join().unwrap();
+    studio.close();
+    assert_eq!(alloc_counter::armings(), armings + 1, "the hook armed the guard");
+    let n = Counts {
+        allocations: alloc_counter::allocations() - before,
+        syscalls: syscalls::TRAPPED.load(Ordering::SeqCst),
+        first_syscall: syscalls::FIRST.load(Ordering::SeqCst),
+    };
+    assert_eq!(n, CLEAN, "allocations/frees or system calls on the real-time thread with the studio attached");
+    // The studio did its part: frames flowed and every change was answered,
+    // the out-of-limits one refused.
+    assert!(frames >= 20, "{frames} frames");
+    assert_eq!(replies.len(), sets.len(), "{replies:?}");
+    assert!(replies[..4].iter().all(|r| r["ok"] == true), "{replies:?}");
+    assert_eq!(replies[4]["ok"], false, "{replies:?}");
+    for want in ["interp.\"texture\"=2.0", "gain.\"gain\"=0.5", "limit.\"enable\"=0.0", "limit.\"enable\"=1.0"] {
+        assert!(applied.iter().any(|a| a == want), "{want} applied: {applied:?}");
     }
 }

@@ -167,15 +167,84 @@ fn base64_round_trip() {
     assert_eq!(base64_decode("TQ=="), b"M");
 }
 
-#[test]
-fn the_page_shows_and_steers_a_live_session_in_chromium() {
-    let Some(exe) = chromium() else {
+/// Chromium, or `None` (after saying so loudly) when it is missing and
+/// `EVFLOW_SKIP_BROWSER=1` allows that.
+fn browser_or_skip() -> Option<String> {
+    let exe = chromium();
+    if exe.is_none() {
         if std::env::var("EVFLOW_SKIP_BROWSER").is_ok_and(|v| v == "1") {
             eprintln!("\n*** SKIPPED: no chromium; EVFLOW_SKIP_BROWSER=1 says to skip the studio's browser test ***\n");
-            return;
+            return None;
         }
         panic!("the studio's browser test needs chromium (`apt-get install chromium`; .ci/run does it), or EVFLOW_SKIP_BROWSER=1");
-    };
+    }
+    exe
+}
+
+#[test]
+fn the_page_shows_a_recorded_session_with_its_events_and_replay_check() {
+    let Some(exe) = browser_or_skip() else { return };
+    let tmp = tempfile::tempdir().unwrap();
+    let s = tmp.path().join("s");
+    let out = Command::new(common::evflow())
+        .arg("live")
+        .arg(evflow_tests::root().join("graphs/texture-live.toml"))
+        .arg("--session")
+        .arg(&s)
+        .args(["--no-realtime", "--miss-streak", "0", "-q", "--duration", "3"])
+        .args(["--change", "1:texture=2", "--change", "1.5:limit.enable=false", "--change", "2:limit.enable=true"])
+        .output()
+        .unwrap();
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    let mut studio = Command::new(common::evflow())
+        .arg("studio")
+        .arg(&s)
+        .args(["--addr", "127.0.0.1:0"])
+        .stdout(Stdio::piped())
+        .stderr(Stdio::null())
+        .spawn()
+        .unwrap();
+    let mut lines = BufReader::new(studio.stdout.take().unwrap()).lines();
+    let url = lines
+        .by_ref()
+        .map_while(Result::ok)
+        .find_map(|l| l.strip_prefix("studio: ").map(str::to_string))
+        .expect("evflow studio prints its address");
+    let browser = launch(&exe, &url);
+    let mut cdp = Cdp::attach(&browser, &url);
+    cdp.until("!!(window.studio && studio.hello && studio.frames >= 1)", 60);
+    assert_eq!(cdp.eval("studio.hello.mode"), json!("recorded"));
+    // The whole session is there, at most ~4000 pairs per stream.
+    let i = cdp.eval("studio.taps.findIndex(t => t.node === 'limit' && t.port === 'out')").as_i64().unwrap();
+    let last = cdp.eval(&format!("studio.series[{i}].t.at(-1)")).as_f64().unwrap();
+    assert!((2.9..3.02).contains(&last), "the trace covers the session: ends at {last} s");
+    // Its events, on the time axis.
+    let ev = cdp.eval("studio.events.filter(e => e.event === 'set').map(e => [e.t, e.node + '.' + e.param, e.value])");
+    let row =
+        |k: usize| (ev[k][0].as_f64().unwrap(), ev[k][1].as_str().unwrap().to_string(), ev[k][2].as_f64().unwrap());
+    assert_eq!(row(0), (1.0, "interp.texture".to_string(), 2.0), "{ev}");
+    assert_eq!(row(1), (1.5, "limit.enable".to_string(), 0.0), "{ev}");
+    // The limiter's states over time: armed, fading, faded, armed again, then the stop's fade.
+    let segs = cdp.eval("studio.timelines[0].segments.map(s => s.state)");
+    let states: Vec<&str> = segs.as_array().unwrap().iter().map(|s| s.as_str().unwrap()).collect();
+    let at = |w: &str| states.iter().position(|s| *s == w);
+    assert!(at("armed") < at("faded") && states[at("faded").unwrap()..].contains(&"armed"), "{states:?}");
+    // Scrubbing: a narrower span shows fewer pairs.
+    cdp.eval("document.getElementById('scrub-span').value = 0.5; document.getElementById('scrub-span').dispatchEvent(new Event('input'))");
+    assert_eq!(cdp.eval("studio.view[1] - studio.view[0] < 0.51"), json!(true));
+    // The replay check's result arrives.
+    cdp.until("!!studio.replay", 120);
+    assert_eq!(cdp.eval("studio.replay.ok"), json!(true), "{}", cdp.eval("studio.replay.summary"));
+    assert_eq!(cdp.eval("document.getElementById('replay-check').textContent.startsWith('✓ reproduced')"), json!(true));
+    drop(cdp);
+    drop(browser);
+    let _ = studio.kill();
+    let _ = studio.wait();
+}
+
+#[test]
+fn the_page_shows_and_steers_a_live_session_in_chromium() {
+    let Some(exe) = browser_or_skip() else { return };
     let tmp = tempfile::tempdir().unwrap();
     let session = common::start("texture-live.toml", tmp.path(), &["127.0.0.1:0"], &["--endless"]);
     let browser = launch(&exe, &session.url);

@@ -97,6 +97,14 @@ enum Command {
     ///
     /// Example: evflow dot graphs/excitation.toml | dot -Tpng > graph.png
     Dot(cli::dot::Args),
+    /// Open a recorded session in the studio (a local web page): every
+    /// recording over the whole session with scrubbing, the events on the
+    /// time axis, the limiter's states, the timing figures and the replay
+    /// check (docs/studio.md). `evflow live --studio` shows a running one.
+    ///
+    /// Example: evflow studio sessions/texture-live-20250101-120000
+    #[cfg(feature = "studio")]
+    Studio(cli::studio::Args),
     /// Emulate a friction-display device on a pseudo-terminal: it speaks
     /// the serial protocol (docs/serial-protocol.md) with the simulated lab
     /// inside, so serial graphs run without hardware.
@@ -131,6 +139,8 @@ fn main() -> ExitCode {
         Command::Check(a) => cli::check::main(a),
         Command::Nodes(a) => cli::nodes::main(a),
         Command::Dot(a) => cli::dot::main(a),
+        #[cfg(feature = "studio")]
+        Command::Studio(a) => cli::studio::main(a),
         Command::Import(a) => cli::import::main(a),
         Command::Live(a) => cli::live::main(a),
         Command::Replay(a) => cli::replay::main(a),

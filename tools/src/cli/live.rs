@@ -165,7 +165,11 @@ pub fn main(a: Args) -> Result<()> {
     };
     let vars = live::live_vars(&checked);
     #[cfg(feature = "studio")]
-    let description = a.studio.is_some().then(|| evflow_tools::studio::Description::live(&checked, &lp, &vars));
+    let description = a.studio.is_some().then(|| {
+        let graph_dir = a.graph.file.parent().unwrap_or(Path::new("."));
+        evflow_tools::studio::Description::live(&checked, &lp, &vars)
+            .with_scene(evflow_tools::studio::scene_json(&checked, graph_dir))
+    });
     let mut session = live::start(lp, &cfg).map_err(|e| anyhow!("{e}"))?;
     let vars_line = vars
         .iter()
@@ -193,7 +197,8 @@ pub fn main(a: Args) -> Result<()> {
     #[cfg(feature = "studio")]
     let studio = match (&a.studio, description) {
         (Some(addr), Some(d)) => {
-            let cfg = evflow_tools::studio::StudioConfig { addr: studio_addr(addr)?, public: a.studio_public };
+            let cfg =
+                evflow_tools::studio::StudioConfig { addr: super::studio::studio_addr(addr)?, public: a.studio_public };
             let (studio, ingest) = evflow_tools::studio::Studio::start_live(&cfg, &d, control.clone(), shared.clone())?;
             eprintln!("studio: {}", studio.url());
             if studio.token().is_some() {
@@ -419,19 +424,6 @@ fn drain_to_studio(
         }
         chunk.commit_all();
     }
-}
-
-/// The studio's address from `--studio`: `PORT`, `HOST:PORT` or `IP:PORT`.
-#[cfg(feature = "studio")]
-fn studio_addr(text: &str) -> Result<std::net::SocketAddr> {
-    use std::net::ToSocketAddrs;
-    let t = text.trim();
-    let with_host = if t.parse::<u16>().is_ok() { format!("127.0.0.1:{t}") } else { t.to_string() };
-    with_host
-        .to_socket_addrs()
-        .ok()
-        .and_then(|mut a| a.next())
-        .ok_or_else(|| anyhow!("--studio {text}: expected PORT or HOST:PORT (e.g. 127.0.0.1:8737)"))
 }
 
 /// ` unit`, or nothing for dimensionless values.

@@ -15,3 +15,5 @@ pub mod report;
 pub mod run;
 pub mod run_plots;
 pub mod run_report;
+#[cfg(feature = "studio")]
+pub mod studio;

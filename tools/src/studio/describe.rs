@@ -42,10 +42,14 @@ pub struct Description {
 /// feeds each limiter (so clamping shows), and the (load, velocity) point of
 /// each texture interpolator. Only nodes the plan kept.
 pub fn default_taps(checked: &Checked, plan: &evflow_engine::Plan) -> Vec<Tap> {
+    wanted_taps(checked).into_iter().filter(|t| plan.index(&t.node).is_some()).collect()
+}
+
+fn wanted_taps(checked: &Checked) -> Vec<Tap> {
     let mut taps = Vec::new();
     let mut add = |node: &str, port: &str| {
         let t = Tap::new(node, port);
-        if plan.index(node).is_some() && !taps.contains(&t) {
+        if !taps.contains(&t) {
             taps.push(t);
         }
     };
@@ -67,6 +71,80 @@ pub fn default_taps(checked: &Checked, plan: &evflow_engine::Plan) -> Vec<Tap> {
         }
     }
     taps
+}
+
+/// Nodes (with rates, and whether the plan kept them), connections (with
+/// rates) and what was left out and why.
+pub(crate) fn graph_json(checked: &Checked, base: f64, in_plan: &dyn Fn(&str) -> bool) -> Value {
+    let nodes: Vec<Value> = checked
+        .nodes
+        .iter()
+        .map(|n| {
+            json!({
+                "name": n.name, "type": n.spec.name, "rate": n.ratio.hz(base), "in_plan": in_plan(&n.name),
+                "guard": n.spec.safety_guard,
+                "inputs": n.ports.iter().filter(|q| q.dir == Direction::In).map(|q| &q.name).collect::<Vec<_>>(),
+                "outputs": n.ports.iter().filter(|q| q.dir == Direction::Out).map(|q| &q.name).collect::<Vec<_>>(),
+            })
+        })
+        .collect();
+    let edges: Vec<Value> = checked
+        .edges
+        .iter()
+        .map(|e| {
+            let (f, t) = (&checked.nodes[e.from.0], &checked.nodes[e.to.0]);
+            let fp = &f.ports[e.from.1];
+            json!({ "from": f.name, "out": fp.name, "to": t.name, "in": t.ports[e.to.1].name, "rate": fp.ratio.hz(base) })
+        })
+        .collect();
+    let pruned: Vec<Value> = checked.pruned.iter().map(|x| json!({ "node": x.node, "reason": x.reason })).collect();
+    json!({
+        "name": checked.graph.name, "description": checked.graph.description, "base_rate": base,
+        "nodes": nodes, "edges": edges, "pruned": pruned,
+    })
+}
+
+/// The `limit` nodes the plan kept, with the taps of their input and output.
+pub(crate) fn limiter_specs(
+    checked: &Checked,
+    tap_of: &dyn Fn(&str, &str) -> Option<usize>,
+    plan_index: &dyn Fn(&str) -> Option<usize>,
+) -> Vec<LimiterSpec> {
+    let mut limiters = Vec::new();
+    for (k, n) in checked.nodes.iter().enumerate().filter(|(_, n)| n.spec.name == "limit") {
+        let Some(index) = plan_index(&n.name) else { continue };
+        let input = checked.edges.iter().find(|e| e.to.0 == k && n.ports[e.to.1].name == "in").and_then(|e| {
+            let f = &checked.nodes[e.from.0];
+            tap_of(&f.name, &f.ports[e.from.1].name)
+        });
+        limiters.push(LimiterSpec {
+            node: n.name.clone(),
+            index: index as u32,
+            amplitude: n.params.f64("amplitude"),
+            input,
+            output: tap_of(&n.name, "out"),
+            enabled: n.params.bool("enable"),
+        });
+    }
+    limiters
+}
+
+/// The taps for the page: which to show at first (the defaults, the
+/// limiters' outputs, velocities).
+pub(crate) fn taps_json(checked: Option<&Checked>, taps: &[(String, String, f64)], limiters: &[LimiterSpec]) -> Value {
+    let defaults = checked.map(wanted_taps).unwrap_or_default();
+    let list: Vec<Value> = taps
+        .iter()
+        .enumerate()
+        .map(|(i, (node, port, rate))| {
+            let shown = defaults.iter().any(|d| &d.node == node && &d.port == port)
+                || limiters.iter().any(|l| l.output == Some(i))
+                || port == "velocity"
+                || port == "out" && checked.is_none();
+            json!({ "i": i, "node": node, "port": port, "rate": rate, "shown": shown })
+        })
+        .collect();
+    Value::Array(list)
 }
 
 fn param_json(node: &str, p: &ParamSpec, current: Option<&PValue>) -> Value {
@@ -98,29 +176,6 @@ impl Description {
         let base = p.base_rate();
         let taps = plan.taps().to_vec();
         let names: Vec<String> = (0..p.len()).map(|k| p.node_name(k).to_string()).collect();
-        let nodes: Vec<Value> = checked
-            .nodes
-            .iter()
-            .map(|n| {
-                let in_plan = p.index(&n.name).is_some();
-                json!({
-                    "name": n.name, "type": n.spec.name, "rate": n.ratio.hz(base), "in_plan": in_plan,
-                    "guard": n.spec.safety_guard,
-                    "inputs": n.ports.iter().filter(|q| q.dir == Direction::In).map(|q| &q.name).collect::<Vec<_>>(),
-                    "outputs": n.ports.iter().filter(|q| q.dir == Direction::Out).map(|q| &q.name).collect::<Vec<_>>(),
-                })
-            })
-            .collect();
-        let edges: Vec<Value> = checked
-            .edges
-            .iter()
-            .map(|e| {
-                let (f, t) = (&checked.nodes[e.from.0], &checked.nodes[e.to.0]);
-                let fp = &f.ports[e.from.1];
-                json!({ "from": f.name, "out": fp.name, "to": t.name, "in": t.ports[e.to.1].name, "rate": fp.ratio.hz(base) })
-            })
-            .collect();
-        let pruned: Vec<Value> = p.pruned().iter().map(|x| json!({ "node": x.node, "reason": x.reason })).collect();
         let params: Vec<Value> = checked
             .nodes
             .iter()
@@ -139,49 +194,23 @@ impl Description {
             })
             .collect();
         let tap_of = |node: &str, port: &str| taps.iter().position(|t| t.node == node && t.port == port);
-        let mut limiters = Vec::new();
-        for n in checked.nodes.iter().filter(|n| n.spec.name == "limit") {
-            let Some(index) = p.index(&n.name) else { continue };
-            let input = checked
-                .edges
-                .iter()
-                .find(|e| e.to.0 == checked.index(&n.name).unwrap_or(usize::MAX) && n.ports[e.to.1].name == "in")
-                .and_then(|e| {
-                    let f = &checked.nodes[e.from.0];
-                    tap_of(&f.name, &f.ports[e.from.1].name)
-                });
-            limiters.push(LimiterSpec {
-                node: n.name.clone(),
-                index: index as u32,
-                amplitude: n.params.f64("amplitude"),
-                input,
-                output: tap_of(&n.name, "out"),
-                enabled: n.params.bool("enable"),
-            });
-        }
-        let defaults = default_taps(checked, p);
-        let taps_json: Vec<Value> = taps
-            .iter()
-            .enumerate()
-            .map(|(i, t)| {
-                let shown = defaults.iter().any(|d| d.node == t.node && d.port == t.port)
-                    || limiters.iter().any(|l| l.output == Some(i))
-                    || t.port == "velocity";
-                json!({ "i": i, "node": t.node, "port": t.port, "rate": t.rate, "shown": shown })
-            })
-            .collect();
+        let limiters = limiter_specs(checked, &tap_of, &|n| p.index(n));
+        let list: Vec<(String, String, f64)> = taps.iter().map(|t| (t.node.clone(), t.port.clone(), t.rate)).collect();
         let hello = json!({
             "type": "hello",
             "mode": "live",
-            "graph": {
-                "name": checked.graph.name, "description": checked.graph.description, "base_rate": base,
-                "nodes": nodes, "edges": edges, "pruned": pruned,
-            },
-            "taps": taps_json,
+            "graph": graph_json(checked, base, &|n| p.index(n).is_some()),
+            "taps": taps_json(Some(checked), &list, &limiters),
             "params": params,
             "vars": vars_json,
             "limiters": limiters.iter().map(|l| json!({ "node": l.node, "amplitude": l.amplitude })).collect::<Vec<_>>(),
         });
         Self { hello, taps, names, limiters, base_rate: base }
+    }
+
+    /// Adds the finger view's background ([`super::scene_json`]).
+    pub fn with_scene(mut self, scene: Value) -> Self {
+        self.hello["scene"] = scene;
+        self
     }
 }

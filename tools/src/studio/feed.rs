@@ -15,7 +15,7 @@ pub(crate) const BUCKET_S: f64 = 0.005;
 
 /// Pairs kept per tap between two frames (a frame not taken for this long
 /// loses its oldest pairs, counted).
-const MAX_PENDING: usize = 4096;
+pub(crate) const MAX_PENDING: usize = 4096;
 
 /// Upper edges (µs) of the jitter histogram's bins; the last bin is open.
 pub(crate) const JITTER_EDGES_US: [f64; 14] =
@@ -23,7 +23,7 @@ pub(crate) const JITTER_EDGES_US: [f64; 14] =
 
 /// One tap's decimation.
 #[derive(Debug, Clone)]
-struct Trace {
+pub(crate) struct Trace {
     rate: f64,
     per_bucket: u64,
     /// Samples seen.
@@ -41,7 +41,12 @@ struct Trace {
 
 impl Trace {
     fn new(rate: f64) -> Self {
-        let per_bucket = ((rate * BUCKET_S).round() as u64).max(1);
+        Self::with_bucket(rate, BUCKET_S)
+    }
+
+    /// Min/max pairs of about `bucket_s` seconds each.
+    pub(crate) fn with_bucket(rate: f64, bucket_s: f64) -> Self {
+        let per_bucket = ((rate * bucket_s).round() as u64).max(1);
         Self {
             rate,
             per_bucket,
@@ -57,7 +62,7 @@ impl Trace {
         }
     }
 
-    fn push(&mut self, x: &[f64]) {
+    pub(crate) fn push(&mut self, x: &[f64]) {
         for &v in x {
             if v.is_finite() {
                 self.lo = self.lo.min(v);
@@ -84,7 +89,7 @@ impl Trace {
     }
 
     /// The pending pairs as JSON (times in seconds), emptied.
-    fn take(&mut self, i: usize) -> Option<Value> {
+    pub(crate) fn take(&mut self, i: usize) -> Option<Value> {
         if self.pending.is_empty() {
             return None;
         }

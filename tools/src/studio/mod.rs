@@ -16,10 +16,14 @@ mod describe;
 mod feed;
 mod hub;
 mod limiter;
+mod recorded;
+mod scene;
 mod server;
 mod steer;
 mod token;
 
 pub use describe::{default_taps, Description};
 pub use feed::Ingest;
+pub use recorded::{publish_replay, serve_recorded, RecordedSession, RecordedTap};
+pub use scene::scene_json;
 pub use server::{Studio, StudioConfig, StudioError};

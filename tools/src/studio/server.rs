@@ -84,8 +84,8 @@ fn bound_send_buffer(s: &TcpStream) {
 struct Ctx {
     hub: Arc<Hub>,
     hello: Arc<str>,
-    /// Sent after `hello` (a recorded session's whole data).
-    initial: Vec<Arc<str>>,
+    /// Sent after `hello` (a recorded session's whole data, results).
+    initial: Mutex<Vec<Arc<str>>>,
     token: Option<String>,
     control: Option<Arc<Mutex<Control>>>,
     stop: Arc<AtomicBool>,
@@ -99,6 +99,7 @@ pub struct Studio {
     token: Option<String>,
     stop: Arc<AtomicBool>,
     hub: Arc<Hub>,
+    ctx: Arc<Ctx>,
     threads: Vec<JoinHandle<()>>,
 }
 
@@ -151,13 +152,14 @@ impl Studio {
         let ctx = Arc::new(Ctx {
             hub: hub.clone(),
             hello: Arc::from(hello),
-            initial: initial.into_iter().map(Arc::from).collect(),
+            initial: Mutex::new(initial.into_iter().map(Arc::from).collect()),
             token: token.clone(),
             control,
             stop: stop.clone(),
             public: cfg.public,
             active: AtomicUsize::new(0),
         });
+        let ctx2 = ctx.clone();
         let acceptor = std::thread::Builder::new().name("evflow-studio".into()).spawn(move || {
             while !ctx.stop.load(Ordering::Acquire) {
                 match listener.accept() {
@@ -179,7 +181,15 @@ impl Studio {
                 }
             }
         })?;
-        Ok(Self { addr, token, stop, hub, threads: vec![acceptor] })
+        Ok(Self { addr, token, stop, hub, ctx: ctx2, threads: vec![acceptor] })
+    }
+
+    /// Sends `message` to every browser, and to every browser that
+    /// connects later (a result that arrives after the page opened).
+    pub(crate) fn publish(&self, message: String) {
+        let m: Arc<str> = Arc::from(message);
+        self.ctx.initial.lock().unwrap_or_else(|e| e.into_inner()).push(m.clone());
+        self.hub.broadcast(m);
     }
 
     /// The address it listens on.
@@ -323,7 +333,8 @@ fn websocket(s: TcpStream, ctx: &Ctx) {
     };
     let _ = ws.get_mut().set_read_timeout(Some(Duration::from_millis(2)));
     let _ = ws.get_mut().set_write_timeout(Some(Duration::from_secs(2)));
-    for m in std::iter::once(&ctx.hello).chain(&ctx.initial) {
+    let initial: Vec<Arc<str>> = ctx.initial.lock().unwrap_or_else(|e| e.into_inner()).clone();
+    for m in std::iter::once(&ctx.hello).chain(&initial) {
         if ws.send(Message::text(m.to_string())).is_err() {
             return;
         }

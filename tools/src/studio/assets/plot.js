@@ -14,8 +14,8 @@ const plot = (() => {
   function fmt(v) {
     const a = Math.abs(v);
     if (a === 0) return "0";
-    if (a >= 1e4 || a < 1e-2) return v.toExponential(1);
-    return v.toPrecision(3);
+    if (a >= 1e6 || a < 1e-2) return v.toExponential(1);
+    return String(Number(v.toPrecision(a >= 1000 ? 6 : 3)));
   }
   function range(lo, hi) {
     if (!(hi > lo)) { const c = isFinite(lo) ? lo : 0; return [c - 1, c + 1]; }
@@ -64,10 +64,11 @@ const plot = (() => {
     g.fillText(title, w - g.measureText(title).width - 4, 10 * r);
   }
   // Points (x, y, c) with c in [0, 1] as colour; the last one large.
-  function trail(canvas, pts, xr, yr, xl, yl) {
+  function trail(canvas, pts, xr, yr, xl, yl, background) {
     const { g, w, h, r } = fit(canvas);
     const X = x => (x - xr[0]) / (xr[1] - xr[0]) * (w - 20 * r) + 10 * r;
     const Y = y => h - 14 * r - (y - yr[0]) / (yr[1] - yr[0]) * (h - 24 * r);
+    if (background) background(g, X, Y, r);
     for (let i = 0; i < pts.length; i++) {
       const [x, y, c] = pts[i], a = 0.15 + 0.85 * i / pts.length, last = i === pts.length - 1;
       g.fillStyle = `hsla(${240 - 240 * Math.min(1, Math.max(0, c))}, 85%, 45%, ${last ? 1 : a})`;

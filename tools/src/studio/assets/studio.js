@@ -20,6 +20,7 @@ ws.onmessage = m => {
   else if (msg.type === "frame") frame(msg);
   else if (msg.type === "reply") reply(msg);
   else if (msg.type === "drops") $("drops").textContent = msg.frames;
+  else if (msg.type === "replay") replayShow(msg);
   else if (msg.type === "error") status(msg.message, "bad");
 };
 function status(text, cls) { const s = $("status"); s.textContent = text; s.className = "status " + cls; }
@@ -63,6 +64,7 @@ function frame(f) {
     const s = S.series[d.i];
     for (let k = 0; k < d.lo.length; k++) { s.t.push(d.t0 + k * d.dt); s.lo.push(d.lo[k]); s.hi.push(d.hi[k]); }
     s.last = d.last;
+    if (S.recorded) continue;
     const cut = s.t.findIndex(x => x >= s.t[s.t.length - 1] - S.keepS);
     if (cut > 0) { s.t.splice(0, cut); s.lo.splice(0, cut); s.hi.splice(0, cut); }
   }
@@ -70,7 +72,8 @@ function frame(f) {
   for (const e of f.events) eventShow(e);
   if (f.timing) timingShow(f);
   if (f.studio) { $("drops-all").textContent = f.studio.frames_dropped; $("browsers").textContent = f.studio.browsers; }
-  if (!S.recorded) requestDraw();
+  if (f.limiter_timelines) S.timelines = f.limiter_timelines;
+  if (S.recorded) draw(); else requestDraw();
 }
 
 let drawPending = false;
@@ -85,8 +88,9 @@ function draw() {
     const last = S.series[i].last;
     $("last-" + i).textContent = last === null ? "" : plot.fmt(last);
   });
-  plot.band($("compute"), S.compute, t0, t1, "#7b3fb8");
+  if (!S.recorded) plot.band($("compute"), S.compute, t0, t1, "#7b3fb8");
   sceneDraw(t0, t1);
+  if (S.recorded) markers();
 }
 
 // --- limiters ---
@@ -154,6 +158,7 @@ function timingShow(f) {
   ];
   const tb = $("timing"); tb.textContent = "";
   for (const [k, v, warn] of rows) tb.append(el("tr", {}, el("td", {}, k), el("td", { class: warn ? "warn" : "" }, v)));
+  if (!m.jitter_hist) return;
   const e = m.jitter_hist.edges_us, labels = e.map(x => "<" + (x >= 1000 ? x / 1000 + "ms" : x + "µs")).concat([">" + e[e.length - 1] / 1000 + "ms"]);
   plot.bars($("jitter-hist"), labels, m.jitter_hist.counts, "wake-up jitter (ticks, log)");
   if (m.window) { S.compute.t.push(f.t); S.compute.lo.push(0); S.compute.hi.push(m.window.compute_max_us); }
@@ -161,36 +166,87 @@ function timingShow(f) {
 
 // --- finger over the scene ---
 function findTap(pred) { return S.taps.findIndex(pred); }
+// The value a live parameter had at time t: its initial value, then its `set` events.
+function paramAt(node, param, initial, t) {
+  let v = initial;
+  for (const e of S.events) if (e.event === "set" && e.node === node && e.param === param && e.t <= t) v = e.value;
+  return v;
+}
+function heightColor(z, zmax) {
+  const a = Math.max(-1, Math.min(1, z / zmax));
+  return a >= 0 ? `rgb(${255 - 60 * a},${255 - 120 * a},${255 - 200 * a})` : `rgb(${255 + 200 * a},${255 + 120 * a},255)`;
+}
 function sceneDraw(t0, t1) {
-  const c = $("scene");
-  let xi = findTap(t => t.port === "x" && S.hello.graph.nodes.some(n => n.name === t.node && n.type.startsWith("sim.user")));
-  let yi = findTap(t => t.port === "y" && t.node === (S.taps[xi] || {}).node);
-  let ci = findTap(t => t.port === "intensity");
-  let xl = "x (m)", yl = "y (m)";
-  if (xi < 0 || yi < 0) { // texture chains: the interpolator's (load, velocity) point
-    const ed = S.hello.graph.edges;
-    const src = inp => { const e = ed.find(e => S.hello.graph.nodes.some(n => n.name === e.to && n.type === "interp") && e.in === inp); return e ? findTap(t => t.node === e.from && t.port === e.out) : -1; };
+  const c = $("scene"), sc = S.hello.scene || { kind: "none" }, g = S.hello.graph;
+  const tnow = S.view ? t1 : S.t;
+  let xi, yi, ci, xl, yl, background = null, xr = null, yr = null, note = "";
+  if (sc.kind === "grid") {
+    const src = inp => { const e = g.edges.find(e => e.to === sc.node && e.in === inp); return e ? findTap(t => t.node === e.from && t.port === e.out) : -1; };
     xi = src("velocity"); yi = src("load"); ci = findTap(t => t.port === "force"); xl = "velocity (cm/s)"; yl = "load (g)";
+    const k = paramAt(sc.node, "texture", sc.texture, tnow), grid = sc.grids[k] || sc.grids[0];
+    const L = grid.loads_g, V = grid.velocities_cm_s;
+    xr = plot.range(Math.min(V[0], 0), V[V.length - 1] * 1.25); yr = plot.range(Math.min(L[0], 0), L[L.length - 1] * 1.25);
+    note = `texture ${k}: ${grid.name}; grid ${L.join("/")} g × ${V.join("/")} cm/s; `;
+    background = (ctx, X, Y, r) => {
+      ctx.strokeStyle = "#ccd"; ctx.lineWidth = r;
+      for (const v of V) { ctx.beginPath(); ctx.moveTo(X(v), Y(yr[0])); ctx.lineTo(X(v), Y(yr[1])); ctx.stroke(); }
+      for (const l of L) { ctx.beginPath(); ctx.moveTo(X(xr[0]), Y(l)); ctx.lineTo(X(xr[1]), Y(l)); ctx.stroke(); }
+      const px = S.series[xi] && S.series[xi].last, py = S.series[yi] && S.series[yi].last;
+      const xv = S.view ? sampleAt(S.series[xi], tnow) : px, yv = S.view ? sampleAt(S.series[yi], tnow) : py;
+      if (xv === null || yv === null || xv === undefined || yv === undefined) return;
+      const cell = (ax, x) => { let i = 0; while (i + 2 < ax.length && x > ax[i + 1]) i++; return ax.length > 1 ? [ax[i], ax[i + 1]] : [ax[0], ax[0]]; };
+      const [v0, v1] = cell(V, xv), [l0, l1] = cell(L, yv);
+      ctx.fillStyle = "#fde68a88"; ctx.fillRect(X(v0), Y(l1), X(v1) - X(v0), Y(l0) - Y(l1));
+      ctx.fillStyle = "#d98200";
+      for (const [v, l] of [[v0, l0], [v0, l1], [v1, l0], [v1, l1]]) ctx.fillRect(X(v) - 4 * r, Y(l) - 4 * r, 8 * r, 8 * r);
+      S.cells = [[l0, v0], [l0, v1], [l1, v0], [l1, v1]];
+    };
+  } else {
+    xi = findTap(t => t.port === "x" && g.nodes.some(n => n.name === t.node && n.type.startsWith("sim.user")));
+    if (xi < 0) xi = findTap(t => t.port === "x");
+    yi = findTap(t => t.port === "y" && t.node === (S.taps[xi] || {}).node);
+    ci = findTap(t => t.port === "intensity");
+    xl = "x (m)"; yl = "y (m)";
+    if (sc.kind === "mesh" && sc.maps.length) {
+      const k = paramAt(sc.node, "scene", sc.scene, tnow), m = sc.maps[k] || sc.maps[0];
+      xr = [m.x0, m.x1]; yr = [m.y0, m.y1];
+      const zs = m.z_mm.filter(z => z !== null), zmax = Math.max(1e-9, ...zs.map(Math.abs));
+      note = `scene ${k}: ${m.name}; heights ±${zmax.toFixed(2)} mm (brown up, blue down); `;
+      background = (ctx, X, Y) => {
+        const dx = (m.x1 - m.x0) / m.nx, dy = (m.y1 - m.y0) / m.ny;
+        for (let j = 0; j < m.ny; j++) for (let i = 0; i < m.nx; i++) {
+          const z = m.z_mm[j * m.nx + i];
+          ctx.fillStyle = z === null ? "#eee" : heightColor(z, zmax);
+          const x = m.x0 + i * dx, y = m.y0 + j * dy;
+          ctx.fillRect(X(x), Y(y + dy), X(x + dx) - X(x) + 1, Y(y) - Y(y + dy) + 1);
+        }
+      };
+    }
   }
   if (xi < 0 || yi < 0) { $("scene-note").textContent = "no finger position is tapped in this graph"; return; }
-  const sx = S.series[xi], sy = S.series[yi], sc = ci >= 0 ? S.series[ci] : null;
+  const sx = S.series[xi], sy = S.series[yi], sci = ci >= 0 ? S.series[ci] : null;
   const pts = [];
-  let xr = [Infinity, -Infinity], yr = [Infinity, -Infinity], cr = [Infinity, -Infinity];
-  const at = (s, t) => { let lo = 0, hi = s.t.length - 1; if (hi < 0) return null; while (lo < hi) { const m = (lo + hi + 1) >> 1; if (s.t[m] <= t) lo = m; else hi = m - 1; } return s.hi[lo] === null ? null : (s.lo[lo] + s.hi[lo]) / 2; };
+  let bx = [Infinity, -Infinity], by = [Infinity, -Infinity], cr = [Infinity, -Infinity];
   const n = 150;
   for (let k = 0; k <= n; k++) {
     const t = t0 + (t1 - t0) * k / n;
     if (t > S.t && !S.view) break;
-    const x = at(sx, t), y = at(sy, t), cv = sc ? at(sc, t) : 0;
+    const x = sampleAt(sx, t), y = sampleAt(sy, t), cv = sci ? sampleAt(sci, t) : 0;
     if (x === null || y === null) continue;
     pts.push([x, y, cv ?? 0]);
-    xr = [Math.min(xr[0], x), Math.max(xr[1], x)]; yr = [Math.min(yr[0], y), Math.max(yr[1], y)]; cr = [Math.min(cr[0], cv ?? 0), Math.max(cr[1], cv ?? 0)];
+    bx = [Math.min(bx[0], x), Math.max(bx[1], x)]; by = [Math.min(by[0], y), Math.max(by[1], y)]; cr = [Math.min(cr[0], Math.abs(cv ?? 0)), Math.max(cr[1], Math.abs(cv ?? 0))];
   }
   if (!pts.length) return;
   const span = cr[1] - cr[0] || 1;
-  for (const p of pts) p[2] = (p[2] - cr[0]) / span;
-  plot.trail(c, pts, plot.range(xr[0], xr[1]), plot.range(yr[0], yr[1]), xl, yl);
-  $("scene-note").textContent = `${tapName(S.taps[xi])} × ${tapName(S.taps[yi])}` + (sc ? `, colour: ${tapName(S.taps[ci])} (blue low → red high)` : "") + "; the large dot is now";
+  for (const p of pts) p[2] = (Math.abs(p[2]) - cr[0]) / span;
+  plot.trail(c, pts, xr || plot.range(bx[0], bx[1]), yr || plot.range(by[0], by[1]), xl, yl, background);
+  $("scene-note").textContent = note + `${tapName(S.taps[xi])} × ${tapName(S.taps[yi])}` + (sci ? `; dots coloured by |${tapName(S.taps[ci])}| (blue low → red high)` : "") + "; the large dot is now";
+}
+function sampleAt(s, t) {
+  let lo = 0, hi = s.t.length - 1;
+  if (hi < 0) return null;
+  while (lo < hi) { const m = (lo + hi + 1) >> 1; if (s.t[m] <= t) lo = m; else hi = m - 1; }
+  return s.hi[lo] === null ? null : (s.lo[lo] + s.hi[lo]) / 2;
 }
 
 // --- graph ---
@@ -241,17 +297,42 @@ function recordedInit(h) {
   $("window-s").textContent = "scrub";
   const from = el("input", { type: "range", id: "scrub-from", min: 0, max: r.seconds, step: r.seconds / 1000, value: 0 });
   const span = el("input", { type: "range", id: "scrub-span", min: Math.min(0.05, r.seconds), max: r.seconds, step: r.seconds / 1000, value: r.seconds });
-  const upd = () => { const a = +from.value, w = +span.value; S.view = [a, Math.min(a + w, Math.max(r.seconds, a + 0.01))]; draw(); markers(); };
+  const upd = () => { const a = +from.value, w = +span.value; S.view = [a, Math.min(a + w, Math.max(r.seconds, a + 0.01))]; draw(); };
   from.oninput = upd; span.oninput = upd;
   $("traces-panel").insertBefore(el("div", { class: "row" }, "from", from, "span", span,
     el("span", { class: "small" }, `${r.seconds.toFixed(3)} s · stopped: ${r.stopped} · replay check: `),
-    el("b", { id: "replay-check" }, r.replay.ok ? "✓ " + r.replay.summary : "✗ " + r.replay.summary)), $("traces"));
+    el("b", { id: "replay-check" }, r.replay.summary)), $("traces"));
   S.view = [0, r.seconds];
-  setTimeout(() => { draw(); markers(); }, 0);
+  $("drops").parentElement.style.display = "none";
+  for (const l of h.limiters) $(`limiter-${l.node}`).parentElement.after(el("div", { class: "small" }, "state over the shown span:"), el("canvas", { id: `timeline-${l.node}`, class: "timeline", width: 600, height: 18 }));
+  $("compute").style.display = "none";
+}
+function replayShow(r) {
+  S.replay = r;
+  const b = $("replay-check");
+  if (b) { b.textContent = (r.ok ? "✓ reproduced: " : "✗ ") + r.summary; b.className = r.ok ? "ok" : "bad"; }
+}
+const STATE_COLORS = { armed: "#1c8a3a", clamping: "#d98200", faulted: "#c0162b", fading: "#3566c4", faded: "#6b7280" };
+function timelinesDraw() {
+  if (!S.timelines || !S.view) return;
+  const [t0, t1] = S.view;
+  for (const l of S.timelines) {
+    const c = $(`timeline-${l.node}`);
+    if (!c) continue;
+    const g = c.getContext("2d");
+    g.clearRect(0, 0, c.width, c.height);
+    for (const seg of l.segments) {
+      const a = Math.max(seg.t0, t0), b = Math.min(seg.t1, t1);
+      if (b <= a) continue;
+      g.fillStyle = STATE_COLORS[seg.state] || "#999";
+      g.fillRect((a - t0) / (t1 - t0) * c.width, 0, Math.max(1, (b - a) / (t1 - t0) * c.width), c.height);
+    }
+  }
 }
 function markers() {
   // Events on the time axis of every trace.
   if (!S.view) return;
+  timelinesDraw();
   const [t0, t1] = S.view;
   S.taps.forEach((t, i) => {
     const c = $("canvas-" + i);

@@ -1,0 +1,167 @@
+//! What the finger moves over, for the page's finger view: the height map
+//! of each scene a `mesh.gradient` node can switch between (sampled by the
+//! node family's own ray caster, on a grid over the scene's footprint), or
+//! the (load, velocity) axes of each texture grid an `interp` node can
+//! switch between. Computed once, off the real-time thread, before the
+//! session starts.
+
+use evflow_engine::{BuildContext, Checked};
+use serde_json::{json, Value};
+use std::path::Path;
+
+/// Height-map samples along the longer side of a scene's footprint.
+#[cfg(feature = "mesh")]
+const MAP_SAMPLES: usize = 96;
+
+#[allow(dead_code)]
+fn context(checked: &Checked, k: usize, base_dir: &Path) -> BuildContext {
+    let n = &checked.nodes[k];
+    BuildContext {
+        node: n.name.clone(),
+        base_rate: checked.graph.rate,
+        rate: n.ratio.hz(checked.graph.rate),
+        port_rates: n.ports.iter().map(|p| p.ratio.hz(checked.graph.rate)).collect(),
+        base_dir: base_dir.to_path_buf(),
+        out_dir: std::env::temp_dir(),
+        seed: checked.graph.seed,
+    }
+}
+
+/// The height maps (mm, on a grid in touch coordinates, m) of the scenes
+/// of the first `mesh.gradient` node.
+#[cfg(feature = "mesh")]
+fn mesh_maps(checked: &Checked, base_dir: &Path) -> Option<Value> {
+    use evflow_nodes::mesh::{place, raycast::RayCaster, source};
+    let k = checked.order.iter().copied().find(|&k| checked.nodes[k].spec.name == "mesh.gradient")?;
+    let n = &checked.nodes[k];
+    let placed = match source::load_scenes(&n.params, &context(checked, k, base_dir)) {
+        Ok(p) => p,
+        Err(e) => return Some(json!({ "kind": "none", "why": format!("{}: {e}", n.name) })),
+    };
+    let mut maps = Vec::new();
+    for p in &placed {
+        let Some((lo, hi)) = place::footprint(&p.mesh) else { continue };
+        let rc = RayCaster::new(&p.mesh);
+        let (x0, y0) = (p.offset[0] + lo[0] * p.unit, p.offset[1] + lo[1] * p.unit);
+        let (x1, y1) = (p.offset[0] + hi[0] * p.unit, p.offset[1] + hi[1] * p.unit);
+        let long = (x1 - x0).max(y1 - y0).max(1e-12);
+        let nx = (((x1 - x0) / long * MAP_SAMPLES as f64).round() as usize).max(2);
+        let ny = (((y1 - y0) / long * MAP_SAMPLES as f64).round() as usize).max(2);
+        let mut z = Vec::with_capacity(nx * ny);
+        for j in 0..ny {
+            let y = y0 + (y1 - y0) * (j as f64 + 0.5) / ny as f64;
+            for i in 0..nx {
+                let x = x0 + (x1 - x0) * (i as f64 + 0.5) / nx as f64;
+                let (mx, my) = p.to_mesh(x, y);
+                let h = rc.cast(mx, my).map(|h| (h.z - p.z0) * p.unit * 1e3);
+                z.push(h.filter(|h| h.is_finite()).map(|h| (h * 1e3).round() / 1e3));
+            }
+        }
+        maps.push(json!({ "name": p.name, "x0": x0, "x1": x1, "y0": y0, "y1": y1, "nx": nx, "ny": ny, "z_mm": z }));
+    }
+    Some(
+        json!({ "kind": "mesh", "node": n.name, "scene": n.params.get("scene").and_then(|v| v.as_f64()), "maps": maps }),
+    )
+}
+
+#[cfg(not(feature = "mesh"))]
+fn mesh_maps(_: &Checked, _: &Path) -> Option<Value> {
+    None
+}
+
+/// The (load, velocity) axes of every texture of the first `interp` node.
+#[cfg(feature = "texture")]
+fn texture_grids(checked: &Checked, base_dir: &Path) -> Option<Value> {
+    use evflow_nodes::texture::grid::{Grid, GridSource};
+    let k = checked.order.iter().copied().find(|&k| checked.nodes[k].spec.name == "interp")?;
+    let n = &checked.nodes[k];
+    let p = &n.params;
+    let ctx = context(checked, k, base_dir);
+    let range = |name: &str| match p.float_list(name) {
+        [lo, hi] => Some((*lo, *hi)),
+        _ => None,
+    };
+    let base = GridSource {
+        folder: None,
+        paths: Vec::new(),
+        material: p.str("material").to_string(),
+        channel: p.str("channel").to_string(),
+        load_range: range("load_range"),
+        velocity_range: range("velocity_range"),
+        apply_gain: false,
+    };
+    let sources: Vec<(GridSource, String)> = if !p.text_list("textures").is_empty() {
+        p.text_list("textures")
+            .iter()
+            .map(|t| (GridSource { folder: Some(ctx.path(t)), ..base.clone() }, t.clone()))
+            .collect()
+    } else if !p.str("folder").is_empty() {
+        vec![(GridSource { folder: Some(ctx.path(p.str("folder"))), ..base.clone() }, p.str("folder").to_string())]
+    } else {
+        let paths = p.text_list("paths").iter().map(|s| ctx.path(s)).collect();
+        vec![(GridSource { paths, ..base.clone() }, "recordings".to_string())]
+    };
+    let mut grids = Vec::new();
+    for (src, name) in sources {
+        match Grid::load(&src) {
+            Ok(g) => grids.push(json!({ "name": name, "loads_g": g.loads, "velocities_cm_s": g.velocities })),
+            Err(e) => return Some(json!({ "kind": "none", "why": format!("{}: {name}: {e}", n.name) })),
+        }
+    }
+    Some(
+        json!({ "kind": "grid", "node": n.name, "texture": p.get("texture").and_then(|v| v.as_f64()), "grids": grids }),
+    )
+}
+
+#[cfg(not(feature = "texture"))]
+fn texture_grids(_: &Checked, _: &Path) -> Option<Value> {
+    None
+}
+
+/// The finger view's background for `checked` (relative paths from
+/// `base_dir`, the graph file's folder): a mesh scene's height maps, else a
+/// texture's (load, velocity) grid, else `{"kind": "none"}`.
+pub fn scene_json(checked: &Checked, base_dir: &Path) -> Value {
+    mesh_maps(checked, base_dir)
+        .or_else(|| texture_grids(checked, base_dir))
+        .unwrap_or_else(|| json!({ "kind": "none", "why": "no mesh.gradient or interp node" }))
+}
+
+#[cfg(all(test, feature = "mesh", feature = "texture"))]
+mod tests {
+    use super::*;
+
+    fn load(name: &str) -> (Checked, std::path::PathBuf) {
+        let root = Path::new(env!("CARGO_MANIFEST_DIR")).parent().unwrap().join("graphs");
+        let c = evflow_engine::load_file(&root.join(name), &evflow_nodes::registry(), &[]).unwrap();
+        (c, root)
+    }
+
+    #[test]
+    fn mesh_live_has_five_height_maps_with_bumps_and_holes() {
+        let (c, dir) = load("mesh-live.toml");
+        let s = scene_json(&c, &dir);
+        assert_eq!(s["kind"], "mesh");
+        let maps = s["maps"].as_array().unwrap();
+        assert_eq!(maps.len(), 5);
+        // 4B0H: four bumps (heights > 0), 0B4H: four holes (< 0).
+        let range = |m: &Value| {
+            let z: Vec<f64> = m["z_mm"].as_array().unwrap().iter().filter_map(Value::as_f64).collect();
+            (z.iter().cloned().fold(f64::INFINITY, f64::min), z.iter().cloned().fold(f64::NEG_INFINITY, f64::max))
+        };
+        let (lo0, hi0) = range(&maps[0]);
+        let (lo4, hi4) = range(&maps[4]);
+        assert!(lo0 < -0.1 && hi0 < 0.1, "0B4H: holes only ({lo0}, {hi0}) mm");
+        assert!(hi4 > 0.1 && lo4 > -0.1, "4B0H: bumps only ({lo4}, {hi4}) mm");
+    }
+
+    #[test]
+    fn texture_live_has_the_grid_axes_of_each_texture() {
+        let (c, dir) = load("texture-live.toml");
+        let s = scene_json(&c, &dir);
+        assert_eq!(s["kind"], "grid");
+        assert_eq!(s["grids"].as_array().unwrap().len(), 6);
+        assert_eq!(s["grids"][0]["loads_g"], json!([60.0, 110.0]));
+        assert_eq!(s["grids"][0]["velocities_cm_s"], json!([3.0, 7.0]));
+    }
+}

@@ -141,3 +141,54 @@ fn shards_merged_equal_one_run_byte_for_byte() {
     let o = evflow(&["merge", merged.to_str().unwrap(), &dirs[0], &dirs[1], &dirs[1], &dirs[2], &dirs[3]]);
     assert!(String::from_utf8_lossy(&o.stderr).contains("both are shard 2/4"));
 }
+
+#[test]
+fn many_sessions_replay_in_order_on_two_jobs_and_a_broken_one_fails_alone() {
+    let base = tempfile::tempdir().unwrap();
+    let mut sessions = Vec::new();
+    for (k, change) in ["0.1:gain.gain=0.3", "0.2:limit.enable=false", "0.05:gain.gain=0.8"].iter().enumerate() {
+        let s = base.path().join(format!("s{k}"));
+        let o = evflow(&[
+            "live",
+            "graphs/display-live.toml",
+            "--session",
+            s.to_str().unwrap(),
+            "--no-realtime",
+            "--miss-streak",
+            "0",
+            "-q",
+            "--duration",
+            "0.3",
+            "--change",
+            change,
+        ]);
+        assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+        sessions.push(s.to_str().unwrap().to_string());
+    }
+    let replay = |jobs: &str, out: &Path, extra: &[&str]| {
+        let mut args = vec!["replay", "--check", "-q", "--jobs", jobs, "--out", out.to_str().unwrap()];
+        args.extend(sessions.iter().map(String::as_str));
+        args.extend_from_slice(extra);
+        evflow(&args)
+    };
+    let a = replay("1", &base.path().join("o1"), &[]);
+    let b = replay("2", &base.path().join("o2"), &[]);
+    assert!(a.status.success(), "{}", String::from_utf8_lossy(&a.stderr));
+    assert_eq!(a.stdout, b.stdout);
+    let out = String::from_utf8_lossy(&b.stdout);
+    let heads: Vec<&str> = out.lines().filter(|l| l.starts_with("── session")).collect();
+    assert_eq!(heads.len(), 3, "{out}");
+    for (k, s) in sessions.iter().enumerate() {
+        assert!(heads[k].contains(&format!("{}/3: {s}", k + 1)), "{out}");
+    }
+    assert_eq!(out.matches("limit.out: identical to the live session, bit for bit").count(), 3, "{out}");
+
+    // A session without its manifest fails alone; the summary names it.
+    let broken = base.path().join("broken");
+    std::fs::create_dir(&broken).unwrap();
+    let c = replay("2", &base.path().join("o3"), &[broken.to_str().unwrap()]);
+    let (out, err) = (String::from_utf8_lossy(&c.stdout), String::from_utf8_lossy(&c.stderr));
+    assert!(!c.status.success());
+    assert_eq!(out.matches("limit.out: identical to the live session, bit for bit").count(), 3, "{out}");
+    assert!(err.contains("1 of 4 sessions failed") && err.contains("broken"), "{err}");
+}

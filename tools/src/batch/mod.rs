@@ -6,13 +6,28 @@
 use evflow_engine::batch::{default_jobs, Shard};
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 
-/// `--jobs` and `--shard`.
+/// `--jobs`, for batches that cannot be sharded.
 #[derive(clap::Args, Debug, Clone)]
-pub struct BatchArgs {
+pub struct JobsArg {
     /// Independent runs at once (default: the cores available). Results,
     /// files and what is printed are the same for any number.
     #[arg(long, short = 'j', value_name = "N")]
     pub jobs: Option<usize>,
+}
+
+impl JobsArg {
+    /// The number of jobs: `--jobs`, else the cores available; at least 1.
+    pub fn jobs(&self) -> usize {
+        self.jobs.unwrap_or_else(default_jobs).max(1)
+    }
+}
+
+/// `--jobs` and `--shard`.
+#[derive(clap::Args, Debug, Clone)]
+pub struct BatchArgs {
+    #[command(flatten)]
+    /// `--jobs`.
+    pub jobs: JobsArg,
     /// Run only the K-th of N contiguous slices of the batch (`3/8`), for
     /// a cluster's job array; `evflow merge` joins the slices' outputs.
     #[arg(long, value_name = "K/N", value_parser = parse_shard)]
@@ -26,7 +41,7 @@ fn parse_shard(s: &str) -> Result<Shard, String> {
 impl BatchArgs {
     /// The number of jobs: `--jobs`, else the cores available; at least 1.
     pub fn jobs(&self) -> usize {
-        self.jobs.unwrap_or_else(default_jobs).max(1)
+        self.jobs.jobs()
     }
 
     /// The slice to run (all of it without `--shard`).

@@ -7,22 +7,30 @@
 //! outputs are compared with the recorded ones: with the session's own
 //! graph they are identical bit for bit, because the live tick and the
 //! offline step are the same code.
+//!
+//! Several sessions (`evflow replay S1 S2 … [GRAPH]`) replay on `--jobs`
+//! threads, each into its own folder under `--out`, printed in the order
+//! given; one that fails does not stop the others.
 
 use super::live::session::{read_events, FileSpec, LoggedEvent, Manifest};
-use anyhow::{anyhow, Context, Result};
+use anyhow::{anyhow, bail, Context, Result};
+use evflow_engine::batch::{for_each_ordered, Failures};
 use evflow_engine::graph::{parse_graph, ParamDecl};
 use evflow_engine::{check, Override, Plan, PlanOptions, Value};
 use evflow_nodes::recording::format::Recording;
+use evflow_tools::batch::{progress_bar, JobsArg};
+use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
+use std::sync::atomic::AtomicBool;
 
 /// Arguments of `evflow replay`.
 #[derive(clap::Args, Debug)]
 pub struct Args {
-    /// The session folder written by `evflow live`.
-    session: PathBuf,
-    /// A graph to run over the session instead of its own (its sources of
+    /// The session folders written by `evflow live`, then optionally a
+    /// graph file to run over them instead of their own (its sources of
     /// the same names take the recorded inputs).
-    graph: Option<PathBuf>,
+    #[arg(required = true, value_name = "SESSION... [GRAPH]")]
+    paths: Vec<PathBuf>,
     /// Set a graph variable or node parameter (`name=value`,
     /// `node.param=value`); the session's own overrides apply when GRAPH is
     /// not given.
@@ -31,7 +39,8 @@ pub struct Args {
     /// Block size in base ticks (results do not depend on it).
     #[arg(long, default_value_t = 4096)]
     block: usize,
-    /// Folder for files the graph writes.
+    /// Folder for files the graph writes (with several sessions, a folder
+    /// per session in it, named as the session's folder).
     #[arg(long, value_name = "DIR", default_value = ".")]
     out: PathBuf,
     /// Fail unless every recorded output is reproduced bit for bit.
@@ -40,6 +49,8 @@ pub struct Args {
     /// Print only the comparison.
     #[arg(long, short)]
     quiet: bool,
+    #[command(flatten)]
+    jobs: JobsArg,
 }
 
 /// How one recorded output compares with its replay.
@@ -57,18 +68,75 @@ pub struct Comparison {
 
 /// Runs `evflow replay`.
 pub fn main(a: Args) -> Result<()> {
-    let m = Manifest::read(&a.session)?;
-    let own = a.graph.is_none();
-    let (graph_file, base_dir) = match &a.graph {
-        Some(g) => (g.clone(), g.parent().map(Path::to_path_buf).unwrap_or_default()),
-        None => (a.session.join("graph.toml"), m.base_dir.clone()),
+    let mut sessions = a.paths.clone();
+    let graph = match sessions.last() {
+        Some(p) if sessions.len() > 1 && p.is_file() => sessions.pop(),
+        _ => None,
+    };
+    if let [session] = sessions.as_slice() {
+        let (text, ok) = replay_one(session, graph.as_deref(), &a.out, &a)?;
+        print!("{text}");
+        return if ok || !a.check { Ok(()) } else { Err(anyhow!("the replay does not reproduce the live outputs")) };
+    }
+    let mut outs: Vec<PathBuf> = Vec::with_capacity(sessions.len());
+    for s in &sessions {
+        let name = std::fs::canonicalize(s).unwrap_or_else(|_| s.clone());
+        let name = name.file_name().ok_or_else(|| anyhow!("{}: not a session folder", s.display()))?;
+        let out = a.out.join(name);
+        if outs.contains(&out) {
+            bail!("{}: two sessions of one folder name; their outputs would share {}", s.display(), out.display());
+        }
+        outs.push(out);
+    }
+    let n = sessions.len();
+    let bar = progress_bar(n, "sessions", a.quiet);
+    let work = |k: usize, s: &PathBuf| {
+        let r = replay_one(s, graph.as_deref(), &outs[k], &a);
+        bar.inc(1);
+        r
+    };
+    let mut failures = Failures::new();
+    let items: Vec<&PathBuf> = sessions.iter().collect();
+    for_each_ordered(items, a.jobs.jobs(), &AtomicBool::new(false), work, |k, outcome| {
+        println!("── session {}/{n}: {} ──", k + 1, sessions[k].display());
+        match outcome.map_err(|p| anyhow!(p)).and_then(|r| r) {
+            Ok((text, ok)) => {
+                print!("{text}");
+                if a.check && !ok {
+                    failures.push(sessions[k].display().to_string(), "the replay does not reproduce the live outputs");
+                }
+            }
+            Err(e) => {
+                println!("replay failed: {e:#}");
+                failures.push(sessions[k].display().to_string(), format!("{e:#}"));
+            }
+        }
+        println!();
+    });
+    bar.finish_and_clear();
+    if !failures.is_empty() {
+        bail!("{}", failures.summary(n, "sessions").trim_end());
+    }
+    Ok(())
+}
+
+/// Replays one session with `graph` (else its own), the graph's files
+/// written under `out`; returns what to print and whether every recorded
+/// output was reproduced bit for bit.
+fn replay_one(session: &Path, graph: Option<&Path>, out: &Path, a: &Args) -> Result<(String, bool)> {
+    let mut shown = String::new();
+    let m = Manifest::read(session)?;
+    let own = graph.is_none();
+    let (graph_file, base_dir) = match graph {
+        Some(g) => (g.to_path_buf(), g.parent().map(Path::to_path_buf).unwrap_or_default()),
+        None => (session.join("graph.toml"), m.base_dir.clone()),
     };
     let text =
         std::fs::read_to_string(&graph_file).with_context(|| format!("{}: cannot read", graph_file.display()))?;
     let mut graph = parse_graph(&graph_file, &text).map_err(|e| anyhow!("{e}"))?;
 
     // Recorded inputs replace the sources of the same names.
-    let session_dir = std::fs::canonicalize(&a.session).unwrap_or_else(|_| a.session.clone());
+    let session_dir = std::fs::canonicalize(session).unwrap_or_else(|_| session.to_path_buf());
     let mut ticks = u64::MAX;
     let mut replaced = Vec::new();
     for f in &m.inputs {
@@ -114,7 +182,7 @@ pub fn main(a: Args) -> Result<()> {
         ticks = ticks.min(f.ratio.ticks_for(s.len() as u64));
     }
     if ticks == u64::MAX {
-        return Err(anyhow!("{}: the session recorded nothing to replay", a.session.display()));
+        return Err(anyhow!("{}: the session recorded nothing to replay", session.display()));
     }
 
     // Overrides: the session's (for its own graph) and the command line's;
@@ -128,12 +196,12 @@ pub fn main(a: Args) -> Result<()> {
         overrides.push(o);
     }
     let checked = check(&graph, &evflow_nodes::registry(), &overrides).map_err(|e| anyhow!("{e}"))?;
-    std::fs::create_dir_all(&a.out).map_err(|e| anyhow!("{}: cannot create output folder: {e}", a.out.display()))?;
+    std::fs::create_dir_all(out).map_err(|e| anyhow!("{}: cannot create output folder: {e}", out.display()))?;
     let opts = PlanOptions {
         max_block: a.block.max(1),
         seed: Some(m.seed),
         base_dir: Some(base_dir),
-        out_dir: Some(a.out.clone()),
+        out_dir: Some(out.to_path_buf()),
         timing: true,
         mode: evflow_engine::RunMode::Offline,
     };
@@ -145,7 +213,7 @@ pub fn main(a: Args) -> Result<()> {
     // Events: changes to apply; gaps and plan replacements end the exact part.
     let mut exact_until = ticks;
     let mut sets = Vec::new();
-    for e in read_events(&a.session.join("events.jsonl"))? {
+    for e in read_events(&session.join("events.jsonl"))? {
         match e {
             LoggedEvent::Set { tick, node, param, value } if tick < ticks => {
                 if replaced.contains(&node) {
@@ -169,7 +237,8 @@ pub fn main(a: Args) -> Result<()> {
     let summaries = plan.finish().map_err(|e| anyhow!("{e}"))?;
 
     if !a.quiet {
-        println!(
+        let _ = writeln!(
+            shown,
             "replayed {} ticks ({:.3} s) of session `{}`{}",
             report_ticks,
             report_ticks as f64 / m.base_rate,
@@ -178,28 +247,31 @@ pub fn main(a: Args) -> Result<()> {
         );
         for (node, s) in &summaries {
             for l in &s.lines {
-                println!("{node}: {l}");
+                let _ = writeln!(shown, "{node}: {l}");
             }
             for (k, v, unit) in &s.values {
-                println!("{node}: {k} = {v}{}", super::live::unit_suffix(unit));
+                let _ = writeln!(shown, "{node}: {k} = {v}{}", super::live::unit_suffix(unit));
             }
         }
     }
     let mut all_same = true;
-    for ((f, rec), out) in recorded.iter().zip(&replayed) {
+    for ((f, rec), replay) in recorded.iter().zip(&replayed) {
         let name = format!("{}.{}", f.node, f.ports[0]);
-        let Some(out) = out else {
-            println!("{name}: not in the replayed graph");
+        let Some(out) = replay else {
+            let _ = writeln!(shown, "{name}: not in the replayed graph");
             all_same = false;
             continue;
         };
         let n = (f.ratio.count(0, exact_until) as usize).min(rec.len()).min(out.len());
         let c = compare(&name, &rec[..n], &out[..n]);
         match c.first_difference {
-            None => println!("{name}: identical to the live session, bit for bit ({} samples)", c.samples),
+            None => {
+                let _ = writeln!(shown, "{name}: identical to the live session, bit for bit ({} samples)", c.samples);
+            }
             Some((i, r, o)) => {
                 all_same = false;
-                println!(
+                let _ = writeln!(
+                    shown,
                     "{name}: differs from sample {i} (live {r:e}, replay {o:e}); largest difference {:e} over {} samples",
                     c.max_abs, c.samples
                 );
@@ -207,12 +279,10 @@ pub fn main(a: Args) -> Result<()> {
         }
     }
     if exact_until < ticks {
-        println!("compared up to tick {exact_until} (the session lost samples or replaced its plan there)");
+        let _ =
+            writeln!(shown, "compared up to tick {exact_until} (the session lost samples or replaced its plan there)");
     }
-    if a.check && !all_same {
-        return Err(anyhow!("the replay does not reproduce the live outputs"));
-    }
-    Ok(())
+    Ok((shown, all_same))
 }
 
 fn param(name: &str, value: Value) -> ParamDecl {

@@ -1,12 +1,17 @@
 //! The texture study's driver: for every lab profile, the models of every
-//! condition, the recordings of every texture, and every row.
+//! condition, the recordings of every texture, and every row — on several
+//! threads through `evflow_engine::batch` (the models of every profile and
+//! condition at once, then every row at once), with the same results in
+//! the same order as on one.
 
 use super::models::{self, Models};
 use super::recordings;
 use super::row::{self, Row, RowInputs};
 use super::setup::{Cond, Profile};
 use super::StudyError;
+use evflow_engine::batch::for_each_ordered;
 use std::path::PathBuf;
+use std::sync::atomic::AtomicBool;
 use std::time::Instant;
 
 /// What a study covers and how.
@@ -38,12 +43,13 @@ pub struct StudyConfig {
     pub objective: String,
 }
 
-/// Where a study is.
+/// What a study has finished (reported in study order, whatever order the
+/// threads finish in).
 #[derive(Debug, Clone, Copy)]
 pub enum Progress<'a> {
-    /// Building the models of a profile and condition.
+    /// The models of a profile and condition are built (or failed).
     Models(&'a Profile, Cond),
-    /// Running a row.
+    /// A row is done (or failed): profile, sample, condition, rows done, rows in all.
     Row(&'a Profile, &'a str, Cond, usize, usize),
 }
 
@@ -56,10 +62,25 @@ pub struct Study {
     pub models: Vec<(String, Cond, Models)>,
     /// Wall-clock time, s.
     pub seconds: f64,
+    /// The steps that failed, `(step, reason)`, in study order: a model
+    /// build (whose rows are then not run) or a row. The others are kept.
+    pub failures: Vec<(String, String)>,
 }
 
-/// Runs a study.
+/// Runs a study on one thread; the first failed step is the error.
 pub fn run(cfg: &StudyConfig, progress: &mut dyn FnMut(Progress<'_>)) -> Result<Study, StudyError> {
+    let study = run_on(cfg, 1, progress)?;
+    match study.failures.first() {
+        Some((what, why)) => Err(StudyError::Config(format!("{what}: {why}"))),
+        None => Ok(study),
+    }
+}
+
+/// Runs a study with `jobs` steps at once: first the models of every
+/// profile and condition, then every row. A step that fails is listed in
+/// [`Study::failures`] and the others go on; only a study that cannot
+/// start (a graph missing, bad gains) is an error.
+pub fn run_on(cfg: &StudyConfig, jobs: usize, progress: &mut dyn FnMut(Progress<'_>)) -> Result<Study, StudyError> {
     let t0 = Instant::now();
     for g in [
         "model-build.toml",
@@ -76,41 +97,73 @@ pub fn run(cfg: &StudyConfig, progress: &mut dyn FnMut(Progress<'_>)) -> Result<
     if cfg.gains.is_empty() || cfg.gains.iter().any(|g| !(g.is_finite() && *g > 0.0)) {
         return Err(StudyError::Config("the gains must be positive numbers, at least one".into()));
     }
-    let total = cfg.profiles.len() * cfg.samples.len() * cfg.conds.len();
-    let mut done = 0;
-    let mut rows = Vec::new();
-    let mut all_models = Vec::new();
-    for profile in &cfg.profiles {
+    let never = AtomicBool::new(false);
+    let mut failures = Vec::new();
+
+    // The models of every profile and condition.
+    let cells: Vec<(&Profile, Cond)> =
+        cfg.profiles.iter().flat_map(|p| cfg.conds.iter().map(move |c| (p, *c))).collect();
+    let mut built: Vec<Option<Models>> = Vec::with_capacity(cells.len());
+    let build = |_: usize, (profile, c): (&Profile, Cond)| {
+        let dir = cfg.work.join(&profile.name).join("models");
+        models::build(&cfg.graphs, profile, &c, cfg.epochs, cfg.multilevel, &dir)
+    };
+    for_each_ordered(cells.clone(), jobs, &never, build, |k, outcome| {
+        let (profile, c) = cells[k];
+        progress(Progress::Models(profile, c));
+        match outcome.map_err(StudyError::Config).and_then(|r| r) {
+            Ok(m) => built.push(Some(m)),
+            Err(e) => {
+                let why = format!("{e} (its {} rows were not run)", cfg.samples.len());
+                failures.push((format!("{}: models at {}", profile.name, c.label()), why));
+                built.push(None);
+            }
+        }
+    });
+
+    // Every row whose models were built.
+    let total = cells.len() * cfg.samples.len();
+    let rows_to_run: Vec<(usize, &str)> = (0..cells.len())
+        .filter(|k| built[*k].is_some())
+        .flat_map(|k| cfg.samples.iter().map(move |s| (k, s.as_str())))
+        .collect();
+    let one_row = |_: usize, (k, sample): (usize, &str)| -> Result<Row, StudyError> {
+        let (profile, c) = cells[k];
+        let m = built[k].as_ref().expect("rows run only where the models were built");
         let pdir = cfg.work.join(&profile.name);
         let rec_dir = recordings::folder(&cfg.work, profile);
-        for c in &cfg.conds {
-            progress(Progress::Models(profile, *c));
-            let m = models::build(&cfg.graphs, profile, c, cfg.epochs, cfg.multilevel, &pdir.join("models"))?;
-            for sample in &cfg.samples {
-                done += 1;
-                progress(Progress::Row(profile, sample, *c, done, total));
-                recordings::record_pair(&cfg.graphs, profile, sample, c, &rec_dir)?;
-                let inputs = RowInputs {
-                    graphs: &cfg.graphs,
-                    profile,
-                    sample,
-                    cond: *c,
-                    models: &m,
-                    recordings: &rec_dir,
-                    gains: &cfg.gains,
-                    iterations: cfg.iterations,
-                    objective: &cfg.objective,
-                    optimized: None,
-                    dir: pdir.join("rows").join(format!("{sample}-{}", c.tag())),
-                };
-                let mut r = row::run(&inputs)?;
-                if cfg.floor {
-                    r.achievable = Some(super::floor::achievable(&inputs)?);
-                }
-                rows.push(r);
-            }
-            all_models.push((profile.name.clone(), *c, m));
+        recordings::record_pair(&cfg.graphs, profile, sample, &c, &rec_dir)?;
+        let inputs = RowInputs {
+            graphs: &cfg.graphs,
+            profile,
+            sample,
+            cond: c,
+            models: m,
+            recordings: &rec_dir,
+            gains: &cfg.gains,
+            iterations: cfg.iterations,
+            objective: &cfg.objective,
+            optimized: None,
+            dir: pdir.join("rows").join(format!("{sample}-{}", c.tag())),
+        };
+        let mut r = row::run(&inputs)?;
+        if cfg.floor {
+            r.achievable = Some(super::floor::achievable(&inputs)?);
         }
-    }
-    Ok(Study { rows, models: all_models, seconds: t0.elapsed().as_secs_f64() })
+        Ok(r)
+    };
+    let mut rows = Vec::new();
+    let mut done = total - rows_to_run.len();
+    for_each_ordered(rows_to_run.clone(), jobs, &never, one_row, |j, outcome| {
+        let (k, sample) = rows_to_run[j];
+        let (profile, c) = cells[k];
+        done += 1;
+        progress(Progress::Row(profile, sample, c, done, total));
+        match outcome.map_err(StudyError::Config).and_then(|r| r) {
+            Ok(r) => rows.push(r),
+            Err(e) => failures.push((format!("{}: {sample} at {}", profile.name, c.label()), e.to_string())),
+        }
+    });
+    let all_models = cells.iter().zip(built).filter_map(|((p, c), m)| m.map(|m| (p.name.clone(), *c, m))).collect();
+    Ok(Study { rows, models: all_models, seconds: t0.elapsed().as_secs_f64(), failures })
 }

@@ -10,11 +10,11 @@ use evflow_nodes::lab::texture::samples::NAMES;
 use evflow_nodes::recording::format::Recording;
 use evflow_nodes::synth::study::cells::write_actuation;
 use evflow_nodes::synth::study::row::{Method, Row};
-use evflow_nodes::synth::study::run::{run, Progress, StudyConfig};
+use evflow_nodes::synth::study::run::{run_on, Progress, StudyConfig};
 use evflow_nodes::synth::study::setup::{Cond, Profile};
 use evflow_nodes::synth::study::spectrum::gated;
+use evflow_tools::batch::{progress_bar, JobsArg};
 use evflow_tools::plot::{Plot, Series};
-use indicatif::{ProgressBar, ProgressStyle};
 use std::path::PathBuf;
 
 /// Arguments of `evflow report textures`.
@@ -67,6 +67,8 @@ pub struct Args {
     /// The folder of the shipped graphs.
     #[arg(long, default_value = "graphs")]
     graphs: PathBuf,
+    #[command(flatten)]
+    jobs: JobsArg,
 }
 
 /// Runs `evflow report textures`.
@@ -97,19 +99,13 @@ pub fn main(a: Args) -> Result<()> {
         floor: !a.no_floor,
         objective: a.objective.clone(),
     };
-    let total = (cfg.profiles.len() * cfg.samples.len() * cfg.conds.len()) as u64;
-    let bar = ProgressBar::new(total);
-    bar.set_style(
-        ProgressStyle::with_template("{bar:30} {pos}/{len} rows, {elapsed} — {msg}")
-            .unwrap_or(ProgressStyle::default_bar()),
-    );
-    let study = run(&cfg, &mut |p| match p {
-        Progress::Models(profile, c) => {
-            bar.set_message(format!("{}: building the models at {}", profile.name, c.label()))
-        }
-        Progress::Row(profile, s, c, done, _) => {
-            bar.set_position(done as u64 - 1);
-            bar.set_message(format!("{}: {s} at {}", profile.name, c.label()));
+    let cells = cfg.profiles.len() * cfg.conds.len();
+    let bar = progress_bar(cells + cells * cfg.samples.len(), "steps", false);
+    let study = run_on(&cfg, a.jobs.jobs(), &mut |p| {
+        bar.inc(1);
+        match p {
+            Progress::Models(profile, c) => bar.set_message(format!("{}: models at {}", profile.name, c.label())),
+            Progress::Row(profile, s, c, _, _) => bar.set_message(format!("{}: {s} at {}", profile.name, c.label())),
         }
     })?;
     bar.finish_and_clear();
@@ -148,6 +144,13 @@ pub fn main(a: Args) -> Result<()> {
             }
         }
         println!("wrote the grids under {}", g.display());
+    }
+    if !study.failures.is_empty() {
+        let mut f = evflow_engine::batch::Failures::new();
+        for (what, why) in &study.failures {
+            f.push(what.clone(), why);
+        }
+        anyhow::bail!("{}", f.summary(cells + cells * cfg.samples.len(), "steps").trim_end());
     }
     Ok(())
 }

@@ -8,8 +8,11 @@
 pub mod calibrate;
 pub mod edges;
 pub mod error;
+pub mod formats;
+pub mod gltf;
 pub mod gradient;
 pub mod obj;
+pub mod ply;
 pub mod raycast;
 pub mod scenes;
 pub mod trimesh;
@@ -23,6 +26,7 @@ pub mod path;
 pub mod place;
 pub mod profile1d;
 pub mod source;
+pub mod stl;
 
 use evflow_engine::NodeSpec;
 

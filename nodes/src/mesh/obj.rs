@@ -3,7 +3,8 @@
 //! itself reports neither); quads and n-gons are triangulated by tobj (as a
 //! fan); vertex normals, texture coordinates and materials are ignored —
 //! normals are recomputed from the geometry ([`Mesh::new`]), which also
-//! welds the vertices tobj splits per object and group.
+//! welds the vertices tobj splits per object and group. OBJ files are
+//! y-up by convention (docs/mesh.md, "Formats").
 
 use super::error::MeshError;
 use super::trimesh::Mesh;
@@ -35,11 +36,7 @@ pub fn parse_obj(path: &Path, text: &str, weld: f64) -> Result<Mesh, MeshError> 
             triangles.push([base + t[0], base + t[1], base + t[2]]);
         }
     }
-    let mesh = Mesh::new(vertices, triangles, weld);
-    if mesh.triangles.is_empty() {
-        return Err(MeshError::Empty { what: path.display().to_string() });
-    }
-    Ok(mesh)
+    Mesh::from_faces(&path.display().to_string(), vertices, triangles, weld)
 }
 
 /// Checks the lines tobj reads for geometry: `v` needs three finite

@@ -1,19 +1,23 @@
-//! Where a mesh node's mesh comes from — an OBJ file or a generated §4.2
-//! scene — which of its axes is up, and how touch coordinates (metres on
+//! Where a mesh node's mesh comes from — a mesh file (OBJ, STL, PLY,
+//! glTF/GLB: [`super::formats`]) or a generated §4.2 scene — which of its axes is up, and how touch coordinates (metres on
 //! the screen) map to mesh units (`unit` and `offset_x/y`, or `fit`). The
 //! parameters are declared here once and shared by `mesh.gradient` and
 //! `mesh.edges`, so both see the same triangles in the same order at the
 //! same place.
 
-use super::obj::load_obj;
+use super::formats::{Format, EXTENSIONS};
 use super::place::{self, Up};
 use super::scenes::{scene, Shape, CONFIGS};
 use super::trimesh::Mesh;
 use evflow_engine::{BuildContext, NodeError, ParamSpec, Params};
 
-/// `file`: an OBJ file; empty for a generated scene.
-pub const FILE: ParamSpec =
-    ParamSpec::text("file", "", "OBJ mesh (relative to the graph file); empty: the generated scene below");
+/// `file`: a mesh file; empty for a generated scene.
+pub const FILE: ParamSpec = ParamSpec::text(
+    "file",
+    "",
+    "mesh file (relative to the graph file), by extension: .obj, .stl (ASCII or binary), .ply (ASCII or binary), \
+     .gltf or .glb; empty: the generated scene below",
+);
 /// `shape` of a generated scene.
 pub const SHAPE: ParamSpec =
     ParamSpec::choice("shape", &["gaussian", "frustum"], "gaussian", "generated scene: object profile (Fig. 4.5)");
@@ -56,7 +60,8 @@ pub const UP: ParamSpec = ParamSpec::choice(
     &["auto", "+x", "-x", "+y", "-y", "+z", "-z"],
     "auto",
     "mesh axis pointing up, out of the screen (turned to height z by a rotation, never a mirror); \
-     auto: +y for OBJ files (the format's convention), +z for generated scenes",
+     auto: +y for OBJ (convention) and glTF/GLB (specification), +z for STL and PLY (CAD and scanners) and for \
+     generated scenes",
 );
 /// `fit`: how the mesh's footprint is placed on the screen.
 pub const FIT: ParamSpec = ParamSpec::choice(
@@ -79,8 +84,8 @@ pub const FIT_SIZE: ParamSpec = ParamSpec::float(
 /// `scenes`: the meshes a session can switch between.
 pub const SCENES: ParamSpec = ParamSpec::text_list(
     "scenes",
-    "meshes to switch between live: each a generated-scene config (with `shape`, e.g. \"4B0H\") or an OBJ file \
-     (*.obj); empty: the one mesh of `file` or `config`",
+    "meshes to switch between live: each a generated-scene config (with `shape`, e.g. \"4B0H\") or a mesh file \
+     (*.obj, *.stl, *.ply, *.gltf, *.glb); empty: the one mesh of `file` or `config`",
 );
 /// `scene`: which of `scenes` is felt (live).
 pub const SCENE: ParamSpec =
@@ -149,7 +154,7 @@ pub fn load_scenes(p: &Params, ctx: &BuildContext) -> Result<Vec<Placed>, NodeEr
         return Ok(vec![load(p, ctx)?]);
     }
     if !p.str("file").is_empty() {
-        return Err(NodeError::param("scenes", "give `file` or `scenes` (which may list OBJ files), not both"));
+        return Err(NodeError::param("scenes", "give `file` or `scenes` (which may list mesh files), not both"));
     }
     if scene >= list.len() {
         return Err(NodeError::param(
@@ -165,7 +170,7 @@ pub fn load_scenes(p: &Params, ctx: &BuildContext) -> Result<Vec<Placed>, NodeEr
         .collect()
 }
 
-/// One mesh: an OBJ file (a name ending in `.obj`) or a generated scene's
+/// One mesh: a mesh file (a name with a mesh extension) or a generated scene's
 /// config word, turned by `up` and placed by `unit`/`offset_x/y` or `fit`.
 fn load_entry(p: &Params, ctx: &BuildContext, entry: &str) -> Result<Placed, NodeError> {
     let (mesh, floor, name, up) = load_mesh(p, ctx, entry)?;
@@ -186,25 +191,29 @@ fn load_entry(p: &Params, ctx: &BuildContext, entry: &str) -> Result<Placed, Nod
 /// The mesh of one entry turned so that its up axis is +z, with its floor
 /// (mesh units), name and the axis turned.
 fn load_mesh(p: &Params, ctx: &BuildContext, entry: &str) -> Result<(Mesh, f64, String, Up), NodeError> {
-    let is_file = entry.to_ascii_lowercase().ends_with(".obj");
-    let up = match p.str("up") {
-        "auto" if is_file => Up::PlusY,
-        "auto" => Up::PlusZ,
-        w => Up::parse(w).ok_or_else(|| NodeError::param("up", format!("unknown axis `{w}`")))?,
+    let format = Format::of(entry);
+    let up = match (p.str("up"), format) {
+        ("auto", Some(f)) => f.default_up(),
+        ("auto", None) => Up::PlusZ,
+        (w, _) => Up::parse(w).ok_or_else(|| NodeError::param("up", format!("unknown axis `{w}`")))?,
     };
-    if is_file {
+    if let Some(format) = format {
         let path = ctx.path(entry);
-        let mesh = load_obj(&path, p.f64("weld")).map_err(|e| NodeError::Other(e.to_string()))?;
+        let mesh = format.load(&path, p.f64("weld")).map_err(|e| NodeError::Other(e.to_string()))?;
         let mesh = place::reorient(mesh, up);
         let floor = mesh.bounds().min[2];
         return Ok((mesh, floor, path.display().to_string(), up));
     }
     let shape = if p.str("shape") == "frustum" { Shape::Frustum } else { Shape::Gaussian };
+    if !CONFIGS.contains(&entry) && (entry.contains('.') || entry.contains('/')) {
+        let known: Vec<String> = EXTENSIONS.iter().map(|(e, _)| format!(".{e}")).collect();
+        return Err(NodeError::param("file", format!("`{entry}`: unknown mesh format (one of {})", known.join(", "))));
+    }
     if !CONFIGS.contains(&entry) {
         let help = evflow_engine::suggest::help(entry, CONFIGS.iter().copied());
         return Err(NodeError::param(
             "config",
-            format!("unknown scene `{entry}` (one of {}, or an OBJ file); {help}", CONFIGS.join(", ")),
+            format!("unknown scene `{entry}` (one of {}, or a mesh file); {help}", CONFIGS.join(", ")),
         ));
     }
     let mesh = scene(shape, entry, p.usize("resolution")).map_err(|e| NodeError::param("config", e.to_string()))?;

@@ -12,6 +12,7 @@
 //! with outward normals and a terrain with upward ones, whatever the
 //! file's winding was — even mixed.
 
+use super::error::MeshError;
 use std::collections::HashMap;
 
 /// A triangle mesh in mesh units (the scenes of §4.2 are in cm).
@@ -89,6 +90,7 @@ impl Mesh {
                 tris.push(t);
             }
         }
+        let vertices = drop_unused(vertices, &mut tris);
         let mut normals: Vec<[f64; 3]> = tris
             .iter()
             .map(|t| raw_normal(vertices[t[0] as usize], vertices[t[1] as usize], vertices[t[2] as usize]))
@@ -100,6 +102,27 @@ impl Mesh {
             }
         }
         Mesh { vertices, triangles: tris, normals }
+    }
+
+    /// A mesh read from a file or scene named `what`: [`Mesh::new`], refused
+    /// when it has nothing a ray can hit — no face at all
+    /// ([`MeshError::Empty`]) or only faces of zero area, collapsed by the
+    /// weld or with collinear corners ([`MeshError::Degenerate`]).
+    pub fn from_faces(
+        what: &str,
+        vertices: Vec<[f64; 3]>,
+        triangles: Vec<[u32; 3]>,
+        weld: f64,
+    ) -> Result<Self, MeshError> {
+        let read = triangles.len();
+        if read == 0 {
+            return Err(MeshError::Empty { what: what.to_string() });
+        }
+        let mesh = Mesh::new(vertices, triangles, weld);
+        if mesh.normals.iter().all(|n| *n == [0.0; 3]) {
+            return Err(MeshError::Degenerate { what: what.to_string(), triangles: read });
+        }
+        Ok(mesh)
     }
 
     /// The three corners of triangle `t`.
@@ -244,6 +267,28 @@ impl Default for Fnv {
     }
 }
 
+/// Keeps the vertices some triangle uses (in their order), renumbering
+/// the triangles: bounds, floor and hash then describe the surface only.
+fn drop_unused(vertices: Vec<[f64; 3]>, tris: &mut [[u32; 3]]) -> Vec<[f64; 3]> {
+    let mut new_index = vec![u32::MAX; vertices.len()];
+    for t in tris.iter() {
+        for &i in t {
+            new_index[i as usize] = 0;
+        }
+    }
+    let mut kept = Vec::with_capacity(vertices.len());
+    for (i, v) in vertices.into_iter().enumerate() {
+        if new_index[i] == 0 {
+            new_index[i] = kept.len() as u32;
+            kept.push(v);
+        }
+    }
+    for t in tris.iter_mut() {
+        *t = t.map(|i| new_index[i as usize]);
+    }
+    kept
+}
+
 /// Merges vertices closer than `tol` (exactly equal when `tol` = 0): the
 /// merged list and, for each input vertex, its index in it. With a
 /// tolerance the vertices are hashed on a grid of cell `tol` and compared
@@ -314,8 +359,29 @@ mod tests {
         assert_eq!(m.triangles[0][2], m.triangles[1][0]);
         // A tolerance merges near points; a triangle collapsing to a segment goes.
         let v2 = vec![[0.0, 0.0, 0.0], [1e-9, 0.0, 0.0], [0.0, 1.0, 0.0]];
-        assert_eq!(Mesh::new(v2.clone(), vec![[0, 1, 2]], 1e-6).triangles.len(), 0);
-        assert_eq!(Mesh::new(v2, vec![[0, 1, 2]], 0.0).triangles.len(), 1);
+        let collapsed = Mesh::new(v2.clone(), vec![[0, 1, 2]], 1e-6);
+        assert_eq!((collapsed.triangles.len(), collapsed.vertices.len()), (0, 0));
+        assert_eq!(Mesh::new(v2.clone(), vec![[0, 1, 2]], 0.0).triangles.len(), 1);
+        // Vertices no triangle uses are dropped: they would move the bounds and the floor.
+        let mut v3 = v2;
+        v3.insert(0, [5.0, 5.0, -100.0]);
+        let m = Mesh::new(v3, vec![[1, 2, 3]], 0.0);
+        assert_eq!((m.vertices.len(), m.triangles[0]), (3, [0, 1, 2]));
+        assert_eq!(m.bounds().min[2], 0.0);
+    }
+
+    #[test]
+    fn a_file_without_faces_or_with_only_zero_area_faces_is_refused() {
+        let v = vec![[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [2.0, 0.0, 0.0], [0.0, 0.0, 0.0]];
+        let e = Mesh::from_faces("f.stl", v.clone(), vec![], 0.0).unwrap_err();
+        assert_eq!(e.to_string(), "f.stl: the mesh has no triangles");
+        // Collinear corners, and corners welded into one point.
+        let e = Mesh::from_faces("f.stl", v.clone(), vec![[0, 1, 2], [0, 1, 3], [0, 1, 2]], 0.0).unwrap_err();
+        assert_eq!(e, MeshError::Degenerate { what: "f.stl".into(), triangles: 3 });
+        assert!(e.to_string().contains("all 3 triangles have zero area"), "{e}");
+        let mut v = v;
+        v[2] = [0.0, 1.0, 0.0];
+        assert_eq!(Mesh::from_faces("f.stl", v, vec![[0, 1, 2], [0, 1, 3]], 0.0).unwrap().triangles.len(), 1);
     }
 
     #[test]

@@ -266,6 +266,10 @@ fn the_page_shows_and_steers_a_live_session_in_chromium() {
         "the limiter shows armed"
     );
     assert!(cdp.eval("studio.compute.t.length > 5") == json!(true), "compute times arrive");
+    // The finger view: the texture's (load, velocity) grid and the four cells in use.
+    assert_eq!(cdp.eval("studio.hello.scene.kind"), json!("grid"));
+    assert_eq!(cdp.eval("studio.hello.scene.grids[0].loads_g.join()"), json!("60,110"));
+    cdp.until("Array.isArray(studio.cells) && studio.cells.length === 4", 20);
 
     // A change beyond the declared limits is refused by the server, with the reason on the page.
     cdp.eval("document.getElementById('var-gain').value = '1e9'; document.getElementById('set-gain').click()");
@@ -286,7 +290,7 @@ fn the_page_shows_and_steers_a_live_session_in_chromium() {
     );
     let page_tick =
         cdp.eval("studio.events.find(e => e.event === 'set' && e.param === 'texture').tick").as_u64().unwrap();
-    std::thread::sleep(Duration::from_millis(800));
+    std::thread::sleep(Duration::from_millis(2500));
 
     let shot = cdp.call("Page.captureScreenshot", json!({ "format": "png" }));
     let png = base64_decode(shot["data"].as_str().unwrap());

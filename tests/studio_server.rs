@@ -29,6 +29,25 @@ fn a_public_address_needs_the_flag() {
 }
 
 #[test]
+fn a_taken_port_stops_the_session_before_it_starts() {
+    let tmp = tempfile::tempdir().unwrap();
+    let taken = std::net::TcpListener::bind("127.0.0.1:0").unwrap();
+    let addr = taken.local_addr().unwrap().to_string();
+    let out = Command::new(common::evflow())
+        .arg("live")
+        .arg(evflow_tests::root().join("graphs/texture-live.toml"))
+        .arg("--session")
+        .arg(tmp.path().join("s"))
+        .args(["--no-realtime", "--duration", "0.2", "-q", "--studio", &addr])
+        .output()
+        .unwrap();
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(!out.status.success());
+    assert!(err.contains(&format!("studio: cannot listen on {addr}")), "{err}");
+    assert!(!tmp.path().join("s").exists(), "no session folder was made");
+}
+
+#[test]
 fn a_public_studio_requires_its_token_everywhere() {
     let tmp = tempfile::tempdir().unwrap();
     let s = common::start("texture-live.toml", tmp.path(), &["127.0.0.1:0", "--studio-public"], &["--endless"]);

@@ -102,6 +102,17 @@ pub fn main(a: Args) -> Result<()> {
     #[cfg(feature = "serial")]
     evflow_nodes::serial::set_notices(!a.quiet);
     let checked = a.graph.load()?;
+    // Bound before the session (and its folder) starts: a taken port stops
+    // nothing that runs.
+    #[cfg(feature = "studio")]
+    let bound = match &a.studio {
+        Some(addr) => {
+            let cfg =
+                evflow_tools::studio::StudioConfig { addr: super::studio::studio_addr(addr)?, public: a.studio_public };
+            Some(evflow_tools::studio::Bound::bind(&cfg)?)
+        }
+        None => None,
+    };
     let graph_text =
         std::fs::read_to_string(&a.graph.file).with_context(|| format!("{}: cannot read", a.graph.file.display()))?;
     std::fs::create_dir_all(&a.out).map_err(|e| anyhow!("{}: cannot create output folder: {e}", a.out.display()))?;
@@ -195,11 +206,9 @@ pub fn main(a: Args) -> Result<()> {
     // The console and the studio queue changes through the same control.
     let control = Arc::new(std::sync::Mutex::new(parts.control));
     #[cfg(feature = "studio")]
-    let studio = match (&a.studio, description) {
-        (Some(addr), Some(d)) => {
-            let cfg =
-                evflow_tools::studio::StudioConfig { addr: super::studio::studio_addr(addr)?, public: a.studio_public };
-            let (studio, ingest) = evflow_tools::studio::Studio::start_live(&cfg, &d, control.clone(), shared.clone())?;
+    let studio = match (bound, description) {
+        (Some(bound), Some(d)) => {
+            let (studio, ingest) = bound.start_live(&d, control.clone(), shared.clone())?;
             eprintln!("studio: {}", studio.url());
             if studio.token().is_some() {
                 eprintln!("studio: serving beyond this machine; the address above holds its one-time token");

@@ -214,3 +214,67 @@ impl Description {
         self
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use evflow_engine::{Plan, PlanOptions};
+
+    const DOC: &str = r#"
+[graph]
+format = 1
+name = "d"
+rate = 1000.0
+connections = ["s.out -> g.in", "g.out -> limit.in", "limit.out -> st.in", "idle.out -> g2.in"]
+[nodes.s]
+type = "sine"
+[nodes.g]
+type = "gain"
+gain = "$gain"
+[nodes.limit]
+type = "limit"
+amplitude = 0.5
+[nodes.st]
+type = "stats"
+[nodes.idle]
+type = "sine"
+[nodes.g2]
+type = "gain"
+[vars]
+gain = 2.0
+"#;
+
+    #[test]
+    fn the_page_is_told_the_graph_the_plan_left_out_the_limits_and_the_limiter() {
+        let g = evflow_engine::graph::parse_graph(std::path::Path::new("d.toml"), DOC).unwrap();
+        let checked = evflow_engine::check(&g, &evflow_nodes::registry(), &[]).unwrap();
+        let opts = PlanOptions { max_block: 1, mode: evflow_engine::RunMode::Live, ..Default::default() };
+        let plan = Plan::build(&checked, &opts).unwrap();
+        let defaults = default_taps(&checked, &plan);
+        assert_eq!(defaults, vec![Tap::new("g", "out")], "what feeds the limiter");
+        let mut taps = LivePlan::guard_taps(&plan);
+        taps.extend(defaults);
+        let lp = LivePlan::new(plan, &taps).unwrap();
+        let vars = evflow_engine::live::live_vars(&checked);
+        let d = Description::live(&checked, &lp, &vars);
+        let h = &d.hello;
+        // What the plan left out, and why.
+        let pruned: Vec<&str> =
+            h["graph"]["pruned"].as_array().unwrap().iter().map(|p| p["node"].as_str().unwrap()).collect();
+        assert!(pruned.contains(&"g2") && pruned.contains(&"idle"), "{pruned:?}");
+        let idle = h["graph"]["nodes"].as_array().unwrap().iter().find(|n| n["name"] == "idle").unwrap();
+        assert_eq!(idle["in_plan"], false);
+        assert_eq!(h["graph"]["edges"].as_array().unwrap().len(), 4);
+        // Live parameters with their declared limits; the variable bound to one.
+        let gain = h["params"].as_array().unwrap().iter().find(|p| p["node"] == "g" && p["param"] == "gain").unwrap();
+        assert_eq!(gain["kind"], "float");
+        assert_eq!(gain["value"], 2.0);
+        assert_eq!(h["vars"][0]["name"], "gain");
+        assert_eq!(h["vars"][0]["uses"], json!(["g.gain"]));
+        // The limiter watched through its input and output taps.
+        assert_eq!(d.limiters.len(), 1);
+        let l = &d.limiters[0];
+        assert_eq!((l.amplitude, l.input, l.output), (0.5, Some(1), Some(0)));
+        assert_eq!(h["taps"][1]["shown"], true);
+    }
+}

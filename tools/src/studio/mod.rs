@@ -26,4 +26,4 @@ pub use describe::{default_taps, Description};
 pub use feed::Ingest;
 pub use recorded::{publish_replay, serve_recorded, RecordedSession, RecordedTap};
 pub use scene::scene_json;
-pub use server::{Studio, StudioConfig, StudioError};
+pub use server::{Bound, Studio, StudioConfig, StudioError};

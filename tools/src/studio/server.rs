@@ -42,12 +42,12 @@ pub enum StudioError {
     )]
     NotLoopback(SocketAddr),
     /// The address cannot be bound.
-    #[error("studio: cannot listen on {addr}: {source}")]
+    #[error("studio: cannot listen on {addr}: {why}")]
     Bind {
         /// The address.
         addr: SocketAddr,
         /// Why.
-        source: std::io::Error,
+        why: std::io::Error,
     },
     /// Any other I/O failure while starting.
     #[error("studio: {0}")]
@@ -93,27 +93,41 @@ struct Ctx {
     active: AtomicUsize,
 }
 
-/// A running studio.
-pub struct Studio {
+/// A studio's address, bound but not yet served: bind before a session
+/// starts, so that a taken port stops nothing that runs.
+pub struct Bound {
+    listener: TcpListener,
     addr: SocketAddr,
     token: Option<String>,
-    stop: Arc<AtomicBool>,
-    hub: Arc<Hub>,
-    ctx: Arc<Ctx>,
-    threads: Vec<JoinHandle<()>>,
+    public: bool,
 }
 
-impl Studio {
-    /// Serves the page of a live session: `control` is the session's
-    /// command queue (shared with the console), `shared` its counters.
-    /// Returns the studio and the intake the session's threads feed.
+impl Bound {
+    /// Checks the address (loopback unless `public`) and listens on it.
+    pub fn bind(cfg: &StudioConfig) -> Result<Self, StudioError> {
+        if !cfg.addr.ip().is_loopback() && !cfg.public {
+            return Err(StudioError::NotLoopback(cfg.addr));
+        }
+        let listener = TcpListener::bind(cfg.addr).map_err(|why| StudioError::Bind { addr: cfg.addr, why })?;
+        let addr = listener.local_addr()?;
+        listener.set_nonblocking(true)?;
+        let token = if cfg.public { Some(token::new_token()?) } else { None };
+        Ok(Self { listener, addr, token, public: cfg.public })
+    }
+
+    /// The address it listens on.
+    pub fn addr(&self) -> SocketAddr {
+        self.addr
+    }
+
+    /// Serves the page of a live session (see [`Studio::start_live`]).
     pub fn start_live(
-        cfg: &StudioConfig,
+        self,
         d: &Description,
         control: Arc<Mutex<Control>>,
         shared: Arc<Shared>,
-    ) -> Result<(Self, Ingest), StudioError> {
-        let mut studio = Self::serve(cfg, d.hello.to_string(), Vec::new(), Some(control))?;
+    ) -> Result<(Studio, Ingest), StudioError> {
+        let mut studio = self.serve(d.hello.to_string(), Vec::new(), Some(control))?;
         let feed = Arc::new(Mutex::new(FeedState::new(d, Some(shared))));
         let ingest = Ingest { feed: feed.clone() };
         let (stop, hub) = (studio.stop.clone(), studio.hub.clone());
@@ -134,19 +148,13 @@ impl Studio {
 
     /// Serves a page that receives `hello` then `initial` on connecting
     /// (and steers `control`, if any).
-    pub(crate) fn serve(
-        cfg: &StudioConfig,
+    fn serve(
+        self,
         hello: String,
         initial: Vec<String>,
         control: Option<Arc<Mutex<Control>>>,
-    ) -> Result<Self, StudioError> {
-        if !cfg.addr.ip().is_loopback() && !cfg.public {
-            return Err(StudioError::NotLoopback(cfg.addr));
-        }
-        let listener = TcpListener::bind(cfg.addr).map_err(|source| StudioError::Bind { addr: cfg.addr, source })?;
-        let addr = listener.local_addr()?;
-        listener.set_nonblocking(true)?;
-        let token = if cfg.public { Some(token::new_token()?) } else { None };
+    ) -> Result<Studio, StudioError> {
+        let Bound { listener, addr, token, public } = self;
         let stop = Arc::new(AtomicBool::new(false));
         let hub = Arc::new(Hub::default());
         let ctx = Arc::new(Ctx {
@@ -156,7 +164,7 @@ impl Studio {
             token: token.clone(),
             control,
             stop: stop.clone(),
-            public: cfg.public,
+            public,
             active: AtomicUsize::new(0),
         });
         let ctx2 = ctx.clone();
@@ -181,7 +189,42 @@ impl Studio {
                 }
             }
         })?;
-        Ok(Self { addr, token, stop, hub, ctx: ctx2, threads: vec![acceptor] })
+        Ok(Studio { addr, token, stop, hub, ctx: ctx2, threads: vec![acceptor] })
+    }
+}
+
+/// A running studio.
+pub struct Studio {
+    addr: SocketAddr,
+    token: Option<String>,
+    stop: Arc<AtomicBool>,
+    hub: Arc<Hub>,
+    ctx: Arc<Ctx>,
+    threads: Vec<JoinHandle<()>>,
+}
+
+impl Studio {
+    /// Serves the page of a live session: `control` is the session's
+    /// command queue (shared with the console), `shared` its counters.
+    /// Returns the studio and the intake the session's threads feed.
+    pub fn start_live(
+        cfg: &StudioConfig,
+        d: &Description,
+        control: Arc<Mutex<Control>>,
+        shared: Arc<Shared>,
+    ) -> Result<(Self, Ingest), StudioError> {
+        Bound::bind(cfg)?.start_live(d, control, shared)
+    }
+
+    /// Serves a page that receives `hello` then `initial` on connecting
+    /// (and steers `control`, if any).
+    pub(crate) fn serve(
+        cfg: &StudioConfig,
+        hello: String,
+        initial: Vec<String>,
+        control: Option<Arc<Mutex<Control>>>,
+    ) -> Result<Self, StudioError> {
+        Bound::bind(cfg)?.serve(hello, initial, control)
     }
 
     /// Sends `message` to every browser, and to every browser that
@@ -254,7 +297,8 @@ fn peek_head(s: &TcpStream) -> Option<Vec<u8>> {
 fn respond(s: &mut TcpStream, status: &str, ctype: &str, body: &[u8]) {
     let head = format!(
         "HTTP/1.1 {status}\r\nContent-Type: {ctype}\r\nContent-Length: {}\r\nCache-Control: no-store\r\n\
-         X-Content-Type-Options: nosniff\r\nConnection: close\r\n\r\n",
+         X-Content-Type-Options: nosniff\r\nContent-Security-Policy: default-src 'self'; connect-src 'self'; \
+         frame-ancestors 'none'\r\nConnection: close\r\n\r\n",
         body.len()
     );
     let _ = s.write_all(head.as_bytes()).and_then(|_| s.write_all(body)).and_then(|_| s.flush());

@@ -250,6 +250,7 @@ function sampleAt(s, t) {
 }
 
 // --- graph ---
+const esc = x => String(x).replace(/[&<>"']/g, c => ({ "&": "&amp;", "<": "&lt;", ">": "&gt;", '"': "&quot;", "'": "&#39;" })[c]);
 function graphDraw(g) {
   const depth = {};
   g.nodes.forEach(n => depth[n.name] = 0);
@@ -264,14 +265,14 @@ function graphDraw(g) {
   for (const e of g.edges) {
     const [x1, y1] = pos[e.from], [x2, y2] = pos[e.to];
     const a = [x1 + W, y1 + H / 2], b = [x2, y2 + H / 2];
-    svg += `<path class="edge" d="M${a[0]},${a[1]} C${a[0] + 25},${a[1]} ${b[0] - 25},${b[1]} ${b[0]},${b[1]}"><title>${e.from}.${e.out} → ${e.to}.${e.in} (${e.rate} Hz)</title></path>`;
+    svg += `<path class="edge" d="M${a[0]},${a[1]} C${a[0] + 25},${a[1]} ${b[0] - 25},${b[1]} ${b[0]},${b[1]}"><title>${esc(e.from)}.${esc(e.out)} → ${esc(e.to)}.${esc(e.in)} (${e.rate} Hz)</title></path>`;
     svg += `<text class="edge-label" x="${(a[0] + b[0]) / 2 - 10}" y="${(a[1] + b[1]) / 2 - 2}">${plot.fmt(e.rate)}</text>`;
   }
   for (const n of g.nodes) {
     const [x, y] = pos[n.name];
     const why = (g.pruned.find(p => p.node === n.name) || {}).reason;
-    svg += `<g class="node${n.in_plan ? "" : " pruned"}${n.guard ? " guard" : ""}"><rect x="${x}" y="${y}" width="${W}" height="${H}" rx="5"/><title>${n.type}${why ? " — left out: " + why : ""}</title>` +
-      `<text x="${x + 6}" y="${y + 15}"><tspan font-weight="700">${n.name}</tspan></text><text x="${x + 6}" y="${y + 29}">${n.type}</text><text x="${x + 6}" y="${y + 41}">${plot.fmt(n.rate)} Hz${n.in_plan ? "" : " · left out"}</text></g>`;
+    svg += `<g class="node${n.in_plan ? "" : " pruned"}${n.guard ? " guard" : ""}"><rect x="${x}" y="${y}" width="${W}" height="${H}" rx="5"/><title>${esc(n.type)}${why ? " — left out: " + esc(why) : ""}</title>` +
+      `<text x="${x + 6}" y="${y + 15}"><tspan font-weight="700">${esc(n.name)}</tspan></text><text x="${x + 6}" y="${y + 29}">${esc(n.type)}</text><text x="${x + 6}" y="${y + 41}">${plot.fmt(n.rate)} Hz${n.in_plan ? "" : " · left out"}</text></g>`;
   }
   $("graph").innerHTML = svg + "</svg>";
   const pr = $("pruned"); pr.textContent = "";

@@ -218,6 +218,24 @@ fn slope_angle(n: [f64; 3], d: [f64; 2]) -> f64 {
     (-(n[0] * d[0] + n[1] * d[1])).atan2(n[2]).to_degrees()
 }
 
+/// The height of triangle (a, b, c)'s plane above (x, y) when the point
+/// lies inside it or outside by at most 1e-9 of its size (barycentric), else `None`.
+fn near_hit(a: &[f64; 3], b: &[f64; 3], c: &[f64; 3], x: f64, y: f64) -> Option<f64> {
+    let d = (b[0] - a[0]) * (c[1] - a[1]) - (c[0] - a[0]) * (b[1] - a[1]);
+    if d == 0.0 || !d.is_finite() {
+        return None;
+    }
+    let u = ((x - a[0]) * (c[1] - a[1]) - (c[0] - a[0]) * (y - a[1])) / d;
+    let v = ((b[0] - a[0]) * (y - a[1]) - (x - a[0]) * (b[1] - a[1])) / d;
+    let tol = 1e-9;
+    if u >= -tol && v >= -tol && u + v <= 1.0 + tol {
+        let z = a[2] + u * (b[2] - a[2]) + v * (c[2] - a[2]);
+        Some(z.clamp(a[2].min(b[2]).min(c[2]), a[2].max(b[2]).max(c[2])))
+    } else {
+        None
+    }
+}
+
 impl EdgeTracker {
     /// A tracker for a mesh with the given θ_min.
     pub fn new(theta_min: f64, max_angle: f64, max_step: f64, floor: f64) -> Self {
@@ -236,6 +254,12 @@ impl EdgeTracker {
         if let Some(t) = tri.filter(|&t| (t as usize) < m.triangles.len()) {
             let [a, b, c] = m.corners(t as usize);
             if let Some(z) = vertical_hit(&a, &b, &c, x, y) {
+                return ([x, y, z], Some(t));
+            }
+            // On an edge the ray caster (relative coordinates) and this test (absolute)
+            // can round to different sides: a point within a hair of the triangle is on it,
+            // or the finger would seem to drop to the floor and back — a spurious cliff.
+            if let Some(z) = near_hit(&a, &b, &c, x, y) {
                 return ([x, y, z], Some(t));
             }
         }

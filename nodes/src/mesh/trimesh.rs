@@ -13,7 +13,7 @@
 //! file's winding was — even mixed.
 
 use super::error::MeshError;
-use std::collections::HashMap;
+use std::collections::{HashMap, HashSet};
 
 /// A triangle mesh in mesh units (the scenes of §4.2 are in cm).
 #[derive(Debug, Clone, PartialEq)]
@@ -23,8 +23,8 @@ pub struct Mesh {
     /// Triangles as indices into `vertices`.
     pub triangles: Vec<[u32; 3]>,
     /// Unit normal of each triangle in the oriented winding (see the module
-    /// doc); the faces a ray from above hits first face up. Zero for
-    /// degenerate (zero-area) triangles.
+    /// doc); the faces a ray from above hits first face up. Never zero:
+    /// zero-area triangles are dropped.
     pub normals: Vec<[f64; 3]>,
 }
 
@@ -77,24 +77,31 @@ pub fn cross(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
 
 impl Mesh {
     /// A mesh from vertices and triangles: vertices at the same position
-    /// (within `weld` mesh units; 0 = bit-identical coordinates) are merged,
-    /// triangles whose corners merged into fewer than three are dropped,
+    /// (within `weld` mesh units; 0 = bit-identical coordinates) are merged;
+    /// triangles of zero area (corners merged into fewer than three, or
+    /// collinear) and repeats of a triangle already kept (the same three
+    /// corners, in either winding: a two-sided sheet) are dropped — they
+    /// hold no surface a ray could feel, and would make the edges they
+    /// share look non-manifold; vertices no triangle uses are dropped;
     /// the triangles are oriented consistently (module doc) and normals are
     /// computed from the geometry (never taken from a file).
     pub fn new(vertices: Vec<[f64; 3]>, triangles: Vec<[u32; 3]>, weld: f64) -> Self {
         let (vertices, remap) = weld_vertices(&vertices, weld);
         let mut tris = Vec::with_capacity(triangles.len());
+        let mut normals: Vec<[f64; 3]> = Vec::with_capacity(triangles.len());
+        let mut seen: HashSet<[u32; 3]> = HashSet::with_capacity(triangles.len());
         for t in triangles {
             let t = t.map(|i| remap[i as usize]);
-            if t[0] != t[1] && t[1] != t[2] && t[0] != t[2] {
+            let n = raw_normal(vertices[t[0] as usize], vertices[t[1] as usize], vertices[t[2] as usize]);
+            let mut key = t;
+            key.sort_unstable();
+            // Zero area (corners merged or collinear) or the same corners again (either winding).
+            if n != [0.0; 3] && seen.insert(key) {
                 tris.push(t);
+                normals.push(n);
             }
         }
         let vertices = drop_unused(vertices, &mut tris);
-        let mut normals: Vec<[f64; 3]> = tris
-            .iter()
-            .map(|t| raw_normal(vertices[t[0] as usize], vertices[t[1] as usize], vertices[t[2] as usize]))
-            .collect();
         for (t, flip) in orientation(&vertices, &tris, &normals).into_iter().enumerate() {
             if flip {
                 tris[t].swap(1, 2);
@@ -360,6 +367,10 @@ mod tests {
         // A tolerance merges near points; a triangle collapsing to a segment goes.
         let v2 = vec![[0.0, 0.0, 0.0], [1e-9, 0.0, 0.0], [0.0, 1.0, 0.0]];
         let collapsed = Mesh::new(v2.clone(), vec![[0, 1, 2]], 1e-6);
+        // Repeats (either winding, any rotation) and collinear triangles go too.
+        let sq = vec![[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [1.0, 1.0, 0.0], [0.5, 0.0, 0.0]];
+        let m = Mesh::new(sq, vec![[0, 1, 2], [2, 1, 0], [1, 2, 0], [0, 3, 1], [0, 1, 2]], 0.0);
+        assert_eq!((m.triangles.len(), m.vertices.len()), (1, 3));
         assert_eq!((collapsed.triangles.len(), collapsed.vertices.len()), (0, 0));
         assert_eq!(Mesh::new(v2.clone(), vec![[0, 1, 2]], 0.0).triangles.len(), 1);
         // Vertices no triangle uses are dropped: they would move the bounds and the floor.

@@ -6,7 +6,7 @@
 
 use anyhow::{Context, Result};
 use evflow_nodes::mesh::fidelity::{edge_fidelity, gradient_fidelity, line_trace, ScanPlan};
-use evflow_nodes::mesh::obj::load_obj;
+use evflow_nodes::mesh::formats::load_file;
 use evflow_tools::plot::{write_png, Plot, Series};
 use std::path::PathBuf;
 
@@ -22,7 +22,8 @@ pub struct Args {
     /// Grid cells per 6 cm object side, coarse to fine.
     #[arg(long, value_delimiter = ',', default_value = "4,8,16,32,64,128,256,512")]
     resolutions: Vec<usize>,
-    /// A mesh with sharp edges for the edge report (units taken as cm).
+    /// A mesh with sharp edges for the edge report (units taken as cm): .obj,
+    /// .stl, .ply, .gltf or .glb.
     #[arg(long, default_value = "../shared/data/meshes/fandisk.obj")]
     edges_mesh: PathBuf,
     /// The edge mesh's axis that points up, toward the viewer (x, y, z, -x, -y, -z).
@@ -122,7 +123,7 @@ pub fn main(a: Args) -> Result<()> {
     report_png(&line, &a.out.join("mesh-fsq-line.png"))?;
 
     if a.edges_mesh.exists() {
-        let m = load_obj(&a.edges_mesh, 0.0).map_err(|e| anyhow::anyhow!("{e}"))?;
+        let m = load_file(&a.edges_mesh, 0.0).map_err(|e| anyhow::anyhow!("{e}"))?;
         let turned: Vec<[f64; 3]> = m.vertices.iter().map(|&p| turn(p, &a.up)).collect::<Result<_>>()?;
         let m = evflow_nodes::mesh::Mesh::new(turned, m.triangles.clone(), 0.0);
         let b = m.bounds();

@@ -227,7 +227,7 @@ pub fn placement_note(placed: &Placed, p: &Params) -> String {
     let up = format!("{} ({})", placed.up.word(), if p.str("up") == "auto" { "auto" } else { "set" });
     let how = if p.str("fit") == "footprint" { "fit = footprint" } else { "unit" };
     let (u, o) = (placed.unit, placed.offset);
-    let g = |x: f64| format!("{x:.4}");
+    let g = |x: f64| format!("{:.4}", x + 0.0);
     format!(
         "{}: {} triangles; bounds x {} … {}, y {} … {}, z {} … {} (mesh units, up turned to z); up {up}; \
          scale {} m per unit ({how}); on the screen x {} … {} m, y {} … {} m, heights {} … {} m",

@@ -8,7 +8,7 @@ use crate::check::check;
 use crate::graph::parse_graph;
 use crate::node::{BuildContext, Io, Node, NodeError, RunMode};
 use crate::params::{toml_float, Params};
-use crate::plan::{Plan, PlanOptions};
+use crate::plan::{Folding, Plan, PlanOptions};
 use crate::registry::Registry;
 use crate::spec::{NodeSpec, ParamSpec, PortSpec, RateSpec, Role};
 use std::path::Path;
@@ -138,7 +138,8 @@ impl Single<'_> {
             timing: false,
             mode: RunMode::Offline,
         };
-        let plan = Plan::build(&checked, &opts).map_err(|e| e.to_string())?;
+        // The node under test always runs: never replaced by a constant.
+        let plan = Plan::build_with(&checked, &opts, Folding::Off).map_err(|e| e.to_string())?;
         Ok((plan, out_index))
     }
 

@@ -160,13 +160,16 @@ impl Summary {
     }
 }
 
-/// A node's output declared constant for a plan: one value per output port
-/// (in the order of the node's resolved outputs), and why, in words for
-/// `evflow check` (see `docs/pruning.md`).
+/// A node's output declared constant for a plan: per output port (in the
+/// order of the node's resolved outputs) its value, or `None` for a port
+/// that is not constant (a diagnostic output), and why, in words for
+/// `evflow check` (see `docs/pruning.md`). The planner replaces the node
+/// only when every output some node reads is constant.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Constant {
-    /// The value of each output port, at every sample from t = 0.
-    pub outputs: Vec<f64>,
+    /// The value of each output port at every sample from t = 0 (`None`:
+    /// not constant).
+    pub outputs: Vec<Option<f64>>,
     /// Why, e.g. `gain = 0`.
     pub reason: String,
 }
@@ -174,10 +177,10 @@ pub struct Constant {
 impl Constant {
     /// Every one of `n` outputs at `value`.
     pub fn all(n: usize, value: f64, reason: impl Into<String>) -> Self {
-        Self { outputs: vec![value; n], reason: reason.into() }
+        Self { outputs: vec![Some(value); n], reason: reason.into() }
     }
-    /// The given output values.
-    pub fn new(outputs: Vec<f64>, reason: impl Into<String>) -> Self {
+    /// The given output values (`None`: that port is not constant).
+    pub fn new(outputs: Vec<Option<f64>>, reason: impl Into<String>) -> Self {
         Self { outputs, reason: reason.into() }
     }
 }

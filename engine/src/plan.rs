@@ -68,8 +68,9 @@ struct Entry {
     out_lens: Vec<usize>,
     scratch: Vec<Vec<f64>>,
     split: bool,
-    /// The output values of a node replaced by a constant (never stepped).
-    held: Option<Vec<f64>>,
+    /// The output values of a node replaced by a constant (never stepped;
+    /// `None`: an output no node reads, held at 0).
+    held: Option<Vec<Option<f64>>>,
     /// Time in build and prepare.
     setup: Duration,
     /// Time in process, emit and absorb.
@@ -207,9 +208,11 @@ impl Plan {
             if !lines.is_empty() {
                 notes.push((i, lines));
             }
-            match constant {
-                Some(k) => pruning.declare(i, k).map_err(|(j, e)| fail(j, e))?,
-                None => built[i] = Some(node),
+            if let Some(k) = constant {
+                pruning.declare(i, k).map_err(|(j, e)| fail(j, e))?;
+            }
+            if pruning.constant(i).is_none() {
+                built[i] = Some(node);
             }
         }
         let order = pruning.order();
@@ -341,7 +344,7 @@ impl Plan {
         for e in &self.entries {
             if let Some(values) = &e.held {
                 for (&s, &v) in e.out_slots.iter().zip(values) {
-                    self.pool[s].fill(v);
+                    self.pool[s].fill(v.unwrap_or(0.0));
                 }
             }
         }
@@ -541,6 +544,12 @@ impl Plan {
     /// values and why.
     pub fn folded(&self) -> &[Folded] {
         &self.folded
+    }
+    /// True when output `j` of node `k` is held by a node replaced by a
+    /// constant but is not constant itself: no node of the plan reads it,
+    /// and its buffer holds 0, not what the node would have computed.
+    pub fn output_dropped(&self, k: usize, j: usize) -> bool {
+        self.entries[k].held.as_ref().is_some_and(|h| h.get(j).is_some_and(Option::is_none))
     }
     /// What the built nodes said about what they loaded
     /// ([`Node::notes`]), by node, in plan order.

@@ -70,8 +70,9 @@ pub fn may_fold(spec: &NodeSpec) -> bool {
 pub struct Folded {
     /// The node.
     pub node: String,
-    /// Each output port's name and value.
-    pub outputs: Vec<(String, f64)>,
+    /// Each output port's name and value (`None`: not constant, and read
+    /// by no node of the plan).
+    pub outputs: Vec<(String, Option<f64>)>,
     /// Why its output is constant.
     pub reason: String,
 }
@@ -178,10 +179,16 @@ impl<'a> Pruning<'a> {
             let msg = format!("declared {} constant outputs for its {n_out} output ports", k.outputs.len());
             return Err((i, NodeError::Other(msg)));
         }
-        if let Some(v) = k.outputs.iter().find(|v| !v.is_finite()) {
+        if let Some(v) = k.outputs.iter().flatten().find(|v| !v.is_finite()) {
             return Err((i, NodeError::Other(format!("declared a constant output of {v}"))));
         }
-        self.constant[i] = Some(k);
+        // An output that varies keeps the node when any node reads it.
+        let varying_read = node.outputs().zip(&k.outputs).any(|(p, v)| {
+            v.is_none() && self.c.edges.iter().any(|e| e.from == (i, p) && self.c.order.contains(&e.to.0))
+        });
+        if !varying_read {
+            self.constant[i] = Some(k);
+        }
         Ok(())
     }
 
@@ -221,7 +228,7 @@ impl<'a> Pruning<'a> {
         let producer = &self.c.nodes[e.from.0];
         let k = self.constant[e.from.0].as_ref()?;
         let index = producer.outputs().position(|q| q == e.from.1)?;
-        k.outputs.get(index).copied()
+        k.outputs.get(index).copied().flatten()
     }
 }
 

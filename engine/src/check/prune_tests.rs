@@ -113,11 +113,13 @@ static PROBE: NodeSpec = NodeSpec::new("t.probe", "test", Role::Filter, "constan
     .params(&[
         ParamSpec::flag("flat", false, "loaded a flat scene"),
         ParamSpec::int("outputs", 0, 3, 2, "1", "declared"),
+        ParamSpec::flag("vary_angle", false, "the angle output is not constant"),
     ]);
 
 struct Probe {
     flat: bool,
     outputs: usize,
+    vary_angle: bool,
 }
 impl Node for Probe {
     fn process(&mut self, io: &mut Io<'_>) -> Result<(), NodeError> {
@@ -129,7 +131,8 @@ impl Node for Probe {
     }
     fn reset(&mut self) {}
     fn constant_output(&self) -> Option<Constant> {
-        self.flat.then(|| Constant::new([0.0, 180.0, 7.0][..self.outputs].to_vec(), "flat scene"))
+        let angle = (!self.vary_angle).then_some(180.0);
+        self.flat.then(|| Constant::new([Some(0.0), angle, Some(7.0)][..self.outputs].to_vec(), "flat scene"))
     }
     fn notes(&self) -> Vec<String> {
         vec![format!("flat: {}", self.flat)]
@@ -137,7 +140,7 @@ impl Node for Probe {
 }
 
 fn build_probe(p: &Params, _: &BuildContext) -> Result<Box<dyn Node>, NodeError> {
-    Ok(Box::new(Probe { flat: p.bool("flat"), outputs: p.usize("outputs") }))
+    Ok(Box::new(Probe { flat: p.bool("flat"), outputs: p.usize("outputs"), vary_angle: p.bool("vary_angle") }))
 }
 
 fn registry() -> Registry {
@@ -189,7 +192,7 @@ fn a_zero_gain_is_a_constant_and_its_missing_file_is_never_opened() {
     assert!(!opened("missing-gain-zero.wav"));
     let folded = plan.folded();
     assert_eq!(folded.len(), 1, "{folded:?}");
-    assert_eq!((folded[0].node.as_str(), folded[0].outputs.clone()), ("g", vec![("out".to_string(), 0.0)]));
+    assert_eq!((folded[0].node.as_str(), folded[0].outputs.clone()), ("g", vec![("out".to_string(), Some(0.0))]));
     assert_eq!(folded[0].reason, "k = 0");
     assert_eq!(plan.pruned().len(), 1);
     assert_eq!(plan.pruned()[0].node, "rec");
@@ -239,8 +242,8 @@ type = "harness.tap"
     let c = checked(&text);
     let mut plan = Plan::build(&c, &opts(4)).unwrap_or_else(|e| panic!("{e}"));
     // The whole chain collapses into the sum: only it stays, as a constant.
-    let folded: Vec<(&str, f64)> = plan.folded().iter().map(|f| (f.node.as_str(), f.outputs[0].1)).collect();
-    assert_eq!(folded, [("s", 0.0)]);
+    let folded: Vec<(&str, Option<f64>)> = plan.folded().iter().map(|f| (f.node.as_str(), f.outputs[0].1)).collect();
+    assert_eq!(folded, [("s", Some(0.0))]);
     assert_eq!(plan.folded()[0].reason, "sum of constants");
     let mut pruned: Vec<(&str, &str)> = plan.pruned().iter().map(|p| (p.node.as_str(), p.reason.as_str())).collect();
     pruned.sort_unstable();
@@ -327,4 +330,19 @@ fn a_constant_of_the_wrong_shape_is_an_error_of_its_node() {
         let e = Plan::build(&checked(&text), &opts(1)).err().unwrap().to_string();
         assert!(e.contains("node `p`") && e.contains(says), "{e}");
     }
+}
+
+#[test]
+fn an_output_that_varies_keeps_the_node_only_when_something_reads_it() {
+    let base = "[nodes.feed]\ntype = \"harness.feed\"\nvalues = [1.0]\n[nodes.p]\ntype = \"t.probe\"\nflat = true\nvary_angle = true\n[nodes.tap]\ntype = \"harness.tap\"\n[nodes.tap2]\ntype = \"harness.tap\"\n";
+    // `angle` read by nobody: the node is replaced, `angle` is dropped.
+    let text = format!("connections = [\"feed.out -> p.in\", \"p.out -> tap.in\", \"feed.out -> tap2.in\"]\n{base}");
+    let plan = Plan::build(&checked(&text), &opts(1)).unwrap();
+    assert_eq!(plan.folded()[0].outputs, [("out".to_string(), Some(0.0)), ("angle".to_string(), None)]);
+    let p = plan.index("p").unwrap();
+    assert!(!plan.output_dropped(p, 0) && plan.output_dropped(p, 1));
+    // `angle` read by a sink: the node stays.
+    let text = format!("connections = [\"feed.out -> p.in\", \"p.out -> tap.in\", \"p.angle -> tap2.in\"]\n{base}");
+    let plan = Plan::build(&checked(&text), &opts(1)).unwrap();
+    assert!(plan.folded().is_empty());
 }

@@ -140,6 +140,14 @@ impl LivePlan {
                     crate::suggest::help(&t.port, names.iter().map(String::as_str))
                 ))
             })?;
+            if plan.output_dropped(k, j) {
+                let why = plan.folded().iter().find(|f| f.node == t.node).map_or("", |f| f.reason.as_str());
+                return Err(unknown(format!(
+                    "`{}` is replaced by a constant for this plan ({why}) and this output, read by no node, is not \
+                     computed; connect it to a sink to keep the node (docs/pruning.md)",
+                    t.node
+                )));
+            }
             let ratio = plan.output_ratio(k, j);
             resolved.push((k, j));
             info.push(TapInfo { node: t.node.clone(), port: t.port.clone(), ratio, rate: ratio.hz(plan.base_rate()) });

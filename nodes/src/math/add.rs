@@ -1,6 +1,8 @@
 //! `add`: the sum of two streams.
 
 use super::binary::Binary;
+use evflow_engine::node::Constant;
+use evflow_engine::spec::FoldArgs;
 use evflow_engine::{BuildContext, Node, NodeError, NodeSpec, Params, PortSpec, Role};
 
 /// Declaration of `add`.
@@ -10,15 +12,23 @@ pub static SPEC: NodeSpec =
             "Adds two streams sample by sample: e.g. a force and the display's own friction noise, \
 to score what a perfect rendering would still carry (the display floor of `graphs/synthesize.toml`, \
 docs/narx.md §11). Both inputs and the output run at the node's rate, the rate of its producers. \
-Exact to one IEEE addition per sample.",
+Exact to one IEEE addition per sample. Two constant inputs make a constant output, which the planner \
+holds (docs/pruning.md).",
         )
         .ports(&[
             PortSpec::input("a", "1", "first term"),
             PortSpec::input("b", "1", "second term"),
             PortSpec::output("out", "1", "a + b"),
         ])
-        .example("");
+        .example("")
+        .fold(fold);
 
 fn build(_: &Params, _: &BuildContext) -> Result<Box<dyn Node>, NodeError> {
     Ok(Box::new(Binary(|a, b| a + b)))
+}
+
+/// Constant when both terms are.
+fn fold(f: &FoldArgs<'_>) -> Option<Constant> {
+    let (a, b) = (f.input(0)?, f.input(1)?);
+    Some(Constant::all(1, a + b, format!("{a} + {b}, both constant")))
 }

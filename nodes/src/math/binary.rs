@@ -42,6 +42,22 @@ mod tests {
     }
 
     #[test]
+    fn add_and_mul_fold_constants() {
+        use evflow_engine::spec::FoldArgs;
+        let p = evflow_engine::Params::default();
+        let (add, mul) = (&super::super::add::SPEC, &super::super::mul::SPEC);
+        let at = |spec: &'static NodeSpec, a, b| {
+            (spec.fold.unwrap())(&FoldArgs::new(spec, &p, &[a, b], 1, true)).map(|k| k.outputs[0].unwrap())
+        };
+        assert_eq!(at(add, Some(1.5), Some(-0.25)), Some(1.25));
+        assert_eq!(at(add, Some(0.0), None), None);
+        assert_eq!(at(mul, Some(1.5), Some(-2.0)), Some(-3.0));
+        assert_eq!(at(mul, Some(0.0), None), Some(0.0));
+        assert_eq!(at(mul, None, Some(0.0)), Some(0.0));
+        assert_eq!(at(mul, None, Some(2.0)), None);
+    }
+
+    #[test]
     fn add_and_mul_work_sample_by_sample_across_blocks() {
         let a: Vec<f64> = (0..50).map(|i| i as f64 * 0.5).collect();
         let b: Vec<f64> = (0..50).map(|i| if i % 3 == 0 { -2.0 } else { 1e-17 }).collect();

@@ -1,6 +1,8 @@
 //! `mul`: the product of two streams.
 
 use super::binary::Binary;
+use evflow_engine::node::Constant;
+use evflow_engine::spec::FoldArgs;
 use evflow_engine::{BuildContext, Node, NodeError, NodeSpec, Params, PortSpec, Role};
 
 /// Declaration of `mul`.
@@ -10,15 +12,27 @@ pub static SPEC: NodeSpec =
             "Multiplies two streams sample by sample: an actuation waveform by an intensity or a \
 gate (dissertation §3.1.2: a haptic effect switched on in one segment of eight; §4.1: a grain scaled \
 by the rendered intensity). Both inputs and the output run at the node's rate, the rate of its \
-producers. Exact: one IEEE multiplication per sample.",
+producers. Exact: one IEEE multiplication per sample. A constant 0 on either input (the other is finite, as \
+every node's output is) or two constant inputs make a constant output, which the planner holds and \
+leaves out what fed only the other input (docs/pruning.md).",
         )
         .ports(&[
             PortSpec::input("a", "1", "first factor"),
             PortSpec::input("b", "1", "second factor"),
             PortSpec::output("out", "1", "a · b"),
         ])
-        .example("");
+        .example("")
+        .fold(fold);
 
 fn build(_: &Params, _: &BuildContext) -> Result<Box<dyn Node>, NodeError> {
     Ok(Box::new(Binary(|a, b| a * b)))
+}
+
+/// Constant when either factor is a constant 0, or both are constant.
+fn fold(f: &FoldArgs<'_>) -> Option<Constant> {
+    match (f.input(0), f.input(1)) {
+        (Some(a), Some(b)) => Some(Constant::all(1, a * b, format!("{a} · {b}, both constant"))),
+        (Some(z), _) | (_, Some(z)) if z == 0.0 => Some(Constant::all(1, 0.0, "a factor is a constant 0")),
+        _ => None,
+    }
 }

@@ -32,7 +32,12 @@
 //! the pair is consistently oriented, else as a wall going down from the
 //! edge, θ = 180° − ∠(n_a, w), w the horizontal outward direction), and
 //! boundary edges of open meshes: wholly above the floor a boundary is a
-//! cliff (the same wall rule); touching or below the floor it meets the
+//! cliff (the same wall rule) — when it stands higher than the face beside
+//! it is wide × tan(180° − `max_angle`); a lower step bends no more than a
+//! facet and is not an edge (the 0.2 % tails of the Gaussian bumps where a
+//! generated scene ends, 30 µm above the screen, are no cliff, so the
+//! Gaussian scenes have no convex edge and `mesh.edges` on them is a
+//! constant, `docs/pruning.md`); touching or below the floor it meets the
 //! floor plane from below or level and is not convex. A mesh without a
 //! convex edge has θ_min = 180° and never ticks (S = 0).
 //!
@@ -80,6 +85,17 @@ fn wall_angle(n: [f64; 3], v0: [f64; 3], v1: [f64; 3], o: [f64; 3]) -> Option<f6
         w = w.map(|x| -x);
     }
     Some(180.0 - angle(n, w))
+}
+
+/// Horizontal distance from `o` to the line through `v0`, `v1` (the width
+/// of a face across its edge, seen from above).
+fn across(v0: [f64; 3], v1: [f64; 3], o: [f64; 3]) -> f64 {
+    let (ex, ey) = (v1[0] - v0[0], v1[1] - v0[1]);
+    let len = ex.hypot(ey);
+    if len == 0.0 {
+        return 0.0;
+    }
+    ((o[0] - v0[0]) * ey - (o[1] - v0[1]) * ex).abs() / len
 }
 
 /// A normal turned to face up (the slope along a direction does not depend
@@ -150,10 +166,15 @@ pub fn census(m: &Mesh, floor: f64, max_angle: f64) -> EdgeCensus {
                 let t = faces[0];
                 let n = up(m.normals[t as usize]);
                 let (p0, p1) = (m.vertices[v0 as usize], m.vertices[v1 as usize]);
-                let above = p0[2].min(p1[2]) > floor + 1e-9 * ext;
-                if n[2] > VERTICAL && above {
-                    let o = m.triangles[t as usize].into_iter().find(|&k| k != v0 && k != v1);
-                    if let Some(th) = o.and_then(|o| wall_angle(n, p0, p1, m.vertices[o as usize])) {
+                let drop = p0[2].min(p1[2]) - floor;
+                let o = m.triangles[t as usize].into_iter().find(|&k| k != v0 && k != v1);
+                if n[2] > VERTICAL && drop > 1e-9 * ext {
+                    let o = o.map(|o| m.vertices[o as usize]);
+                    // A step lower than the face beside it is wide × tan(180° − max_angle)
+                    // bends no more than a facet would: not a cliff.
+                    let turn = (180.0 - max_angle).clamp(0.0, 89.0).to_radians().tan();
+                    let tall = o.is_some_and(|o| drop > turn * across(p0, p1, o));
+                    if let Some(th) = o.filter(|_| tall).and_then(|o| wall_angle(n, p0, p1, o)) {
                         take(th, &mut c);
                     }
                 }

@@ -200,6 +200,11 @@ struct GradientNode {
     /// (scene faded out, samples of the fade done).
     fade: Option<(usize, usize)>,
     fade_len: usize,
+    /// Build notes: where each mesh lands ([`placement_note`]).
+    notes: Vec<String>,
+    /// Ticks on the mesh felt and off it (the `tri` output ≥ 0 or −1).
+    on: u64,
+    off: u64,
 }
 
 fn build(p: &Params, ctx: &BuildContext) -> Result<Box<dyn Node>, NodeError> {
@@ -207,9 +212,41 @@ fn build(p: &Params, ctx: &BuildContext) -> Result<Box<dyn Node>, NodeError> {
         .into_iter()
         .map(|placed| build_state(p, ctx, placed))
         .collect::<Result<Vec<_>, _>>()?;
+    let notes = scenes.iter().map(|s| placement_note(&s.placed, p)).collect();
     let initial = p.usize("scene");
     let fade_len = (p.f64("switch_fade") * 1e-3 * ctx.rate).round() as usize;
-    Ok(Box::new(GradientNode { scenes, current: initial, initial, fade: None, fade_len }))
+    Ok(Box::new(GradientNode { scenes, current: initial, initial, fade: None, fade_len, notes, on: 0, off: 0 }))
+}
+
+/// What `evflow check --build` says about a loaded mesh (the build note of
+/// every node that loads one): its size, its bounds in its own units after
+/// `up` was turned to height, the axis taken as up and why, the scale, and
+/// where it lands on the screen in metres.
+pub fn placement_note(placed: &Placed, p: &Params) -> String {
+    let b = placed.mesh.bounds();
+    let up = format!("{} ({})", placed.up.word(), if p.str("up") == "auto" { "auto" } else { "set" });
+    let how = if p.str("fit") == "footprint" { "fit = footprint" } else { "unit" };
+    let (u, o) = (placed.unit, placed.offset);
+    let g = |x: f64| format!("{:.4}", x + 0.0);
+    format!(
+        "{}: {} triangles; bounds x {} … {}, y {} … {}, z {} … {} (mesh units, up turned to z); up {up}; \
+         scale {} m per unit ({how}); on the screen x {} … {} m, y {} … {} m, heights {} … {} m",
+        placed.name,
+        placed.mesh.triangles.len(),
+        g(b.min[0]),
+        g(b.max[0]),
+        g(b.min[1]),
+        g(b.max[1]),
+        g(b.min[2]),
+        g(b.max[2]),
+        u,
+        g(o[0] + b.min[0] * u),
+        g(o[0] + b.max[0] * u),
+        g(o[1] + b.min[1] * u),
+        g(o[1] + b.max[1] * u),
+        g((b.min[2] - placed.z0) * u),
+        g((b.max[2] - placed.z0) * u),
+    )
 }
 
 /// One tick's outputs: intensity, F^sq, slope, z (m), triangle (−1: none).
@@ -270,6 +307,11 @@ impl Node for GradientNode {
                 out[0] = (1.0 - w) * old[0] + w * out[0];
                 self.fade = (done + 1 < self.fade_len).then_some((from, done + 1));
             }
+            if out[4] >= 0.0 {
+                self.on += 1;
+            } else {
+                self.off += 1;
+            }
             for (k, v) in out.into_iter().enumerate() {
                 io.output(k)[i] = v;
             }
@@ -285,24 +327,17 @@ impl Node for GradientNode {
         }
         self.current = self.initial;
         self.fade = None;
+        self.on = 0;
+        self.off = 0;
     }
 
     fn finish(&mut self) -> Result<Summary, NodeError> {
-        let first = &self.scenes[self.initial];
-        if self.scenes.len() == 1 {
-            return Ok(first.summary(Summary::default(), ""));
-        }
-        // The starting scene's figures as values, every scene's as a line.
-        let on = first.hits as f64 / (first.hits + first.misses).max(1) as f64;
-        let mut s = Summary::default()
-            .value("f_min", first.range.f_min, "sqrt(N)")
-            .value("f_max", first.range.f_max, "sqrt(N)")
-            .value("triangles", first.placed.mesh.triangles.len() as f64, "1")
-            .value("on_mesh", on, "1");
-        for (k, sc) in self.scenes.iter().enumerate() {
-            s = sc.summary(s, &format!("scene {k}: "));
-        }
-        Ok(s)
+        let s = self.scene_summary();
+        Ok(off_mesh_warning(s, self.on, self.off))
+    }
+
+    fn notes(&self) -> Vec<String> {
+        self.notes.clone()
     }
 
     fn set(&mut self, param: &'static str, value: f64) -> Result<(), Refused> {
@@ -326,5 +361,90 @@ impl Node for GradientNode {
             }
             _ => Err(Refused(param)),
         }
+    }
+}
+
+/// The fraction of ticks the finger was off the mesh felt, as the value
+/// `off_mesh`, and a warning line when it was off for most of them (more
+/// than half): the mesh is probably not where the finger goes.
+fn off_mesh_warning(s: Summary, on: u64, off: u64) -> Summary {
+    let total = on + off;
+    if total == 0 {
+        return s;
+    }
+    let fraction = off as f64 / total as f64;
+    let s = s.value("off_mesh", fraction, "1");
+    if 2 * off <= total {
+        return s;
+    }
+    s.line(format!(
+        "warning: the finger was off the mesh on {:.1} % of the ticks ({off} of {total}); check where the mesh \
+         lies (offset_x/y, unit or fit; `evflow check --build` prints its place on the screen)",
+        100.0 * fraction
+    ))
+}
+
+impl GradientNode {
+    /// The meshes' figures: the starting one's as values, and with several
+    /// scenes every scene's as a line.
+    fn scene_summary(&self) -> Summary {
+        let first = &self.scenes[self.initial];
+        if self.scenes.len() == 1 {
+            return first.summary(Summary::default(), "");
+        }
+        // The starting scene's figures as values, every scene's as a line.
+        let on = first.hits as f64 / (first.hits + first.misses).max(1) as f64;
+        let mut s = Summary::default()
+            .value("f_min", first.range.f_min, "sqrt(N)")
+            .value("f_max", first.range.f_max, "sqrt(N)")
+            .value("triangles", first.placed.mesh.triangles.len() as f64, "1")
+            .value("on_mesh", on, "1");
+        for (k, sc) in self.scenes.iter().enumerate() {
+            s = sc.summary(s, &format!("scene {k}: "));
+        }
+        s
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::SPEC;
+    use evflow_engine::harness::Single;
+    use evflow_engine::Summary;
+
+    /// `on` ticks on a 1 cm plate, then `off` ticks beside it.
+    fn summary(dir: &std::path::Path, on: usize, off: usize) -> Summary {
+        let n = on + off;
+        let x: Vec<f64> = (0..n).map(|i| if i < on { 0.002 + 0.001 * i as f64 % 0.006 } else { 0.05 }).collect();
+        Single {
+            spec: &SPEC,
+            params: "file = \"plate.obj\"\nup = \"+z\"\nrange = \"fixed\"",
+            inputs: vec![("x", x, 1000.0), ("y", vec![0.005; n], 1000.0)],
+            outputs: vec!["tri"],
+            base_rate: 1000.0,
+            ticks: n as u64,
+            block: 4,
+            base_dir: dir,
+        }
+        .summary()
+        .unwrap()
+    }
+
+    #[test]
+    fn a_finger_off_the_mesh_for_most_ticks_is_reported_with_the_exact_fraction() {
+        let dir = tempfile::tempdir().unwrap();
+        std::fs::write(dir.path().join("plate.obj"), "v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nf 1 2 3 4\n").unwrap();
+        let s = summary(dir.path(), 3, 7);
+        assert_eq!(s.get("off_mesh"), Some(0.7));
+        let warning: Vec<&String> = s.lines.iter().filter(|l| l.starts_with("warning:")).collect();
+        assert_eq!(warning.len(), 1, "{:?}", s.lines);
+        assert!(warning[0].starts_with("warning: the finger was off the mesh on 70.0 % of the ticks (7 of 10)"));
+        // Off for exactly half the ticks is not most of them: no warning.
+        let s = summary(dir.path(), 500, 500);
+        assert_eq!(s.get("off_mesh"), Some(0.5));
+        assert!(!s.lines.iter().any(|l| l.starts_with("warning:")), "{:?}", s.lines);
+        // 1 tick on, 2 off: 66.7 %.
+        let s = summary(dir.path(), 1, 2);
+        assert!(s.lines.iter().any(|l| l.contains("66.7 % of the ticks (2 of 3)")), "{:?}", s.lines);
     }
 }

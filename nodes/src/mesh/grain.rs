@@ -2,6 +2,8 @@
 //! dissertation Fig. 4.3 — AREA-EVEN for the surface gradient and
 //! EDGE-TICK for sharp edges — scaled by their intensities.
 
+use evflow_engine::node::Constant;
+use evflow_engine::spec::FoldArgs;
 use evflow_engine::{BuildContext, Io, Node, NodeError, NodeSpec, ParamSpec, Params, PortSpec, Role};
 use std::f64::consts::TAU;
 
@@ -38,7 +40,11 @@ line holding > 99 % of the energy; the EDGE-TICK spectrum has three separate pea
 first sample equals I_e.\n\n\
 **Ports:** `area` (0–1), one edge input per entry of `edges` (0–1; 0 = no edge), output `out`; \
 all at the node's rate. Intensities are clamped to [0, 1]; NaN counts as 0. Every partial must lie \
-below the Nyquist frequency (checked when the node is built).",
+below the Nyquist frequency (checked when the node is built).\n\n\
+**Pruning** (docs/pruning.md): when the `area` input and every edge input (or none, with `edges` \
+empty) are a constant 0 — e.g. fed by a `mesh.edges` the planner replaced by its constant and a \
+`gain` of 0 — the output is the constant 0: the planner holds it and leaves out what fed only this \
+node.",
 )
 .ports(&[
     PortSpec::input("area", "1", "AREA-EVEN intensity (mesh.gradient's `intensity`)"),
@@ -53,7 +59,20 @@ below the Nyquist frequency (checked when the node is built).",
     ParamSpec::float("tick_length", 1e-3, 1.0, 0.04, "s", "duration of one EDGE-TICK burst"),
     ParamSpec::text_list("edges", "names of EDGE-TICK inputs (e.g. [\"edge\"]); none: area grain only"),
 ])
-.example("area_frequency = 100.0\nedges = [\"edge\"]");
+.example("area_frequency = 100.0\nedges = [\"edge\"]")
+.fold(fold);
+
+/// Constant 0 when every intensity is a constant 0 (NaN counts as 0): the
+/// smoothed amplitude stays 0 and no burst starts.
+fn fold(f: &FoldArgs<'_>) -> Option<Constant> {
+    for v in f.inputs() {
+        if level((*v)?) != 0.0 {
+            return None;
+        }
+    }
+    let what = if f.inputs().len() == 1 { "the area intensity is" } else { "every intensity is" };
+    Some(Constant::all(1, 0.0, format!("{what} a constant 0")))
+}
 
 struct Grain {
     /// f_a / f_s, cycles per sample.
@@ -247,6 +266,23 @@ mod tests {
         let area: Vec<f64> = (0..600).map(|i| if i % 90 < 45 { 1.0 } else { 0.2 }).collect();
         let out = run("edges = [\"edge\"]\nsmoothing = 0.001", area, Some(edge));
         assert!(out.iter().all(|x| x.is_finite() && x.abs() <= 1.0 + 1e-12));
+    }
+
+    #[test]
+    fn folds_to_zero_only_when_every_intensity_is_a_constant_zero() {
+        let mut m = std::collections::BTreeMap::new();
+        m.insert("edges".to_string(), evflow_engine::Value::TextList(vec!["edge".into()]));
+        let p = Params::from_map(m);
+        let fold = |inputs: &[Option<f64>]| (SPEC.fold.unwrap())(&FoldArgs::new(&SPEC, &p, inputs, 1, true));
+        assert_eq!(fold(&[Some(0.0), Some(0.0)]).unwrap().outputs, [Some(0.0)]);
+        assert_eq!(fold(&[Some(-2.0), Some(f64::NAN)]).unwrap().outputs, [Some(0.0)]); // clamped, NaN as 0
+        assert!(fold(&[Some(0.5), Some(0.0)]).is_none()); // AREA-EVEN plays
+        assert!(fold(&[Some(0.0), Some(0.3)]).is_none()); // one burst
+        assert!(fold(&[None, Some(0.0)]).is_none());
+        assert!(fold(&[Some(0.0)]).unwrap().reason.contains("area intensity"));
+        // What the fold claims is what the node does.
+        let out = run("edges = [\"edge\"]", vec![0.0; 300], Some(vec![0.0; 300]));
+        assert!(out.iter().all(|&v| v == 0.0));
     }
 
     #[test]

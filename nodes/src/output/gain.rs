@@ -1,5 +1,7 @@
 //! `gain`: multiplies a stream by a constant.
 
+use evflow_engine::node::Constant;
+use evflow_engine::spec::FoldArgs;
 use evflow_engine::{BuildContext, Io, Node, NodeError, NodeSpec, ParamSpec, Params, PortSpec, Refused, Role};
 
 /// Declaration of `gain`.
@@ -13,14 +15,27 @@ pub static SPEC: NodeSpec =
          from its current value to the new one over `ramp` seconds (round(ramp·rate) samples, at \
          least one), so a change never clicks; a change during a ramp starts a new ramp from where \
          the gain is. Checked by the exact ramp values in its unit tests and the generic \
-         block ≡ per-sample test.",
+         block ≡ per-sample test.\n\n\
+         **Pruning** (docs/pruning.md): a gain of 0 makes the output the constant 0, and a \
+         constant input c makes it g·c; the planner then holds the output and leaves out what fed \
+         only this node. A live plan never folds on `gain`, which may change while it runs.",
         )
         .ports(&[PortSpec::input("in", "1", "signal"), PortSpec::output("out", "1", "signal × gain")])
         .params(&[
             ParamSpec::float("gain", -1e6, 1e6, 1.0, "1", "multiplier").live(),
             ParamSpec::float("ramp", 0.0, 10.0, 0.01, "s", "time a live change of `gain` takes"),
         ])
-        .example("gain = 1.2");
+        .example("gain = 1.2")
+        .fold(fold);
+
+/// Constant when the gain is 0 (inputs are finite), or of a constant input.
+fn fold(f: &FoldArgs<'_>) -> Option<Constant> {
+    let g = f.f64("gain")?;
+    if g == 0.0 {
+        return Some(Constant::all(1, 0.0, "gain = 0"));
+    }
+    f.input(0).map(|x| Constant::all(1, g * x, format!("gain {g} × constant input {x}")))
+}
 
 struct Gain {
     /// The gain at t = 0.
@@ -99,6 +114,24 @@ mod tests {
         for (y, x) in out[0].iter().zip(&x) {
             assert_eq!(*y, -2.5 * x);
         }
+    }
+
+    #[test]
+    fn folds_a_zero_gain_and_constant_inputs_but_never_a_live_gain() {
+        let params = |g: f64| {
+            let mut m = std::collections::BTreeMap::new();
+            m.insert("gain".to_string(), evflow_engine::Value::Float(g));
+            m.insert("ramp".to_string(), evflow_engine::Value::Float(0.01));
+            Params::from_map(m)
+        };
+        let fold = SPEC.fold.unwrap();
+        let (zero, two) = (params(0.0), params(2.0));
+        let k = fold(&FoldArgs::new(&SPEC, &zero, &[None], 1, true)).unwrap();
+        assert_eq!((k.outputs, k.reason.as_str()), (vec![Some(0.0)], "gain = 0"));
+        assert_eq!(fold(&FoldArgs::new(&SPEC, &two, &[Some(-1.5)], 1, true)).unwrap().outputs, [Some(-3.0)]);
+        assert!(fold(&FoldArgs::new(&SPEC, &two, &[None], 1, true)).is_none());
+        // A plan that takes live changes may not rely on `gain`.
+        assert!(fold(&FoldArgs::new(&SPEC, &zero, &[Some(1.0)], 1, false)).is_none());
     }
 
     #[test]

@@ -2,6 +2,8 @@
 
 use super::graph_args::GraphArgs;
 use anyhow::{anyhow, Result};
+use evflow_engine::check::prune::{Folded, Pruning};
+use evflow_engine::check::Pruned;
 use evflow_engine::{Direction, Plan, PlanOptions};
 
 /// Arguments of `evflow check`.
@@ -10,7 +12,9 @@ pub struct Args {
     #[command(flatten)]
     graph: GraphArgs,
     /// Also construct and prepare the plan's nodes (opens their files),
-    /// without running anything.
+    /// without running anything: prints what each node loaded (a mesh's
+    /// bounds, up axis, scale and place on the screen) and what it then
+    /// found constant and left out.
     #[arg(long)]
     build: bool,
 }
@@ -23,9 +27,16 @@ pub fn main(a: Args) -> Result<()> {
     if !g.description.is_empty() {
         println!("  {}", g.description);
     }
-    println!("\nplan ({} of {} nodes, in execution order):", c.order.len(), c.nodes.len());
-    for &i in &c.order {
+    // What an offline run leaves out before building anything.
+    let pruning = Pruning::new(&c, true, true).map_err(|(i, e)| anyhow!("node `{}`: {e}", c.nodes[i].name))?;
+    let order = pruning.order();
+    println!("\nplan ({} of {} nodes, in execution order):", order.len(), c.nodes.len());
+    for &i in &order {
         let n = &c.nodes[i];
+        if let Some(k) = pruning.constant(i) {
+            println!("  {:<16} {:<16} constant: {}", n.name, n.spec.name, k.reason);
+            continue;
+        }
         let ins: Vec<String> = c
             .edges
             .iter()
@@ -49,14 +60,8 @@ pub fn main(a: Args) -> Result<()> {
             if outs.is_empty() { "-".into() } else { outs.join(", ") }
         );
     }
-    if c.pruned.is_empty() {
-        println!("\nleft out: nothing");
-    } else {
-        println!("\nleft out (never constructed, their files never opened):");
-        for p in &c.pruned {
-            println!("  {:<16} {}", p.node, p.reason);
-        }
-    }
+    print_folded("replaced by constants (held, never run; docs/pruning.md):", &pruning.folded());
+    print_pruned("left out (never constructed, their files never opened):", &pruning.pruned(), true);
     if !c.in_cycle.is_empty() {
         let names: Vec<&str> = c.in_cycle.iter().map(|&i| c.nodes[i].name.as_str()).collect();
         println!("\nfeedback cycles broken by: {}", names.join(", "));
@@ -90,7 +95,58 @@ sweep: {} → {runs} runs (`evflow run` runs them all)",
     if a.build {
         let plan = Plan::build(&c, &PlanOptions::default()).map_err(|e| anyhow!("{e}"))?;
         println!("\nbuilt: {} nodes, block {} base ticks", plan.schedule().len(), plan.max_block());
+        for (node, lines) in plan.notes() {
+            for l in lines {
+                println!("  {node}: {l}");
+            }
+        }
+        let before = pruning.folded();
+        let folded: Vec<Folded> =
+            plan.folded().iter().filter(|f| !before.iter().any(|b| b.node == f.node)).cloned().collect();
+        let before = pruning.pruned();
+        let pruned: Vec<Pruned> =
+            plan.pruned().iter().filter(|p| !before.iter().any(|b| b.node == p.node)).cloned().collect();
+        print_folded("replaced by constants when built:", &folded);
+        print_pruned("left out when built (the nodes were built first, or never):", &pruned, false);
+    } else {
+        println!(
+            "\n(a node may find more to leave out once it has loaded its files, e.g. `mesh.edges` on a mesh \
+             without sharp edges: `--build` builds the plan and says)"
+        );
     }
     println!("\nok");
     Ok(())
+}
+
+/// Nodes replaced by constants, each with its outputs' values and why.
+fn print_folded(title: &str, folded: &[Folded]) {
+    if folded.is_empty() {
+        return;
+    }
+    println!("\n{title}");
+    for f in folded {
+        let outs: Vec<String> = f
+            .outputs
+            .iter()
+            .map(|(p, v)| match v {
+                Some(v) => format!("{p} = {v}"),
+                None => format!("{p} not computed (read by no node)"),
+            })
+            .collect();
+        println!("  {:<16} {}: {}", f.node, outs.join(", "), f.reason);
+    }
+}
+
+/// Nodes left out, and why; `nothing` says so when there are none.
+fn print_pruned(title: &str, pruned: &[Pruned], nothing: bool) {
+    if pruned.is_empty() {
+        if nothing {
+            println!("\nleft out: nothing");
+        }
+        return;
+    }
+    println!("\n{title}");
+    for p in pruned {
+        println!("  {:<16} {}", p.node, p.reason);
+    }
 }

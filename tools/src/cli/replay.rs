@@ -205,7 +205,9 @@ fn replay_one(session: &Path, graph: Option<&Path>, out: &Path, a: &Args) -> Res
         timing: true,
         mode: evflow_engine::RunMode::Offline,
     };
-    let mut plan = Plan::build(&checked, &opts).map_err(|e| anyhow!("{e}"))?;
+    // The session's parameter changes apply: no constant may rest on a live parameter.
+    let mut plan =
+        Plan::build_with(&checked, &opts, evflow_engine::plan::Folding::Changes).map_err(|e| anyhow!("{e}"))?;
     if (plan.base_rate() - m.base_rate).abs() > 1e-9 * m.base_rate {
         return Err(anyhow!("the graph runs at {} Hz but the session at {} Hz", plan.base_rate(), m.base_rate));
     }

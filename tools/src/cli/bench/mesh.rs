@@ -32,6 +32,11 @@ pub struct Args {
     /// Gaussian scene configuration (0B4H … 4B0H).
     #[arg(long, default_value = "2B2H")]
     config: String,
+    /// Instead: time the live chain (`--graph`, as shipped) per tick with
+    /// and without the planner's constants (`docs/pruning.md`), in
+    /// alternating rounds of `--ticks` / 10.
+    #[arg(long)]
+    pruning: bool,
 }
 
 /// One row of the result table.
@@ -48,6 +53,9 @@ struct Row {
 
 /// Runs the benchmark and prints a Markdown table.
 pub fn main(a: Args) -> Result<()> {
+    if a.pruning {
+        return super::mesh_prune::compare(&a.graph, &[], a.ticks, 10);
+    }
     if a.sizes.is_empty() {
         return Err(anyhow!("--sizes needs at least one triangle count"));
     }

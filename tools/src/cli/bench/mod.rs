@@ -5,6 +5,8 @@
 
 #[cfg(feature = "mesh")]
 pub mod mesh;
+#[cfg(feature = "mesh")]
+pub mod mesh_prune;
 #[cfg(feature = "narx")]
 pub mod narx;
 #[cfg(feature = "narx")]
@@ -27,6 +29,9 @@ enum Which {
     /// through the BVH against a brute-force loop over all triangles, and
     /// the live chain's per-tick compute time, for meshes of 1 k, 100 k and
     /// 1 M triangles. Build with --release.
+    ///
+    /// With --pruning: the per-tick time of the live chain with and without
+    /// the planner's constants (mesh.edges held on the Gaussian scenes).
     ///
     /// Example: cargo run --release -p evflow -- bench mesh
     #[cfg(feature = "mesh")]

@@ -41,6 +41,12 @@ enum Command {
     ///   for k in 1 2 3; do evflow run graphs/excitation.toml --shard $k/3 --out part$k --csv part$k/grid.csv; done
     ///   evflow merge grid part1 part2 part3
     Merge(cli::merge::Args),
+    /// The model library: inverse models and actuation cells for every
+    /// texture sample × the 3×3 grid, with an index; resumable.
+    ///
+    /// Example: cargo run --release -p evflow -- library build --out library --jobs 2
+    #[cfg(feature = "synth")]
+    Library(cli::library::Args),
     /// Validate a graph and print its plan: execution order, rates, buffer
     /// block size, and which nodes were left out and why.
     ///
@@ -145,6 +151,8 @@ fn main() -> ExitCode {
         Command::Live(a) => cli::live::main(a),
         Command::Replay(a) => cli::replay::main(a),
         Command::Merge(a) => cli::merge::main(a),
+        #[cfg(feature = "synth")]
+        Command::Library(a) => cli::library::main(a),
         Command::Report(a) => cli::report::main(a),
         Command::Bench(a) => cli::bench::main(a),
         #[cfg(all(feature = "serial", feature = "lab"))]

@@ -192,3 +192,76 @@ fn many_sessions_replay_in_order_on_two_jobs_and_a_broken_one_fails_alone() {
     assert_eq!(out.matches("limit.out: identical to the live session, bit for bit").count(), 3, "{out}");
     assert!(err.contains("1 of 4 sessions failed") && err.contains("broken"), "{err}");
 }
+
+/// The model library: built, usable by the texture-live grid, resumed
+/// (nothing redone), and a half-written item redone.
+#[cfg(feature = "synth")]
+#[test]
+fn a_model_library_resumes_and_redoes_a_half_written_item() {
+    let base = tempfile::tempdir().unwrap();
+    let lib = base.path().join("lib");
+    let l = lib.to_str().unwrap();
+    let build = |jobs: &str| {
+        evflow(&[
+            "library",
+            "build",
+            "--out",
+            l,
+            "--samples",
+            "felt-fabric",
+            "--masses",
+            "60,110",
+            "--speeds",
+            "3,5",
+            "--epochs",
+            "3",
+            "--iterations",
+            "3",
+            "--gains",
+            "1.0",
+            "--jobs",
+            jobs,
+        ])
+    };
+    let o = build("2");
+    let out = String::from_utf8_lossy(&o.stdout);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    assert!(out.contains("8 items built, 0 already there, 0 failed, of 8"), "{out}");
+    let index: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(lib.join("index.json")).unwrap()).unwrap();
+    let entries = index["entries"].as_array().unwrap();
+    assert_eq!(entries.len(), 4);
+    let tags: Vec<&str> = entries.iter().map(|e| e["tag"].as_str().unwrap()).collect();
+    assert_eq!(tags, ["60g-3cms", "60g-5cms", "110g-3cms", "110g-5cms"]);
+    for e in entries {
+        assert_eq!(e["texture"], "felt-fabric");
+        assert!(lib.join(e["model"].as_str().unwrap()).is_file());
+        assert!(e["training"]["validation_mse"].as_f64().unwrap().is_finite());
+        for m in ["narx", "optimized", "playback"] {
+            let es = e["E_s"][m]["welch"].as_f64().unwrap();
+            assert!(es.is_finite() && es > 0.0, "{m}: {es}");
+            assert!(lib.join(e["cells"][m].as_str().unwrap()).is_file());
+        }
+    }
+    // The texture-live grid plays the library's cells.
+    let grid = format!("textures=[\"{}\"]", lib.join("narx-felt-fabric").display());
+    let o = evflow(&["run", "graphs/texture-live.toml", "--set", &grid, "--duration", "0.5", "-q", "--out", l]);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+
+    // Rerun: everything is there.
+    let o = build("2");
+    assert!(String::from_utf8_lossy(&o.stdout).contains("0 items built, 8 already there"));
+
+    // An interruption while one cell was being moved in: its sample file
+    // is gone and a partial folder is left. That item alone is redone.
+    let cell = lib.join("optimized-felt-fabric/u-felt-fabric-110g-3cms.wav");
+    let before = std::fs::read(&cell).unwrap();
+    std::fs::remove_file(&cell).unwrap();
+    std::fs::create_dir_all(lib.join(".partial/felt-fabric-110g-3cms/cells")).unwrap();
+    std::fs::write(lib.join(".partial/felt-fabric-110g-3cms/cells/junk"), "half").unwrap();
+    let o = build("1");
+    let out = String::from_utf8_lossy(&o.stdout);
+    assert!(out.contains("1 items built, 7 already there"), "{out}");
+    assert_eq!(std::fs::read(&cell).unwrap(), before, "the redone cell is the one first built");
+    assert!(!lib.join(".partial").exists());
+}

@@ -367,13 +367,22 @@ pub fn main(a: Args) -> Result<()> {
             failures.push(format!("{l} (shard {})", r.shard), why);
         }
     }
+    // A table the shards wrote outside their --out goes into OUT by its file name.
+    let inside = |p: &str| {
+        let p = Path::new(p);
+        if p.is_absolute() {
+            a.out.join(p.file_name().unwrap_or_default())
+        } else {
+            a.out.join(p)
+        }
+    };
     if let Some(csv) = &first.csv {
-        write(&a.out.join(csv), &sweep_csv(&runs, first.timings))?;
-        println!("wrote {}", a.out.join(csv).display());
+        write(&inside(csv), &sweep_csv(&runs, first.timings))?;
+        println!("wrote {}", inside(csv).display());
     }
     if let Some(json) = &first.json {
-        write(&a.out.join(json), &report_json(&runs, first.sweep, first.timings))?;
-        println!("wrote {}", a.out.join(json).display());
+        write(&inside(json), &report_json(&runs, first.sweep, first.timings))?;
+        println!("wrote {}", inside(json).display());
     }
     println!(
         "merged {} shards of {}: {} of {} runs, {} files the graphs wrote",

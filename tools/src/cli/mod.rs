@@ -7,6 +7,10 @@ pub mod devsim;
 pub mod dot;
 pub mod graph_args;
 pub mod import;
+#[cfg(feature = "synth")]
+pub mod library;
+#[cfg(feature = "synth")]
+pub mod library_build;
 pub mod live;
 pub mod merge;
 pub mod nodes;

@@ -6,9 +6,11 @@
 //! R²). A table and a PNG.
 
 use super::lab_recording::{record, Condition};
-use anyhow::{Context, Result};
+use anyhow::{anyhow, Context, Result};
+use evflow_engine::batch::{for_each_ordered, Failures};
 use evflow_nodes::lab::texture::samples::NAMES;
 use evflow_nodes::texture::freqvel::relation;
+use evflow_tools::batch::{progress_bar, JobsArg};
 use evflow_tools::plot::{Plot, Series};
 use std::path::PathBuf;
 
@@ -36,6 +38,8 @@ pub struct Args {
     /// The recording graph.
     #[arg(long, default_value = "graphs/record-textures.toml")]
     graph: PathBuf,
+    #[command(flatten)]
+    jobs: JobsArg,
 }
 
 /// Runs `evflow report freqvel`.
@@ -60,8 +64,10 @@ pub fn main(a: Args) -> Result<()> {
     println!(" slope (Hz per cm/s) | intercept (Hz) | R² |");
     println!("|---|{}---:|---:|---:|", "---:|".repeat(a.speeds.len()));
     let mut series = Vec::new();
-    for s in &samples {
-        eprintln!("recording {s} …");
+    let mut failures = Failures::new();
+    // Each sample's recordings on --jobs threads; its row printed in sample order.
+    let bar = progress_bar(samples.len(), "samples", false);
+    let work = |_: usize, s: &String| {
         let recs = a
             .speeds
             .iter()
@@ -69,11 +75,17 @@ pub fn main(a: Args) -> Result<()> {
                 let c = Condition { sample: s, mass: a.mass, speed: v, passes: a.passes, rep: 1 };
                 record(&a.graph, &c, tmp.path()).map(|r| (v, r))
             })
-            .collect::<Result<Vec<_>>>()?;
+            .collect::<Result<Vec<_>>>();
+        bar.inc(1);
+        let recs = recs?;
         let rate = recs[0].1 .0;
         let signals: Vec<(f64, &[f64])> = recs.iter().map(|(v, (_, x))| (*v, x.as_slice())).collect();
-        match relation(&signals, rate, a.band[0], a.band[1]) {
-            Ok(r) => {
+        Ok::<_, anyhow::Error>(relation(&signals, rate, a.band[0], a.band[1]))
+    };
+    for_each_ordered(samples.iter().collect(), a.jobs.jobs(), &Default::default(), work, |k, outcome| {
+        let s = &samples[k];
+        match outcome.map_err(|p| anyhow!(p)).and_then(|r| r) {
+            Ok(Ok(r)) => {
                 print!("| {s} |");
                 for (_, f) in &r.points {
                     print!(" {f:.1} Hz |");
@@ -86,9 +98,14 @@ pub fn main(a: Args) -> Result<()> {
                     vec![(lo, r.fit.slope * lo + r.fit.intercept), (hi, r.fit.slope * hi + r.fit.intercept)],
                 ));
             }
-            Err(e) => println!("| {s} | {e} |"),
+            Ok(Err(e)) => println!("| {s} | {e} |"),
+            Err(e) => {
+                println!("| {s} | failed |");
+                failures.push(s.clone(), format!("{e:#}"));
+            }
         }
-    }
+    });
+    bar.finish_and_clear();
     let plot = Plot {
         title: format!("Main component frequency against scanning speed ({} g; cf. Fig. 6.6)", a.mass),
         x_label: "scanning speed (cm/s)".into(),
@@ -99,5 +116,6 @@ pub fn main(a: Args) -> Result<()> {
     };
     println!();
     super::save_png(&plot, &a.out.join("freqvel.png"));
+    anyhow::ensure!(failures.is_empty(), "{}", failures.summary(samples.len(), "samples").trim_end());
     Ok(())
 }

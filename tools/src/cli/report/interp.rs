@@ -14,6 +14,7 @@
 
 use super::lab_recording::{record, Condition};
 use anyhow::{anyhow, Context, Result};
+use evflow_engine::batch::{for_each_ordered, Failures};
 use evflow_nodes::lab::texture::samples::NAMES;
 use evflow_nodes::metric::spectral_error::{spectral_rms_error, Band};
 use evflow_nodes::metric::spectrum::{averaged_spectrum, SpectrumConfig, Window};
@@ -21,6 +22,7 @@ use evflow_nodes::synth::study::grid_plan::GridPlan;
 use evflow_nodes::texture::grid::Grid;
 use evflow_nodes::texture::kernel::SincKernel;
 use evflow_nodes::texture::scheme::{Geometry, Mix, Scheme};
+use evflow_tools::batch::{progress_bar, JobsArg};
 use evflow_tools::plot::{Plot, Series};
 use std::path::{Path, PathBuf};
 
@@ -88,6 +90,9 @@ pub struct Args {
     /// The folder of the shipped graphs (synthesized cells).
     #[arg(long, default_value = "graphs")]
     pub(super) graphs: PathBuf,
+    /// Samples at once (--cells recorded; default: the cores available).
+    #[command(flatten)]
+    pub(super) jobs: JobsArg,
 }
 
 /// Magnitude spectrum (1 Hz bins, Hann, half overlap).
@@ -109,7 +114,9 @@ struct Row {
     improved: f64,
 }
 
-fn evaluate(a: &Args, sample: &str, tmp: &Path, band: &Band, plots: &mut Vec<Plot>) -> Result<Vec<Row>> {
+/// One sample's rows and figures.
+fn evaluate(a: &Args, sample: &str, tmp: &Path, band: &Band) -> Result<(Vec<Row>, Vec<Plot>)> {
+    let mut plots = Vec::new();
     let p = GridPlan::of(sample);
     let rec = |mass: f64, speed: f64, rep: u32| {
         record(&a.graph, &Condition { sample, mass, speed, passes: a.passes, rep }, tmp)
@@ -168,7 +175,7 @@ fn evaluate(a: &Args, sample: &str, tmp: &Path, band: &Band, plots: &mut Vec<Plo
             });
         }
     }
-    Ok(rows)
+    Ok((rows, plots))
 }
 
 /// Runs `evflow report interp`.
@@ -187,10 +194,24 @@ pub fn main(a: Args) -> Result<()> {
     let band = Band::new(1000.0, 1000, a.band[0], a.band[1], false).map_err(|e| anyhow!("--band: {e}"))?;
     let mut plots = Vec::new();
     let mut rows = Vec::new();
-    for s in &samples {
-        eprintln!("recording and interpolating {s} …");
-        rows.extend(evaluate(&a, s, tmp.path(), &band, &mut plots)?);
-    }
+    let mut failures = Failures::new();
+    // The samples on --jobs threads, their rows and figures in sample order.
+    let bar = progress_bar(samples.len(), "samples", false);
+    let work = |_: usize, s: &String| {
+        let r = evaluate(&a, s, tmp.path(), &band);
+        bar.inc(1);
+        r
+    };
+    for_each_ordered(samples.iter().collect(), a.jobs.jobs(), &Default::default(), work, |k, outcome| {
+        match outcome.map_err(|p| anyhow!(p)).and_then(|r| r) {
+            Ok((r, p)) => {
+                rows.extend(r);
+                plots.extend(p);
+            }
+            Err(e) => failures.push(samples[k].clone(), format!("{e:#}")),
+        }
+    });
+    bar.finish_and_clear();
     println!(
         "E_s (Eq. 5.2, {}–{} Hz) against the recording at each untrained condition; cells: recorded forces.\n",
         a.band[0], a.band[1]
@@ -231,5 +252,6 @@ pub fn main(a: Args) -> Result<()> {
     for (i, plot) in plots.iter().enumerate() {
         super::save_png(plot, &a.out.join(format!("interp-spectra-{}.png", i + 1)));
     }
+    anyhow::ensure!(failures.is_empty(), "{}", failures.summary(samples.len(), "samples").trim_end());
     Ok(())
 }

@@ -13,12 +13,14 @@
 //! lower E_s.
 
 use anyhow::{anyhow, ensure, Context, Result};
+use evflow_engine::batch::for_each_ordered;
 use evflow_nodes::lab::texture::samples::NAMES;
 use evflow_nodes::narx::model::Model;
 use evflow_nodes::synth::study::models::{self, Models};
 use evflow_nodes::synth::study::recordings::record_pair;
 use evflow_nodes::synth::study::row::{self, Method, RowInputs};
 use evflow_nodes::synth::study::setup::{Cond, Profile};
+use evflow_tools::batch::{progress_bar, JobsArg};
 use evflow_tools::plot::{Plot, Series};
 use std::fmt::Write as _;
 use std::path::PathBuf;
@@ -60,6 +62,8 @@ pub struct Args {
     /// The folder of the shipped graphs.
     #[arg(long, default_value = "graphs")]
     graphs: PathBuf,
+    #[command(flatten)]
+    jobs: JobsArg,
 }
 
 /// The settings compared by default; the first is evflow's default network.
@@ -172,19 +176,61 @@ pub fn main(a: Args) -> Result<()> {
     let profile = Profile::nominal();
     eprintln!("building the default inverse model and the forward model at {} …", cond.label());
     let base = models::build(&graphs, &profile, &cond, a.epochs, false, &out.join("models").join("base"))?;
-    // Each texture recorded, and its optimized actuation synthesized, once.
+    // Each texture recorded, and its optimized actuation synthesized, once
+    // (the samples on --jobs threads).
+    let jobs = a.jobs.jobs();
+    let never = Default::default();
     let mut optimized = Vec::new();
-    for s in &samples {
+    let mut first_error = None;
+    let prepare = |_: usize, s: &String| -> Result<_> {
         record_pair(&graphs, &profile, s, &cond, &textures)?;
         let inputs = inputs(&a, &graphs, &profile, s, &cond, &base, &textures, tmp.path().join("optimized").join(s));
-        optimized.push(row::optimize(&inputs)?);
+        Ok(row::optimize(&inputs)?)
+    };
+    for_each_ordered(samples.iter().collect(), jobs, &never, prepare, |_, r| {
+        match r.map_err(|p| anyhow!(p)).and_then(|r| r) {
+            Ok(o) => optimized.push(o),
+            Err(e) => {
+                first_error.get_or_insert(e);
+            }
+        }
+    });
+    if let Some(e) = first_error {
+        return Err(e);
     }
+    // Every setting × seed: a model trained, every texture synthesized with
+    // it (on --jobs threads; summed in setting and seed order, as on one).
+    let pairs: Vec<(usize, u32)> = (0..settings.len()).flat_map(|i| (1..=a.seeds).map(move |seed| (i, seed))).collect();
+    let bar = progress_bar(pairs.len(), "models", false);
+    let one = |_: usize, (i, seed): (usize, u32)| -> Result<(f64, f64, Model)> {
+        let st = &settings[i];
+        let dir = out.join("models").join(&st.name).join(format!("seed-{seed}"));
+        let mut sets = st.overrides();
+        sets.push(format!("train.seed={seed}"));
+        let path = models::inverse(&graphs, &profile, &cond, a.epochs, &sets, &dir)?;
+        let model = Model::load(&path).map_err(|e| anyhow!("{e}"))?;
+        let m = Models { narx: path, narx_multilevel: None, forward: base.forward.clone(), seconds: [0.0; 3] };
+        let (mut this, mut this_best) = (0.0, 0.0);
+        for (s, opt) in samples.iter().zip(&optimized) {
+            let work = tmp.path().join(&st.name).join(format!("seed-{seed}")).join(s);
+            let mut inputs = inputs(&a, &graphs, &profile, s, &cond, &m, &textures, work);
+            inputs.optimized = Some(opt.clone());
+            let r = row::run(&inputs)?;
+            let narx = r.method(Method::NarxBinary).ok_or_else(|| anyhow!("the study scored no NARX chain"))?;
+            this += narx.chosen.table51.rect / samples.len() as f64;
+            this_best += narx.chosen.best_rect.rect / samples.len() as f64;
+        }
+        bar.inc(1);
+        Ok((this, this_best, model))
+    };
+    let mut results: Vec<Result<(f64, f64, Model)>> = Vec::with_capacity(pairs.len());
+    for_each_ordered(pairs.clone(), jobs, &never, one, |_, r| results.push(r.map_err(|p| anyhow!(p)).and_then(|r| r)));
+    bar.finish_and_clear();
+    let mut results = results.into_iter();
     let mut scored = Vec::new();
-    for (i, st) in settings.iter().enumerate() {
+    for st in settings.iter() {
         eprintln!(
-            "[{}/{}] {} ({}): training at {}, synthesizing {} textures …",
-            i + 1,
-            settings.len(),
+            "{} ({}): trained at {}, {} textures synthesized",
             st.name,
             st.describe(),
             cond.label(),
@@ -192,23 +238,8 @@ pub fn main(a: Args) -> Result<()> {
         );
         let (mut es, mut best, mut seconds, mut epochs, mut transitions, mut weights) = (0.0, 0.0, 0.0, 0.0, 0.0, 0);
         let mut spread = (f64::INFINITY, f64::NEG_INFINITY);
-        for seed in 1..=a.seeds {
-            let dir = out.join("models").join(&st.name).join(format!("seed-{seed}"));
-            let mut sets = st.overrides();
-            sets.push(format!("train.seed={seed}"));
-            let path = models::inverse(&graphs, &profile, &cond, a.epochs, &sets, &dir)?;
-            let model = Model::load(&path).map_err(|e| anyhow!("{e}"))?;
-            let m = Models { narx: path, narx_multilevel: None, forward: base.forward.clone(), seconds: [0.0; 3] };
-            let (mut this, mut this_best) = (0.0, 0.0);
-            for (s, opt) in samples.iter().zip(&optimized) {
-                let work = tmp.path().join(&st.name).join(format!("seed-{seed}")).join(s);
-                let mut inputs = inputs(&a, &graphs, &profile, s, &cond, &m, &textures, work);
-                inputs.optimized = Some(opt.clone());
-                let r = row::run(&inputs)?;
-                let narx = r.method(Method::NarxBinary).ok_or_else(|| anyhow!("the study scored no NARX chain"))?;
-                this += narx.chosen.table51.rect / samples.len() as f64;
-                this_best += narx.chosen.best_rect.rect / samples.len() as f64;
-            }
+        for _ in 1..=a.seeds {
+            let (this, this_best, model) = results.next().expect("one result per setting and seed")?;
             es += this;
             best += this_best;
             spread = (spread.0.min(this), spread.1.max(this));

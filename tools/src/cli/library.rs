@@ -1,0 +1,118 @@
+//! `evflow library build --out DIR`: the model library (issue 17, point 3)
+//! — parse, call `library_build`, print. docs/scale.md describes it.
+
+use super::library_build::{build, Plan};
+use anyhow::{ensure, Context, Result};
+use evflow_nodes::lab::texture::samples::NAMES;
+use evflow_nodes::synth::study::setup::{Cond, Profile};
+use evflow_tools::batch::{progress_bar, JobsArg};
+use std::path::PathBuf;
+
+/// Arguments of `evflow library`.
+#[derive(clap::Args, Debug)]
+pub struct Args {
+    #[command(subcommand)]
+    which: Which,
+}
+
+#[derive(clap::Subcommand, Debug)]
+enum Which {
+    /// Build (or complete) a library: for every texture sample × every
+    /// condition of the grid, the inverse NARX model of the condition and
+    /// each method's actuation cell at its Table 5.1 gain, with index.json
+    /// (texture, condition, model file, training scores, E_s). A rerun
+    /// skips what is done and redoes what an interruption left half
+    /// written. Point graphs/texture-live.toml at `DIR/narx-SAMPLE` (or
+    /// `optimized-`, `playback-`).
+    ///
+    /// Example: cargo run --release -p evflow -- library build --out library
+    Build(BuildArgs),
+}
+
+/// Arguments of `evflow library build`.
+#[derive(clap::Args, Debug)]
+struct BuildArgs {
+    /// The library folder (created; an existing library is completed).
+    #[arg(long)]
+    out: PathBuf,
+    /// Texture samples (default: every sample of the simulated lab).
+    #[arg(long, value_delimiter = ',')]
+    samples: Vec<String>,
+    /// Stylus masses of the grid, g.
+    #[arg(long, value_delimiter = ',', default_value = "60,85,110")]
+    masses: Vec<f64>,
+    /// Scanning speeds of the grid, cm/s.
+    #[arg(long, value_delimiter = ',', default_value = "3,5,7")]
+    speeds: Vec<f64>,
+    /// Lab profile: `nominal`, a name of graphs/lab/*.toml, or a profile file.
+    #[arg(long, default_value = "nominal")]
+    profile: String,
+    /// Gains of each cell's sweep (§5.3.2).
+    #[arg(long, value_delimiter = ',', default_value = "0.6,0.8,1.0,1.2,1.4")]
+    gains: Vec<f64>,
+    /// Levenberg–Marquardt epochs at most per inverse model.
+    #[arg(long, default_value_t = 200)]
+    epochs: u32,
+    /// Iterations at most of the optimized synthesis.
+    #[arg(long, default_value_t = 100)]
+    iterations: usize,
+    /// The folder of the shipped graphs.
+    #[arg(long, default_value = "graphs")]
+    graphs: PathBuf,
+    #[command(flatten)]
+    jobs: JobsArg,
+}
+
+/// Runs `evflow library`.
+pub fn main(a: Args) -> Result<()> {
+    let Which::Build(b) = a.which;
+    let samples: Vec<String> =
+        if b.samples.is_empty() { NAMES.iter().map(|s| s.to_string()).collect() } else { b.samples.clone() };
+    for s in &samples {
+        ensure!(NAMES.contains(&s.as_str()), "--samples: unknown sample `{s}` (one of {})", NAMES.join(", "));
+    }
+    let mut conds = Vec::new();
+    for m in &b.masses {
+        for v in &b.speeds {
+            conds.push(Cond::parse(&format!("{m}:{v}"))?);
+        }
+    }
+    ensure!(!conds.is_empty(), "--masses and --speeds: at least one of each");
+    ensure!(
+        !b.gains.is_empty() && b.gains.iter().all(|g| g.is_finite() && *g > 0.0),
+        "--gains: positive numbers, at least one"
+    );
+    let profile = Profile::resolve(&b.profile, &b.graphs)?;
+    let graphs = std::fs::canonicalize(&b.graphs).with_context(|| format!("--graphs {}", b.graphs.display()))?;
+    std::fs::create_dir_all(&b.out).with_context(|| format!("{}: cannot create", b.out.display()))?;
+    let dir = std::fs::canonicalize(&b.out)?;
+    let plan = Plan {
+        dir,
+        graphs,
+        profile,
+        samples,
+        conds,
+        gains: b.gains.clone(),
+        epochs: b.epochs,
+        iterations: b.iterations,
+        jobs: b.jobs.jobs(),
+    };
+    let total = plan.conds.len() * (1 + plan.samples.len());
+    let bar = progress_bar(total, "items", false);
+    let outcome = build(&plan, &|label| {
+        bar.inc(1);
+        bar.set_message(label.to_string());
+    })?;
+    bar.finish_and_clear();
+    println!(
+        "library {}: {} items built, {} already there, {} failed, of {}; index {}",
+        b.out.display(),
+        outcome.built,
+        outcome.skipped,
+        outcome.failures.len(),
+        outcome.total,
+        b.out.join("index.json").display()
+    );
+    anyhow::ensure!(outcome.failures.is_empty(), "{}", outcome.failures.summary(outcome.total, "items").trim_end());
+    Ok(())
+}

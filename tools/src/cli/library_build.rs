@@ -1,0 +1,312 @@
+//! The model library (issue 17, point 3): for every texture sample × every
+//! condition of a grid, the inverse NARX model of the condition and the
+//! actuation cells U_ij of each method (inverse NARX, optimized synthesis,
+//! fair playback) at their Table 5.1 gains, in the folder layout the
+//! texture-live grids read (`METHOD-SAMPLE/u-SAMPLE-TAG.{wav,json}`), with
+//! `index.json` saying, per texture and condition, which model and cells,
+//! the model's training scores and each method's E_s.
+//!
+//! Resumable: an item (a condition's models, a texture at a condition) is
+//! built in `DIR/.partial/…` and moved into place when complete, then
+//! entered into the index (rewritten through a temporary file after every
+//! item). A rerun skips the items the index lists whose files are there,
+//! and redoes the rest — a half-written item included, its partial folder
+//! removed first.
+
+use anyhow::{anyhow, Context, Result};
+use evflow_engine::batch::{for_each_ordered, Failures};
+use evflow_nodes::synth::study::cells::write_actuation;
+use evflow_nodes::synth::study::models::{self, Models};
+use evflow_nodes::synth::study::recordings;
+use evflow_nodes::synth::study::row::{self, Method, Row, RowInputs};
+use evflow_nodes::synth::study::setup::{Cond, Profile};
+use serde_json::{json, Value as Json};
+use std::path::{Path, PathBuf};
+use std::sync::atomic::AtomicBool;
+
+/// What a library covers.
+#[derive(Debug, Clone)]
+pub struct Plan {
+    /// The library folder.
+    pub dir: PathBuf,
+    /// The folder of the shipped graphs (absolute).
+    pub graphs: PathBuf,
+    /// The lab profile the models and cells are made on.
+    pub profile: Profile,
+    /// Texture samples.
+    pub samples: Vec<String>,
+    /// The grid's conditions, in index order.
+    pub conds: Vec<Cond>,
+    /// The gain sweep of each cell (§5.3.2).
+    pub gains: Vec<f64>,
+    /// NARX training epochs at most.
+    pub epochs: u32,
+    /// The optimized synthesis' iterations at most.
+    pub iterations: usize,
+    /// Runs at once.
+    pub jobs: usize,
+}
+
+/// The methods whose cells the library keeps: (method, recording channel, folder prefix).
+const CELLS: [(Method, &str, &str); 3] = [
+    (Method::NarxBinary, "u", "narx"),
+    (Method::Optimized, "optimized_u", "optimized"),
+    (Method::Playback, "playback_u", "playback"),
+];
+
+/// What a build did.
+#[derive(Debug, Default)]
+pub struct Outcome {
+    /// Items found complete and skipped.
+    pub skipped: usize,
+    /// Items built.
+    pub built: usize,
+    /// Items that failed, with why.
+    pub failures: Failures,
+    /// Items in all.
+    pub total: usize,
+}
+
+fn index_path(dir: &Path) -> PathBuf {
+    dir.join("index.json")
+}
+
+/// The index's entries from an earlier build (none when there is no index).
+fn read_index(dir: &Path) -> Result<Vec<Json>> {
+    let p = index_path(dir);
+    let text = match std::fs::read_to_string(&p) {
+        Ok(t) => t,
+        Err(e) if e.kind() == std::io::ErrorKind::NotFound => return Ok(Vec::new()),
+        Err(e) => return Err(anyhow!("{}: cannot read: {e}", p.display())),
+    };
+    let doc: Json = serde_json::from_str(&text).map_err(|e| anyhow!("{}: {e}", p.display()))?;
+    doc.get("entries")
+        .and_then(Json::as_array)
+        .cloned()
+        .ok_or_else(|| anyhow!("{}: no `entries` list (not a library index?)", p.display()))
+}
+
+/// Writes `text` to `path` through a temporary file beside it.
+fn write_atomic(path: &Path, text: &str) -> Result<()> {
+    let tmp = path.with_extension("json.tmp");
+    std::fs::write(&tmp, text)
+        .and_then(|_| std::fs::rename(&tmp, path))
+        .with_context(|| format!("{}: cannot write", path.display()))
+}
+
+fn write_index(dir: &Path, entries: &[Json]) -> Result<()> {
+    let doc = json!({ "format": "evflow-model-library", "version": 1, "entries": entries });
+    write_atomic(&index_path(dir), &serde_json::to_string_pretty(&doc)?)
+}
+
+/// The key of an entry: texture and condition tag.
+fn key(e: &Json) -> Option<(String, String)> {
+    Some((e.get("texture")?.as_str()?.to_string(), e.get("tag")?.as_str()?.to_string()))
+}
+
+/// Whether every file an entry names is in the library: its models, and
+/// each cell's recording (the sidecar the index names and its samples).
+fn complete(dir: &Path, e: &Json) -> bool {
+    let models = ["model", "forward_model"]
+        .iter()
+        .all(|k| e.get(*k).and_then(Json::as_str).is_some_and(|f| dir.join(f).is_file()));
+    let Some(cells) = e.get("cells").and_then(Json::as_object) else { return false };
+    let cells = cells.values().all(|f| {
+        f.as_str().is_some_and(|f| {
+            let p = dir.join(f);
+            p.is_file() && p.with_extension("wav").is_file()
+        })
+    });
+    models && cells
+}
+
+/// A condition's models in the library (`models/narx-TAG.json`,
+/// `models/forward-TAG.json`): kept when both are there, else built in a
+/// partial folder and moved in. The flag says whether they were built now.
+fn condition_models(plan: &Plan, c: &Cond) -> Result<(Models, bool)> {
+    let final_dir = plan.dir.join("models");
+    if let Ok(m) = models::given(&final_dir, c) {
+        return Ok((m, false));
+    }
+    let partial = plan.dir.join(".partial").join(format!("models-{}", c.tag()));
+    let _ = std::fs::remove_dir_all(&partial);
+    let built =
+        models::build(&plan.graphs, &plan.profile, c, plan.epochs, false, &partial).map_err(|e| anyhow!("{e}"))?;
+    std::fs::create_dir_all(&final_dir).with_context(|| format!("{}: cannot create", final_dir.display()))?;
+    // The forward model first: `given` needs both, so a crash between the
+    // two moves leaves an item that is redone.
+    for from in [&built.forward, &built.narx] {
+        let to = final_dir.join(from.file_name().unwrap_or_default());
+        std::fs::rename(from, &to).with_context(|| format!("{}: cannot move into the library", to.display()))?;
+    }
+    let _ = std::fs::remove_dir_all(&partial);
+    Ok((models::given(&final_dir, c).map_err(|e| anyhow!("{e}"))?, true))
+}
+
+/// Reads a model file's `training` section (its scores).
+fn training(path: &Path) -> Json {
+    std::fs::read_to_string(path)
+        .ok()
+        .and_then(|t| serde_json::from_str::<Json>(&t).ok())
+        .and_then(|d| d.get("training").cloned())
+        .unwrap_or(Json::Null)
+}
+
+fn rel(dir: &Path, p: &Path) -> String {
+    p.strip_prefix(dir).unwrap_or(p).to_string_lossy().replace('\\', "/")
+}
+
+/// One texture at one condition: recordings, the row (every method over
+/// the gain sweep), the cells moved into the library; returns its entry.
+fn texture_cell(plan: &Plan, m: &Models, sample: &str, c: &Cond) -> Result<Json> {
+    let partial = plan.dir.join(".partial").join(format!("{sample}-{}", c.tag()));
+    let _ = std::fs::remove_dir_all(&partial);
+    let rec_dir = partial.join("recordings");
+    recordings::record_pair(&plan.graphs, &plan.profile, sample, c, &rec_dir).map_err(|e| anyhow!("{e}"))?;
+    let inputs = RowInputs {
+        graphs: &plan.graphs,
+        profile: &plan.profile,
+        sample,
+        cond: *c,
+        models: m,
+        recordings: &rec_dir,
+        gains: &plan.gains,
+        iterations: plan.iterations,
+        objective: "expected",
+        optimized: None,
+        dir: partial.join("row"),
+    };
+    let r: Row = row::run(&inputs).map_err(|e| anyhow!("{e}"))?;
+    let mut cells = serde_json::Map::new();
+    let mut es = serde_json::Map::new();
+    let mut gains = serde_json::Map::new();
+    for (method, channel, folder) in CELLS {
+        let Some(res) = r.method(method) else { continue };
+        let gain = res.chosen.table51.gain;
+        let staged = partial.join("cells").join(format!("{folder}-{sample}"));
+        let written =
+            write_actuation(&r.recording(gain), channel, &staged, sample, c, gain).map_err(|e| anyhow!("{e}"))?;
+        let to_dir = plan.dir.join(format!("{folder}-{sample}"));
+        std::fs::create_dir_all(&to_dir).with_context(|| format!("{}: cannot create", to_dir.display()))?;
+        let name = written.file_name().unwrap_or_default().to_string_lossy().into_owned();
+        // A recording is NAME.wav + NAME.json: the sidecar last, so that a
+        // reader never finds a sidecar without its samples.
+        for ext in ["wav", "json"] {
+            let from = staged.join(format!("{name}.{ext}"));
+            let to = to_dir.join(format!("{name}.{ext}"));
+            std::fs::rename(&from, &to).with_context(|| format!("{}: cannot move into the library", to.display()))?;
+        }
+        cells.insert(folder.into(), json!(rel(&plan.dir, &to_dir.join(format!("{name}.json")))));
+        es.insert(folder.into(), json!({ "rect": res.chosen.table51.rect, "welch": res.chosen.table51.welch }));
+        gains.insert(folder.into(), json!(gain));
+    }
+    let _ = std::fs::remove_dir_all(&partial);
+    Ok(json!({
+        "texture": sample,
+        "tag": c.tag(),
+        "condition": { "load_g": c.mass, "velocity_cm_s": c.speed },
+        "profile": plan.profile.name,
+        "model": rel(&plan.dir, &m.narx),
+        "forward_model": rel(&plan.dir, &m.forward),
+        "training": training(&m.narx),
+        "cells": cells,
+        "gain": gains,
+        "E_s": es,
+        "E_s_repeat": { "rect": r.repeat.rect, "welch": r.repeat.welch },
+        "E_s_display_floor": { "rect": r.display_floor.rect, "welch": r.display_floor.welch },
+    }))
+}
+
+/// Builds (or completes) the library; `progress` is called once per item
+/// received, with a label.
+pub fn build(plan: &Plan, progress: &(dyn Fn(&str) + Sync)) -> Result<Outcome> {
+    std::fs::create_dir_all(&plan.dir).with_context(|| format!("{}: cannot create", plan.dir.display()))?;
+    let mut entries = read_index(&plan.dir)?;
+    // Entries whose files are gone are redone.
+    entries.retain(|e| complete(&plan.dir, e));
+    let mut out = Outcome { total: plan.conds.len() + plan.conds.len() * plan.samples.len(), ..Outcome::default() };
+    let never = AtomicBool::new(false);
+
+    // The models of every condition.
+    let mut built: Vec<Option<Models>> = Vec::new();
+    for_each_ordered(
+        plan.conds.clone(),
+        plan.jobs,
+        &never,
+        |_, c| condition_models(plan, &c),
+        |k, r| {
+            progress(&format!("models at {}", plan.conds[k].label()));
+            match r.map_err(|p| anyhow!(p)).and_then(|r| r) {
+                Ok((m, fresh)) => {
+                    if fresh {
+                        out.built += 1;
+                    } else {
+                        out.skipped += 1;
+                    }
+                    built.push(Some(m));
+                }
+                Err(e) => {
+                    out.failures.push(format!("models at {}", plan.conds[k].label()), format!("{e:#}"));
+                    built.push(None);
+                }
+            }
+        },
+    );
+
+    // Every texture at every condition whose models are there.
+    let mut todo = Vec::new();
+    for (k, c) in plan.conds.iter().enumerate() {
+        for s in &plan.samples {
+            let done = entries.iter().any(|e| key(e) == Some((s.clone(), c.tag())));
+            if done {
+                out.skipped += 1;
+            } else if built[k].is_some() {
+                todo.push((k, s.clone()));
+            } else {
+                out.failures.push(format!("{s} at {}", c.label()), "its condition's models failed");
+            }
+        }
+    }
+    let work = |_: usize, (k, s): (usize, String)| {
+        let m = built[k].as_ref().expect("only conditions with models");
+        texture_cell(plan, m, &s, &plan.conds[k])
+    };
+    let mut write_error = None;
+    for_each_ordered(todo.clone(), plan.jobs, &never, work, |j, r| {
+        let (k, s) = &todo[j];
+        let label = format!("{s} at {}", plan.conds[*k].label());
+        progress(&label);
+        match r.map_err(|p| anyhow!(p)).and_then(|r| r) {
+            Ok(entry) => {
+                entries.retain(|e| key(e) != key(&entry));
+                entries.push(entry);
+                out.built += 1;
+                // The index after every item: an interruption loses at most the items in flight.
+                if let Err(e) = write_index(&plan.dir, &sorted(plan, &entries)) {
+                    write_error.get_or_insert(e);
+                }
+            }
+            Err(e) => out.failures.push(label, format!("{e:#}")),
+        }
+    });
+    if let Some(e) = write_error {
+        return Err(e);
+    }
+    write_index(&plan.dir, &sorted(plan, &entries))?;
+    let _ = std::fs::remove_dir(plan.dir.join(".partial"));
+    Ok(out)
+}
+
+/// The entries in library order: texture by texture (as the plan lists
+/// them, others after), condition by condition.
+fn sorted(plan: &Plan, entries: &[Json]) -> Vec<Json> {
+    let mut v = entries.to_vec();
+    let rank = |e: &Json| {
+        let (s, t) = key(e).unwrap_or_default();
+        let si = plan.samples.iter().position(|x| *x == s).unwrap_or(usize::MAX);
+        let ci = plan.conds.iter().position(|c| c.tag() == t).unwrap_or(usize::MAX);
+        (si, ci, s, t)
+    };
+    v.sort_by_key(rank);
+    v
+}

@@ -573,6 +573,38 @@ mod tests {
     }
 
     #[test]
+    fn external_buffers_strips_and_fans() {
+        let dir = tempfile::tempdir().unwrap();
+        // A buffer file beside the .gltf, its name percent-encoded in the URI.
+        std::fs::write(dir.path().join("mesh data.bin"), buffer()).unwrap();
+        let path = dir.path().join("t.gltf");
+        std::fs::write(&path, json(Some("mesh%20data.bin"), "")).unwrap();
+        let a = load_gltf(&path, 0.0).unwrap();
+        assert_eq!(a.triangles.len(), 3);
+        // The square as a strip (0 1 3 2) and as a fan (0 1 2 3): the same two triangles.
+        for (mode, idx) in [(5, [0u16, 1, 3, 2]), (6, [0, 1, 2, 3])] {
+            let mut b = buffer();
+            for (k, i) in idx.iter().enumerate() {
+                b[60 + 2 * k..62 + 2 * k].copy_from_slice(&i.to_le_bytes());
+            }
+            std::fs::write(dir.path().join("mesh data.bin"), b).unwrap();
+            let text = json(Some("mesh%20data.bin"), "")
+                .replace(r#""indices":1"#, &format!(r#""indices":1,"mode":{mode}"#))
+                .replace(r#""count":9"#, r#""count":4"#);
+            std::fs::write(&path, text).unwrap();
+            let m = load_gltf(&path, 0.0).unwrap();
+            assert_eq!(m.triangles.len(), 2, "mode {mode}");
+            let area: f64 = (0..2)
+                .map(|t| {
+                    let [p, q, r] = m.corners(t);
+                    0.5 * ((q[0] - p[0]) * (r[2] - p[2]) - (r[0] - p[0]) * (q[2] - p[2])).abs()
+                })
+                .sum();
+            assert!((area - 1.0).abs() < 1e-12, "mode {mode}: {area}");
+        }
+    }
+
+    #[test]
     fn malformed_files_name_the_byte_line_or_json_path() {
         let p = Path::new("t.glb");
         let good = glb(&json(None, ""), &buffer());

@@ -35,7 +35,8 @@ enum Command {
     /// Join the outputs of the shards of a sweep (`run --shard K/N`) into
     /// what one run would have written: the files the graphs wrote, and
     /// the --csv / --json tables in sweep order. Checks that the folders
-    /// are every K of N of one sweep; lists the shards' failed runs.
+    /// are every K of N of one sweep; lists the shards' failed runs. The
+    /// shards of a model library (`library build --shard`) merge alike.
     ///
     /// Example (docs/scale.md):
     ///   for k in 1 2 3; do evflow run graphs/excitation.toml --shard $k/3 --out part$k --csv part$k/grid.csv; done

@@ -5,7 +5,7 @@ use super::library_build::{build, Plan};
 use anyhow::{ensure, Context, Result};
 use evflow_nodes::lab::texture::samples::NAMES;
 use evflow_nodes::synth::study::setup::{Cond, Profile};
-use evflow_tools::batch::{progress_bar, JobsArg};
+use evflow_tools::batch::{progress_bar, BatchArgs};
 use std::path::PathBuf;
 
 /// Arguments of `evflow library`.
@@ -60,7 +60,7 @@ struct BuildArgs {
     #[arg(long, default_value = "graphs")]
     graphs: PathBuf,
     #[command(flatten)]
-    jobs: JobsArg,
+    batch: BatchArgs,
 }
 
 /// Runs `evflow library`.
@@ -95,9 +95,10 @@ pub fn main(a: Args) -> Result<()> {
         gains: b.gains.clone(),
         epochs: b.epochs,
         iterations: b.iterations,
-        jobs: b.jobs.jobs(),
+        jobs: b.batch.jobs(),
+        shard: b.batch.shard(),
     };
-    let total = plan.conds.len() * (1 + plan.samples.len());
+    let total = plan.shard.range(plan.conds.len()).len() * (1 + plan.samples.len());
     let bar = progress_bar(total, "items", false);
     let outcome = build(&plan, &|label| {
         bar.inc(1);

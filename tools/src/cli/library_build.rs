@@ -12,9 +12,14 @@
 //! item). A rerun skips the items the index lists whose files are there,
 //! and redoes the rest — a half-written item included, its partial folder
 //! removed first.
+//!
+//! Sharded (`--shard K/N`), a build takes the K-th contiguous slice of the
+//! grid's conditions: their models and every texture at them. Its index
+//! says which shard it is; `evflow merge` joins the shards' folders into
+//! the library one build would have made.
 
 use anyhow::{anyhow, Context, Result};
-use evflow_engine::batch::{for_each_ordered, Failures};
+use evflow_engine::batch::{for_each_ordered, Failures, Shard};
 use evflow_nodes::synth::study::cells::write_actuation;
 use evflow_nodes::synth::study::models::{self, Models};
 use evflow_nodes::synth::study::recordings;
@@ -45,6 +50,8 @@ pub struct Plan {
     pub iterations: usize,
     /// Runs at once.
     pub jobs: usize,
+    /// The slice of the conditions this build makes.
+    pub shard: Shard,
 }
 
 /// The methods whose cells the library keeps: (method, recording channel, folder prefix).
@@ -94,9 +101,19 @@ fn write_atomic(path: &Path, text: &str) -> Result<()> {
         .with_context(|| format!("{}: cannot write", path.display()))
 }
 
-fn write_index(dir: &Path, entries: &[Json]) -> Result<()> {
-    let doc = json!({ "format": "evflow-model-library", "version": 1, "entries": entries });
-    write_atomic(&index_path(dir), &serde_json::to_string_pretty(&doc)?)
+/// The index's format name.
+pub const FORMAT: &str = "evflow-model-library";
+
+/// Writes the index: the plan's samples and condition tags (the library's
+/// order), the shard when not the whole, and the entries.
+fn write_index(plan: &Plan, entries: &[Json]) -> Result<()> {
+    let tags: Vec<String> = plan.conds.iter().map(Cond::tag).collect();
+    let mut doc =
+        json!({ "format": FORMAT, "version": 1, "samples": plan.samples, "conditions": tags, "entries": entries });
+    if plan.shard != Shard::ALL {
+        doc["shard"] = json!(plan.shard.to_string());
+    }
+    write_atomic(&index_path(&plan.dir), &serde_json::to_string_pretty(&doc)?)
 }
 
 /// The key of an entry: texture and condition tag.
@@ -224,18 +241,19 @@ pub fn build(plan: &Plan, progress: &(dyn Fn(&str) + Sync)) -> Result<Outcome> {
     let mut entries = read_index(&plan.dir)?;
     // Entries whose files are gone are redone.
     entries.retain(|e| complete(&plan.dir, e));
-    let mut out = Outcome { total: plan.conds.len() + plan.conds.len() * plan.samples.len(), ..Outcome::default() };
+    let conds: Vec<Cond> = plan.conds[plan.shard.range(plan.conds.len())].to_vec();
+    let mut out = Outcome { total: conds.len() * (1 + plan.samples.len()), ..Outcome::default() };
     let never = AtomicBool::new(false);
 
-    // The models of every condition.
+    // The models of every condition (of this shard).
     let mut built: Vec<Option<Models>> = Vec::new();
     for_each_ordered(
-        plan.conds.clone(),
+        conds.clone(),
         plan.jobs,
         &never,
         |_, c| condition_models(plan, &c),
         |k, r| {
-            progress(&format!("models at {}", plan.conds[k].label()));
+            progress(&format!("models at {}", conds[k].label()));
             match r.map_err(|p| anyhow!(p)).and_then(|r| r) {
                 Ok((m, fresh)) => {
                     if fresh {
@@ -246,7 +264,7 @@ pub fn build(plan: &Plan, progress: &(dyn Fn(&str) + Sync)) -> Result<Outcome> {
                     built.push(Some(m));
                 }
                 Err(e) => {
-                    out.failures.push(format!("models at {}", plan.conds[k].label()), format!("{e:#}"));
+                    out.failures.push(format!("models at {}", conds[k].label()), format!("{e:#}"));
                     built.push(None);
                 }
             }
@@ -255,7 +273,7 @@ pub fn build(plan: &Plan, progress: &(dyn Fn(&str) + Sync)) -> Result<Outcome> {
 
     // Every texture at every condition whose models are there.
     let mut todo = Vec::new();
-    for (k, c) in plan.conds.iter().enumerate() {
+    for (k, c) in conds.iter().enumerate() {
         for s in &plan.samples {
             let done = entries.iter().any(|e| key(e) == Some((s.clone(), c.tag())));
             if done {
@@ -269,12 +287,12 @@ pub fn build(plan: &Plan, progress: &(dyn Fn(&str) + Sync)) -> Result<Outcome> {
     }
     let work = |_: usize, (k, s): (usize, String)| {
         let m = built[k].as_ref().expect("only conditions with models");
-        texture_cell(plan, m, &s, &plan.conds[k])
+        texture_cell(plan, m, &s, &conds[k])
     };
     let mut write_error = None;
     for_each_ordered(todo.clone(), plan.jobs, &never, work, |j, r| {
         let (k, s) = &todo[j];
-        let label = format!("{s} at {}", plan.conds[*k].label());
+        let label = format!("{s} at {}", conds[*k].label());
         progress(&label);
         match r.map_err(|p| anyhow!(p)).and_then(|r| r) {
             Ok(entry) => {
@@ -282,7 +300,7 @@ pub fn build(plan: &Plan, progress: &(dyn Fn(&str) + Sync)) -> Result<Outcome> {
                 entries.push(entry);
                 out.built += 1;
                 // The index after every item: an interruption loses at most the items in flight.
-                if let Err(e) = write_index(&plan.dir, &sorted(plan, &entries)) {
+                if let Err(e) = write_index(plan, &sorted(plan, &entries)) {
                     write_error.get_or_insert(e);
                 }
             }
@@ -292,7 +310,7 @@ pub fn build(plan: &Plan, progress: &(dyn Fn(&str) + Sync)) -> Result<Outcome> {
     if let Some(e) = write_error {
         return Err(e);
     }
-    write_index(&plan.dir, &sorted(plan, &entries))?;
+    write_index(plan, &sorted(plan, &entries))?;
     let _ = std::fs::remove_dir(plan.dir.join(".partial"));
     Ok(out)
 }
@@ -309,4 +327,76 @@ fn sorted(plan: &Plan, entries: &[Json]) -> Vec<Json> {
     };
     v.sort_by_key(rank);
     v
+}
+
+/// One shard's library as `evflow merge` reads it.
+pub struct ShardIndex {
+    /// Its folder.
+    pub dir: PathBuf,
+    /// Which slice.
+    pub shard: Shard,
+    /// The plan's samples, in order.
+    pub samples: Vec<String>,
+    /// The plan's condition tags, in order.
+    pub conditions: Vec<String>,
+    /// Its entries.
+    pub entries: Vec<Json>,
+}
+
+/// Whether `dir` holds a library (its index.json).
+pub fn is_library(dir: &Path) -> bool {
+    std::fs::read_to_string(index_path(dir))
+        .ok()
+        .and_then(|t| serde_json::from_str::<Json>(&t).ok())
+        .is_some_and(|d| d.get("format").and_then(Json::as_str) == Some(FORMAT))
+}
+
+/// Reads a sharded library's index; errors name the file.
+pub fn read_shard(dir: &Path) -> Result<ShardIndex> {
+    let p = index_path(dir);
+    let doc: Json =
+        serde_json::from_str(&std::fs::read_to_string(&p).with_context(|| format!("{}: cannot read", p.display()))?)
+            .map_err(|e| anyhow!("{}: {e}", p.display()))?;
+    let texts = |k: &str| -> Result<Vec<String>> {
+        doc.get(k)
+            .and_then(Json::as_array)
+            .and_then(|l| l.iter().map(|x| x.as_str().map(str::to_string)).collect())
+            .ok_or_else(|| anyhow!("{}: `{k}` is not a list of text", p.display()))
+    };
+    let shard = doc
+        .get("shard")
+        .and_then(Json::as_str)
+        .ok_or_else(|| anyhow!("{}: not a shard (built without --shard)", p.display()))?;
+    Ok(ShardIndex {
+        dir: dir.to_path_buf(),
+        shard: Shard::parse(shard).map_err(|e| anyhow!("{}: {e}", p.display()))?,
+        samples: texts("samples")?,
+        conditions: texts("conditions")?,
+        entries: read_index(dir)?,
+    })
+}
+
+/// The merged index of every shard (checked to be the N slices of one
+/// plan, sorted as one build sorts them) written into `out`.
+pub fn merge_index(out: &Path, shards: &[ShardIndex]) -> Result<usize> {
+    let first = &shards[0];
+    for s in shards {
+        if s.samples != first.samples || s.conditions != first.conditions || s.shard.n != first.shard.n {
+            anyhow::bail!(
+                "{} and {}: not shards of one library (samples, conditions or N differ)",
+                first.dir.display(),
+                s.dir.display()
+            );
+        }
+    }
+    let mut entries: Vec<Json> = shards.iter().flat_map(|s| s.entries.iter().cloned()).collect();
+    let rank = |e: &Json| {
+        let (s, t) = key(e).unwrap_or_default();
+        (first.samples.iter().position(|x| *x == s), first.conditions.iter().position(|x| *x == t))
+    };
+    entries.sort_by_key(rank);
+    let doc = json!({ "format": FORMAT, "version": 1, "samples": first.samples, "conditions": first.conditions, "entries": entries });
+    std::fs::create_dir_all(out).with_context(|| format!("{}: cannot create", out.display()))?;
+    write_atomic(&index_path(out), &serde_json::to_string_pretty(&doc)?)?;
+    Ok(entries.len())
 }

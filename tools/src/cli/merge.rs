@@ -9,6 +9,10 @@
 //! with the same code as `evflow run`, from the runs in sweep order. With
 //! `--no-times` on the shards the tables are byte for byte those of one
 //! run; with times, only the measured times differ.
+//!
+//! Folders of a model library built in shards (`evflow library build
+//! --shard K/N`) merge the same way: their files copied, their indexes
+//! joined in the library's order.
 
 use super::run_report::{report_json, sweep_csv, Timings};
 use anyhow::{anyhow, bail, Context, Result};
@@ -272,16 +276,8 @@ fn in_order(mut shards: Vec<(PathBuf, ShardRecord)>) -> Result<Vec<(PathBuf, Sha
             bail!("{}: shard {} should hold runs {:?} of {}", dir.display(), r.shard, r.shard.range(r.total), r.total);
         }
     }
-    for w in shards.windows(2) {
-        if w[0].1.shard.k == w[1].1.shard.k {
-            bail!("{} and {}: both are shard {}", w[0].0.display(), w[1].0.display(), w[0].1.shard);
-        }
-    }
-    let have: Vec<usize> = shards.iter().map(|(_, r)| r.shard.k).collect();
-    let missing: Vec<String> = (1..=n).filter(|k| !have.contains(k)).map(|k| format!("{k}/{n}")).collect();
-    if !missing.is_empty() {
-        bail!("shards missing: {} (given {} of {n})", missing.join(", "), shards.len());
-    }
+    let shards = k_order(shards.into_iter().map(|(d, r)| (d, r.shard, r)).collect())?;
+    let shards: Vec<(PathBuf, ShardRecord)> = shards.into_iter().map(|(d, _, r)| (d, r)).collect();
     Ok(shards)
 }
 
@@ -329,20 +325,12 @@ fn write(path: &Path, text: &str) -> Result<()> {
         .with_context(|| format!("{}: cannot write", path.display()))
 }
 
-/// Runs `evflow merge`.
-pub fn main(a: Args) -> Result<()> {
-    let shards = a.shards.iter().map(|d| Ok((d.clone(), ShardRecord::read(d)?))).collect::<Result<Vec<_>>>()?;
-    let shards = in_order(shards)?;
-    let first = shards[0].1.clone();
-    // The files the graphs wrote: each once; two shards writing the same
-    // name must have written the same bytes.
-    let skip: Vec<PathBuf> = [Some(RECORD.to_string()), first.csv.clone(), first.json.clone()]
-        .into_iter()
-        .flatten()
-        .map(PathBuf::from)
-        .collect();
+/// Copies every file under the shard folders into `out` (as relative
+/// paths), leaving out `skip` and temporary files; two shards writing one
+/// name must have written the same bytes. Returns how many were copied.
+fn copy_files(out: &Path, dirs: &[&Path], skip: &[PathBuf]) -> Result<usize> {
     let mut copied: Vec<(PathBuf, PathBuf)> = Vec::new();
-    for (dir, _) in &shards {
+    for dir in dirs {
         for rel in files_under(dir)? {
             if skip.contains(&rel) || rel.file_name().is_some_and(|n| n.to_string_lossy().ends_with(".tmp")) {
                 continue;
@@ -355,10 +343,66 @@ pub fn main(a: Args) -> Result<()> {
                 }
                 continue;
             }
-            copy(&from, &a.out.join(&rel))?;
+            copy(&from, &out.join(&rel))?;
             copied.push((rel, from));
         }
     }
+    Ok(copied.len())
+}
+
+/// Checks that the shards' K are 1..=N, each once, and puts them in K order.
+fn k_order<T>(mut shards: Vec<(PathBuf, Shard, T)>) -> Result<Vec<(PathBuf, Shard, T)>> {
+    shards.sort_by_key(|(_, s, _)| s.k);
+    let n = shards[0].1.n;
+    for w in shards.windows(2) {
+        if w[0].1.k == w[1].1.k {
+            bail!("{} and {}: both are shard {}", w[0].0.display(), w[1].0.display(), w[0].1);
+        }
+    }
+    let have: Vec<usize> = shards.iter().map(|(_, s, _)| s.k).collect();
+    let missing: Vec<String> = (1..=n).filter(|k| !have.contains(k)).map(|k| format!("{k}/{n}")).collect();
+    if !missing.is_empty() {
+        bail!("shards missing: {} (given {} of {n})", missing.join(", "), shards.len());
+    }
+    Ok(shards)
+}
+
+/// Joins the shards of a model library (`evflow library build --shard`).
+#[cfg(feature = "synth")]
+fn merge_library(a: &Args) -> Result<()> {
+    use super::library_build::{merge_index, read_shard};
+    let shards = a.shards.iter().map(|d| read_shard(d).map(|s| (d.clone(), s.shard, s))).collect::<Result<Vec<_>>>()?;
+    let shards = k_order(shards)?;
+    let n = shards.len();
+    let indexes: Vec<_> = shards.into_iter().map(|(_, _, s)| s).collect();
+    let dirs: Vec<&Path> = indexes.iter().map(|s| s.dir.as_path()).collect();
+    let files = copy_files(&a.out, &dirs, &[PathBuf::from("index.json")])?;
+    let entries = merge_index(&a.out, &indexes)?;
+    println!(
+        "merged {n} library shards: {entries} entries, {files} files; index {}",
+        a.out.join("index.json").display()
+    );
+    Ok(())
+}
+
+/// Runs `evflow merge`.
+pub fn main(a: Args) -> Result<()> {
+    #[cfg(feature = "synth")]
+    if a.shards.iter().all(|d| !d.join(RECORD).exists() && super::library_build::is_library(d)) {
+        return merge_library(&a);
+    }
+    let shards = a.shards.iter().map(|d| Ok((d.clone(), ShardRecord::read(d)?))).collect::<Result<Vec<_>>>()?;
+    let shards = in_order(shards)?;
+    let first = shards[0].1.clone();
+    // The files the graphs wrote: each once; two shards writing the same
+    // name must have written the same bytes.
+    let skip: Vec<PathBuf> = [Some(RECORD.to_string()), first.csv.clone(), first.json.clone()]
+        .into_iter()
+        .flatten()
+        .map(PathBuf::from)
+        .collect();
+    let dirs: Vec<&Path> = shards.iter().map(|(d, _)| d.as_path()).collect();
+    let copied = copy_files(&a.out, &dirs, &skip)?;
     let mut runs = Vec::new();
     let mut failures = Failures::new();
     for (_, r) in &shards {
@@ -390,7 +434,7 @@ pub fn main(a: Args) -> Result<()> {
         first.graph,
         runs.len(),
         first.total,
-        copied.len()
+        copied
     );
     if !failures.is_empty() {
         bail!("{}", failures.summary(first.total, "sweep runs").trim_end());

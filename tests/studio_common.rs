@@ -27,7 +27,8 @@ pub fn evflow() -> PathBuf {
     bin
 }
 
-/// A live session with the studio, its stderr lines arriving on `lines`.
+/// A live session with the studio, its stderr lines arriving on `lines`;
+/// killed if dropped while it runs (a failed test leaves nothing running).
 pub struct Session {
     pub child: Child,
     pub url: String,
@@ -83,14 +84,37 @@ pub fn start(graph: &str, dir: &Path, studio: &[&str], extra: &[&str]) -> Sessio
     Session { child, url, lines, dir: session }
 }
 
+impl Drop for Session {
+    fn drop(&mut self) {
+        if self.child.try_wait().ok().flatten().is_none() {
+            let _ = self.child.kill();
+            let _ = self.child.wait();
+        }
+    }
+}
+
+/// A child process killed when dropped.
+pub struct KillOnDrop(pub Child);
+
+impl Drop for KillOnDrop {
+    fn drop(&mut self) {
+        let _ = self.0.kill();
+        let _ = self.0.wait();
+    }
+}
+
 impl Session {
     /// Types `stop` on the console and waits for the end; returns stdout.
     pub fn stop(mut self) -> String {
         if let Some(mut i) = self.child.stdin.take() {
             let _ = writeln!(i, "stop");
         }
-        let out = self.child.wait_with_output().expect("evflow live ends");
-        String::from_utf8_lossy(&out.stdout).into_owned()
+        let _ = self.child.wait();
+        let mut out = String::new();
+        if let Some(mut o) = self.child.stdout.take() {
+            let _ = o.read_to_string(&mut out);
+        }
+        out
     }
     /// `host:port` of the studio.
     pub fn host(&self) -> String {

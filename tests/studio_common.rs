@@ -10,12 +10,20 @@ use std::process::{Child, ChildStderr, Command, Stdio};
 use std::sync::mpsc;
 use std::time::Duration;
 
-/// The `evflow` binary beside this test's (built if it is missing).
+/// The `evflow` binary beside this test's, built if it is missing or was
+/// built without the studio (a rig build, `--no-default-features`, leaves
+/// one there).
 pub fn evflow() -> PathBuf {
     let exe = std::env::current_exe().expect("test executable");
     let dir = exe.parent().and_then(Path::parent).expect("target/<profile>");
     let bin = dir.join("evflow");
-    if !bin.exists() {
+    let has_studio = || {
+        Command::new(&bin)
+            .args(["live", "--help"])
+            .output()
+            .is_ok_and(|o| String::from_utf8_lossy(&o.stdout).contains("--studio"))
+    };
+    if !bin.exists() || !has_studio() {
         let cargo = std::env::var("CARGO").unwrap_or_else(|_| "cargo".into());
         let mut cmd = Command::new(cargo);
         cmd.args(["build", "-q", "-p", "evflow"]);

@@ -205,6 +205,7 @@ fn the_page_shows_a_recorded_session_with_its_events_and_replay_check() {
         .spawn()
         .unwrap();
     let mut lines = BufReader::new(studio.stdout.take().unwrap()).lines();
+    let _studio = common::KillOnDrop(studio);
     let url = lines
         .by_ref()
         .map_while(Result::ok)
@@ -236,10 +237,6 @@ fn the_page_shows_a_recorded_session_with_its_events_and_replay_check() {
     cdp.until("!!studio.replay", 120);
     assert_eq!(cdp.eval("studio.replay.ok"), json!(true), "{}", cdp.eval("studio.replay.summary"));
     assert_eq!(cdp.eval("document.getElementById('replay-check').textContent.startsWith('✓ reproduced')"), json!(true));
-    drop(cdp);
-    drop(browser);
-    let _ = studio.kill();
-    let _ = studio.wait();
 }
 
 #[test]

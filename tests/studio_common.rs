@@ -10,12 +10,20 @@ use std::process::{Child, ChildStderr, Command, Stdio};
 use std::sync::mpsc;
 use std::time::Duration;
 
-/// The `evflow` binary beside this test's (built if it is missing).
+/// The `evflow` binary beside this test's, built if it is missing or was
+/// built without the studio (a rig build, `--no-default-features`, leaves
+/// one there).
 pub fn evflow() -> PathBuf {
     let exe = std::env::current_exe().expect("test executable");
     let dir = exe.parent().and_then(Path::parent).expect("target/<profile>");
     let bin = dir.join("evflow");
-    if !bin.exists() {
+    let has_studio = || {
+        Command::new(&bin)
+            .args(["live", "--help"])
+            .output()
+            .is_ok_and(|o| String::from_utf8_lossy(&o.stdout).contains("--studio"))
+    };
+    if !bin.exists() || !has_studio() {
         let cargo = std::env::var("CARGO").unwrap_or_else(|_| "cargo".into());
         let mut cmd = Command::new(cargo);
         cmd.args(["build", "-q", "-p", "evflow"]);
@@ -27,7 +35,8 @@ pub fn evflow() -> PathBuf {
     bin
 }
 
-/// A live session with the studio, its stderr lines arriving on `lines`.
+/// A live session with the studio, its stderr lines arriving on `lines`;
+/// killed if dropped while it runs (a failed test leaves nothing running).
 pub struct Session {
     pub child: Child,
     pub url: String,
@@ -83,14 +92,37 @@ pub fn start(graph: &str, dir: &Path, studio: &[&str], extra: &[&str]) -> Sessio
     Session { child, url, lines, dir: session }
 }
 
+impl Drop for Session {
+    fn drop(&mut self) {
+        if self.child.try_wait().ok().flatten().is_none() {
+            let _ = self.child.kill();
+            let _ = self.child.wait();
+        }
+    }
+}
+
+/// A child process killed when dropped.
+pub struct KillOnDrop(pub Child);
+
+impl Drop for KillOnDrop {
+    fn drop(&mut self) {
+        let _ = self.0.kill();
+        let _ = self.0.wait();
+    }
+}
+
 impl Session {
     /// Types `stop` on the console and waits for the end; returns stdout.
     pub fn stop(mut self) -> String {
         if let Some(mut i) = self.child.stdin.take() {
             let _ = writeln!(i, "stop");
         }
-        let out = self.child.wait_with_output().expect("evflow live ends");
-        String::from_utf8_lossy(&out.stdout).into_owned()
+        let _ = self.child.wait();
+        let mut out = String::new();
+        if let Some(mut o) = self.child.stdout.take() {
+            let _ = o.read_to_string(&mut out);
+        }
+        out
     }
     /// `host:port` of the studio.
     pub fn host(&self) -> String {

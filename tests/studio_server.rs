@@ -155,10 +155,10 @@ fn a_browser_that_stops_reading_loses_frames_not_ticks() {
     // Connected, then never read again.
     let (_stuck, _) = tungstenite::client(format!("ws://{host}/ws"), small_window(&host)).unwrap();
     let started = Instant::now();
-    let mut child = s.child;
-    let status = child.wait().unwrap();
+    let mut s = s;
+    let status = s.child.wait().unwrap();
     let mut stdout = String::new();
-    std::io::Read::read_to_string(&mut child.stdout.take().unwrap(), &mut stdout).unwrap();
+    std::io::Read::read_to_string(&mut s.child.stdout.take().unwrap(), &mut stdout).unwrap();
     let mut stderr = Vec::new();
     while let Ok(l) = s.lines.recv_timeout(Duration::from_secs(5)) {
         stderr.push(l);

@@ -66,8 +66,15 @@ fn read(dir: &Path) -> Result<RecordedSession> {
         .with_context(|| format!("{}: not valid JSON", json_path.display()))?;
     let end = &raw["end"];
     let mut taps = Vec::new();
+    let mut notes = Vec::new();
     for f in m.inputs.iter().chain(&m.outputs) {
         let rec = Recording::open(&dir.join(&f.file)).map_err(|e| anyhow!("{e}"))?;
+        if let Some(short) = rec.shortfall() {
+            notes.push(format!(
+                "{}: cut short — {} of the {} frames claimed are in the file",
+                f.file, short.present, short.claimed
+            ));
+        }
         for port in &f.ports {
             let samples = rec
                 .channel(port)
@@ -79,7 +86,7 @@ fn read(dir: &Path) -> Result<RecordedSession> {
     let checked = match load_with(&dir.join("graph.toml"), &m.overrides) {
         Ok(c) => Some(c),
         Err(e) => {
-            eprintln!("studio: the recorded graph does not load ({e}); the page shows the recordings without it");
+            notes.push(format!("the recorded graph does not load ({e}); the recordings are shown without it"));
             None
         }
     };
@@ -98,12 +105,16 @@ fn read(dir: &Path) -> Result<RecordedSession> {
         steal_s: end["host_steal_seconds"].as_f64(),
         checked,
         scene,
+        notes,
     })
 }
 
 /// Runs `evflow studio`.
 pub fn main(a: Args) -> Result<()> {
     let session = read(&a.session)?;
+    for n in &session.notes {
+        eprintln!("studio: {n}");
+    }
     let cfg = StudioConfig { addr: studio_addr(&a.addr)?, public: a.public };
     let studio = serve_recorded(&cfg, &session)?;
     println!("studio: {}", studio.url());

@@ -12,6 +12,7 @@
 //! session a tick.
 
 mod assets;
+mod connection;
 mod describe;
 mod feed;
 mod hub;

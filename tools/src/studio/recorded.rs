@@ -47,6 +47,9 @@ pub struct RecordedSession {
     pub checked: Option<Checked>,
     /// The finger view's background ([`super::scene_json`]), or null.
     pub scene: Value,
+    /// What the page must warn about (recordings cut short, a graph that
+    /// no longer loads).
+    pub notes: Vec<String>,
 }
 
 /// Window of the limiter's state timeline, seconds.
@@ -147,6 +150,7 @@ impl RecordedSession {
             "recording": {
                 "seconds": seconds, "ticks": self.ticks, "stopped": self.stopped, "bucket_s": bucket,
                 "replay": { "ok": null, "summary": "running `evflow replay --check`…" },
+                "notes": self.notes,
             },
         });
         let taps: Vec<Value> = self
@@ -221,11 +225,13 @@ mod tests {
             steal_s: None,
             checked: None,
             scene: Value::Null,
+            notes: vec!["outputs/a.out: cut short".into()],
         };
         let (hello, frame) = s.messages();
         let h: Value = serde_json::from_str(&hello).unwrap();
         assert_eq!(h["mode"], "recorded");
         assert_eq!(h["recording"]["seconds"], 3600.0);
+        assert_eq!(h["recording"]["notes"][0], "outputs/a.out: cut short");
         let f: Value = serde_json::from_str(&frame).unwrap();
         let n = f["taps"][0]["lo"].as_array().unwrap().len();
         assert!(n <= MAX_PENDING && n > 3000, "{n} pairs for an hour");

@@ -10,18 +10,17 @@
 //! `Origin`, when present, must be the studio itself (another site's page
 //! open in the same browser cannot steer the session).
 
+use super::connection::{connection, Ctx, MAX_CONNECTIONS};
 use super::describe::Description;
 use super::feed::{FeedState, Ingest};
 use super::hub::Hub;
-use super::{assets, steer, token};
+use super::token;
 use evflow_engine::live::{Control, Shared};
-use std::io::{Read, Write};
-use std::net::{SocketAddr, TcpListener, TcpStream};
+use std::net::{SocketAddr, TcpListener};
 use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
 use std::sync::{Arc, Mutex};
 use std::thread::JoinHandle;
 use std::time::{Duration, Instant};
-use tungstenite::Message;
 
 /// Where and how to serve.
 #[derive(Debug, Clone)]
@@ -56,43 +55,6 @@ pub enum StudioError {
 
 /// Frames per second sent to each browser.
 const FRAME_PERIOD: Duration = Duration::from_millis(50);
-/// Connections (page loads and WebSockets) served at once.
-const MAX_CONNECTIONS: usize = 32;
-/// Largest request head accepted.
-const MAX_HEAD: usize = 8192;
-/// The kernel's send buffer per browser (about a second of frames): a
-/// browser that stops reading is found out within seconds, not after
-/// megabytes of stale frames, and then loses frames in its queue.
-const SEND_BUFFER: libc::c_int = 64 * 1024;
-
-/// Bounds the kernel's send buffer of `s` (best effort).
-fn bound_send_buffer(s: &TcpStream) {
-    use std::os::fd::AsRawFd;
-    let size = SEND_BUFFER;
-    // SAFETY: setsockopt on an open socket with a pointer to a c_int of the given size.
-    unsafe {
-        libc::setsockopt(
-            s.as_raw_fd(),
-            libc::SOL_SOCKET,
-            libc::SO_SNDBUF,
-            &size as *const libc::c_int as *const libc::c_void,
-            std::mem::size_of::<libc::c_int>() as libc::socklen_t,
-        );
-    }
-}
-
-struct Ctx {
-    hub: Arc<Hub>,
-    hello: Arc<str>,
-    /// Sent after `hello` (a recorded session's whole data, results).
-    initial: Mutex<Vec<Arc<str>>>,
-    token: Option<String>,
-    control: Option<Arc<Mutex<Control>>>,
-    stop: Arc<AtomicBool>,
-    public: bool,
-    active: AtomicUsize,
-}
-
 /// A studio's address, bound but not yet served: bind before a session
 /// starts, so that a taken port stops nothing that runs.
 pub struct Bound {
@@ -273,170 +235,9 @@ impl Studio {
     }
 }
 
-/// Reads (without consuming) a whole request head.
-fn peek_head(s: &TcpStream) -> Option<Vec<u8>> {
-    let mut buf = vec![0u8; MAX_HEAD];
-    let deadline = Instant::now() + Duration::from_secs(3);
-    while Instant::now() < deadline {
-        let n = s.peek(&mut buf).ok()?;
-        if n == 0 {
-            return None;
-        }
-        if let Some(end) = buf[..n].windows(4).position(|w| w == b"\r\n\r\n") {
-            buf.truncate(end + 4);
-            return Some(buf);
-        }
-        if n == MAX_HEAD {
-            return None;
-        }
-        std::thread::sleep(Duration::from_millis(5));
-    }
-    None
-}
-
-fn respond(s: &mut TcpStream, status: &str, ctype: &str, body: &[u8]) {
-    let head = format!(
-        "HTTP/1.1 {status}\r\nContent-Type: {ctype}\r\nContent-Length: {}\r\nCache-Control: no-store\r\n\
-         X-Content-Type-Options: nosniff\r\nContent-Security-Policy: default-src 'self'; connect-src 'self'; \
-         frame-ancestors 'none'\r\nConnection: close\r\n\r\n",
-        body.len()
-    );
-    let _ = s.write_all(head.as_bytes()).and_then(|_| s.write_all(body)).and_then(|_| s.flush());
-}
-
-fn header<'a>(req: &'a httparse::Request, name: &str) -> Option<&'a str> {
-    req.headers.iter().find(|h| h.name.eq_ignore_ascii_case(name)).and_then(|h| std::str::from_utf8(h.value).ok())
-}
-
-/// True for `127.0.0.1`, `[::1]`, `localhost` (with any port).
-fn loopback_host(host: &str) -> bool {
-    let h = if host.starts_with('[') { host.split(']').next().map(|h| &h[1..]) } else { host.split(':').next() };
-    match h {
-        Some("localhost") => true,
-        Some(h) => h.parse::<std::net::IpAddr>().is_ok_and(|ip| ip.is_loopback()),
-        None => false,
-    }
-}
-
-fn connection(mut s: TcpStream, ctx: &Ctx) {
-    let _ = s.set_nonblocking(false);
-    let _ = s.set_read_timeout(Some(Duration::from_secs(3)));
-    let _ = s.set_write_timeout(Some(Duration::from_secs(3)));
-    let Some(head) = peek_head(&s) else { return };
-    let mut headers = [httparse::EMPTY_HEADER; 32];
-    let mut req = httparse::Request::new(&mut headers);
-    if !matches!(req.parse(&head), Ok(httparse::Status::Complete(_))) {
-        let _ = s.read_exact(&mut vec![0; head.len()]);
-        return respond(&mut s, "400 Bad Request", "text/plain", b"malformed request\n");
-    }
-    let target = req.path.unwrap_or("/").to_string();
-    let host = header(&req, "host").unwrap_or("").to_string();
-    let origin = header(&req, "origin").map(str::to_string);
-    let upgrade = header(&req, "upgrade").is_some_and(|u| u.eq_ignore_ascii_case("websocket"));
-    let method = req.method.unwrap_or("").to_string();
-    let refuse = |s: &mut TcpStream, status: &str, why: &str| {
-        let _ = s.read_exact(&mut vec![0; head.len()]);
-        respond(s, status, "text/plain; charset=utf-8", why.as_bytes());
-    };
-    if method != "GET" {
-        return refuse(&mut s, "405 Method Not Allowed", "only GET\n");
-    }
-    if !ctx.public && !loopback_host(&host) {
-        return refuse(&mut s, "403 Forbidden", "this studio serves loopback host names only\n");
-    }
-    if let Some(t) = &ctx.token {
-        if !token::query(&target, "token").is_some_and(|g| token::matches(t, g)) {
-            return refuse(
-                &mut s,
-                "403 Forbidden",
-                "this studio needs its one-time token: open the address printed by evflow (…/?token=…)\n",
-            );
-        }
-    }
-    let path = target.split('?').next().unwrap_or("/");
-    if path == "/ws" && upgrade {
-        if origin.as_deref().is_some_and(|o| o != format!("http://{host}")) {
-            return refuse(&mut s, "403 Forbidden", "WebSocket from another origin\n");
-        }
-        return websocket(s, ctx);
-    }
-    let _ = s.read_exact(&mut vec![0; head.len()]);
-    match assets::get(path) {
-        Some((ctype, body)) => respond(&mut s, "200 OK", ctype, body.as_bytes()),
-        None => respond(&mut s, "404 Not Found", "text/plain", b"not found\n"),
-    }
-}
-
-fn websocket(s: TcpStream, ctx: &Ctx) {
-    bound_send_buffer(&s);
-    let Ok(mut ws) = tungstenite::accept(s) else { return };
-    let Some((rx, drops)) = ctx.hub.join() else {
-        let _ = ws.send(Message::text(r#"{"type":"error","message":"too many browsers are connected"}"#));
-        let _ = ws.close(None);
-        return;
-    };
-    let _ = ws.get_mut().set_read_timeout(Some(Duration::from_millis(2)));
-    let _ = ws.get_mut().set_write_timeout(Some(Duration::from_secs(2)));
-    let initial: Vec<Arc<str>> = ctx.initial.lock().unwrap_or_else(|e| e.into_inner()).clone();
-    for m in std::iter::once(&ctx.hello).chain(&initial) {
-        if ws.send(Message::text(m.to_string())).is_err() {
-            return;
-        }
-    }
-    let mut told = Instant::now();
-    'session: while !ctx.stop.load(Ordering::Acquire) {
-        match rx.recv_timeout(Duration::from_millis(20)) {
-            Ok(frame) => {
-                if ws.send(Message::text(frame.to_string())).is_err() {
-                    break;
-                }
-            }
-            Err(std::sync::mpsc::RecvTimeoutError::Timeout) => {}
-            Err(std::sync::mpsc::RecvTimeoutError::Disconnected) => break,
-        }
-        loop {
-            match ws.read() {
-                Ok(Message::Text(t)) => {
-                    let reply = steer::handle(t.as_str(), ctx.control.as_deref());
-                    if ws.send(Message::text(reply.to_string())).is_err() {
-                        break 'session;
-                    }
-                }
-                Ok(Message::Close(_)) => break 'session,
-                Ok(_) => {}
-                Err(tungstenite::Error::Io(e))
-                    if matches!(e.kind(), std::io::ErrorKind::WouldBlock | std::io::ErrorKind::TimedOut) =>
-                {
-                    break
-                }
-                Err(_) => break 'session,
-            }
-        }
-        if told.elapsed() >= Duration::from_secs(1) {
-            let n = drops.load(Ordering::Relaxed);
-            if ws.send(Message::text(format!(r#"{{"type":"drops","frames":{n}}}"#))).is_err() {
-                break;
-            }
-            told = Instant::now();
-        }
-    }
-    let _ = ws.close(None);
-    let _ = ws.flush();
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
-
-    #[test]
-    fn loopback_hosts() {
-        for h in ["127.0.0.1:8080", "localhost:1", "[::1]:99", "127.0.0.2"] {
-            assert!(loopback_host(h), "{h}");
-        }
-        for h in ["evil.example:8080", "192.168.1.2:1", "", "[fe80::1]:2"] {
-            assert!(!loopback_host(h), "{h}");
-        }
-    }
 
     #[test]
     fn a_public_address_needs_the_flag() {

@@ -305,6 +305,7 @@ function recordedInit(h) {
     el("b", { id: "replay-check" }, r.replay.summary)), $("traces"));
   S.view = [0, r.seconds];
   $("drops").parentElement.style.display = "none";
+  for (const n of r.notes || []) $("traces-panel").insertBefore(el("p", { class: "note" }, "⚠ " + n), $("traces"));
   for (const l of h.limiters) $(`limiter-${l.node}`).parentElement.after(el("div", { class: "small" }, "state over the shown span:"), el("canvas", { id: `timeline-${l.node}`, class: "timeline", width: 600, height: 18 }));
   $("compute").style.display = "none";
 }

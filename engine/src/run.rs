@@ -33,6 +33,9 @@ pub struct RunReport {
     pub times: Vec<NodeTime>,
     /// What each node reported at the end (metrics, files written).
     pub summaries: Vec<(String, Summary)>,
+    /// What the plan held constant or left out, and why, one line each
+    /// (docs/pruning.md) — for people; tables and merges leave it out.
+    pub left_out: Vec<String>,
 }
 
 impl RunReport {
@@ -82,7 +85,21 @@ pub fn run_offline(plan: &mut Plan, mut opts: RunOptions<'_>) -> Result<RunRepor
     }
     let elapsed = started.elapsed();
     let summaries = plan.finish()?;
-    Ok(RunReport { ticks: done, base_rate: plan.base_rate(), elapsed, times: plan.times(), summaries })
+    let left_out = left_out_lines(plan);
+    Ok(RunReport { ticks: done, base_rate: plan.base_rate(), elapsed, times: plan.times(), summaries, left_out })
+}
+
+/// One line per node the plan held constant (with its values) or left out.
+fn left_out_lines(plan: &Plan) -> Vec<String> {
+    let mut lines = Vec::new();
+    for f in plan.folded() {
+        let values: Vec<String> = f.outputs.iter().filter_map(|(port, v)| v.map(|v| format!("{port} = {v}"))).collect();
+        lines.push(format!("held constant `{}` ({}): {}", f.node, values.join(", "), f.reason));
+    }
+    for p in plan.pruned() {
+        lines.push(format!("left out `{}`: {}", p.node, p.reason));
+    }
+    lines
 }
 
 #[cfg(test)]

@@ -72,9 +72,19 @@ impl Control {
 
     /// Tells the control side which graph variables set live parameters
     /// (see [`crate::live::live_vars`]), so `set_var` and `set_text("name=value")`
-    /// can change them.
+    /// can change them. A use naming a node the running plan does not hold
+    /// (left out when the plan was built: it fed only a node that turned
+    /// out constant, docs/pruning.md) is dropped, and so is a variable left
+    /// with no use: changing it could change nothing that runs.
     pub fn bind_vars(&mut self, vars: Vec<LiveVar>) {
-        self.vars = vars;
+        let nodes = &self.nodes;
+        self.vars = vars
+            .into_iter()
+            .filter_map(|mut v| {
+                v.uses.retain(|(node, _)| nodes.iter().any(|(n, _)| n == node));
+                (!v.uses.is_empty()).then_some(v)
+            })
+            .collect();
     }
 
     /// The bound variables.

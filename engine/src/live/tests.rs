@@ -361,6 +361,21 @@ fn a_graph_variable_sets_every_live_parameter_it_names_at_one_tick() {
 }
 
 #[test]
+fn a_variable_bound_to_nodes_the_plan_left_out_binds_only_what_runs() {
+    let (_, lp) = two_counters();
+    let mut live = start(lp, &config(Some(0.05))).unwrap();
+    live.control.bind_vars(vec![
+        LiveVar { name: "level".into(), uses: vec![("a".into(), "level"), ("gone".into(), "level")] },
+        LiveVar { name: "only_gone".into(), uses: vec![("gone".into(), "level")] },
+    ]);
+    assert_eq!(live.control.vars(), &[LiveVar { name: "level".into(), uses: vec![("a".into(), "level")] }]);
+    live.control.set_var("level", "3", None).unwrap();
+    let e = live.control.set_var("only_gone", "3", None).unwrap_err().to_string();
+    assert!(e.contains("no graph variable `only_gone`"), "{e}");
+    live.into_parts().thread.join();
+}
+
+#[test]
 fn a_plan_built_to_run_offline_is_refused_by_the_live_runner() {
     let doc = "[graph]\nformat = 1\nname = \"t\"\nrate = 1000.0\nconnections = [\"c.out -> g.in\", \"g.out -> t.in\"]\n\
                [nodes.c]\ntype = \"test.counter\"\n[nodes.g]\ntype = \"test.guard\"\n[nodes.t]\ntype = \"harness.tap\"\n";

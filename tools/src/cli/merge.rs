@@ -207,6 +207,7 @@ fn parse_report(v: &Json) -> Result<RunReport> {
         elapsed: Duration::from_nanos(count(v, "elapsed_ns")?),
         times,
         summaries,
+        left_out: Vec::new(),
     })
 }
 

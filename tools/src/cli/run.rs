@@ -101,13 +101,6 @@ pub fn main(a: Args) -> Result<()> {
         }
         bail!("nothing was run: {}", f.summary(items.len(), "sweep runs").trim_end());
     }
-    if !a.quiet {
-        if let Some((_, _, Ok(c))) = items.iter().find(|(_, _, c)| c.is_ok()) {
-            for p in &c.pruned {
-                eprintln!("left out `{}`: {}", p.node, p.reason);
-            }
-        }
-    }
     std::fs::create_dir_all(&a.out).map_err(|e| anyhow!("{}: cannot create output folder: {e}", a.out.display()))?;
 
     let stop = Arc::new(AtomicBool::new(false));

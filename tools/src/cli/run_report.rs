@@ -30,6 +30,11 @@ pub enum Timings {
 /// Prints what the sinks report and, unless `quiet`, the run's times.
 pub fn print_report(r: &RunReport, quiet: bool, timings: Timings) {
     let base_rate = r.base_rate;
+    if !quiet {
+        for l in &r.left_out {
+            eprintln!("{l}");
+        }
+    }
     for (node, s) in &r.summaries {
         for l in &s.lines {
             println!("{node}: {l}");

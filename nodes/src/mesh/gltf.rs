@@ -367,7 +367,8 @@ fn layout(
         )
     })?;
     let start = view.offset() + a.offset();
-    let need = if a.count() == 0 { Some(0) } else { (a.count() - 1).checked_mul(stride).and_then(|b| b.checked_add(elem)) };
+    let need =
+        if a.count() == 0 { Some(0) } else { (a.count() - 1).checked_mul(stride).and_then(|b| b.checked_add(elem)) };
     if need.and_then(|n| start.checked_add(n)).is_none_or(|e| e > view_end) {
         return Err(gltf_msg(path, format!("{name}: {} elements of {elem} bytes (stride {stride}) from byte {} run past the end of bufferViews[{}]", a.count(), a.offset(), view.index())));
     }
@@ -658,7 +659,8 @@ mod tests {
         // Nine nested nodes scaled 10³⁸ each: the product overflows f64.
         let chain: Vec<String> =
             (0..9).map(|k| format!(r#"{{"children":[{}],"scale":[1e38,1e38,1e38]}}"#, k + 1)).collect();
-        let nested = embedded("").replace(r#""nodes":[{"mesh":0}]"#, &format!(r#""nodes":[{},{{"mesh":0}}]"#, chain.join(",")));
+        let nested =
+            embedded("").replace(r#""nodes":[{"mesh":0}]"#, &format!(r#""nodes":[{},{{"mesh":0}}]"#, chain.join(",")));
         let s = e(nested);
         assert!(s.contains("meshes[0].primitives[0]: a node transform takes"), "{s}");
         let s = e(json(Some("missing.bin"), ""));

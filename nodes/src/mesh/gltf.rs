@@ -63,7 +63,11 @@ pub fn parse_gltf(path: &Path, bytes: &[u8], glb: bool, weld: f64) -> Result<Mes
             }
             let base = vertices.len() as u64;
             for p in read_positions(path, &buffers, &pos, &what)? {
-                vertices.push(m.apply(p));
+                let q = m.apply(p);
+                if !q.iter().all(|x| x.is_finite()) {
+                    return Err(gltf_msg(path, format!("{what}: a node transform takes {p:?} to {q:?}")));
+                }
+                vertices.push(q);
             }
             let n = pos.count();
             let idx: Vec<u32> = match prim.indices() {
@@ -363,8 +367,9 @@ fn layout(
         )
     })?;
     let start = view.offset() + a.offset();
-    let need = if a.count() == 0 { 0 } else { (a.count() - 1) * stride + elem };
-    if start.checked_add(need).is_none_or(|e| e > view_end) {
+    let need =
+        if a.count() == 0 { Some(0) } else { (a.count() - 1).checked_mul(stride).and_then(|b| b.checked_add(elem)) };
+    if need.and_then(|n| start.checked_add(n)).is_none_or(|e| e > view_end) {
         return Err(gltf_msg(path, format!("{name}: {} elements of {elem} bytes (stride {stride}) from byte {} run past the end of bufferViews[{}]", a.count(), a.offset(), view.index())));
     }
     Ok((buffer, start, stride))
@@ -651,6 +656,13 @@ mod tests {
         assert!(s.contains("extensionsRequired"), "{s}");
         let s = e(embedded("").replace(";base64,", ";base64,%%"));
         assert!(s.contains("buffers[0]: data URI"), "{s}");
+        // Nine nested nodes scaled 10³⁸ each: the product overflows f64.
+        let chain: Vec<String> =
+            (0..9).map(|k| format!(r#"{{"children":[{}],"scale":[1e38,1e38,1e38]}}"#, k + 1)).collect();
+        let nested =
+            embedded("").replace(r#""nodes":[{"mesh":0}]"#, &format!(r#""nodes":[{},{{"mesh":0}}]"#, chain.join(",")));
+        let s = e(nested);
+        assert!(s.contains("meshes[0].primitives[0]: a node transform takes"), "{s}");
         let s = e(json(Some("missing.bin"), ""));
         assert!(s.contains("missing.bin") && s.contains("buffers[0] of t.gltf"), "{s}");
     }

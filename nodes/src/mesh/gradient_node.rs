@@ -34,17 +34,20 @@ cached under a hash of the mesh and the settings, so the next session starts at 
 `cache` (relative to the output folder), by default the user's cache folder ($EVFLOW_CACHE, else \
 $XDG_CACHE_HOME/evflow, else ~/.cache/evflow), or nowhere with `cache = \"none\"`; `range = \"fixed\"` takes `f_min`/`f_max` \
 (the formative study's ±1). A flat mesh has F_min = F_max = 0 and renders I = `i_max`.\n\n\
-**Mesh.** `file` (OBJ via tobj; quads and n-gons triangulated; normals recomputed; vertices welded \
-so neighbouring triangles share edges, within `weld`), or a generated §4.2 scene (`shape`, `config`, \
+**Mesh.** `file`: OBJ, STL (ASCII or binary), PLY (ASCII or binary) or glTF/GLB, by extension \
+(docs/mesh.md, Formats; quads and n-gons triangulated; normals recomputed; vertices welded \
+so neighbouring triangles share edges, within `weld`; zero-area and repeated triangles dropped), or a generated §4.2 scene (`shape`, `config`, \
 `resolution`; cm). **Orientation and fit:** `up` names the mesh axis that points out of the screen \
-(default `auto`: +y for OBJ files, as OBJ models conventionally are, +z for generated scenes); the mesh \
+(default `auto`: +y for OBJ and glTF/GLB, as OBJ models conventionally are and as glTF's spec says; \
++z for STL, PLY — CAD and scanners — and generated scenes); the mesh \
 is turned so that it becomes height z. `fit = \"footprint\"` centres the mesh's x–y bounds on \
 (`offset_x`, `offset_y`) and scales the mesh uniformly (heights too, so slopes keep their values) so that \
 the larger side spans `fit_size` metres — whatever its units (mm, m) or however far from the origin it \
 was modelled — and reports heights `z` from its lowest point; the default `fit = \"none\"` keeps `unit` and the origin at `offset_x/y`. Each entry of \
 `scenes` is turned and fitted on its own. The BVH (obvhs CWBVH) is built when the node is constructed — never for a pruned \
-node. The hit test is f64 and watertight: rays through vertices and edges hit whatever the winding.\n\n\
-**Scenes.** `scenes` lists several meshes (generated-scene configs such as \"4B0H\", or OBJ files); all \
+node. The hit test is f64 and watertight: rays through vertices and edges hit whatever the winding; \
+where the mesh overhangs (a teapot's handle or spout), the highest hit is the one felt, never the surface beneath.\n\n\
+**Scenes.** `scenes` lists several meshes (generated-scene configs such as \"4B0H\", or mesh files of any of the formats above); all \
 are loaded, ray-cast structures built and calibrated when the node is built, and the live parameter \
 `scene` (0-based index) picks the one felt. On a change the slope estimate continues on the new mesh from the finger's last point and \
 direction (its held slope: the new mesh's slope there), and \

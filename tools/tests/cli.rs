@@ -192,6 +192,21 @@ fn check_prints_the_plan_and_what_was_left_out() {
 }
 
 #[test]
+fn check_prints_each_mesh_s_bounds_up_axis_and_scale_unless_told_not_to_build() {
+    let o = evflow(&["check", "graphs/mesh-scan.toml"]);
+    let (stdout, stderr) = text(&o);
+    assert!(o.status.success(), "{stderr}");
+    let surface = stdout.lines().find(|l| l.trim_start().starts_with("surface:")).unwrap_or_else(|| panic!("{stdout}"));
+    for part in ["bounds x", "up +z (auto)", "scale 0.01 m per unit", "on the screen"] {
+        assert!(surface.contains(part), "`{part}` missing: {surface}");
+    }
+    let o = evflow(&["check", "graphs/mesh-scan.toml", "--no-build"]);
+    let (stdout, stderr) = text(&o);
+    assert!(o.status.success(), "{stderr}");
+    assert!(!stdout.contains("bounds x") && stdout.contains("--no-build"), "{stdout}");
+}
+
+#[test]
 fn nodes_lists_and_describes_node_types() {
     let (out, _) = text(&evflow(&["nodes"]));
     for t in ["prbs", "butterworth", "sim.display", "recording.out", "metric"] {

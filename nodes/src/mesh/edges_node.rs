@@ -38,7 +38,7 @@ one graph variable.\n\n\
 (θ_min = 180°, e.g. the Gaussian scenes), `intensity` and `sharpness` are 0 at every tick whatever the \
 finger does; the node says so when built, and unless something reads its `angle` (which still reports \
 the bends of the facets crossed) the planner replaces it by those constants — it is never stepped — and \
-leaves out what fed only it. Its summary is then not reported; `evflow check --build` lists it.\n\n\
+leaves out what fed only it. Its summary is then not reported; `evflow check` lists it.\n\n\
 **Ports** (all at the node's rate): inputs `x`, `y` (m), `tri`; outputs `intensity` (I_e), \
 `sharpness` (S), `angle` (θ of the bend crossed this tick, degrees; 180 when none). **Checked \
 against:** a cube standing on an edge (90°, either winding), an axis-aligned cube stepped off (90° \

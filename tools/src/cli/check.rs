@@ -11,12 +11,13 @@ use evflow_engine::{Direction, Plan, PlanOptions};
 pub struct Args {
     #[command(flatten)]
     graph: GraphArgs,
-    /// Also construct and prepare the plan's nodes (opens their files),
-    /// without running anything: prints what each node loaded (a mesh's
-    /// bounds, up axis, scale and place on the screen) and what it then
-    /// found constant and left out.
+    /// Only validate: do not construct the plan's nodes (opens no files,
+    /// loads no mesh). By default `check` also builds the plan as `run`
+    /// does, without running anything, and prints what each node loaded (a
+    /// mesh's bounds, up axis, scale and place on the screen) and what it
+    /// then found constant and left out.
     #[arg(long)]
-    build: bool,
+    no_build: bool,
 }
 
 /// Runs `evflow check`.
@@ -92,7 +93,7 @@ sweep: {} → {runs} runs (`evflow run` runs them all)",
             if p.fit == evflow_engine::graph::Fit::None { String::new() } else { format!(", {} fit", p.fit.name()) };
         println!("plot {}: {} against {}{fit}", p.file, p.y.join(", "), p.x);
     }
-    if a.build {
+    if !a.no_build {
         let plan = Plan::build(&c, &PlanOptions::default()).map_err(|e| anyhow!("{e}"))?;
         println!("\nbuilt: {} nodes, block {} base ticks", plan.schedule().len(), plan.max_block());
         for (node, lines) in plan.notes() {
@@ -111,7 +112,7 @@ sweep: {} → {runs} runs (`evflow run` runs them all)",
     } else {
         println!(
             "\n(a node may find more to leave out once it has loaded its files, e.g. `mesh.edges` on a mesh \
-             without sharp edges: `--build` builds the plan and says)"
+             without sharp edges: without `--no-build`, check builds the plan and says)"
         );
     }
     println!("\nok");

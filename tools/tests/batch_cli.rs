@@ -400,3 +400,43 @@ fn a_library_takes_generated_samples_and_refuses_malformed_names() {
     assert!(!o.status.success());
     assert!(err.contains("sample") && err.contains("`generated-x`") && err.contains("generated-<seed>"), "{err}");
 }
+
+/// A sweep whose runs would write the same file (its output name does not
+/// vary with a swept variable) is refused before anything runs, naming
+/// the file and the runs that share it.
+#[test]
+fn a_sweep_whose_runs_share_an_output_file_is_refused_before_running() {
+    let base = tempfile::tempdir().unwrap();
+    let text = std::fs::read_to_string(root().join("graphs/excitation.toml")).unwrap();
+    assert!(text.contains("path = \"excitation-${mass}g-${speed}cms\""));
+    let graph = base.path().join("clash.toml");
+    std::fs::write(&graph, text.replace("excitation-${mass}g-${speed}cms", "excitation-${mass}g")).unwrap();
+    let out = base.path().join("out");
+    let args = |extra: &[&str]| {
+        let mut v = vec!["run", graph.to_str().unwrap(), "--out", out.to_str().unwrap(), "-q", "--jobs", "2"];
+        v.extend_from_slice(extra);
+        evflow(&v)
+    };
+    let o = args(&["--sweep", "mass=60,110", "--sweep", "speed=3,5"]);
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert!(!o.status.success());
+    assert!(err.contains("2 output files would be written by more than one run"), "{err}");
+    let f60 = out.join("excitation-60g");
+    let f110 = out.join("excitation-110g");
+    assert!(
+        err.contains(&format!("{}: mass=60 speed=3 (node `record`), mass=60 speed=5 (node `record`)", f60.display())),
+        "{err}"
+    );
+    assert!(
+        err.contains(&format!(
+            "{}: mass=110 speed=3 (node `record`), mass=110 speed=5 (node `record`)",
+            f110.display()
+        )),
+        "{err}"
+    );
+    assert!(!out.exists(), "nothing written");
+    // Sweeping only the variable the name holds is fine.
+    let o = args(&["--sweep", "mass=60,110", "--set", "speed=3"]);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    assert!(out.join("excitation-60g.wav").is_file() && out.join("excitation-110g.wav").is_file());
+}

@@ -326,3 +326,117 @@ fn library_shards_merged_equal_one_build() {
     let o = evflow(&["merge", base.path().join("m2").to_str().unwrap(), p1.to_str().unwrap()]);
     assert!(String::from_utf8_lossy(&o.stderr).contains("shards missing: 2/2"));
 }
+
+/// Generated texture samples in the library: `--generated 2` adds
+/// generated-1 and generated-2 after `--samples`, the texture-live grid
+/// plays a generated texture's cells, and malformed names are refused
+/// before anything is built.
+#[cfg(feature = "synth")]
+#[test]
+fn a_library_takes_generated_samples_and_refuses_malformed_names() {
+    let base = tempfile::tempdir().unwrap();
+    let lib = base.path().join("lib");
+    let l = lib.to_str().unwrap();
+    let build = |samples: &str, generated: &str| {
+        evflow(&[
+            "library",
+            "build",
+            "--out",
+            l,
+            "--samples",
+            samples,
+            "--generated",
+            generated,
+            "--masses",
+            "85",
+            "--speeds",
+            "5",
+            "--epochs",
+            "3",
+            "--iterations",
+            "3",
+            "--gains",
+            "1.0",
+            "--jobs",
+            "2",
+        ])
+    };
+    let o = build("felt-fabric", "2");
+    let out = String::from_utf8_lossy(&o.stdout);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    assert!(out.contains("4 items built, 0 already there, 0 failed, of 4"), "{out}");
+    let index: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(lib.join("index.json")).unwrap()).unwrap();
+    assert_eq!(index["samples"], serde_json::json!(["felt-fabric", "generated-1", "generated-2"]));
+    let textures: Vec<&str> =
+        index["entries"].as_array().unwrap().iter().map(|e| e["texture"].as_str().unwrap()).collect();
+    assert_eq!(textures, ["felt-fabric", "generated-1", "generated-2"]);
+    // Two generated textures are two different textures: their cells differ.
+    let cell = |s: &str| std::fs::read(lib.join(format!("narx-{s}/u-{s}-85g-5cms.wav"))).unwrap();
+    assert_ne!(cell("generated-1"), cell("generated-2"));
+    let grid = format!("textures=[\"{}\"]", lib.join("narx-generated-2").display());
+    let o = evflow(&["run", "graphs/texture-live.toml", "--set", &grid, "--duration", "0.5", "-q", "--out", l]);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+
+    for bad in ["generated-x", "generated-07"] {
+        let o = build(bad, "0");
+        let err = String::from_utf8_lossy(&o.stderr);
+        assert!(!o.status.success());
+        assert!(err.contains(&format!("--samples: sample `{bad}`")) && err.contains("generated-<seed>"), "{err}");
+    }
+    let o = build("generated-1", "1");
+    assert!(String::from_utf8_lossy(&o.stderr).contains("sample `generated-1` given twice"));
+    // A graph naming a malformed generated sample is refused, naming the node's parameter.
+    let o = evflow(&[
+        "run",
+        "graphs/record-textures.toml",
+        "--set",
+        "sample=generated-x",
+        "--out",
+        base.path().join("rec").to_str().unwrap(),
+        "-q",
+    ]);
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert!(!o.status.success());
+    assert!(err.contains("sample") && err.contains("`generated-x`") && err.contains("generated-<seed>"), "{err}");
+}
+
+/// A sweep whose runs would write the same file (its output name does not
+/// vary with a swept variable) is refused before anything runs, naming
+/// the file and the runs that share it.
+#[test]
+fn a_sweep_whose_runs_share_an_output_file_is_refused_before_running() {
+    let base = tempfile::tempdir().unwrap();
+    let text = std::fs::read_to_string(root().join("graphs/excitation.toml")).unwrap();
+    assert!(text.contains("path = \"excitation-${mass}g-${speed}cms\""));
+    let graph = base.path().join("clash.toml");
+    std::fs::write(&graph, text.replace("excitation-${mass}g-${speed}cms", "excitation-${mass}g")).unwrap();
+    let out = base.path().join("out");
+    let args = |extra: &[&str]| {
+        let mut v = vec!["run", graph.to_str().unwrap(), "--out", out.to_str().unwrap(), "-q", "--jobs", "2"];
+        v.extend_from_slice(extra);
+        evflow(&v)
+    };
+    let o = args(&["--sweep", "mass=60,110", "--sweep", "speed=3,5"]);
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert!(!o.status.success());
+    assert!(err.contains("2 output files would be written by more than one run"), "{err}");
+    let f60 = out.join("excitation-60g");
+    let f110 = out.join("excitation-110g");
+    assert!(
+        err.contains(&format!("{}: mass=60 speed=3 (node `record`), mass=60 speed=5 (node `record`)", f60.display())),
+        "{err}"
+    );
+    assert!(
+        err.contains(&format!(
+            "{}: mass=110 speed=3 (node `record`), mass=110 speed=5 (node `record`)",
+            f110.display()
+        )),
+        "{err}"
+    );
+    assert!(!out.exists(), "nothing written");
+    // Sweeping only the variable the name holds is fine.
+    let o = args(&["--sweep", "mass=60,110", "--set", "speed=3"]);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    assert!(out.join("excitation-60g.wav").is_file() && out.join("excitation-110g.wav").is_file());
+}

@@ -3,7 +3,7 @@
 
 use super::library_build::{build, Plan};
 use anyhow::{ensure, Context, Result};
-use evflow_nodes::lab::texture::samples::NAMES;
+use evflow_nodes::lab::texture::{generated, samples};
 use evflow_nodes::synth::study::setup::{Cond, Profile};
 use evflow_tools::batch::{progress_bar, BatchArgs};
 use std::path::PathBuf;
@@ -35,9 +35,14 @@ struct BuildArgs {
     /// The library folder (created; an existing library is completed).
     #[arg(long)]
     out: PathBuf,
-    /// Texture samples (default: every sample of the simulated lab).
+    /// Texture samples: names of the simulated lab's samples or
+    /// `generated-<seed>` (default: the lab's seven).
     #[arg(long, value_delimiter = ',')]
     samples: Vec<String>,
+    /// Add the generated samples generated-1 … generated-N after --samples
+    /// (or after the lab's seven when --samples is not given).
+    #[arg(long, default_value_t = 0)]
+    generated: u64,
     /// Stylus masses of the grid, g.
     #[arg(long, value_delimiter = ',', default_value = "60,85,110")]
     masses: Vec<f64>,
@@ -66,10 +71,17 @@ struct BuildArgs {
 /// Runs `evflow library`.
 pub fn main(a: Args) -> Result<()> {
     let Which::Build(b) = a.which;
-    let samples: Vec<String> =
-        if b.samples.is_empty() { NAMES.iter().map(|s| s.to_string()).collect() } else { b.samples.clone() };
+    let mut samples: Vec<String> =
+        if b.samples.is_empty() { samples::NAMES.iter().map(|s| s.to_string()).collect() } else { b.samples.clone() };
     for s in &samples {
-        ensure!(NAMES.contains(&s.as_str()), "--samples: unknown sample `{s}` (one of {})", NAMES.join(", "));
+        if let Err(e) = samples::lookup(s) {
+            anyhow::bail!("--samples: {e}");
+        }
+    }
+    samples.extend((1..=b.generated).map(generated::name));
+    let mut seen = std::collections::HashSet::new();
+    if let Some(d) = samples.iter().find(|s| !seen.insert(s.as_str())) {
+        anyhow::bail!("--samples/--generated: sample `{d}` given twice");
     }
     let mut conds = Vec::new();
     for m in &b.masses {

@@ -5,7 +5,7 @@
 use super::graph_args::GraphArgs;
 use super::run_report::{print_report, report_json, sweep_csv, sweep_table, Timings};
 use anyhow::{anyhow, bail, Result};
-use evflow_engine::batch::{for_each_ordered, Failures};
+use evflow_engine::batch::{check_outputs, for_each_ordered, output_files, Failures};
 use evflow_engine::sweep::{parse_axis, points, Point};
 use evflow_engine::{check, read_graph, run_offline, Checked, Plan, PlanOptions, RunOptions, RunReport};
 use evflow_tools::batch::{progress_bar, BatchArgs};
@@ -101,6 +101,11 @@ pub fn main(a: Args) -> Result<()> {
         }
         bail!("nothing was run: {}", f.summary(items.len(), "sweep runs").trim_end());
     }
+    // Runs (or nodes) that would write the same file would overwrite each
+    // other, or race on `--jobs`: refused before anything runs.
+    let outputs: Vec<_> =
+        items.iter().filter_map(|(_, p, c)| c.as_ref().ok().map(|c| (p.label(), output_files(c, &a.out)))).collect();
+    check_outputs(&outputs).map_err(|e| anyhow!("{}: {e}", graph.file.display()))?;
     std::fs::create_dir_all(&a.out).map_err(|e| anyhow!("{}: cannot create output folder: {e}", a.out.display()))?;
 
     let stop = Arc::new(AtomicBool::new(false));

@@ -3,6 +3,7 @@
 //! a tribometer's stylus or the virtual user's finger slides on
 //! ([`surface`] the model, [`samples`] the seven definitions).
 
+pub mod generated;
 pub mod samples;
 pub mod surface;
 
@@ -36,7 +37,8 @@ a component of wavelength λ sounds at v/λ, the linear frequency–velocity rel
 wavelengths (0.9–2.5 mm) put the main component above the 10 Hz high-pass of §5.1.1 at 3 cm/s; the \
 power grows with the load (§5.3.1); the soft samples (chair and felt fabric) keep little power below \
 1 mm, the rough ones much. The seven samples, with their values and reasons: `docs/simulated-lab.md` \
-(Texture samples).\n\n\
+(Texture samples). `generated-<seed>` names a generated sample: a surface drawn from the seed within \
+the ranges the seven cover (the same seed, the same surface; `lab::texture::generated`).\n\n\
 **Ports** (at the node's rate): `position` (m), `velocity` (m/s), `load` (N) from `sim.tribometer` or \
 `sim.user`; `force` (N) to `sim.forcesensor`. Non-finite inputs give 0 N.\n\n\
 **Parameters.** `sample`; `friction` overrides μ₀ and `contact` overrides σ₁ (0: the sample's).\n\n\
@@ -55,7 +57,12 @@ and 1000 g.",
     PortSpec::output("force", "N", "lateral friction force (positive opposes +x motion)"),
 ])
 .params(&[
-    ParamSpec::choice("sample", samples::NAMES, "dotted-sheet", "texture sample (§5.3, §6.3)"),
+    ParamSpec::text(
+        "sample",
+        "dotted-sheet",
+        "texture sample (§5.3, §6.3): dotted-sheet, chair-fabric, felt-fabric, painting-canvas, plastic-sheet, \
+scrunched-paper, rippled-paper, or generated-<seed> (a generated sample, seed 0–2⁶⁴−1)",
+    ),
     ParamSpec::float("friction", 0.0, 2.0, 0.0, "1", "base friction coefficient μ₀ (0: the sample's)"),
     ParamSpec::float("contact", 0.0, 0.01, 0.0, "m", "contact half-width at 1 N, σ₁ (0: the sample's)"),
 ])
@@ -70,9 +77,7 @@ struct SimTexture {
 
 fn build(p: &Params, _ctx: &BuildContext) -> Result<Box<dyn Node>, NodeError> {
     let name = p.str("sample");
-    let mut surface = samples::sample(name).ok_or_else(|| {
-        NodeError::param("sample", format!("unknown sample `{name}` (one of {})", samples::NAMES.join(", ")))
-    })?;
+    let mut surface = samples::lookup(name).map_err(|e| NodeError::param("sample", e))?;
     if p.f64("friction") > 0.0 {
         surface.mu = p.f64("friction");
     }

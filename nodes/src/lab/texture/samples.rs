@@ -31,6 +31,7 @@
 //!   paper and fabric, so that the mean friction at 60–110 g stays within
 //!   0.075–0.25 N (the force range of §3.2.1).
 
+use super::generated;
 use super::surface::{Component, Roughness, Shape, Surface};
 
 /// The sample names, as the `sample` parameter takes them.
@@ -44,9 +45,25 @@ pub const NAMES: &[&str] = &[
     "rippled-paper",
 ];
 
-/// Whether a sample is soft (the dissertation's grouping, §6.5.1).
+/// Whether a sample is soft (the dissertation's grouping, §6.5.1; for a
+/// generated sample, a wide contact patch).
 pub fn is_soft(name: &str) -> bool {
-    matches!(name, "chair-fabric" | "felt-fabric")
+    match generated::parse(name) {
+        Some(seed) => seed.is_ok_and(generated::is_soft),
+        None => matches!(name, "chair-fabric" | "felt-fabric"),
+    }
+}
+
+/// The surface of a sample — one of [`NAMES`] or a generated sample
+/// `generated-<seed>` ([`generated`]) — or an error naming it and what a
+/// sample's name may be.
+pub fn lookup(name: &str) -> Result<Surface, String> {
+    match generated::parse(name) {
+        Some(seed) => seed.map(generated::surface).map_err(|e| e.to_string()),
+        None => named(name).ok_or_else(|| {
+            format!("unknown sample `{name}` (one of {}, or generated-<seed> for a generated sample)", NAMES.join(", "))
+        }),
+    }
 }
 
 const MM: f64 = 1e-3;
@@ -76,8 +93,14 @@ fn scaled(rms: f64, center_mm: f64, width: f64, count: usize, seed: u64) -> Roug
     }
 }
 
-/// The surface of a named sample, or `None` for an unknown name.
+/// The surface of a sample (one of [`NAMES`] or `generated-<seed>`), or
+/// `None` for an unknown or malformed name ([`lookup`] says why).
 pub fn sample(name: &str) -> Option<Surface> {
+    lookup(name).ok()
+}
+
+/// The surface of one of the seven [`NAMES`].
+fn named(name: &str) -> Option<Surface> {
     Some(match name {
         // Holes on a 1.5 mm grid: a strong fundamental and the harmonics of
         // short dips at the hole edges; thin stiff plastic, a narrow contact.

@@ -8,7 +8,7 @@
 use super::lab_recording::{record, Condition};
 use anyhow::{anyhow, Context, Result};
 use evflow_engine::batch::{for_each_ordered, Failures};
-use evflow_nodes::lab::texture::samples::NAMES;
+use evflow_nodes::lab::texture::samples::{self, NAMES};
 use evflow_nodes::texture::freqvel::relation;
 use evflow_tools::batch::{progress_bar, JobsArg};
 use evflow_tools::plot::{Plot, Series};
@@ -20,7 +20,7 @@ pub struct Args {
     /// Folder for the PNG figure.
     #[arg(long, default_value = ".")]
     out: PathBuf,
-    /// Texture samples (default: all seven).
+    /// Texture samples (default: all seven; `generated-<seed>` for a generated one).
     #[arg(long, value_delimiter = ',')]
     samples: Vec<String>,
     /// Scanning speeds, cm/s (Fig. 6.6: 3, 4, 5, 6, 7).
@@ -49,7 +49,7 @@ pub fn main(a: Args) -> Result<()> {
     let samples: Vec<String> =
         if a.samples.is_empty() { NAMES.iter().map(|s| s.to_string()).collect() } else { a.samples.clone() };
     for s in &samples {
-        anyhow::ensure!(NAMES.contains(&s.as_str()), "--samples: unknown sample `{s}` (one of {})", NAMES.join(", "));
+        samples::lookup(s).map_err(|e| anyhow::anyhow!("--samples: {e}"))?;
     }
     std::fs::create_dir_all(&a.out).with_context(|| format!("{}: cannot create", a.out.display()))?;
     let tmp = tempfile::tempdir().context("cannot create a temporary folder")?;

@@ -15,7 +15,7 @@
 use super::lab_recording::{record, Condition};
 use anyhow::{anyhow, Context, Result};
 use evflow_engine::batch::{for_each_ordered, Failures};
-use evflow_nodes::lab::texture::samples::NAMES;
+use evflow_nodes::lab::texture::samples::{self, NAMES};
 use evflow_nodes::metric::spectral_error::{spectral_rms_error, Band};
 use evflow_nodes::metric::spectrum::{averaged_spectrum, SpectrumConfig, Window};
 use evflow_nodes::synth::study::grid_plan::GridPlan;
@@ -56,7 +56,7 @@ pub struct Args {
     /// `grids/playback-SAMPLE`, `grids/forces-SAMPLE`).
     #[arg(long, default_value = ".")]
     pub(super) out: PathBuf,
-    /// Texture samples (default: all seven; the rippled paper uses the grid of Fig. 6.8).
+    /// Texture samples (default: all seven; the rippled paper uses the grid of Fig. 6.8; `generated-<seed>` for a generated one).
     #[arg(long, value_delimiter = ',')]
     pub(super) samples: Vec<String>,
     /// What the grid cells are: the recorded forces, or one synthesis
@@ -184,7 +184,7 @@ pub fn main(a: Args) -> Result<()> {
     let samples: Vec<String> =
         if a.samples.is_empty() { NAMES.iter().map(|s| s.to_string()).collect() } else { a.samples.clone() };
     for s in &samples {
-        anyhow::ensure!(NAMES.contains(&s.as_str()), "--samples: unknown sample `{s}` (one of {})", NAMES.join(", "));
+        samples::lookup(s).map_err(|e| anyhow::anyhow!("--samples: {e}"))?;
     }
     std::fs::create_dir_all(&a.out).with_context(|| format!("{}: cannot create", a.out.display()))?;
     if a.cells != Cells::Recorded {

@@ -14,7 +14,7 @@
 
 use anyhow::{anyhow, ensure, Context, Result};
 use evflow_engine::batch::for_each_ordered;
-use evflow_nodes::lab::texture::samples::NAMES;
+use evflow_nodes::lab::texture::samples::{self, NAMES};
 use evflow_nodes::narx::model::Model;
 use evflow_nodes::synth::study::models::{self, Models};
 use evflow_nodes::synth::study::recordings::record_pair;
@@ -41,7 +41,7 @@ pub struct Args {
     /// the default network (15-10-5, taps 1/10, LM).
     #[arg(long, value_delimiter = ',')]
     settings: Vec<String>,
-    /// Texture samples scored (default: the six of §5.3).
+    /// Texture samples scored (default: the six of §5.3; `generated-<seed>` for a generated one).
     #[arg(long, value_delimiter = ',')]
     samples: Vec<String>,
     /// Gains of the sweep (§5.3.2).
@@ -165,7 +165,7 @@ pub fn main(a: Args) -> Result<()> {
         a.samples.clone()
     };
     for s in &samples {
-        ensure!(NAMES.contains(&s.as_str()), "--samples: unknown sample `{s}` (one of {})", NAMES.join(", "));
+        samples::lookup(s).map_err(|e| anyhow::anyhow!("--samples: {e}"))?;
     }
     ensure!(!a.gains.is_empty() && a.gains.iter().all(|g| g.is_finite() && *g > 0.0), "--gains: positive numbers");
     std::fs::create_dir_all(&a.out).with_context(|| format!("{}: cannot create", a.out.display()))?;

@@ -5,8 +5,8 @@
 //! draws.
 
 use super::textures_table::{csv, markdown};
-use anyhow::{anyhow, ensure, Context, Result};
-use evflow_nodes::lab::texture::samples::NAMES;
+use anyhow::{anyhow, Context, Result};
+use evflow_nodes::lab::texture::samples::{self, NAMES};
 use evflow_nodes::recording::format::Recording;
 use evflow_nodes::synth::study::cells::write_actuation;
 use evflow_nodes::synth::study::row::{Method, Row};
@@ -24,7 +24,7 @@ pub struct Args {
     /// spectra and the work files (models, recordings, runs).
     #[arg(long, default_value = ".")]
     out: PathBuf,
-    /// Texture samples (default: the six of §5.3, TS1–TS6).
+    /// Texture samples (default: the six of §5.3, TS1–TS6; `generated-<seed>` for a generated one).
     #[arg(long, value_delimiter = ',')]
     samples: Vec<String>,
     /// Trained conditions as MASS:SPEED in g and cm/s (default: the corners of Fig. 5.6).
@@ -79,7 +79,7 @@ pub fn main(a: Args) -> Result<()> {
         a.samples.clone()
     };
     for s in &samples {
-        ensure!(NAMES.contains(&s.as_str()), "--samples: unknown sample `{s}` (one of {})", NAMES.join(", "));
+        samples::lookup(s).map_err(|e| anyhow::anyhow!("--samples: {e}"))?;
     }
     let conds = a.conditions.iter().map(|s| Cond::parse(s)).collect::<Result<Vec<_>, _>>()?;
     let profiles = a.profiles.iter().map(|p| Profile::resolve(p, &a.graphs)).collect::<Result<Vec<_>, _>>()?;

@@ -1,9 +1,9 @@
 //! `evflow library build --out DIR`: the model library (issue 17, point 3)
-//! — parse, call `library_build`, print. docs/scale.md describes it.
+//! — parse, call `evflow_nodes::synth::study::library`, print. docs/scale.md describes it.
 
-use super::library_build::{build, Plan};
 use anyhow::{ensure, Context, Result};
 use evflow_nodes::lab::texture::{generated, samples};
+use evflow_nodes::synth::study::library::{build, Plan};
 use evflow_nodes::synth::study::setup::{Cond, Profile};
 use evflow_tools::batch::{progress_bar, BatchArgs};
 use std::path::PathBuf;

@@ -371,8 +371,12 @@ fn k_order<T>(mut shards: Vec<(PathBuf, Shard, T)>) -> Result<Vec<(PathBuf, Shar
 /// Joins the shards of a model library (`evflow library build --shard`).
 #[cfg(feature = "synth")]
 fn merge_library(a: &Args) -> Result<()> {
-    use super::library_build::{merge_index, read_shard};
-    let shards = a.shards.iter().map(|d| read_shard(d).map(|s| (d.clone(), s.shard, s))).collect::<Result<Vec<_>>>()?;
+    use evflow_nodes::synth::study::library::{merge_index, read_shard};
+    let shards = a
+        .shards
+        .iter()
+        .map(|d| read_shard(d).map(|s| (d.clone(), s.shard, s)).map_err(anyhow::Error::from))
+        .collect::<Result<Vec<_>>>()?;
     let shards = k_order(shards)?;
     let n = shards.len();
     let indexes: Vec<_> = shards.into_iter().map(|(_, _, s)| s).collect();
@@ -389,7 +393,7 @@ fn merge_library(a: &Args) -> Result<()> {
 /// Runs `evflow merge`.
 pub fn main(a: Args) -> Result<()> {
     #[cfg(feature = "synth")]
-    if a.shards.iter().all(|d| !d.join(RECORD).exists() && super::library_build::is_library(d)) {
+    if a.shards.iter().all(|d| !d.join(RECORD).exists() && evflow_nodes::synth::study::library::is_library(d)) {
         return merge_library(&a);
     }
     let shards = a.shards.iter().map(|d| Ok((d.clone(), ShardRecord::read(d)?))).collect::<Result<Vec<_>>>()?;

@@ -9,8 +9,6 @@ pub mod graph_args;
 pub mod import;
 #[cfg(feature = "synth")]
 pub mod library;
-#[cfg(feature = "synth")]
-pub mod library_build;
 pub mod live;
 pub mod merge;
 pub mod nodes;

@@ -19,6 +19,7 @@ pub mod forces_first;
 pub mod gains;
 pub mod graphs;
 pub mod grid_plan;
+pub mod library;
 pub mod models;
 pub mod recordings;
 pub mod row;

@@ -18,16 +18,23 @@
 //! says which shard it is; `evflow merge` joins the shards' folders into
 //! the library one build would have made.
 
-use anyhow::{anyhow, Context, Result};
+use super::cells::write_actuation;
+use super::models::{self, Models};
+use super::recordings;
+use super::row::{self, Method, Row, RowInputs};
+use super::setup::{Cond, Profile};
+use super::StudyError;
 use evflow_engine::batch::{for_each_ordered, Failures, Shard};
-use evflow_nodes::synth::study::cells::write_actuation;
-use evflow_nodes::synth::study::models::{self, Models};
-use evflow_nodes::synth::study::recordings;
-use evflow_nodes::synth::study::row::{self, Method, Row, RowInputs};
-use evflow_nodes::synth::study::setup::{Cond, Profile};
 use serde_json::{json, Value as Json};
 use std::path::{Path, PathBuf};
 use std::sync::atomic::AtomicBool;
+
+type Result<T> = std::result::Result<T, StudyError>;
+
+/// An error about the file or folder `path`.
+fn io(path: &Path, message: impl std::fmt::Display) -> StudyError {
+    StudyError::Io { path: path.to_path_buf(), message: message.to_string() }
+}
 
 /// What a library covers.
 #[derive(Debug, Clone)]
@@ -84,13 +91,13 @@ fn read_index(dir: &Path) -> Result<Vec<Json>> {
     let text = match std::fs::read_to_string(&p) {
         Ok(t) => t,
         Err(e) if e.kind() == std::io::ErrorKind::NotFound => return Ok(Vec::new()),
-        Err(e) => return Err(anyhow!("{}: cannot read: {e}", p.display())),
+        Err(e) => return Err(io(&p, format!("cannot read: {e}"))),
     };
-    let doc: Json = serde_json::from_str(&text).map_err(|e| anyhow!("{}: {e}", p.display()))?;
+    let doc: Json = serde_json::from_str(&text).map_err(|e| io(&p, e))?;
     doc.get("entries")
         .and_then(Json::as_array)
         .cloned()
-        .ok_or_else(|| anyhow!("{}: no `entries` list (not a library index?)", p.display()))
+        .ok_or_else(|| io(&p, "no `entries` list (not a library index?)"))
 }
 
 /// Writes `text` to `path` through a temporary file beside it.
@@ -98,7 +105,7 @@ fn write_atomic(path: &Path, text: &str) -> Result<()> {
     let tmp = path.with_extension("json.tmp");
     std::fs::write(&tmp, text)
         .and_then(|_| std::fs::rename(&tmp, path))
-        .with_context(|| format!("{}: cannot write", path.display()))
+        .map_err(|e| io(path, format!("cannot write: {e}")))
 }
 
 /// The index's format name.
@@ -113,7 +120,7 @@ fn write_index(plan: &Plan, entries: &[Json]) -> Result<()> {
     if plan.shard != Shard::ALL {
         doc["shard"] = json!(plan.shard.to_string());
     }
-    write_atomic(&index_path(&plan.dir), &serde_json::to_string_pretty(&doc)?)
+    write_atomic(&index_path(&plan.dir), &serde_json::to_string_pretty(&doc).map_err(|e| io(&plan.dir, e))?)
 }
 
 /// The key of an entry: texture and condition tag.
@@ -147,17 +154,16 @@ fn condition_models(plan: &Plan, c: &Cond) -> Result<(Models, bool)> {
     }
     let partial = plan.dir.join(".partial").join(format!("models-{}", c.tag()));
     let _ = std::fs::remove_dir_all(&partial);
-    let built =
-        models::build(&plan.graphs, &plan.profile, c, plan.epochs, false, &partial).map_err(|e| anyhow!("{e}"))?;
-    std::fs::create_dir_all(&final_dir).with_context(|| format!("{}: cannot create", final_dir.display()))?;
+    let built = models::build(&plan.graphs, &plan.profile, c, plan.epochs, false, &partial)?;
+    std::fs::create_dir_all(&final_dir).map_err(|e| io(&final_dir, format!("cannot create: {e}")))?;
     // The forward model first: `given` needs both, so a crash between the
     // two moves leaves an item that is redone.
     for from in [&built.forward, &built.narx] {
         let to = final_dir.join(from.file_name().unwrap_or_default());
-        std::fs::rename(from, &to).with_context(|| format!("{}: cannot move into the library", to.display()))?;
+        std::fs::rename(from, &to).map_err(|e| io(&to, format!("cannot move into the library: {e}")))?;
     }
     let _ = std::fs::remove_dir_all(&partial);
-    Ok((models::given(&final_dir, c).map_err(|e| anyhow!("{e}"))?, true))
+    Ok((models::given(&final_dir, c)?, true))
 }
 
 /// Reads a model file's `training` section (its scores).
@@ -179,7 +185,7 @@ fn texture_cell(plan: &Plan, m: &Models, sample: &str, c: &Cond) -> Result<Json>
     let partial = plan.dir.join(".partial").join(format!("{sample}-{}", c.tag()));
     let _ = std::fs::remove_dir_all(&partial);
     let rec_dir = partial.join("recordings");
-    recordings::record_pair(&plan.graphs, &plan.profile, sample, c, &rec_dir).map_err(|e| anyhow!("{e}"))?;
+    recordings::record_pair(&plan.graphs, &plan.profile, sample, c, &rec_dir)?;
     let inputs = RowInputs {
         graphs: &plan.graphs,
         profile: &plan.profile,
@@ -193,7 +199,7 @@ fn texture_cell(plan: &Plan, m: &Models, sample: &str, c: &Cond) -> Result<Json>
         optimized: None,
         dir: partial.join("row"),
     };
-    let r: Row = row::run(&inputs).map_err(|e| anyhow!("{e}"))?;
+    let r: Row = row::run(&inputs)?;
     let mut cells = serde_json::Map::new();
     let mut es = serde_json::Map::new();
     let mut gains = serde_json::Map::new();
@@ -201,17 +207,16 @@ fn texture_cell(plan: &Plan, m: &Models, sample: &str, c: &Cond) -> Result<Json>
         let Some(res) = r.method(method) else { continue };
         let gain = res.chosen.table51.gain;
         let staged = partial.join("cells").join(format!("{folder}-{sample}"));
-        let written =
-            write_actuation(&r.recording(gain), channel, &staged, sample, c, gain).map_err(|e| anyhow!("{e}"))?;
+        let written = write_actuation(&r.recording(gain), channel, &staged, sample, c, gain)?;
         let to_dir = plan.dir.join(format!("{folder}-{sample}"));
-        std::fs::create_dir_all(&to_dir).with_context(|| format!("{}: cannot create", to_dir.display()))?;
+        std::fs::create_dir_all(&to_dir).map_err(|e| io(&to_dir, format!("cannot create: {e}")))?;
         let name = written.file_name().unwrap_or_default().to_string_lossy().into_owned();
         // A recording is NAME.wav + NAME.json: the sidecar last, so that a
         // reader never finds a sidecar without its samples.
         for ext in ["wav", "json"] {
             let from = staged.join(format!("{name}.{ext}"));
             let to = to_dir.join(format!("{name}.{ext}"));
-            std::fs::rename(&from, &to).with_context(|| format!("{}: cannot move into the library", to.display()))?;
+            std::fs::rename(&from, &to).map_err(|e| io(&to, format!("cannot move into the library: {e}")))?;
         }
         cells.insert(folder.into(), json!(rel(&plan.dir, &to_dir.join(format!("{name}.json")))));
         es.insert(folder.into(), json!({ "rect": res.chosen.table51.rect, "welch": res.chosen.table51.welch }));
@@ -237,7 +242,7 @@ fn texture_cell(plan: &Plan, m: &Models, sample: &str, c: &Cond) -> Result<Json>
 /// Builds (or completes) the library; `progress` is called once per item
 /// received, with a label.
 pub fn build(plan: &Plan, progress: &(dyn Fn(&str) + Sync)) -> Result<Outcome> {
-    std::fs::create_dir_all(&plan.dir).with_context(|| format!("{}: cannot create", plan.dir.display()))?;
+    std::fs::create_dir_all(&plan.dir).map_err(|e| io(&plan.dir, format!("cannot create: {e}")))?;
     let mut entries = read_index(&plan.dir)?;
     // Entries whose files are gone are redone.
     entries.retain(|e| complete(&plan.dir, e));
@@ -254,7 +259,7 @@ pub fn build(plan: &Plan, progress: &(dyn Fn(&str) + Sync)) -> Result<Outcome> {
         |_, c| condition_models(plan, &c),
         |k, r| {
             progress(&format!("models at {}", conds[k].label()));
-            match r.map_err(|p| anyhow!(p)).and_then(|r| r) {
+            match r.map_err(|p| StudyError::Config(format!("panicked: {p}"))).and_then(|r| r) {
                 Ok((m, fresh)) => {
                     if fresh {
                         out.built += 1;
@@ -264,7 +269,7 @@ pub fn build(plan: &Plan, progress: &(dyn Fn(&str) + Sync)) -> Result<Outcome> {
                     built.push(Some(m));
                 }
                 Err(e) => {
-                    out.failures.push(format!("models at {}", conds[k].label()), format!("{e:#}"));
+                    out.failures.push(format!("models at {}", conds[k].label()), e.to_string());
                     built.push(None);
                 }
             }
@@ -294,7 +299,7 @@ pub fn build(plan: &Plan, progress: &(dyn Fn(&str) + Sync)) -> Result<Outcome> {
         let (k, s) = &todo[j];
         let label = format!("{s} at {}", conds[*k].label());
         progress(&label);
-        match r.map_err(|p| anyhow!(p)).and_then(|r| r) {
+        match r.map_err(|p| StudyError::Config(format!("panicked: {p}"))).and_then(|r| r) {
             Ok(entry) => {
                 entries.retain(|e| key(e) != key(&entry));
                 entries.push(entry);
@@ -304,7 +309,7 @@ pub fn build(plan: &Plan, progress: &(dyn Fn(&str) + Sync)) -> Result<Outcome> {
                     write_error.get_or_insert(e);
                 }
             }
-            Err(e) => out.failures.push(label, format!("{e:#}")),
+            Err(e) => out.failures.push(label, e.to_string()),
         }
     });
     if let Some(e) = write_error {
@@ -355,21 +360,18 @@ pub fn is_library(dir: &Path) -> bool {
 pub fn read_shard(dir: &Path) -> Result<ShardIndex> {
     let p = index_path(dir);
     let doc: Json =
-        serde_json::from_str(&std::fs::read_to_string(&p).with_context(|| format!("{}: cannot read", p.display()))?)
-            .map_err(|e| anyhow!("{}: {e}", p.display()))?;
+        serde_json::from_str(&std::fs::read_to_string(&p).map_err(|e| io(&p, format!("cannot read: {e}")))?)
+            .map_err(|e| io(&p, e))?;
     let texts = |k: &str| -> Result<Vec<String>> {
         doc.get(k)
             .and_then(Json::as_array)
             .and_then(|l| l.iter().map(|x| x.as_str().map(str::to_string)).collect())
-            .ok_or_else(|| anyhow!("{}: `{k}` is not a list of text", p.display()))
+            .ok_or_else(|| io(&p, format!("`{k}` is not a list of text")))
     };
-    let shard = doc
-        .get("shard")
-        .and_then(Json::as_str)
-        .ok_or_else(|| anyhow!("{}: not a shard (built without --shard)", p.display()))?;
+    let shard = doc.get("shard").and_then(Json::as_str).ok_or_else(|| io(&p, "not a shard (built without --shard)"))?;
     Ok(ShardIndex {
         dir: dir.to_path_buf(),
-        shard: Shard::parse(shard).map_err(|e| anyhow!("{}: {e}", p.display()))?,
+        shard: Shard::parse(shard).map_err(|e| io(&p, e))?,
         samples: texts("samples")?,
         conditions: texts("conditions")?,
         entries: read_index(dir)?,
@@ -382,11 +384,11 @@ pub fn merge_index(out: &Path, shards: &[ShardIndex]) -> Result<usize> {
     let first = &shards[0];
     for s in shards {
         if s.samples != first.samples || s.conditions != first.conditions || s.shard.n != first.shard.n {
-            anyhow::bail!(
+            return Err(StudyError::Config(format!(
                 "{} and {}: not shards of one library (samples, conditions or N differ)",
                 first.dir.display(),
                 s.dir.display()
-            );
+            )));
         }
     }
     let mut entries: Vec<Json> = shards.iter().flat_map(|s| s.entries.iter().cloned()).collect();
@@ -396,7 +398,7 @@ pub fn merge_index(out: &Path, shards: &[ShardIndex]) -> Result<usize> {
     };
     entries.sort_by_key(rank);
     let doc = json!({ "format": FORMAT, "version": 1, "samples": first.samples, "conditions": first.conditions, "entries": entries });
-    std::fs::create_dir_all(out).with_context(|| format!("{}: cannot create", out.display()))?;
-    write_atomic(&index_path(out), &serde_json::to_string_pretty(&doc)?)?;
+    std::fs::create_dir_all(out).map_err(|e| io(out, format!("cannot create: {e}")))?;
+    write_atomic(&index_path(out), &serde_json::to_string_pretty(&doc).map_err(|e| io(out, e))?)?;
     Ok(entries.len())
 }

@@ -124,7 +124,11 @@ struct Interp {
     scratch: [Vec<f64>; 2],
 }
 
-fn build(p: &Params, ctx: &BuildContext) -> Result<Box<dyn Node>, NodeError> {
+/// The grid sources an `interp` node's parameters name — one per texture of
+/// `textures`, or the one `folder`, or the list `paths` — each with how
+/// errors and the summary name it. Shared with whatever shows the node's
+/// grids (the studio), so both read the parameters alike.
+pub fn grid_sources(p: &Params, ctx: &BuildContext) -> Result<Vec<(GridSource, String)>, NodeError> {
     let folder = p.str("folder");
     let paths = p.text_list("paths");
     let textures = p.text_list("textures");
@@ -152,15 +156,18 @@ fn build(p: &Params, ctx: &BuildContext) -> Result<Box<dyn Node>, NodeError> {
         velocity_range: range("velocity_range")?,
         apply_gain: p.bool("apply_gain"),
     };
-    // (source, how errors and the summary name it)
-    let sources: Vec<(GridSource, String)> = if !textures.is_empty() {
+    Ok(if !textures.is_empty() {
         textures.iter().map(|t| (GridSource { folder: Some(ctx.path(t)), ..base.clone() }, t.to_string())).collect()
     } else if !folder.is_empty() {
         vec![(GridSource { folder: Some(ctx.path(folder)), ..base.clone() }, folder.to_string())]
     } else {
         let paths = paths.iter().map(|s| ctx.path(s)).collect::<Vec<PathBuf>>();
         vec![(GridSource { paths, ..base.clone() }, format!("{} recordings", p.text_list("paths").len()))]
-    };
+    })
+}
+
+fn build(p: &Params, ctx: &BuildContext) -> Result<Box<dyn Node>, NodeError> {
+    let sources = grid_sources(p, ctx)?;
     let initial = p.usize("texture");
     if initial >= sources.len() {
         return Err(NodeError::param(

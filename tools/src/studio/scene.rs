@@ -72,34 +72,15 @@ fn mesh_maps(_: &Checked, _: &Path) -> Option<Value> {
 /// The (load, velocity) axes of every texture of the first `interp` node.
 #[cfg(feature = "texture")]
 fn texture_grids(checked: &Checked, base_dir: &Path) -> Option<Value> {
-    use evflow_nodes::texture::grid::{Grid, GridSource};
+    use evflow_nodes::texture::grid::Grid;
+    use evflow_nodes::texture::interp::grid_sources;
     let k = checked.order.iter().copied().find(|&k| checked.nodes[k].spec.name == "interp")?;
     let n = &checked.nodes[k];
     let p = &n.params;
     let ctx = context(checked, k, base_dir);
-    let range = |name: &str| match p.float_list(name) {
-        [lo, hi] => Some((*lo, *hi)),
-        _ => None,
-    };
-    let base = GridSource {
-        folder: None,
-        paths: Vec::new(),
-        material: p.str("material").to_string(),
-        channel: p.str("channel").to_string(),
-        load_range: range("load_range"),
-        velocity_range: range("velocity_range"),
-        apply_gain: false,
-    };
-    let sources: Vec<(GridSource, String)> = if !p.text_list("textures").is_empty() {
-        p.text_list("textures")
-            .iter()
-            .map(|t| (GridSource { folder: Some(ctx.path(t)), ..base.clone() }, t.clone()))
-            .collect()
-    } else if !p.str("folder").is_empty() {
-        vec![(GridSource { folder: Some(ctx.path(p.str("folder"))), ..base.clone() }, p.str("folder").to_string())]
-    } else {
-        let paths = p.text_list("paths").iter().map(|s| ctx.path(s)).collect();
-        vec![(GridSource { paths, ..base.clone() }, "recordings".to_string())]
+    let sources = match grid_sources(p, &ctx) {
+        Ok(s) => s,
+        Err(e) => return Some(json!({ "kind": "none", "why": format!("{}: {e}", n.name) })),
     };
     let mut grids = Vec::new();
     for (src, name) in sources {

@@ -230,6 +230,15 @@ fn the_page_shows_a_recorded_session_with_its_events_and_replay_check() {
     let states: Vec<&str> = segs.as_array().unwrap().iter().map(|s| s.as_str().unwrap()).collect();
     let at = |w: &str| states.iter().position(|s| *s == w);
     assert!(at("armed") < at("faded") && states[at("faded").unwrap()..].contains(&"armed"), "{states:?}");
+    // Read from the recorded `limit.state`, the node's own report: faded
+    // in the window of the disable (the 10 ms fade ends inside it), armed
+    // in the window of the re-arm, and the stop's fade at the end.
+    assert_eq!(cdp.eval("studio.limiters.limit.source"), json!("node"));
+    let mut t0 =
+        |w: &str| cdp.eval(&format!("studio.timelines[0].segments.find(s => s.state === '{w}' && s.t0 > 1).t0"));
+    assert!((t0("faded").as_f64().unwrap() - 1.5).abs() < 1e-9, "{states:?}");
+    assert!((t0("armed").as_f64().unwrap() - 2.0).abs() < 1e-9, "{states:?}");
+    assert_eq!(states.last(), Some(&"faded"), "the stop fades the limiter out: {states:?}");
     // Scrubbing: a narrower span shows fewer pairs.
     cdp.eval("document.getElementById('scrub-span').value = 0.5; document.getElementById('scrub-span').dispatchEvent(new Event('input'))");
     assert_eq!(cdp.eval("studio.view[1] - studio.view[0] < 0.51"), json!(true));
@@ -261,6 +270,11 @@ fn the_page_shows_and_steers_a_live_session_in_chromium() {
     assert!(
         cdp.eval("document.getElementById('limiter-limit').textContent") == json!("ARMED"),
         "the limiter shows armed"
+    );
+    assert_eq!(cdp.eval("studio.limiters.limit.source"), json!("node"), "the state the node reports");
+    assert_eq!(
+        cdp.eval("document.getElementById('limiter-info-limit').textContent.includes('state reported by the node')"),
+        json!(true)
     );
     assert!(cdp.eval("studio.compute.t.length > 5") == json!(true), "compute times arrive");
     // The finger view: the texture's (load, velocity) grid and the four cells in use.
@@ -300,6 +314,12 @@ fn the_page_shows_and_steers_a_live_session_in_chromium() {
         std::fs::write(&p, &png).unwrap();
     }
     eprintln!("screenshot: {}", out.display());
+    // Fade out from the page: the badge follows the node's state to FADED;
+    // re-arm: ARMED again.
+    cdp.eval("document.getElementById('disable-limit').click()");
+    cdp.until("document.getElementById('limiter-limit').textContent === 'FADED'", 20);
+    cdp.eval("document.getElementById('rearm-limit').click()");
+    cdp.until("document.getElementById('limiter-limit').textContent === 'ARMED'", 20);
     drop(cdp);
     drop(browser);
 

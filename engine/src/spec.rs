@@ -348,7 +348,8 @@ pub struct NodeSpec {
     /// True for nodes that drive hardware: each of their inputs must come
     /// straight from a node with `safety_guard` (the `limit` node).
     pub hardware: bool,
-    /// True for the safety limiter, the only node allowed to feed hardware.
+    /// True for the safety limiter, the only node allowed to feed hardware,
+    /// and only from its first output.
     pub safety_guard: bool,
     /// Why the node cannot run in a live session (e.g. it does blocking file
     /// I/O while processing); `None` for nodes that can.

@@ -283,8 +283,12 @@ pub fn check(graph: &Graph, registry: &Registry, overrides: &[Override]) -> Resu
         }
         if n.spec.hardware {
             for p in n.inputs() {
-                if let Some((src, _, _)) = &producer[i][p] {
-                    let guarded = nodes[*src].as_ref().is_some_and(|s| s.spec.safety_guard);
+                if let Some((src, _, from)) = &producer[i][p] {
+                    // Only a guard's first output is the guarded signal (the
+                    // others, like `limit.state`, are for monitoring).
+                    let guarded = nodes[*src].as_ref().is_some_and(|s| {
+                        s.spec.safety_guard && s.outputs().next().is_some_and(|o| s.ports[o].name == from.port)
+                    });
                     if !guarded {
                         sink.err(n.loc, Some(&n.name), format!("hardware output `{}.{}` is not fed by a `limit` node", n.name, n.ports[p].name), Some("every signal that reaches hardware must pass a `limit` node (amplitude clamp, slew limit, ramp to zero on faults)".into()));
                     }

@@ -7,6 +7,71 @@ use evflow_engine::{BuildContext, Io, Node, NodeError, NodeSpec, ParamSpec, Para
 /// runs this long (plus one tick) before it ends a session.
 pub const MAX_RAMP_S: f64 = 0.010;
 
+/// What the limiter did at one sample, as its `state` output reports it
+/// (the code is the sample's value). One per sample, so a reader (the
+/// studio, a recording) never has to infer it from the signals.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum State {
+    /// Enabled, no fault latched, and neither clamp nor slew limit acted:
+    /// the signal passes (also while the gate opens at the start or after
+    /// a re-arm).
+    Armed,
+    /// Enabled, no fault latched, and the amplitude clamp or the slew-rate
+    /// limit changed this sample.
+    Clamping,
+    /// `enable` is false and the gate is still closing: the output is not
+    /// yet exactly zero.
+    Fading,
+    /// `enable` is false and the gate is closed: the output is exactly zero.
+    Faded,
+    /// A NaN/infinite input or a fault input latched the gate: it is
+    /// closing or closed, until `enable` is set true again.
+    Faulted,
+}
+
+/// `state` code of [`State::Armed`].
+pub const STATE_ARMED: f64 = 0.0;
+/// `state` code of [`State::Clamping`].
+pub const STATE_CLAMPING: f64 = 1.0;
+/// `state` code of [`State::Fading`].
+pub const STATE_FADING: f64 = 2.0;
+/// `state` code of [`State::Faded`].
+pub const STATE_FADED: f64 = 3.0;
+/// `state` code of [`State::Faulted`].
+pub const STATE_FAULTED: f64 = 4.0;
+
+impl State {
+    /// Every state, in code order.
+    pub const ALL: [State; 5] = [State::Armed, State::Clamping, State::Fading, State::Faded, State::Faulted];
+
+    /// The value the `state` output carries.
+    pub const fn code(self) -> f64 {
+        match self {
+            State::Armed => STATE_ARMED,
+            State::Clamping => STATE_CLAMPING,
+            State::Fading => STATE_FADING,
+            State::Faded => STATE_FADED,
+            State::Faulted => STATE_FAULTED,
+        }
+    }
+
+    /// The state a `state` sample stands for; `None` for any other value.
+    pub fn from_code(x: f64) -> Option<State> {
+        State::ALL.into_iter().find(|s| s.code() == x)
+    }
+
+    /// Lower-case name (`armed`, `clamping`, `fading`, `faded`, `faulted`).
+    pub const fn name(self) -> &'static str {
+        match self {
+            State::Armed => "armed",
+            State::Clamping => "clamping",
+            State::Fading => "fading",
+            State::Faded => "faded",
+            State::Faulted => "faulted",
+        }
+    }
+}
+
 /// Declaration of `limit`.
 pub static SPEC: NodeSpec = NodeSpec::new(
     "limit",
@@ -34,17 +99,32 @@ sample on any fault input (one input per `faults` entry, e.g. a link or contact 
 streak of deadline misses and device disconnects). NaN and fault-input faults latch: the output \
 stays at zero until `enable` is set to true again (re-arming), after which it fades back in.\n\
 \n\
+**State**: the second output, `state`, says at every sample what the limiter did (the code is \
+the sample's value; `evflow_nodes::safety::limit::State`): 0 = *armed* (the signal passes; also \
+while the gate opens at the start or after a re-arm), 1 = *clamping* (the amplitude clamp or the \
+slew-rate limit changed this sample), 2 = *fading* (`enable` false, the output not yet zero), \
+3 = *faded* (`enable` false, the output exactly zero — from the round(ramp·rate)-th sample of the \
+fade on), 4 = *faulted* (a NaN/infinite input or a fault input latched the gate: closing or \
+closed, until re-armed). A latched fault outranks a disable, a disable outranks clamping. \
+`state` is for monitoring (the studio, recordings), never an actuation signal: the loader lets \
+only `out` feed hardware.\n\
+\n\
 Outputs are always finite. `enable` is the one parameter that changes live. The summary reports \
 how many samples were clamped and slew-limited, and every fault with its sample index.\n\
 \n\
 **Checked against:** the clamp and slew bounds on random and extreme inputs (±1e300, steps, NaN \
 bursts); the fade reaching exactly zero within round(ramp·rate) samples after a NaN, a fault \
-input and a disable; the latch and re-arm; block ≡ per-sample processing (generic node test).",
+input and a disable; the latch and re-arm; the `state` code at each transition; block ≡ per-sample processing (generic node test).",
 )
 .ports(&[
     PortSpec::input("in", "1", "actuation signal"),
     PortSpec::input("fault", "1", "fault flag: nonzero (or NaN) closes the gate and latches").per("faults"),
     PortSpec::output("out", "1", "limited actuation signal"),
+    PortSpec::output(
+        "state",
+        "1",
+        "what the limiter did at each sample: 0 armed, 1 clamping, 2 fading, 3 faded, 4 faulted",
+    ),
 ])
 .params(&[
     ParamSpec::float("amplitude", 0.0, 10.0, 1.0, "1", "largest |out| (1.0 = 50 V peak, 100 Vpp)"),
@@ -143,18 +223,22 @@ impl Node for Limit {
                     self.record(Fault::Input { port: port - 1, sample });
                 }
             }
+            let mut acted = false;
             if x.is_finite() {
                 let c = x.clamp(-self.amplitude, self.amplitude);
                 if c != x {
                     self.clamped += 1;
+                    acted = true;
                 }
                 let d = c - self.held;
                 if d > self.step {
                     self.held += self.step;
                     self.slewed += 1;
+                    acted = true;
                 } else if d < -self.step {
                     self.held -= self.step;
                     self.slewed += 1;
+                    acted = true;
                 } else {
                     self.held = c;
                 }
@@ -163,6 +247,20 @@ impl Node for Limit {
             }
             let g = self.gate.advance(self.enabled && !self.latched);
             io.output(0)[i] = g * self.held;
+            let state = if self.latched {
+                State::Faulted
+            } else if !self.enabled {
+                if g == 0.0 {
+                    State::Faded
+                } else {
+                    State::Fading
+                }
+            } else if acted {
+                State::Clamping
+            } else {
+                State::Armed
+            };
+            io.output(1)[i] = state.code();
         }
         self.next += n as u64;
         Ok(())

@@ -9,8 +9,10 @@ use evflow_engine::spec::{ParamKind, ParamSpec};
 use evflow_engine::{Checked, Direction};
 use serde_json::{json, Value};
 
-/// A safety limiter (`limit`) whose state the studio infers from its
-/// input and output taps and its `enable` changes.
+/// A safety limiter (`limit`) whose state the studio shows: from its
+/// `state` output when tapped (always, in a live session: every output of
+/// a guard is), else inferred from its input and output taps and its
+/// `enable` changes (recordings made before `limit` had `state`).
 #[derive(Debug, Clone)]
 pub(crate) struct LimiterSpec {
     /// Node name.
@@ -23,6 +25,9 @@ pub(crate) struct LimiterSpec {
     pub input: Option<usize>,
     /// Tap of its `out`, if tapped.
     pub output: Option<usize>,
+    /// Tap of its `state` output (`evflow_nodes::safety::limit::State`
+    /// codes), if tapped.
+    pub state: Option<usize>,
     /// `enable` as the graph sets it.
     pub enabled: bool,
 }
@@ -39,8 +44,9 @@ pub struct Description {
 
 /// Streams worth seeing by default on top of the sources and guards the
 /// session records anyway: the display's force, the mesh intensities, what
-/// feeds each limiter (so clamping shows), and the (load, velocity) point of
-/// each texture interpolator. Only nodes the plan kept.
+/// feeds each limiter (its peak shows), each limiter's `state` (also a
+/// guard output, so normally tapped already), and the (load, velocity)
+/// point of each texture interpolator. Only nodes the plan kept.
 pub fn default_taps(checked: &Checked, plan: &evflow_engine::Plan) -> Vec<Tap> {
     wanted_taps(checked).into_iter().filter(|t| plan.index(&t.node).is_some()).collect()
 }
@@ -57,6 +63,7 @@ fn wanted_taps(checked: &Checked) -> Vec<Tap> {
         match n.spec.name {
             "sim.display" => add(&n.name, "force"),
             "mesh.gradient" | "mesh.edges" => add(&n.name, "intensity"),
+            "limit" => add(&n.name, "state"),
             _ => {}
         }
     }
@@ -123,6 +130,7 @@ pub(crate) fn limiter_specs(
             amplitude: n.params.f64("amplitude"),
             input,
             output: tap_of(&n.name, "out"),
+            state: tap_of(&n.name, "state"),
             enabled: n.params.bool("enable"),
         });
     }
@@ -130,14 +138,16 @@ pub(crate) fn limiter_specs(
 }
 
 /// The taps for the page: which to show at first (the defaults, the
-/// limiters' outputs, velocities).
+/// limiters' outputs, velocities; not the limiters' `state`, which the
+/// badges show).
 pub(crate) fn taps_json(checked: Option<&Checked>, taps: &[(String, String, f64)], limiters: &[LimiterSpec]) -> Value {
     let defaults = checked.map(wanted_taps).unwrap_or_default();
     let list: Vec<Value> = taps
         .iter()
         .enumerate()
         .map(|(i, (node, port, rate))| {
-            let shown = defaults.iter().any(|d| &d.node == node && &d.port == port)
+            let is_state = limiters.iter().any(|l| l.state == Some(i));
+            let shown = !is_state && defaults.iter().any(|d| &d.node == node && &d.port == port)
                 || limiters.iter().any(|l| l.output == Some(i))
                 || port == "velocity"
                 || port == "out" && checked.is_none();
@@ -251,9 +261,14 @@ gain = 2.0
         let opts = PlanOptions { max_block: 1, mode: evflow_engine::RunMode::Live, ..Default::default() };
         let plan = Plan::build(&checked, &opts).unwrap();
         let defaults = default_taps(&checked, &plan);
-        assert_eq!(defaults, vec![Tap::new("g", "out")], "what feeds the limiter");
+        assert_eq!(
+            defaults,
+            vec![Tap::new("limit", "state"), Tap::new("g", "out")],
+            "the limiter's state, what feeds it"
+        );
+        assert_eq!(LivePlan::guard_taps(&plan), vec![Tap::new("limit", "out"), Tap::new("limit", "state")]);
         let mut taps = LivePlan::guard_taps(&plan);
-        taps.extend(defaults);
+        taps.extend(defaults.into_iter().filter(|t| t.port != "state"));
         let lp = LivePlan::new(plan, &taps).unwrap();
         let vars = evflow_engine::live::live_vars(&checked);
         let d = Description::live(&checked, &lp, &vars);
@@ -271,10 +286,12 @@ gain = 2.0
         assert_eq!(gain["value"], 2.0);
         assert_eq!(h["vars"][0]["name"], "gain");
         assert_eq!(h["vars"][0]["uses"], json!(["g.gain"]));
-        // The limiter watched through its input and output taps.
+        // The limiter watched through its state, input and output taps.
         assert_eq!(d.limiters.len(), 1);
         let l = &d.limiters[0];
-        assert_eq!((l.amplitude, l.input, l.output), (0.5, Some(1), Some(0)));
-        assert_eq!(h["taps"][1]["shown"], true);
+        assert_eq!((l.amplitude, l.input, l.output, l.state), (0.5, Some(2), Some(0), Some(1)));
+        assert_eq!(h["taps"][0]["shown"], true);
+        assert_eq!(h["taps"][1]["shown"], false, "the state is the badge, not a trace");
+        assert_eq!(h["taps"][2]["shown"], true);
     }
 }

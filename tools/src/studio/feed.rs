@@ -160,6 +160,9 @@ impl FeedState {
             if l.spec.output == Some(tap) {
                 l.output(x);
             }
+            if l.spec.state == Some(tap) {
+                l.states(x);
+            }
         }
     }
 

@@ -107,6 +107,7 @@ impl RecordedSession {
                 };
                 track.input(slice(spec.input));
                 track.output(slice(spec.output));
+                track.states(slice(spec.state));
                 last = track.window();
                 let state = last["state"].clone();
                 match segs.last_mut() {
@@ -236,5 +237,68 @@ mod tests {
         let n = f["taps"][0]["lo"].as_array().unwrap().len();
         assert!(n <= MAX_PENDING && n > 3000, "{n} pairs for an hour");
         assert_eq!(f["events"][0]["t"], 1.0);
+    }
+
+    /// A recorded `sine → limit` session of 0.3 s whose limiter faded out
+    /// at 0.1 s; `state` recorded or not.
+    fn faded_session(with_state: bool) -> RecordedSession {
+        let doc = "[graph]\nformat = 1\nname = \"r\"\nrate = 1000.0\nconnections = [\"s.out -> limit.in\", \"limit.out -> st.in\"]\n\
+                   [nodes.s]\ntype = \"sine\"\n[nodes.limit]\ntype = \"limit\"\n[nodes.st]\ntype = \"stats\"\n";
+        let g = evflow_engine::graph::parse_graph(std::path::Path::new("r.toml"), doc).unwrap();
+        let checked = evflow_engine::check(&g, &evflow_nodes::registry(), &[]).unwrap();
+        use evflow_nodes::safety::limit::State;
+        // The output is made up so that it contradicts the state: the
+        // strip must follow the node's report, not the signal.
+        let state: Vec<f64> = (0..300)
+            .map(|i| {
+                if i < 100 {
+                    State::Armed
+                } else if i < 109 {
+                    State::Fading
+                } else {
+                    State::Faded
+                }
+                .code()
+            })
+            .collect();
+        let mut taps =
+            vec![RecordedTap { node: "limit".into(), port: "out".into(), rate: 1000.0, samples: vec![0.5; 300] }];
+        if with_state {
+            taps.push(RecordedTap { node: "limit".into(), port: "state".into(), rate: 1000.0, samples: state });
+        }
+        RecordedSession {
+            name: "r".into(),
+            base_rate: 1000.0,
+            ticks: 300,
+            stopped: "duration".into(),
+            taps,
+            events: vec![json!({ "tick": 100, "event": "set", "node": "limit", "param": "enable", "value": 0.0 })],
+            metrics: Value::Null,
+            steal_s: None,
+            checked: Some(checked),
+            scene: Value::Null,
+            notes: Vec::new(),
+        }
+    }
+
+    fn strip(s: &RecordedSession) -> (Vec<String>, Value) {
+        let (_, frame) = s.messages();
+        let f: Value = serde_json::from_str(&frame).unwrap();
+        let l = &f["limiter_timelines"][0];
+        let states =
+            l["segments"].as_array().unwrap().iter().map(|x| x["state"].as_str().unwrap().to_string()).collect();
+        (states, l["last"].clone())
+    }
+
+    #[test]
+    fn a_recorded_state_drives_the_strip() {
+        let (states, last) = strip(&faded_session(true));
+        assert_eq!(states, ["armed", "faded"], "the 100..150 ms window ends faded");
+        assert_eq!(last["source"], "node");
+        // Without `limit.state`: inferred from the output (never zero here)
+        // and the disable — fading to the end.
+        let (states, last) = strip(&faded_session(false));
+        assert_eq!(states, ["armed", "fading"]);
+        assert_eq!(last["source"], "inferred");
     }
 }

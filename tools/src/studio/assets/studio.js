@@ -111,7 +111,12 @@ function limiterShow(l) {
   S.limiters[l.node] = l;
   b.className = "badge " + l.state;
   b.textContent = l.state.toUpperCase();
-  $(`limiter-info-${l.node}`).textContent = `enable ${l.enable} · peak in ${plot.fmt(l.in_peak)} out ${plot.fmt(l.out_peak)} · clamped ${l.clamped_samples} samples · non-finite inputs ${l.non_finite_inputs}` + (l.watching_input ? "" : " · (input not tapped: clamping not seen)");
+  b.title = l.source === "node" ? "as the limiter reports it (its `state` output)" : "inferred from the limiter's input, output and enable (state not recorded)";
+  const counts = l.source === "node"
+    ? `clamped or slew-limited ${l.clamped_samples} samples · faults ${l.faults}` + (l.watching_input ? ` · non-finite inputs ${l.non_finite_inputs}` : "")
+    : `clamped ${l.clamped_samples} samples · non-finite inputs ${l.non_finite_inputs}` + (l.watching_input ? "" : " · (input not tapped: clamping not seen)");
+  $(`limiter-info-${l.node}`).textContent = `enable ${l.enable} · peak in ${plot.fmt(l.in_peak)} out ${plot.fmt(l.out_peak)} · ${counts}` +
+    (l.source === "node" ? " · state reported by the node" : " · state inferred (limit.state not recorded)");
 }
 
 // --- steering ---

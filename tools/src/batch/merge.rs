@@ -377,3 +377,89 @@ fn copy_files(out: &Path, dirs: &[&Path], skip: &[PathBuf]) -> Result<usize, Mer
     }
     Ok(copied.len())
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::batch::shard_record::tests::{record, run};
+    use crate::batch::tables::Timings;
+
+    /// Three shards of a five-run sweep, written into `base/s1..s3`, each
+    /// with the files its graph wrote.
+    fn three_shards(base: &Path) -> Vec<PathBuf> {
+        let all: Vec<_> = (0..5).map(|i| run(i as f64 * 0.1, 1000 + i)).collect();
+        (1..=3)
+            .map(|k| {
+                let shard = Shard { k, n: 3 };
+                let dir = base.join(format!("s{k}"));
+                std::fs::create_dir_all(dir.join("wav")).unwrap();
+                std::fs::write(dir.join(format!("wav/run{k}.wav")), [k as u8; 3]).unwrap();
+                std::fs::write(dir.join("common.txt"), "same").unwrap();
+                std::fs::write(dir.join("t.csv"), "the shard's own table").unwrap();
+                let mut r = record(shard, 5, all[shard.range(5)].to_vec());
+                r.failures = vec![(format!("f{k}"), "why".into())];
+                r.write(&dir).unwrap();
+                dir
+            })
+            .collect()
+    }
+
+    #[test]
+    fn shards_merge_into_the_tables_of_one_run() {
+        let base = tempfile::tempdir().unwrap();
+        let mut dirs = three_shards(base.path());
+        dirs.reverse();
+        let out = base.path().join("out");
+        let m = merge_sweep(&out, &dirs).unwrap();
+        let all: Vec<_> = (0..5).map(|i| run(i as f64 * 0.1, 1000 + i)).collect();
+        assert_eq!(std::fs::read_to_string(out.join("t.csv")).unwrap(), sweep_csv(&all, Timings::Show));
+        assert_eq!((m.shards, m.runs, m.total, m.files, m.graph.as_str()), (3, 5, 5, 4, "graphs/g.toml"));
+        assert_eq!(m.tables, vec![out.join("t.csv")]);
+        let labels: Vec<&str> = m.failures.list.iter().map(|(l, _)| l.as_str()).collect();
+        assert_eq!(labels, ["f1 (shard 1/3)", "f2 (shard 2/3)", "f3 (shard 3/3)"]);
+        for k in 1..=3 {
+            assert_eq!(std::fs::read(out.join(format!("wav/run{k}.wav"))).unwrap(), [k as u8; 3]);
+        }
+        assert!(!out.join(RECORD).exists());
+    }
+
+    #[test]
+    fn shards_that_do_not_make_one_sweep_are_refused_by_name() {
+        let base = tempfile::tempdir().unwrap();
+        let dirs = three_shards(base.path());
+        let out = base.path().join("out");
+        let e = merge_sweep(&out, &dirs[..2]).unwrap_err();
+        assert_eq!(e.to_string(), "shards missing: 3/3 (given 2 of 3)");
+        let e = merge_sweep(&out, &[dirs[0].clone(), dirs[1].clone(), dirs[1].clone(), dirs[2].clone()]).unwrap_err();
+        assert_eq!(e.to_string(), format!("{} and {}: both are shard 2/3", dirs[1].display(), dirs[1].display()));
+        assert!(matches!(merge_sweep(&out, &[]), Err(MergeError::NoShards)));
+
+        let mut other = ShardRecord::read(&dirs[2]).unwrap();
+        other.graph = "graphs/other.toml".into();
+        other.write(&dirs[2]).unwrap();
+        let e = merge_sweep(&out, &dirs).unwrap_err();
+        let (d0, d2) = (dirs[0].display(), dirs[2].display());
+        assert_eq!(e.to_string(), format!("{d0} and {d2}: not shards of one sweep (the graphs differ)"));
+
+        let mut other = ShardRecord::read(&dirs[2]).unwrap();
+        other.graph = "graphs/g.toml".into();
+        other.range = 0..1;
+        other.write(&dirs[2]).unwrap();
+        let e = merge_sweep(&out, &dirs).unwrap_err();
+        assert_eq!(e.to_string(), format!("{d2}: shard 3/3 should hold runs 4..5 of 5"));
+        assert!(!out.exists(), "a refused merge wrote {}", out.display());
+    }
+
+    #[test]
+    fn two_shards_writing_one_name_must_agree() {
+        let base = tempfile::tempdir().unwrap();
+        let dirs = three_shards(base.path());
+        std::fs::write(dirs[1].join("common.txt"), "differs").unwrap();
+        let e = merge_sweep(&base.path().join("out"), &dirs).unwrap_err();
+        let (a, b) = (dirs[0].join("common.txt"), dirs[1].join("common.txt"));
+        assert_eq!(
+            e.to_string(),
+            format!("{} and {}: two shards wrote different files of one name", a.display(), b.display())
+        );
+    }
+}

@@ -280,3 +280,132 @@ fn parse_record(doc: &Json) -> Fault<ShardRecord> {
         json: optional_text(doc, "json")?,
     })
 }
+
+/// Records for tests here and in the merge's.
+#[cfg(test)]
+pub(crate) mod tests {
+    use super::*;
+    use evflow_engine::graph::parse_cli_value;
+
+    /// A run with awkward floats and a node type no build knows.
+    pub(crate) fn run(x: f64, elapsed_ns: u64) -> (Point, RunReport) {
+        let point = Point { values: vec![("gain".into(), parse_cli_value(&format!("{x:?}")))] };
+        let report = RunReport {
+            ticks: 1000,
+            base_rate: 1000.0 / 3.0,
+            elapsed: Duration::from_nanos(elapsed_ns),
+            times: vec![NodeTime {
+                node: "src".into(),
+                kind: "no.such.type",
+                setup: Duration::from_nanos(1),
+                process: Duration::from_nanos(u64::MAX),
+                finish: Duration::ZERO,
+                elapsed: Duration::from_nanos(elapsed_ns),
+            }],
+            summaries: vec![(
+                "probe".into(),
+                Summary {
+                    values: vec![("rms".into(), x * (0.1 + 0.2), "V".into()), ("tiny".into(), 5e-324, "".into())],
+                    lines: vec!["a line, with \"quotes\"".into()],
+                },
+            )],
+            left_out: Vec::new(),
+        };
+        (point, report)
+    }
+
+    /// A record of shard `shard` of `total` runs holding `runs`.
+    pub(crate) fn record(shard: Shard, total: usize, runs: Vec<(Point, RunReport)>) -> ShardRecord {
+        let range = shard.range(total);
+        ShardRecord {
+            graph: "graphs/g.toml".into(),
+            shard,
+            total,
+            indices: range.clone().take(runs.len()).collect(),
+            range,
+            runs,
+            failures: vec![("gain=9".into(), "it broke".into())],
+            sweep: true,
+            timings: Timings::Show,
+            csv: Some("t.csv".into()),
+            json: None,
+        }
+    }
+
+    #[test]
+    fn a_record_reads_back_bit_for_bit() {
+        let dir = tempfile::tempdir().unwrap();
+        let rec = record(Shard { k: 2, n: 3 }, 7, vec![run(1.0 / 7.0, 123_456_789), run(1e300, 0)]);
+        rec.write(dir.path()).unwrap();
+        assert!(!dir.path().join(format!(".{RECORD}.tmp")).exists());
+        let back = ShardRecord::read(dir.path()).unwrap();
+        assert_eq!(
+            (back.graph.as_str(), back.shard, back.total, back.range.clone()),
+            ("graphs/g.toml", rec.shard, 7, 3..5)
+        );
+        assert_eq!(back.indices, rec.indices);
+        assert_eq!(back.failures, rec.failures);
+        assert_eq!(
+            (back.sweep, back.timings, back.csv.clone(), back.json.clone()),
+            (true, Timings::Show, rec.csv, None)
+        );
+        for ((p, r), (q, s)) in rec.runs.iter().zip(&back.runs) {
+            assert_eq!(p.label(), q.label());
+            assert_eq!(r.base_rate.to_bits(), s.base_rate.to_bits());
+            assert_eq!((r.ticks, r.elapsed), (s.ticks, s.elapsed));
+            assert_eq!(s.times[0].kind, "no.such.type");
+            assert_eq!((s.times[0].process, s.times[0].setup), (r.times[0].process, r.times[0].setup));
+            let bits = |x: &RunReport| -> Vec<u64> { x.summaries[0].1.values.iter().map(|v| v.1.to_bits()).collect() };
+            assert_eq!(bits(r), bits(s));
+            assert_eq!(r.summaries[0].1.lines, s.summaries[0].1.lines);
+        }
+    }
+
+    #[test]
+    fn bad_records_name_the_file_and_the_fault() {
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join(RECORD);
+        let e = ShardRecord::read(dir.path()).unwrap_err();
+        assert!(matches!(e, RecordError::Read { .. }));
+        assert_eq!(
+            e.to_string(),
+            format!("{}: cannot read (is it the --out of `evflow run --shard`?)", path.display())
+        );
+
+        std::fs::write(&path, "{ not json").unwrap();
+        let e = ShardRecord::read(dir.path()).unwrap_err();
+        assert!(matches!(e, RecordError::Json { .. }), "{e}");
+        assert!(e.to_string().starts_with(&format!("{}: ", path.display())), "{e}");
+
+        record(Shard { k: 1, n: 1 }, 1, vec![run(2.0, 5)]).write(dir.path()).unwrap();
+        let good: Json = serde_json::from_str(&std::fs::read_to_string(&path).unwrap()).unwrap();
+        /// Spoils one field of a good record.
+        type Spoil = fn(&mut Json);
+        let cases: [(Spoil, &str); 6] = [
+            (|d| d["shard"] = json!("4/3"), "shard `4/3`: expected K/N with 1 ≤ K ≤ N (e.g. 3/8)"),
+            (|d| _ = d.as_object_mut().unwrap().remove("graph"), "missing `graph`"),
+            (|d| d["range"] = json!([0]), "`range` is not [first, end]"),
+            (|d| d["runs"][0]["vars"][0] = json!([1, 2]), "run 1: a variable is not [name, text]"),
+            (
+                |d| d["runs"][0]["report"]["summaries"][0]["values"][0][1] = json!(0.5),
+                "run 1: `probe.rms`: not a number written as text",
+            ),
+            (|d| d["times"] = json!("yes"), "`times` is not true or false"),
+        ];
+        for (spoil, what) in cases {
+            let mut doc = good.clone();
+            spoil(&mut doc);
+            std::fs::write(&path, doc.to_string()).unwrap();
+            let e = ShardRecord::read(dir.path()).unwrap_err();
+            assert!(matches!(e, RecordError::Invalid { .. }), "{e}");
+            assert_eq!(e.to_string(), format!("{}: {what}", path.display()));
+        }
+    }
+
+    #[test]
+    fn paths_inside_the_folder_are_relative() {
+        assert_eq!(relative_to(Path::new("out/sub/t.csv"), Path::new("out")), "sub/t.csv");
+        let outside = relative_to(Path::new("elsewhere/t.csv"), Path::new("out"));
+        assert!(outside.ends_with("elsewhere/t.csv") && Path::new(&outside).is_absolute(), "{outside}");
+    }
+}

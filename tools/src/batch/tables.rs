@@ -160,3 +160,64 @@ pub fn sweep_csv(runs: &[(Point, RunReport)], timings: Timings) -> String {
     }
     s
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use evflow_engine::graph::parse_cli_value;
+    use evflow_engine::Summary;
+    use std::time::Duration;
+
+    fn run(label: &str, values: &[(&str, f64)]) -> (Point, RunReport) {
+        let point = Point { values: vec![("name".into(), parse_cli_value(label))] };
+        let summary =
+            Summary { values: values.iter().map(|(k, v)| (k.to_string(), *v, "V".into())).collect(), lines: vec![] };
+        let report = RunReport {
+            ticks: 10,
+            base_rate: 1000.0,
+            elapsed: Duration::from_millis(1500),
+            times: vec![],
+            summaries: vec![("p".into(), summary)],
+            left_out: vec![],
+        };
+        (point, report)
+    }
+
+    #[test]
+    fn numbers_for_people() {
+        assert_eq!(number(3.0), "3");
+        assert_eq!(number(-1e15), "-1.00000e15");
+        assert_eq!(number(0.5), "0.500000");
+        assert_eq!(number(123.456789), "123.457");
+        assert_eq!(number(2.5e-4), "2.50000e-4");
+        assert_eq!(number(0.0), "0");
+    }
+
+    #[test]
+    fn csv_quotes_and_keeps_full_precision_and_missing_columns() {
+        let runs = [run("\"a,b\"", &[("x", 0.1 + 0.2)]), run("\"c\"", &[("y", 1.0)])];
+        let csv = sweep_csv(&runs, Timings::Leave);
+        assert_eq!(csv, "name,p.x,p.y\n\"a,b\",0.30000000000000004,\nc,,1\n");
+        let timed = sweep_csv(&runs, Timings::Show);
+        assert!(timed.starts_with("name,p.x,p.y,seconds\n") && timed.contains(",1.5\n"), "{timed}");
+    }
+
+    #[test]
+    fn text_table_marks_missing_values() {
+        let runs = [run("1", &[("x", 2.0)]), run("22", &[])];
+        assert_eq!(sweep_table(&runs, Timings::Leave), "name  p.x\n----  ---\n   1    2\n  22    -\n");
+    }
+
+    #[test]
+    fn json_of_one_run_or_a_sweep() {
+        let runs = [run("1", &[("x", 2.0)])];
+        let one: serde_json::Value = serde_json::from_str(&report_json(&runs, false, Timings::Leave)).unwrap();
+        assert_eq!(
+            one,
+            serde_json::json!({ "ticks": 10, "base_rate": 1000.0, "summaries": { "p": { "values": { "x": 2.0 }, "lines": [] } } })
+        );
+        let sweep: serde_json::Value = serde_json::from_str(&report_json(&runs, true, Timings::Show)).unwrap();
+        assert_eq!(sweep[0]["vars"]["name"], "1");
+        assert_eq!(sweep[0]["run"]["seconds"], 1.5);
+    }
+}

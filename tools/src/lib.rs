@@ -1,5 +1,6 @@
 //! The library half of the `evflow` program: what its commands share with
-//! tests and benchmarks — plots for reports.
+//! tests and benchmarks: plots for reports, fits, and batch computations
+//! (a sweep's tables, shard records, the merge of shards).
 #![deny(missing_docs)]
 
 pub mod batch;

@@ -1,7 +1,13 @@
 //! What the batch commands (`run --sweep`, `report`, `replay` of many
 //! sessions) share on the command line: `--jobs`, `--shard`, and the one
-//! progress bar of a batch. The pool itself is engine code
-//! (`evflow_engine::batch`), shared with tests and benchmarks.
+//! progress bar of a batch; and, in submodules, the computations of batches
+//! that commands, tests and benchmarks share: a sweep's tables, a shard's
+//! record, and the merge of shards. The pool itself is engine code
+//! (`evflow_engine::batch`).
+
+pub mod merge;
+pub mod shard_record;
+pub mod tables;
 
 use evflow_engine::batch::{default_jobs, Shard};
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};

@@ -3,11 +3,13 @@
 //! (through `evflow_engine::batch`), printed and written in sweep order.
 
 use super::graph_args::GraphArgs;
-use super::run_report::{print_report, report_json, sweep_csv, sweep_table, Timings};
+use super::run_report::print_report;
 use anyhow::{anyhow, bail, Result};
 use evflow_engine::batch::{check_outputs, for_each_ordered, output_files, Failures};
 use evflow_engine::sweep::{parse_axis, points, Point};
 use evflow_engine::{check, read_graph, run_offline, Checked, Plan, PlanOptions, RunOptions, RunReport};
+use evflow_tools::batch::shard_record::{relative_to, ShardRecord};
+use evflow_tools::batch::tables::{report_json, sweep_csv, sweep_table, Timings};
 use evflow_tools::batch::{progress_bar, BatchArgs};
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 use std::sync::atomic::{AtomicBool, Ordering};
@@ -179,7 +181,7 @@ pub fn main(a: Args) -> Result<()> {
         write(path, &sweep_csv(&reports, timings), "table")?;
     }
     if a.batch.shard.is_some() {
-        let record = super::merge::ShardRecord {
+        let record = ShardRecord {
             graph: graph.file.display().to_string(),
             shard,
             total,
@@ -189,8 +191,8 @@ pub fn main(a: Args) -> Result<()> {
             failures: failures.list.clone(),
             sweep: is_sweep,
             timings,
-            csv: a.csv.as_deref().map(|p| super::merge::relative_to(p, &a.out)),
-            json: a.json.as_deref().map(|p| super::merge::relative_to(p, &a.out)),
+            csv: a.csv.as_deref().map(|p| relative_to(p, &a.out)),
+            json: a.json.as_deref().map(|p| relative_to(p, &a.out)),
         };
         record.write(&a.out)?;
     }

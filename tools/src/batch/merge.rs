@@ -357,25 +357,29 @@ fn write(path: &Path, text: &str) -> Result<(), MergeError> {
 /// paths), leaving out `skip` and temporary files; two shards writing one
 /// name must have written the same bytes. Returns how many were copied.
 fn copy_files(out: &Path, dirs: &[&Path], skip: &[PathBuf]) -> Result<usize, MergeError> {
-    let mut copied: Vec<(PathBuf, PathBuf)> = Vec::new();
+    // Every file and every clash first, so that a clash leaves `out`
+    // untouched; then the copies.
+    let mut planned: Vec<(PathBuf, PathBuf)> = Vec::new();
     for dir in dirs {
         for rel in files_under(dir)? {
             if skip.contains(&rel) || rel.file_name().is_some_and(|n| n.to_string_lossy().ends_with(".tmp")) {
                 continue;
             }
             let from = dir.join(&rel);
-            if let Some((_, earlier)) = copied.iter().find(|(r, _)| *r == rel) {
+            if let Some((_, earlier)) = planned.iter().find(|(r, _)| *r == rel) {
                 let same = std::fs::read(earlier).ok() == std::fs::read(&from).ok();
                 if !same {
                     return Err(MergeError::DifferentFiles { first: earlier.clone(), second: from });
                 }
                 continue;
             }
-            copy(&from, &out.join(&rel))?;
-            copied.push((rel, from));
+            planned.push((rel, from));
         }
     }
-    Ok(copied.len())
+    for (rel, from) in &planned {
+        copy(from, &out.join(rel))?;
+    }
+    Ok(planned.len())
 }
 
 #[cfg(test)]
@@ -461,5 +465,8 @@ mod tests {
             e.to_string(),
             format!("{} and {}: two shards wrote different files of one name", a.display(), b.display())
         );
+        // Refused before anything is copied: no half-merged folder.
+        let out = base.path().join("out");
+        assert!(!out.join("wav/run1.wav").exists() && !out.join("common.txt").exists());
     }
 }

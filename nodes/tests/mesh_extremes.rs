@@ -6,27 +6,14 @@
 //! the screen plane; an empty or all-degenerate file is refused. Every
 //! output finite.
 
+mod mesh_formats_util;
+
 use evflow_engine::harness::Single;
 use evflow_engine::Summary;
-use evflow_nodes::mesh::{edges_node, gradient_node};
+use evflow_nodes::mesh::edges_node;
+use mesh_formats_util::gradient;
 use std::fmt::Write;
 use std::path::Path;
-
-/// `mesh.gradient` (fixed range, every tick's secant): intensity, fsq, slope, z, tri.
-fn gradient(dir: &Path, params: &str, x: &[f64], y: &[f64]) -> Result<Vec<Vec<f64>>, String> {
-    let params = format!("{params}\nrange = \"fixed\"\nmin_step = 0.0");
-    Single {
-        spec: &gradient_node::SPEC,
-        params: &params,
-        inputs: vec![("x", x.to_vec(), 1000.0), ("y", y.to_vec(), 1000.0)],
-        outputs: vec!["intensity", "fsq", "slope", "z", "tri"],
-        base_rate: 1000.0,
-        ticks: x.len() as u64,
-        block: 64,
-        base_dir: dir,
-    }
-    .run()
-}
 
 /// `mesh.edges` fed by `tri` from [`gradient`]: its outputs and summary.
 fn edges(dir: &Path, params: &str, x: &[f64], y: &[f64], tri: &[f64]) -> (Vec<Vec<f64>>, Summary) {

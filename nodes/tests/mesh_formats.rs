@@ -7,34 +7,15 @@
 
 mod mesh_formats_util;
 
-use evflow_engine::harness::Single;
 use evflow_nodes::mesh::formats::load_file;
-use evflow_nodes::mesh::gradient_node;
 use evflow_nodes::mesh::place::{reorient, Up};
 use evflow_nodes::mesh::Mesh;
-use mesh_formats_util::{obj, Axis, WRITERS};
+use mesh_formats_util::{gradient, obj, Axis, WRITERS};
 use std::path::{Path, PathBuf};
 
 /// A file of the shipped test data.
 fn data(name: &str) -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/data").join(name)
-}
-
-/// `mesh.gradient` over touch points, every tick's secant, fixed range:
-/// intensity, fsq, slope, z, tri.
-fn run(dir: &Path, params: &str, x: &[f64], y: &[f64]) -> Result<Vec<Vec<f64>>, String> {
-    let params = format!("{params}\nrange = \"fixed\"\nmin_step = 0.0");
-    Single {
-        spec: &gradient_node::SPEC,
-        params: &params,
-        inputs: vec![("x", x.to_vec(), 1000.0), ("y", y.to_vec(), 1000.0)],
-        outputs: vec!["intensity", "fsq", "slope", "z", "tri"],
-        base_rate: 1000.0,
-        ticks: x.len() as u64,
-        block: 64,
-        base_dir: dir,
-    }
-    .run()
 }
 
 /// Touch points: five diagonal strokes over a 0.1 m fitted footprint.
@@ -80,7 +61,7 @@ fn same_in_every_format(dir: &Path, name: &str, mesh: &Mesh, reference: &[Vec<f6
             let loaded = reorient(load_file(&dir.join(&file), 0.0).unwrap(), up);
             assert_eq!(loaded.triangles.len(), mesh.triangles.len(), "{file}: welded triangles");
             assert_eq!(loaded.vertices.len(), mesh.vertices.len(), "{file}: welded vertices");
-            let out = run(dir, &format!("file = \"{file}\"\nup = \"{}\"\n{fit}", axis.word()), &x, &y).unwrap();
+            let out = gradient(dir, &format!("file = \"{file}\"\nup = \"{}\"\n{fit}", axis.word()), &x, &y).unwrap();
             assert!(out.iter().flatten().all(|v| v.is_finite()), "{file}");
             same(&out, reference, &file);
             let default_is_right = match suffix {
@@ -89,7 +70,7 @@ fn same_in_every_format(dir: &Path, name: &str, mesh: &Mesh, reference: &[Vec<f6
             };
             if default_is_right {
                 same(
-                    &run(dir, &format!("file = \"{file}\"\n{fit}"), &x, &y).unwrap(),
+                    &gradient(dir, &format!("file = \"{file}\"\n{fit}"), &x, &y).unwrap(),
                     reference,
                     &format!("{file}, up = auto"),
                 );
@@ -122,13 +103,13 @@ fn a_written_height_field_is_the_same_in_every_format_and_orientation() {
     std::fs::write(dir.path().join("ref.obj"), obj(&mesh, Axis::ZUp)).unwrap();
     let (x, y) = strokes();
     let fit = "fit = \"footprint\"";
-    let reference = run(dir.path(), &format!("file = \"ref.obj\"\nup = \"+z\"\n{fit}"), &x, &y).unwrap();
+    let reference = gradient(dir.path(), &format!("file = \"ref.obj\"\nup = \"+z\"\n{fit}"), &x, &y).unwrap();
     // Inside the fitted footprint (0.1 × 0.075 m) the finger is on the mesh.
     let on = reference[4].iter().filter(|&&t| t >= 0.0).count();
     assert!(on > x.len() / 2, "{on} of {}", x.len());
     same_in_every_format(dir.path(), "grid", &mesh, &reference, fit);
     // Unfitted too: the same surface in cm at the same place.
-    let reference = run(dir.path(), "file = \"ref.obj\"\nup = \"+z\"", &x, &y).unwrap();
+    let reference = gradient(dir.path(), "file = \"ref.obj\"\nup = \"+z\"", &x, &y).unwrap();
     same_in_every_format(dir.path(), "grid-cm", &mesh, &reference, "");
 }
 
@@ -150,11 +131,11 @@ fn suzanne_fandisk_and_bunny_are_the_same_in_every_format_and_orientation() {
         let mesh = Mesh::new(rounded, shipped.triangles.clone(), 0.0);
         let ref_file = format!("{name}-ref.obj");
         std::fs::write(dir.path().join(&ref_file), obj(&mesh, Axis::ZUp)).unwrap();
-        let reference = run(dir.path(), &format!("file = \"{ref_file}\"\nup = \"+z\"\n{fit}"), &x, &y).unwrap();
+        let reference = gradient(dir.path(), &format!("file = \"{ref_file}\"\nup = \"+z\"\n{fit}"), &x, &y).unwrap();
         let on = reference[4].iter().filter(|&&t| t >= 0.0).count();
         assert!(on > x.len() / 5, "{file}: on the mesh {on} of {} ticks", x.len());
         // The shipped file itself, `up` left to its format's default.
-        let own = run(dir.path(), &format!("file = \"{}\"\n{fit}", data(file).display()), &x, &y).unwrap();
+        let own = gradient(dir.path(), &format!("file = \"{}\"\n{fit}", data(file).display()), &x, &y).unwrap();
         if file.ends_with(".obj") {
             // Rounding to f32 moves the surface by ~1e-7 of its size: the same triangles but
             // for points within that of an edge, the same heights within that.
@@ -201,7 +182,7 @@ fn malformed_files_of_each_format_name_the_file_and_the_line_or_byte() {
     ];
     for (file, bytes, want) in cases {
         std::fs::write(dir.path().join(file), bytes).unwrap();
-        let e = run(dir.path(), &format!("file = \"{file}\""), &[0.0], &[0.0]).err().unwrap();
+        let e = gradient(dir.path(), &format!("file = \"{file}\""), &[0.0], &[0.0]).err().unwrap();
         assert!(e.contains(want), "{file}: {e}\nwant: {want}");
     }
 }

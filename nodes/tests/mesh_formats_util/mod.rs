@@ -1,12 +1,14 @@
-//! Writers of every mesh format, shared by `tests/mesh_formats.rs` and
-//! `benches/mesh_formats.rs`: a [`Mesh`] written as OBJ, ASCII and binary
+//! Writers of every mesh format, shared by `tests/mesh_formats.rs`,
+//! `tests/mesh_extremes.rs` and `benches/mesh_formats.rs`: a [`Mesh`] written as OBJ, ASCII and binary
 //! STL, ASCII and binary (both byte orders) PLY, glTF with a base64
 //! buffer and GLB, z-up or y-up.
 #![allow(dead_code)]
 
 use base64::Engine;
-use evflow_nodes::mesh::Mesh;
+use evflow_engine::harness::Single;
+use evflow_nodes::mesh::{gradient_node, Mesh};
 use std::fmt::Write;
+use std::path::Path;
 
 /// How a file's coordinates relate to the z-up mesh: written as is, or
 /// y-up (the inverse of the turn `up = "+y"` makes: (x, y, z) → (x, z, −y)).
@@ -206,4 +208,22 @@ pub fn glb(m: &Mesh, a: Axis) -> Vec<u8> {
     b.extend(0x004E_4942u32.to_le_bytes());
     b.extend(bin);
     b
+}
+
+/// `mesh.gradient` over touch points (1 kHz), every tick's secant, fixed
+/// range: intensity, fsq, slope, z, tri. Shared by the format and the
+/// extreme-mesh tests.
+pub fn gradient(dir: &Path, params: &str, x: &[f64], y: &[f64]) -> Result<Vec<Vec<f64>>, String> {
+    let params = format!("{params}\nrange = \"fixed\"\nmin_step = 0.0");
+    Single {
+        spec: &gradient_node::SPEC,
+        params: &params,
+        inputs: vec![("x", x.to_vec(), 1000.0), ("y", y.to_vec(), 1000.0)],
+        outputs: vec!["intensity", "fsq", "slope", "z", "tri"],
+        base_rate: 1000.0,
+        ticks: x.len() as u64,
+        block: 64,
+        base_dir: dir,
+    }
+    .run()
 }

@@ -289,7 +289,7 @@ fn in_order(mut shards: Vec<(PathBuf, ShardRecord)>) -> Result<Vec<(PathBuf, Sha
 }
 
 /// Checks that the shards' K are 1..=N, each once, and puts them in K order.
-fn k_order<T>(mut shards: Vec<(PathBuf, Shard, T)>) -> Result<Vec<(PathBuf, Shard, T)>, MergeError> {
+pub(crate) fn k_order<T>(mut shards: Vec<(PathBuf, Shard, T)>) -> Result<Vec<(PathBuf, Shard, T)>, MergeError> {
     shards.sort_by_key(|(_, s, _)| s.k);
     let n = shards[0].1.n;
     for w in shards.windows(2) {
@@ -346,7 +346,7 @@ fn copy(from: &Path, to: &Path) -> Result<(), MergeError> {
 }
 
 /// Writes `text` to `path` through a temporary file beside it.
-fn write(path: &Path, text: &str) -> Result<(), MergeError> {
+pub(crate) fn write(path: &Path, text: &str) -> Result<(), MergeError> {
     let tmp = prepare(path)?;
     std::fs::write(&tmp, text)
         .and_then(|_| std::fs::rename(&tmp, path))
@@ -356,7 +356,7 @@ fn write(path: &Path, text: &str) -> Result<(), MergeError> {
 /// Copies every file under the shard folders into `out` (as relative
 /// paths), leaving out `skip` and temporary files; two shards writing one
 /// name must have written the same bytes. Returns how many were copied.
-fn copy_files(out: &Path, dirs: &[&Path], skip: &[PathBuf]) -> Result<usize, MergeError> {
+pub(crate) fn copy_files(out: &Path, dirs: &[&Path], skip: &[PathBuf]) -> Result<usize, MergeError> {
     // Every file and every clash first, so that a clash leaves `out`
     // untouched; then the copies.
     let mut planned: Vec<(PathBuf, PathBuf)> = Vec::new();

@@ -1,10 +1,12 @@
 //! The library half of the `evflow` program: what its commands share with
 //! tests and benchmarks: plots for reports, fits, and batch computations
-//! (a sweep's tables, shard records, the merge of shards).
+//! (a sweep's tables, shard records, the merge of shards), and the tables
+//! of reports.
 #![deny(missing_docs)]
 
 pub mod batch;
 pub mod fit;
 pub mod plot;
+pub mod report;
 #[cfg(feature = "studio")]
 pub mod studio;

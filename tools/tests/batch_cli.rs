@@ -440,3 +440,93 @@ fn a_sweep_whose_runs_share_an_output_file_is_refused_before_running() {
     assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
     assert!(out.join("excitation-60g.wav").is_file() && out.join("excitation-110g.wav").is_file());
 }
+
+/// `report textures` in three shards (four (profile, condition) cells
+/// split 2, 1, 1, across two profiles), merged out of order, is the report
+/// one run writes: textures.md, rows.csv, the spectra, the recordings and
+/// runs byte for byte; the model files but for their training times.
+/// Missing shards, shards of another report and `--grid` with `--shard`
+/// are refused by name.
+#[cfg(feature = "synth")]
+#[test]
+fn report_textures_shards_merged_equal_one_report() {
+    let base = tempfile::tempdir().unwrap();
+    let report = |dir: &Path, shard: Option<&str>, gains: &str| {
+        let mut args = vec![
+            "report",
+            "textures",
+            "--out",
+            dir.to_str().unwrap(),
+            "--samples",
+            "plastic-sheet",
+            "--conditions",
+            "60:3,110:5",
+            "--profiles",
+            "nominal,stiff",
+            "--epochs",
+            "3",
+            "--iterations",
+            "3",
+            "--gains",
+            gains,
+            "--no-times",
+            "--jobs",
+            "2",
+        ];
+        if let Some(s) = shard {
+            args.extend(["--shard", s]);
+        }
+        evflow(&args)
+    };
+    let one = base.path().join("one");
+    let o = report(&one, None, "1.0");
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let mut dirs = Vec::new();
+    for k in 1..=3 {
+        let d = base.path().join(format!("part{k}"));
+        let o = report(&d, Some(&format!("{k}/3")), "1.0");
+        assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+        assert!(!d.join("textures.md").exists(), "a shard writes its record, not the tables");
+        dirs.push(d.to_str().unwrap().to_string());
+    }
+    let merged = base.path().join("merged");
+    let m = merged.to_str().unwrap();
+    let o = evflow(&["merge", m, &dirs[0], &dirs[2]]);
+    assert!(
+        String::from_utf8_lossy(&o.stderr).contains("shards missing: 2/3"),
+        "{}",
+        String::from_utf8_lossy(&o.stderr)
+    );
+    assert!(!merged.exists(), "a refused merge wrote {m}");
+    let o = evflow(&["merge", m, &dirs[2], &dirs[0], &dirs[1]]);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let stdout = String::from_utf8_lossy(&o.stdout);
+    assert!(stdout.contains("merged 3 shards of a texture report: 4 rows"), "{stdout}");
+    assert_eq!(
+        stdout.lines().take_while(|l| !l.starts_with("wrote ")).collect::<Vec<_>>().join("\n") + "\n",
+        std::fs::read_to_string(one.join("textures.md")).unwrap(),
+        "merge prints the report one run prints"
+    );
+    let timeless = |b: &[u8]| -> String {
+        String::from_utf8_lossy(b).lines().filter(|l| !l.contains("\"seconds\"")).collect::<Vec<_>>().join("\n")
+    };
+    let (a, b) = (tree(&one), tree(&merged));
+    assert_eq!(a.iter().map(|t| &t.0).collect::<Vec<_>>(), b.iter().map(|t| &t.0).collect::<Vec<_>>());
+    assert!(a.iter().any(|(p, _)| p.ends_with("rows.csv")) && a.iter().any(|(p, _)| p.ends_with("textures.md")));
+    for ((p, x), (_, y)) in a.iter().zip(&b) {
+        if p.starts_with("work") && p.to_string_lossy().contains("/models/") {
+            assert_eq!(timeless(x), timeless(y), "{}", p.display());
+        } else {
+            assert_eq!(x, y, "{}", p.display());
+        }
+    }
+    // A shard of a report with other gains is not one of these.
+    let other = base.path().join("other");
+    assert!(report(&other, Some("2/3"), "0.8").status.success());
+    let o = evflow(&["merge", base.path().join("m2").to_str().unwrap(), &dirs[0], other.to_str().unwrap(), &dirs[2]]);
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert!(err.contains("not shards of one batch") && err.contains("gains"), "{err}");
+    // --grid needs every condition of a texture.
+    let o = evflow(&["report", "textures", "--shard", "1/2", "--grid", "g", "--out", base.path().to_str().unwrap()]);
+    assert!(String::from_utf8_lossy(&o.stderr).contains("--grid with --shard"));
+}

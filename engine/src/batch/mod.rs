@@ -19,4 +19,4 @@ pub mod shard;
 pub use clash::{check_outputs, output_files, ClashError};
 pub use failures::Failures;
 pub use pool::{default_jobs, for_each_ordered, Outcome};
-pub use shard::Shard;
+pub use shard::{Shard, ShardError};

@@ -1,6 +1,7 @@
 //! `evflow merge OUT SHARD_DIRS...`: joins the outputs of the shards of a
-//! sweep (`evflow run --shard K/N`), or of a model library (`evflow library
-//! build --shard K/N`), into what one run would have written. The merge is
+//! sweep (`evflow run --shard K/N`), of a model library (`evflow library
+//! build --shard K/N`) or of a texture report (`evflow report textures
+//! --shard K/N`) into what one run would have written. The merge is
 //! library code (`evflow_tools::batch::merge`); this parses, calls and prints.
 
 use anyhow::{bail, Result};
@@ -20,6 +21,7 @@ pub struct Args {
 /// Runs `evflow merge`.
 pub fn main(a: Args) -> Result<()> {
     match merge(&a.out, &a.shards)? {
+        #[cfg(feature = "synth")]
         Merged::Library(m) => {
             println!(
                 "merged {} library shards: {} entries, {} files; index {}",
@@ -28,6 +30,20 @@ pub fn main(a: Args) -> Result<()> {
                 m.files,
                 m.index.display()
             );
+        }
+        #[cfg(feature = "synth")]
+        Merged::Textures(m) => {
+            print!("{}", m.markdown);
+            for table in &m.tables {
+                println!("wrote {}", table.display());
+            }
+            println!(
+                "merged {} shards of a texture report: {} rows, {} files the shards wrote",
+                m.shards, m.rows, m.files
+            );
+            if !m.failures.is_empty() {
+                bail!("{}", m.failures.summary(m.steps, "steps").trim_end());
+            }
         }
         Merged::Sweep(m) => {
             for table in &m.tables {

@@ -10,20 +10,24 @@
 //!   upper bound on what any gain rule could give a method.
 
 /// One method's scores at one gain.
-#[derive(Debug, Clone, Copy, PartialEq)]
+#[derive(Debug, Clone, Copy, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct AtGain {
     /// The gain.
+    #[serde(with = "super::exact")]
     pub gain: f64,
     /// E_s, rectangular one-second segments (the dissertation's reading).
+    #[serde(with = "super::exact")]
     pub rect: f64,
     /// E_s, Hann-windowed half-overlapping segments (Welch's reading).
+    #[serde(with = "super::exact")]
     pub welch: f64,
     /// Virtual over real peak power density (rect spectra).
+    #[serde(with = "super::exact")]
     pub peak_ratio: f64,
 }
 
 /// The chosen gains of one method.
-#[derive(Debug, Clone, Copy, PartialEq)]
+#[derive(Debug, Clone, Copy, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct Chosen {
     /// By Table 5.1's rule.
     pub table51: AtGain,

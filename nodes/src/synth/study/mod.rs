@@ -14,6 +14,7 @@
 pub mod cells;
 pub mod constant_speed;
 pub mod crossval;
+pub mod exact;
 pub mod floor;
 pub mod forces_first;
 pub mod gains;
@@ -24,6 +25,7 @@ pub mod models;
 pub mod recordings;
 pub mod row;
 pub mod run;
+pub mod saved;
 pub mod setup;
 pub mod spectrum;
 pub mod summary;

@@ -10,7 +10,7 @@ use super::StudyError;
 use std::path::{Path, PathBuf};
 
 /// The models of one profile and condition.
-#[derive(Debug, Clone, PartialEq)]
+#[derive(Debug, Clone, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct Models {
     /// Inverse NARX, binary excitation.
     pub narx: PathBuf,
@@ -19,6 +19,7 @@ pub struct Models {
     /// Forward model.
     pub forward: PathBuf,
     /// Seconds each took to build: inverse binary, inverse multilevel, forward.
+    #[serde(with = "super::exact::triple")]
     pub seconds: [f64; 3],
 }
 

@@ -10,7 +10,8 @@ use super::StudyError;
 use std::path::{Path, PathBuf};
 
 /// A synthesis method.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord, serde::Serialize, serde::Deserialize)]
+#[serde(rename_all = "kebab-case")]
 pub enum Method {
     /// Inverse NARX model trained on binary excitation (§5.2).
     NarxBinary,
@@ -48,11 +49,13 @@ impl Method {
 }
 
 /// Two readings of one E_s.
-#[derive(Debug, Clone, Copy, PartialEq, Default)]
+#[derive(Debug, Clone, Copy, PartialEq, Default, serde::Serialize, serde::Deserialize)]
 pub struct Reading {
     /// Rectangular one-second segments (the dissertation's, the `metric` default).
+    #[serde(with = "super::exact")]
     pub rect: f64,
     /// Hann-windowed half-overlapping segments (Welch).
+    #[serde(with = "super::exact")]
     pub welch: f64,
 }
 
@@ -64,7 +67,7 @@ impl Reading {
 }
 
 /// One method's result on a row.
-#[derive(Debug, Clone, PartialEq)]
+#[derive(Debug, Clone, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct MethodResult {
     /// The method.
     pub method: Method,
@@ -73,25 +76,28 @@ pub struct MethodResult {
     /// The gains chosen.
     pub chosen: Chosen,
     /// Time to synthesize the actuation, s (0 for playback).
+    #[serde(with = "super::exact")]
     pub seconds: f64,
 }
 
 /// The achievable floor's actuation: what optimizing through the display
 /// itself reached (see [`super::floor`]).
-#[derive(Debug, Clone, PartialEq)]
+#[derive(Debug, Clone, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct Achievable {
     /// Its scores over the gain sweep (played like every method).
     pub sweep: Vec<AtGain>,
     /// The best of each reading over the sweep.
     pub reached: Reading,
     /// The optimizer's objective (E_s² against repetition 1, noise off) at the best start.
+    #[serde(with = "super::exact")]
     pub objective: f64,
     /// Seconds the optimization took.
+    #[serde(with = "super::exact")]
     pub seconds: f64,
 }
 
 /// One row.
-#[derive(Debug, Clone, PartialEq)]
+#[derive(Debug, Clone, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct Row {
     /// Lab profile.
     pub profile: String,

@@ -9,7 +9,7 @@ use super::recordings;
 use super::row::{self, Row, RowInputs};
 use super::setup::{Cond, Profile};
 use super::StudyError;
-use evflow_engine::batch::for_each_ordered;
+use evflow_engine::batch::{for_each_ordered, Shard};
 use std::path::PathBuf;
 use std::sync::atomic::AtomicBool;
 use std::time::Instant;
@@ -41,6 +41,22 @@ pub struct StudyConfig {
     /// which takes the waveform where a pass keeps less than one spectral
     /// segment).
     pub objective: String,
+    /// The slice of the (profile, condition) cells to run ([`Shard::ALL`]:
+    /// every one); each cell's models and rows run in the slice that holds it.
+    pub shard: Shard,
+}
+
+impl StudyConfig {
+    /// Every (profile, condition) cell, profile by profile, in study order.
+    pub fn all_cells(&self) -> Vec<(&Profile, Cond)> {
+        self.profiles.iter().flat_map(|p| self.conds.iter().map(move |c| (p, *c))).collect()
+    }
+
+    /// The cells of this config's shard.
+    pub fn cells(&self) -> Vec<(&Profile, Cond)> {
+        let all = self.all_cells();
+        all[self.shard.range(all.len())].to_vec()
+    }
 }
 
 /// What a study has finished (reported in study order, whatever order the
@@ -101,8 +117,7 @@ pub fn run_on(cfg: &StudyConfig, jobs: usize, progress: &mut dyn FnMut(Progress<
     let mut failures = Vec::new();
 
     // The models of every profile and condition.
-    let cells: Vec<(&Profile, Cond)> =
-        cfg.profiles.iter().flat_map(|p| cfg.conds.iter().map(move |c| (p, *c))).collect();
+    let cells = cfg.cells();
     let mut built: Vec<Option<Models>> = Vec::with_capacity(cells.len());
     let build = |_: usize, (profile, c): (&Profile, Cond)| {
         let dir = cfg.work.join(&profile.name).join("models");

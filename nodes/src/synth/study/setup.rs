@@ -5,11 +5,13 @@ use super::StudyError;
 use std::path::{Path, PathBuf};
 
 /// A (load, velocity) condition.
-#[derive(Debug, Clone, Copy, PartialEq)]
+#[derive(Debug, Clone, Copy, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct Cond {
     /// Stylus mass, g.
+    #[serde(with = "super::exact")]
     pub mass: f64,
     /// Scanning speed, cm/s.
+    #[serde(with = "super::exact")]
     pub speed: f64,
 }
 

@@ -20,8 +20,6 @@ pub mod narx;
 pub mod resample;
 #[cfg(feature = "synth")]
 pub mod textures;
-#[cfg(feature = "synth")]
-pub mod textures_table;
 
 /// Arguments of `evflow report`.
 #[derive(clap::Args, Debug)]

@@ -4,17 +4,19 @@
 //! (`evflow_nodes::synth::study`); this command parses, calls, prints and
 //! draws.
 
-use super::textures_table::{csv, markdown};
 use anyhow::{anyhow, Context, Result};
 use evflow_nodes::lab::texture::samples::{self, NAMES};
 use evflow_nodes::recording::format::Recording;
 use evflow_nodes::synth::study::cells::write_actuation;
 use evflow_nodes::synth::study::row::{Method, Row};
 use evflow_nodes::synth::study::run::{run_on, Progress, StudyConfig};
+use evflow_nodes::synth::study::saved::{SavedStudy, RECORD};
 use evflow_nodes::synth::study::setup::{Cond, Profile};
 use evflow_nodes::synth::study::spectrum::gated;
-use evflow_tools::batch::{progress_bar, JobsArg};
+use evflow_tools::batch::{progress_bar, BatchArgs};
 use evflow_tools::plot::{Plot, Series};
+use evflow_tools::report::textures_table::Timings;
+use evflow_tools::report::textures_table::{csv, markdown};
 use std::path::PathBuf;
 
 /// Arguments of `evflow report textures`.
@@ -67,8 +69,17 @@ pub struct Args {
     /// The folder of the shipped graphs.
     #[arg(long, default_value = "graphs")]
     graphs: PathBuf,
+    /// Leave the times out of the tables (synthesis and training seconds,
+    /// the report's wall time), so that two runs, or shards merged and one
+    /// run, can be compared byte for byte.
+    #[arg(long)]
+    no_times: bool,
+    /// `--jobs`, and `--shard K/N`: run only the K-th of N slices of the
+    /// (profile, condition) cells — their models and rows — and save them
+    /// in textures-shard.json for `evflow merge OUT SHARDS…`, which writes
+    /// textures.md and rows.csv as one run would (docs/scale.md).
     #[command(flatten)]
-    jobs: JobsArg,
+    batch: BatchArgs,
 }
 
 /// Runs `evflow report textures`.
@@ -83,9 +94,18 @@ pub fn main(a: Args) -> Result<()> {
     }
     let conds = a.conditions.iter().map(|s| Cond::parse(s)).collect::<Result<Vec<_>, _>>()?;
     let profiles = a.profiles.iter().map(|p| Profile::resolve(p, &a.graphs)).collect::<Result<Vec<_>, _>>()?;
+    let shard = a.batch.shard();
+    if a.grid.is_some() && a.batch.shard.is_some() {
+        anyhow::bail!(
+            "--grid with --shard: a texture's grid needs every condition, which the shards split; \
+             run `report interp --cells optimized` or the report unsharded for the grids"
+        );
+    }
+    let timings = if a.no_times { Timings::Leave } else { Timings::Show };
     std::fs::create_dir_all(&a.out).with_context(|| format!("{}: cannot create", a.out.display()))?;
     let graphs = std::fs::canonicalize(&a.graphs).with_context(|| format!("--graphs {}", a.graphs.display()))?;
-    let work = std::fs::canonicalize(&a.out)?.join("work");
+    let base = std::fs::canonicalize(&a.out)?;
+    let work = base.join("work");
     let cfg = StudyConfig {
         graphs,
         work,
@@ -98,10 +118,11 @@ pub fn main(a: Args) -> Result<()> {
         multilevel: !a.no_multilevel,
         floor: !a.no_floor,
         objective: a.objective.clone(),
+        shard,
     };
-    let cells = cfg.profiles.len() * cfg.conds.len();
+    let cells = cfg.cells().len();
     let bar = progress_bar(cells + cells * cfg.samples.len(), "steps", false);
-    let study = run_on(&cfg, a.jobs.jobs(), &mut |p| {
+    let study = run_on(&cfg, a.batch.jobs(), &mut |p| {
         bar.inc(1);
         match p {
             Progress::Models(profile, c) => bar.set_message(format!("{}: models at {}", profile.name, c.label())),
@@ -109,12 +130,25 @@ pub fn main(a: Args) -> Result<()> {
         }
     })?;
     bar.finish_and_clear();
-    let md = markdown(&study, &cfg);
-    print!("{md}");
-    super::save_markdown(&a.out.join("textures.md"), &md)?;
-    let rows_csv = a.out.join("rows.csv");
-    std::fs::write(&rows_csv, csv(&study)).with_context(|| format!("{}: cannot write", rows_csv.display()))?;
-    println!("wrote {}", rows_csv.display());
+    if a.batch.shard.is_some() {
+        SavedStudy::of(&study, &cfg, &base, timings == Timings::Show).write(&base)?;
+        println!(
+            "shard {shard}: {} of {} (profile, condition) cells, {} rows; saved {}. \
+             Join the shards with `evflow merge OUT SHARD_FOLDERS…`.",
+            cells,
+            cfg.all_cells().len(),
+            study.rows.len(),
+            a.out.join(RECORD).display()
+        );
+    } else {
+        let md = markdown(&study, &cfg, timings);
+        print!("{md}");
+        super::save_markdown(&a.out.join("textures.md"), &md)?;
+        let rows_csv = a.out.join("rows.csv");
+        std::fs::write(&rows_csv, csv(&study, timings))
+            .with_context(|| format!("{}: cannot write", rows_csv.display()))?;
+        println!("wrote {}", rows_csv.display());
+    }
     if !a.no_plots {
         for r in &study.rows {
             let name = format!("textures-{}-{}-{}.png", r.profile, r.sample, r.cond.tag());

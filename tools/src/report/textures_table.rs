@@ -1,5 +1,8 @@
 //! The tables of `evflow report textures`: Markdown for people, CSV for
-//! everything else.
+//! everything else. `evflow report textures` writes them from its study,
+//! `evflow merge` from the study its shards saved; with
+//! [`Timings::Leave`] (`--no-times`) no time is written, so that both are
+//! byte for byte the same.
 
 use evflow_nodes::lab::texture::samples::NAMES;
 use evflow_nodes::narx::model::Model;
@@ -7,6 +10,8 @@ use evflow_nodes::synth::model_file::ForwardModel;
 use evflow_nodes::synth::study::row::{Method, Row};
 use evflow_nodes::synth::study::run::{Study, StudyConfig};
 use evflow_nodes::synth::study::summary::{es, standing, Basis};
+
+pub use crate::batch::tables::Timings;
 use std::fmt::Write as _;
 
 /// The basis of the headline figures.
@@ -40,7 +45,7 @@ fn ratio(x: f64) -> String {
 }
 
 /// The report's Markdown.
-pub fn markdown(study: &Study, cfg: &StudyConfig) -> String {
+pub fn markdown(study: &Study, cfg: &StudyConfig, timings: Timings) -> String {
     let mut md = String::new();
     let _ = writeln!(md, "# Texture rendering: every method on every lab profile\n");
     let _ = writeln!(
@@ -63,19 +68,22 @@ pub fn markdown(study: &Study, cfg: &StudyConfig) -> String {
          * **achievable floor**: the best E_s reached by optimizing the actuation through the lab's own simulated \
          display (noise off, u in [−1, 1], several starts, gain sweep), or a method's where one did better.\n"
     );
-    models_table(&mut md, study);
+    models_table(&mut md, study, timings);
     for profile in &cfg.profiles {
         let rows: Vec<&Row> = study.rows.iter().filter(|r| r.profile == profile.name).collect();
-        rows_table(&mut md, &profile.name, &rows);
+        rows_table(&mut md, &profile.name, &rows, timings);
     }
     standing_tables(&mut md, study, cfg);
     table_51(&mut md, study, cfg);
     targets(&mut md, study, cfg);
-    let _ = writeln!(md, "\nWhole report: {:.0} s.", study.seconds);
+    if timings == Timings::Show {
+        let _ = writeln!(md, "\nWhole report: {:.0} s.", study.seconds);
+    }
     md
 }
 
-fn models_table(md: &mut String, study: &Study) {
+fn models_table(md: &mut String, study: &Study, timings: Timings) {
+    let secs = |s: f64| if timings == Timings::Show { format!("{s:.2}") } else { "–".into() };
     let _ = writeln!(md, "## Models\n");
     let _ = writeln!(
         md,
@@ -86,22 +94,22 @@ fn models_table(md: &mut String, study: &Study) {
         let narx = Model::load(&m.narx).map_or("–".to_string(), |m| {
             let t = &m.training;
             format!(
-                "{} / {} / {:.2}",
+                "{} / {} / {}",
                 f3(t.closed_loop.map_or(f64::NAN, |c| c.transition_agreement)),
                 f3(t.closed_loop_noise_force.map_or(f64::NAN, |c| c.transition_agreement)),
-                t.seconds
+                secs(t.seconds)
             )
         });
         let ml = m.narx_multilevel.as_ref().and_then(|p| Model::load(p).ok()).map_or("–".to_string(), |m| {
             let t = &m.training;
-            format!("{} / {:.2}", f3(t.closed_loop.map_or(f64::NAN, |c| c.sign_agreement)), t.seconds)
+            format!("{} / {}", f3(t.closed_loop.map_or(f64::NAN, |c| c.sign_agreement)), secs(t.seconds))
         });
         let fwd = ForwardModel::load(&m.forward).map_or("–".to_string(), |f| {
             format!(
-                "{} / {:.4} / {:.2}",
+                "{} / {:.4} / {}",
                 f3(f.training.scores.validation_rel_rms),
                 f.carrier_gain_n,
-                f.training.seconds
+                secs(f.training.seconds)
             )
         });
         let _ = writeln!(md, "| {profile} | {} | {narx} | {ml} | {fwd} |", c.label());
@@ -109,7 +117,7 @@ fn models_table(md: &mut String, study: &Study) {
     let _ = writeln!(md);
 }
 
-fn rows_table(md: &mut String, profile: &str, rows: &[&Row]) {
+fn rows_table(md: &mut String, profile: &str, rows: &[&Row], timings: Timings) {
     let methods: Vec<Method> =
         Method::ALL.into_iter().filter(|m| rows.iter().any(|r| r.method(*m).is_some())).collect();
     let _ = writeln!(md, "## {profile}\n\n{} per row; time: synthesis of the optimized actuation.\n", HEADLINE.label());
@@ -137,12 +145,15 @@ fn rows_table(md: &mut String, profile: &str, rows: &[&Row]) {
         let play = es(r, Method::Playback, HEADLINE).unwrap_or(f64::NAN);
         let _ = write!(
             line,
-            " {} | {} | {} | {} | {:.2} |",
+            " {} | {} | {} | {} | {} |",
             ratio(best / floor),
             ratio(best / HEADLINE.of(r.display_floor)),
             ratio(best / HEADLINE.of(r.repeat)),
             if best < play { "yes" } else { "**no**" },
-            r.method(BEST).map_or(f64::NAN, |m| m.seconds)
+            match timings {
+                Timings::Show => format!("{:.2}", r.method(BEST).map_or(f64::NAN, |m| m.seconds)),
+                Timings::Leave => "–".into(),
+            }
         );
         let _ = writeln!(md, "{line}");
     }
@@ -234,8 +245,9 @@ fn targets(md: &mut String, study: &Study, cfg: &StudyConfig) {
     }
 }
 
-/// Every row, every method, every reading, as CSV.
-pub fn csv(study: &Study) -> String {
+/// Every row, every method, every reading, as CSV (`seconds` empty
+/// without times).
+pub fn csv(study: &Study, timings: Timings) -> String {
     let mut out = String::from(
         "profile,sample,mass_g,speed_cm_s,repeat_rect,repeat_welch,display_floor_rect,display_floor_welch,achievable_rect,achievable_welch,method,gain_t51,rect_t51,welch_t51,peak_ratio_t51,gain_best_rect,rect_best,gain_best_welch,welch_best,seconds\n",
     );
@@ -265,7 +277,7 @@ pub fn csv(study: &Study) -> String {
                 c.best_rect.rect,
                 c.best_welch.gain,
                 c.best_welch.welch,
-                m.seconds
+                if timings == Timings::Show { m.seconds.to_string() } else { String::new() }
             );
         }
     }

@@ -1,0 +1,68 @@
+//! Joins the outputs of the shards of a sweep (`evflow run --shard K/N`)
+//! into what one run would have written (`evflow merge`).
+//!
+//! The merge reads each shard's record ([`super::shard_record`]), checks
+//! that the shards are one sweep's (same graph, same count, every K of N
+//! once), copies the files the graphs wrote, and writes the CSV and JSON
+//! tables with the same code as `evflow run` ([`super::tables`]), from the
+//! runs in sweep order. With `--no-times` on the shards the tables are byte
+//! for byte those of one run; with times, only the measured times differ.
+//!
+//! Folders of a model library built in shards (`evflow library build
+//! --shard K/N`) merge the same way: their files copied, their indexes
+//! joined in the library's order.
+//!
+//! A texture report run in shards (`evflow report textures --shard K/N`)
+//! merges into its tables ([`textures`]).
+//!
+//! One file per kind of shard; [`error`] and [`files`] are what they share.
+
+pub mod error;
+pub mod files;
+#[cfg(feature = "synth")]
+pub mod library;
+pub mod sweep;
+#[cfg(feature = "synth")]
+pub mod textures;
+
+pub use error::MergeError;
+#[cfg(feature = "synth")]
+pub use library::{merge_library, LibraryMerge};
+pub use sweep::{merge_sweep, SweepMerge};
+
+use std::path::{Path, PathBuf};
+
+/// What a merge did: of a sweep or of a model library.
+#[derive(Debug)]
+pub enum Merged {
+    /// The shards of `evflow run --shard`.
+    Sweep(SweepMerge),
+    /// The shards of `evflow library build --shard`.
+    #[cfg(feature = "synth")]
+    Library(LibraryMerge),
+    /// The shards of `evflow report textures --shard`.
+    #[cfg(feature = "synth")]
+    Textures(textures::TexturesMerge),
+}
+
+/// Merges the shard folders `dirs` (in any order) into `out`: a texture
+/// report's when every folder holds a study shard's record, a model
+/// library's when every folder is one (and none holds a sweep's shard
+/// record), else a sweep's.
+pub fn merge(out: &Path, dirs: &[PathBuf]) -> Result<Merged, MergeError> {
+    if dirs.is_empty() {
+        return Err(MergeError::NoShards);
+    }
+    #[cfg(feature = "synth")]
+    if dirs.iter().all(|d| evflow_nodes::synth::study::saved::SavedStudy::is_in(d)) {
+        return textures::merge_textures(out, dirs).map(Merged::Textures);
+    }
+    #[cfg(feature = "synth")]
+    if dirs
+        .iter()
+        .all(|d| !d.join(super::shard_record::RECORD).exists() && evflow_nodes::synth::study::library::is_library(d))
+    {
+        return merge_library(out, dirs).map(Merged::Library);
+    }
+    merge_sweep(out, dirs).map(Merged::Sweep)
+}

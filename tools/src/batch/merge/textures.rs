@@ -1,0 +1,92 @@
+//! The merge of a texture report's shards (`evflow report textures --shard
+//! K/N`): each shard saved its (profile, condition) cells' rows and models
+//! ([`evflow_nodes::synth::study::saved`]); the merge checks that the
+//! shards are the N slices of one report, copies their files (models,
+//! recordings, runs, spectra), joins the saved studies in study order with
+//! every path put under the output folder, and writes textures.md and
+//! rows.csv with the code `evflow report textures` uses. With `--no-times`
+//! on the shards they are byte for byte one run's.
+
+use super::error::MergeError;
+use super::files::{copy_files, k_order, write};
+use crate::report::textures_table::{csv, markdown, Timings};
+use evflow_engine::batch::{Failures, Shard};
+use evflow_nodes::synth::study::saved::{SavedStudy, RECORD};
+use std::path::{Path, PathBuf};
+
+/// What a merge of a texture report's shards did. Steps that failed in the
+/// shards are listed in `failures`; the merge itself still wrote the tables
+/// of every row that was run.
+#[derive(Debug)]
+pub struct TexturesMerge {
+    /// Shards merged.
+    pub shards: usize,
+    /// Rows over all shards.
+    pub rows: usize,
+    /// Steps of the whole report: every cell's models and every row.
+    pub steps: usize,
+    /// Files copied from the shards (models, recordings, runs, spectra).
+    pub files: usize,
+    /// The tables written (textures.md, rows.csv).
+    pub tables: Vec<PathBuf>,
+    /// The report's Markdown, as `evflow report textures` prints it.
+    pub markdown: String,
+    /// The steps that failed in the shards, labelled with their shard.
+    pub failures: Failures,
+}
+
+/// Merges the shards of `evflow report textures --shard` in `dirs` (in any
+/// order) into `out`.
+pub fn merge_textures(out: &Path, dirs: &[PathBuf]) -> Result<TexturesMerge, MergeError> {
+    if dirs.is_empty() {
+        return Err(MergeError::NoShards);
+    }
+    let mut shards = Vec::new();
+    for d in dirs {
+        let saved = SavedStudy::read(d)?;
+        let shard = saved.slice().expect("a record read is checked to name its K/N");
+        shards.push((d.clone(), shard, saved));
+    }
+    shards.sort_by_key(|(_, s, _)| s.k);
+    let (first_dir, first_shard, first) = &shards[0];
+    for (dir, shard, s) in &shards {
+        let differs = |what| MergeError::NotOneBatch { first: first_dir.clone(), other: dir.clone(), what };
+        if shard.n != first_shard.n {
+            return Err(differs("the shard counts N"));
+        }
+        if s.scope != first.scope || s.cells != first.cells {
+            return Err(differs(
+                "the reports' settings: samples, conditions, profiles, gains, epochs, iterations, objective, \
+                 floor, multilevel or --no-times",
+            ));
+        }
+    }
+    let shards = k_order(shards)?;
+    let folders: Vec<&Path> = shards.iter().map(|(d, _, _)| d.as_path()).collect();
+    let files = copy_files(out, &folders, &[PathBuf::from(RECORD)])?;
+    std::fs::create_dir_all(out).map_err(|source| MergeError::Create { dir: out.to_path_buf(), source })?;
+    let base = std::fs::canonicalize(out).map_err(|source| MergeError::Create { dir: out.to_path_buf(), source })?;
+    let saved: Vec<SavedStudy> = shards.into_iter().map(|(_, _, s)| s).collect();
+    let study = SavedStudy::join(&saved, &base);
+    let scope = &saved[0].scope;
+    let cfg = scope.config(&base, Shard::ALL);
+    let timings = if scope.times { Timings::Show } else { Timings::Leave };
+    let md = markdown(&study, &cfg, timings);
+    let (md_path, csv_path) = (out.join("textures.md"), out.join("rows.csv"));
+    write(&md_path, &md)?;
+    write(&csv_path, &csv(&study, timings))?;
+    let mut failures = Failures::new();
+    for (what, why) in &study.failures {
+        failures.push(what.clone(), why);
+    }
+    let cells = saved[0].cells;
+    Ok(TexturesMerge {
+        shards: saved.len(),
+        rows: study.rows.len(),
+        steps: cells + cells * scope.samples.len(),
+        files,
+        tables: vec![md_path, csv_path],
+        markdown: md,
+        failures,
+    })
+}

@@ -162,14 +162,22 @@ pub enum Merged {
     Sweep(SweepMerge),
     /// The shards of `evflow library build --shard`.
     Library(LibraryMerge),
+    /// The shards of `evflow report narx --shard`.
+    #[cfg(feature = "synth")]
+    Narx(super::merge_narx::NarxMerge),
 }
 
-/// Merges the shard folders `dirs` (in any order) into `out`: a model
+/// Merges the shard folders `dirs` (in any order) into `out`: a `report
+/// narx`'s when a folder holds its record ([`super::merge_narx`]), a model
 /// library's when every folder is one (and none holds a shard record),
 /// else a sweep's.
 pub fn merge(out: &Path, dirs: &[PathBuf]) -> Result<Merged, MergeError> {
     if dirs.is_empty() {
         return Err(MergeError::NoShards);
+    }
+    #[cfg(feature = "synth")]
+    if dirs.iter().any(|d| super::merge_narx::is_narx_shard(d)) {
+        return super::merge_narx::merge_narx(out, dirs).map(Merged::Narx);
     }
     #[cfg(feature = "synth")]
     if dirs.iter().all(|d| !d.join(RECORD).exists() && evflow_nodes::synth::study::library::is_library(d)) {

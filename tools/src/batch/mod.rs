@@ -6,6 +6,10 @@
 //! (`evflow_engine::batch`).
 
 pub mod merge;
+#[cfg(feature = "synth")]
+pub mod merge_narx;
+#[cfg(feature = "synth")]
+pub mod narx_shard;
 pub mod shard_record;
 pub mod tables;
 

@@ -1,7 +1,9 @@
 //! `evflow report narx` end to end on tiny sizes (3 epochs, one texture,
 //! one gain): a failing setting does not lose the others and is listed
-//! with its reason and a failing exit code; shards merged by `evflow merge`
-//! give the table of one run byte for byte.
+//! with its reason and a failing exit code; a texture whose recording fails
+//! is left out of every score; shards merged by `evflow merge` give the
+//! table of one run byte for byte.
+#![cfg(feature = "synth")]
 
 use std::path::{Path, PathBuf};
 use std::process::Command;
@@ -132,4 +134,59 @@ fn shards_merged_out_of_order_give_the_table_of_one_run() {
     for f in a.iter().filter(|f| !f.starts_with("models/base")) {
         assert_eq!(std::fs::read(one.join(f)).unwrap(), std::fs::read(merged.join(f)).unwrap(), "{}", f.display());
     }
+}
+
+/// The study as the library runs it: setting `a` (5 hidden, taps 1/10, LM)
+/// with 2 seeds at 60 g, 5 cm/s on `samples`, in `work`.
+fn study(
+    samples: &[&str],
+    out: &Path,
+    work: &Path,
+) -> Result<evflow_nodes::synth::study::narx_settings::NarxStudy, String> {
+    use evflow_nodes::synth::study::narx_settings::{run, NarxConfig, Setting};
+    use evflow_nodes::synth::study::setup::Cond;
+    let cfg = NarxConfig {
+        condition: Cond { mass: 60.0, speed: 5.0 },
+        settings: vec![Setting::parse("a=5/1/10/lm").unwrap()],
+        samples: samples.iter().map(|s| s.to_string()).collect(),
+        gains: vec![1.0],
+        seeds: 2,
+        epochs: 3,
+        iterations: 3,
+        graphs: root().join("graphs"),
+        out: out.to_path_buf(),
+        work: work.to_path_buf(),
+        jobs: 2,
+        shard: evflow_engine::batch::Shard::ALL,
+        record_time: false,
+    };
+    run(&cfg, &mut |_| {}).map_err(|e| e.to_string())
+}
+
+#[test]
+fn a_texture_whose_recording_fails_is_left_out_of_every_score() {
+    // The recording of the felt fabric cannot be written: a folder holds its name.
+    let base = tempfile::tempdir().unwrap();
+    let work = base.path().join("work");
+    let blocked = work.join("textures").join("felt-fabric-60g-5cms-r1.wav");
+    std::fs::create_dir_all(&blocked).unwrap();
+    let s = study(&["felt-fabric", "plastic-sheet"], &base.path().join("out"), &work).unwrap();
+    assert_eq!(s.textures, ["plastic-sheet"]);
+    assert_eq!(s.left_out.len(), 1);
+    assert_eq!(s.left_out[0].0, "felt-fabric");
+    assert!(s.left_out[0].1.contains("felt-fabric-60g-5cms-r1"), "{}", s.left_out[0].1);
+    let labels: Vec<&str> = s.failures.iter().map(|(l, _)| l.as_str()).collect();
+    assert_eq!(labels, ["texture felt-fabric"]);
+    // The scores are those of a study of the plastic sheet alone, bit for bit.
+    let alone = study(&["plastic-sheet"], &base.path().join("out-alone"), &base.path().join("work-alone")).unwrap();
+    assert_eq!(s.items, alone.items);
+    assert!(s.items.iter().all(|i| i.score.is_ok()));
+    assert_eq!(s.scored[0].seeds, 2);
+    assert_eq!(s.scored[0].es.to_bits(), alone.scored[0].es.to_bits());
+
+    // With every texture left out nothing can be scored: an error naming each.
+    let work = base.path().join("work-none");
+    std::fs::create_dir_all(work.join("textures").join("felt-fabric-60g-5cms-r1.wav")).unwrap();
+    let e = study(&["felt-fabric"], &base.path().join("out-none"), &work).unwrap_err();
+    assert!(e.starts_with("every texture failed:\nfelt-fabric: "), "{e}");
 }

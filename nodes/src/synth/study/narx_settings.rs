@@ -187,8 +187,11 @@ impl NarxConfig {
         if self.samples.is_empty() {
             return bad("samples: at least one".into());
         }
-        for s in &self.samples {
+        for (i, s) in self.samples.iter().enumerate() {
             crate::lab::texture::samples::lookup(s).map_err(|e| StudyError::Config(format!("samples: {e}")))?;
+            if self.samples[..i].contains(s) {
+                return bad(format!("samples: `{s}` is given twice"));
+            }
         }
         if self.gains.is_empty() || !self.gains.iter().all(|g| g.is_finite() && *g > 0.0) {
             return bad("gains: positive numbers".into());
@@ -543,6 +546,9 @@ mod tests {
         cfg.settings.push(Setting::parse("a=1/1/1/lm").unwrap());
         assert_eq!(cfg.check().unwrap_err().to_string(), "settings: the name `a` is given twice");
         cfg.settings.pop();
+        cfg.samples.push("plastic-sheet".into());
+        assert_eq!(cfg.check().unwrap_err().to_string(), "samples: `plastic-sheet` is given twice");
+        cfg.samples.pop();
         cfg.samples.push("no-such-sample".into());
         assert!(cfg.check().unwrap_err().to_string().starts_with("samples: "));
     }

@@ -49,8 +49,13 @@ pub fn merge_narx(out: &Path, dirs: &[PathBuf]) -> Result<NarxMerge, MergeError>
     if dirs.is_empty() {
         return Err(MergeError::NoShards);
     }
-    let shards = dirs.iter().map(|d| Ok((d.clone(), NarxRecord::read(d)?))).collect::<Result<Vec<_>, MergeError>>()?;
-    let mut shards = shards;
+    // A folder of another kind of shard among them: named, not "cannot read".
+    if let (Some(narx), Some(other)) = (dirs.iter().find(|d| is_narx_shard(d)), dirs.iter().find(|d| !is_narx_shard(d)))
+    {
+        return Err(MergeError::NotNarx { dir: other.clone(), narx: narx.clone() });
+    }
+    let mut shards =
+        dirs.iter().map(|d| Ok((d.clone(), NarxRecord::read(d)?))).collect::<Result<Vec<_>, MergeError>>()?;
     shards.sort_by_key(|(_, r)| r.shard.k);
     let (first_dir, first) = &shards[0];
     for (dir, r) in &shards {
@@ -189,5 +194,15 @@ mod tests {
         let e = merge_narx(&out, &dirs).unwrap_err();
         assert_eq!(e.to_string(), format!("{d2}: shard 3/3 should hold runs 3..4 of 4"));
         assert!(!out.exists(), "a refused merge wrote {}", out.display());
+        let sweep = base.path().join("sweep");
+        std::fs::create_dir_all(&sweep).unwrap();
+        let e = merge_narx(&out, &[dirs[0].clone(), sweep.clone()]).unwrap_err();
+        assert_eq!(
+            e.to_string(),
+            format!(
+                "{}: not a shard of `evflow report narx` as {d0} is (it holds no narx-shard.json)",
+                sweep.display()
+            )
+        );
     }
 }

@@ -61,10 +61,11 @@ pub struct Args {
     /// every run, and a merge of shards is byte for byte one run's.
     #[arg(long)]
     no_times: bool,
-    /// `--jobs N`: (setting, seed) items at once. `--shard K/N`: train and
-    /// score only the K-th of N contiguous slices of the (setting, seed)
-    /// items (each shard also builds the default models and prepares the
-    /// textures); join the shards' folders with `evflow merge OUT DIR…`.
+    // `--jobs N`: (setting, seed) items at once (and textures prepared at
+    // once). `--shard K/N`: train and score only the K-th of N contiguous
+    // slices of the (setting, seed) items (each shard also builds the
+    // default models and prepares the textures); `evflow merge OUT DIR…`
+    // joins the shards' folders. The subcommand's help says so.
     #[command(flatten)]
     batch: BatchArgs,
 }

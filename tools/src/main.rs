@@ -36,9 +36,10 @@ enum Command {
     /// what one run would have written: the files the graphs wrote, and
     /// the --csv / --json tables in sweep order. Checks that the folders
     /// are every K of N of one sweep; lists the shards' failed runs. The
-    /// shards of a model library (`library build --shard`) and of a
-    /// texture report (`report textures --shard`: textures.md and rows.csv
-    /// written from every shard's rows) merge alike.
+    /// shards of a model library (`library build --shard`) and of the
+    /// reports `report textures --shard` (textures.md and rows.csv written
+    /// from every shard's rows) and `report narx --shard` (narx.md) merge
+    /// alike.
     ///
     /// Example (docs/scale.md):
     ///   for k in 1 2 3; do evflow run graphs/excitation.toml --shard $k/3 --out part$k --csv part$k/grid.csv; done

@@ -6,6 +6,8 @@
 //! (`evflow_engine::batch`).
 
 pub mod merge;
+#[cfg(feature = "synth")]
+pub mod narx_shard;
 pub mod shard_record;
 pub mod tables;
 

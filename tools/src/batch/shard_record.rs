@@ -7,6 +7,7 @@
 use super::tables::Timings;
 use evflow_engine::batch::Shard;
 use evflow_engine::graph::parse_cli_value;
+use evflow_engine::params::Value;
 use evflow_engine::plan::NodeTime;
 use evflow_engine::sweep::Point;
 use evflow_engine::{RunReport, Summary};
@@ -118,16 +119,34 @@ fn report_to_json(r: &RunReport) -> Json {
             "times": times, "summaries": summaries })
 }
 
+/// A swept value as text that [`parse_cli_value`] reads back as the same
+/// value: floats in Rust's shortest exact form with a decimal point or an
+/// exponent (so `-0.0` stays a float and `60.0` stays `60.0`), lists of
+/// floats as TOML arrays of them; other values as a graph's text shows them.
+fn exact_text(v: &Value) -> String {
+    fn float(x: f64) -> String {
+        if x.is_nan() {
+            "nan".into()
+        } else {
+            format!("{x:?}")
+        }
+    }
+    match v {
+        Value::Float(x) => float(*x),
+        Value::FloatList(l) => format!("[{}]", l.iter().map(|x| float(*x)).collect::<Vec<_>>().join(", ")),
+        other => evflow_engine::check::interpolate::text_of(other),
+    }
+}
+
 impl ShardRecord {
     /// Writes the record into `dir` (through a temporary file).
     pub fn write(&self, dir: &Path) -> Result<(), RecordError> {
-        use evflow_engine::check::interpolate::text_of;
         let runs: Vec<Json> = self
             .runs
             .iter()
             .zip(&self.indices)
             .map(|((p, r), i)| {
-                let vars: Vec<Json> = p.values.iter().map(|(k, v)| json!([k, text_of(v)])).collect();
+                let vars: Vec<Json> = p.values.iter().map(|(k, v)| json!([k, exact_text(v)])).collect();
                 json!({ "index": i, "vars": vars, "report": report_to_json(r) })
             })
             .collect();
@@ -359,6 +378,46 @@ pub(crate) mod tests {
             assert_eq!(bits(r), bits(s));
             assert_eq!(r.summaries[0].1.lines, s.summaries[0].1.lines);
         }
+    }
+
+    #[test]
+    fn swept_values_read_back_as_the_same_values() {
+        let values = [
+            Value::Float(-0.0),
+            Value::Float(60.0),
+            Value::Float(0.1),
+            Value::Float(1e300),
+            Value::Float(5e-324),
+            Value::Float(f64::INFINITY),
+            Value::Float(f64::NEG_INFINITY),
+            Value::Int(-3),
+            Value::Bool(true),
+            Value::Text("felt-fabric".into()),
+            Value::FloatList(vec![-0.0, 2.0, 0.3]),
+        ];
+        let dir = tempfile::tempdir().unwrap();
+        let mut rec = record(Shard { k: 1, n: 1 }, 1, vec![run(1.0, 1)]);
+        rec.runs[0].0.values = values.iter().enumerate().map(|(i, v)| (format!("v{i}"), v.clone())).collect();
+        rec.write(dir.path()).unwrap();
+        let back = ShardRecord::read(dir.path()).unwrap();
+        assert_eq!(back.runs[0].0.label(), rec.runs[0].0.label());
+        for ((_, v), (_, w)) in rec.runs[0].0.values.iter().zip(&back.runs[0].0.values) {
+            match (v, w) {
+                (Value::Float(a), Value::Float(b)) => assert_eq!(a.to_bits(), b.to_bits(), "{a:?} read back as {b:?}"),
+                (Value::FloatList(a), Value::FloatList(b)) => {
+                    assert_eq!(
+                        a.iter().map(|x| x.to_bits()).collect::<Vec<_>>(),
+                        b.iter().map(|x| x.to_bits()).collect::<Vec<_>>()
+                    )
+                }
+                _ => assert_eq!(v, w),
+            }
+        }
+        // NaN reads back as NaN.
+        rec.runs[0].0.values = vec![("x".into(), Value::Float(f64::NAN))];
+        rec.write(dir.path()).unwrap();
+        let back = ShardRecord::read(dir.path()).unwrap();
+        assert!(matches!(back.runs[0].0.values[0].1, Value::Float(x) if x.is_nan()));
     }
 
     #[test]

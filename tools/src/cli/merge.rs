@@ -1,6 +1,6 @@
 //! `evflow merge OUT SHARD_DIRS...`: joins the outputs of the shards of a
 //! sweep (`evflow run --shard K/N`), of a model library (`evflow library
-//! build --shard K/N`) or of a texture report (`evflow report textures
+//! build --shard K/N`) or of a report (`evflow report textures|narx
 //! --shard K/N`) into what one run would have written. The merge is
 //! library code (`evflow_tools::batch::merge`); this parses, calls and prints.
 
@@ -43,6 +43,28 @@ pub fn main(a: Args) -> Result<()> {
             );
             if !m.failures.is_empty() {
                 bail!("{}", m.failures.summary(m.steps, "steps").trim_end());
+            }
+        }
+        #[cfg(feature = "synth")]
+        Merged::Narx(m) => {
+            println!("wrote {}", m.table.display());
+            match &m.figure {
+                Some(Ok(w)) => {
+                    println!(
+                        "wrote {}{}",
+                        w.path.display(),
+                        if w.labelled { "" } else { " (no font found: unlabelled)" }
+                    )
+                }
+                Some(Err(e)) => eprintln!("warning: {e}"),
+                None => {}
+            }
+            println!(
+                "merged {} shards of report narx: {} of {} models scored, {} files copied",
+                m.shards, m.scored, m.total, m.files
+            );
+            if !m.failures.is_empty() {
+                bail!("{}", m.failures.summary(m.samples + m.total, "steps").trim_end());
             }
         }
         Merged::Sweep(m) => {

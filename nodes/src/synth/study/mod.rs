@@ -22,6 +22,8 @@ pub mod graphs;
 pub mod grid_plan;
 pub mod library;
 pub mod models;
+pub mod narx_settings;
+pub mod narx_settings_table;
 pub mod recordings;
 pub mod row;
 pub mod run;
@@ -62,6 +64,9 @@ pub enum StudyError {
     /// Settings that cannot work.
     #[error("{0}")]
     Config(String),
+    /// A NARX model that cannot be read.
+    #[error(transparent)]
+    Narx(#[from] crate::narx::error::NarxError),
     /// A synthesis step failed.
     #[error(transparent)]
     Synth(#[from] super::error::SynthError),

@@ -103,6 +103,14 @@ pub enum MergeError {
         #[source]
         source: std::io::Error,
     },
+    /// A folder among the shards of `evflow report narx` that is not one of them.
+    #[error("{}: not a shard of `evflow report narx` as {} is (it holds no narx-shard.json)", dir.display(), narx.display())]
+    NotNarx {
+        /// The folder without the record.
+        dir: PathBuf,
+        /// A folder with it.
+        narx: PathBuf,
+    },
     /// The shards of a model library or of a texture report could not be
     /// read, or their indexes joined.
     #[cfg(feature = "synth")]

@@ -21,6 +21,8 @@ pub mod error;
 pub mod files;
 #[cfg(feature = "synth")]
 pub mod library;
+#[cfg(feature = "synth")]
+pub mod narx;
 pub mod sweep;
 #[cfg(feature = "synth")]
 pub mod textures;
@@ -43,10 +45,14 @@ pub enum Merged {
     /// The shards of `evflow report textures --shard`.
     #[cfg(feature = "synth")]
     Textures(textures::TexturesMerge),
+    /// The shards of `evflow report narx --shard`.
+    #[cfg(feature = "synth")]
+    Narx(narx::NarxMerge),
 }
 
 /// Merges the shard folders `dirs` (in any order) into `out`: a texture
-/// report's when every folder holds a study shard's record, a model
+/// report's when every folder holds a study shard's record, a `report
+/// narx`'s when a folder holds its record ([`narx`]), a model
 /// library's when every folder is one (and none holds a sweep's shard
 /// record), else a sweep's.
 pub fn merge(out: &Path, dirs: &[PathBuf]) -> Result<Merged, MergeError> {
@@ -56,6 +62,10 @@ pub fn merge(out: &Path, dirs: &[PathBuf]) -> Result<Merged, MergeError> {
     #[cfg(feature = "synth")]
     if dirs.iter().all(|d| evflow_nodes::synth::study::saved::SavedStudy::is_in(d)) {
         return textures::merge_textures(out, dirs).map(Merged::Textures);
+    }
+    #[cfg(feature = "synth")]
+    if dirs.iter().any(|d| narx::is_narx_shard(d)) {
+        return narx::merge_narx(out, dirs).map(Merged::Narx);
     }
     #[cfg(feature = "synth")]
     if dirs

@@ -85,7 +85,10 @@ enum Which {
     /// trained at one condition and scored on the texture study (as
     /// `report textures` scores every method: gain sweep, Table 5.1 rule and
     /// best gain) by the mean E_s of the textures it synthesizes; a table
-    /// with the Pareto front and a PNG.
+    /// with the Pareto front and a PNG. A failed (setting, seed) or texture
+    /// does not stop the others: it is left out, listed at the end, and
+    /// the exit code is 1. `--shard K/N` runs a slice of the (setting, seed)
+    /// items; `evflow merge` joins the slices (docs/scale.md).
     ///
     /// Example: cargo run --release -p evflow -- report narx --out report
     #[cfg(feature = "synth")]

@@ -31,6 +31,7 @@ fn the_best_method_beats_fair_playback_on_two_profiles() {
         floor: true,
         objective: "expected".into(),
         shard: evflow_engine::batch::Shard::ALL,
+        record_time: true,
     };
     let study = run(&cfg, &mut |_| {}).unwrap_or_else(|e| panic!("{e}"));
     assert_eq!(study.rows.len(), 2);

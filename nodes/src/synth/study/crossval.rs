@@ -175,7 +175,7 @@ pub fn run(cfg: &CrossvalConfig<'_>, progress: &mut dyn FnMut(usize, usize, Stri
             None => {
                 step += 1;
                 progress(step, steps, format!("building the models at {}", c.label()));
-                models::build(cfg.graphs, &profile, c, cfg.epochs, false, cfg.models_out)?
+                models::build(cfg.graphs, &profile, c, cfg.epochs, false, true, cfg.models_out)?
             }
         });
     }

@@ -154,7 +154,7 @@ fn condition_models(plan: &Plan, c: &Cond) -> Result<(Models, bool)> {
     }
     let partial = plan.dir.join(".partial").join(format!("models-{}", c.tag()));
     let _ = std::fs::remove_dir_all(&partial);
-    let built = models::build(&plan.graphs, &plan.profile, c, plan.epochs, false, &partial)?;
+    let built = models::build(&plan.graphs, &plan.profile, c, plan.epochs, false, true, &partial)?;
     std::fs::create_dir_all(&final_dir).map_err(|e| io(&final_dir, format!("cannot create: {e}")))?;
     // The forward model first: `given` needs both, so a crash between the
     // two moves leaves an item that is redone.

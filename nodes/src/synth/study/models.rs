@@ -24,13 +24,16 @@ pub struct Models {
 }
 
 /// Builds the models of `c` on `profile` into `dir`; `epochs` bounds the
-/// NARX training; `multilevel` also builds the multilevel inverse model.
+/// NARX training; `multilevel` also builds the multilevel inverse model;
+/// `record_time` writes each model's training time into its file (without
+/// it the files are the same on every run: `--no-times`).
 pub fn build(
     graphs: &Path,
     profile: &Profile,
     c: &Cond,
     epochs: u32,
     multilevel: bool,
+    record_time: bool,
     dir: &Path,
 ) -> Result<Models, StudyError> {
     let common = vec![format!("mass={}", c.mass), format!("speed={}", c.speed), profile.set()];
@@ -38,7 +41,7 @@ pub fn build(
         let mut s = common.clone();
         s.push(format!("epochs={epochs}"));
         s.push("train.progress=false".into());
-        s.push("train.record_time=true".into());
+        s.push(format!("train.record_time={record_time}"));
         s.extend(extra.iter().map(|e| e.to_string()));
         s
     };
@@ -58,7 +61,7 @@ pub fn build(
     };
     let t = std::time::Instant::now();
     let mut forward_sets = common.clone();
-    forward_sets.push("record_time=true".into());
+    forward_sets.push(format!("record_time={record_time}"));
     run_graph(&graphs.join("forward-build.toml"), &forward_sets, dir)?;
     let forward = found(dir.join(format!("forward-{}.json", c.tag())))?;
     Ok(Models { narx, narx_multilevel, forward, seconds: [narx_s, ml_s, t.elapsed().as_secs_f64()] })

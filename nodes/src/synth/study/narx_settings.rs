@@ -353,7 +353,7 @@ pub fn run(cfg: &NarxConfig, progress: &mut dyn FnMut(&Item)) -> Result<NarxStud
     std::fs::create_dir_all(&cfg.out).map_err(io(&cfg.out))?;
     std::fs::create_dir_all(&cfg.work).map_err(io(&cfg.work))?;
     let base_dir = if cfg.shard.k == 1 { cfg.out.join("models").join("base") } else { cfg.work.join("base") };
-    let base = models::build(&cfg.graphs, &profile, &cond, cfg.epochs, false, &base_dir)
+    let base = models::build(&cfg.graphs, &profile, &cond, cfg.epochs, false, cfg.record_time, &base_dir)
         .map_err(|e| e.at(format!("the default models at {}", cond.label())))?;
     let textures = cfg.work.join("textures");
     let never = Default::default();

@@ -44,6 +44,9 @@ pub struct StudyConfig {
     /// The slice of the (profile, condition) cells to run ([`Shard::ALL`]:
     /// every one); each cell's models and rows run in the slice that holds it.
     pub shard: Shard,
+    /// Write each model's training time into its file (`--no-times` does
+    /// not, so that the files are the same on every run).
+    pub record_time: bool,
 }
 
 impl StudyConfig {
@@ -121,7 +124,7 @@ pub fn run_on(cfg: &StudyConfig, jobs: usize, progress: &mut dyn FnMut(Progress<
     let mut built: Vec<Option<Models>> = Vec::with_capacity(cells.len());
     let build = |_: usize, (profile, c): (&Profile, Cond)| {
         let dir = cfg.work.join(&profile.name).join("models");
-        models::build(&cfg.graphs, profile, &c, cfg.epochs, cfg.multilevel, &dir)
+        models::build(&cfg.graphs, profile, &c, cfg.epochs, cfg.multilevel, cfg.record_time, &dir)
     };
     for_each_ordered(cells.clone(), jobs, &never, build, |k, outcome| {
         let (profile, c) = cells[k];

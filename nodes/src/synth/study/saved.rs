@@ -80,6 +80,7 @@ impl Scope {
             floor: self.floor,
             objective: self.objective.clone(),
             shard,
+            record_time: self.times,
         }
     }
 }
@@ -245,6 +246,7 @@ mod tests {
             floor: true,
             objective: "expected".into(),
             shard,
+            record_time: true,
         }
     }
 

@@ -70,8 +70,8 @@ pub struct Args {
     #[arg(long, default_value = "graphs")]
     graphs: PathBuf,
     /// Leave the times out of the tables (synthesis and training seconds,
-    /// the report's wall time), so that two runs, or shards merged and one
-    /// run, can be compared byte for byte.
+    /// the report's wall time) and out of the model files, so that two
+    /// runs, or shards merged and one run, can be compared byte for byte.
     #[arg(long)]
     no_times: bool,
     /// `--jobs`, and `--shard K/N`: run only the K-th of N slices of the
@@ -119,6 +119,7 @@ pub fn main(a: Args) -> Result<()> {
         floor: !a.no_floor,
         objective: a.objective.clone(),
         shard,
+        record_time: !a.no_times,
     };
     let cells = cfg.cells().len();
     let bar = progress_bar(cells + cells * cfg.samples.len(), "steps", false);

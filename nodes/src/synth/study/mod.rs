@@ -23,7 +23,6 @@ pub mod grid_plan;
 pub mod library;
 pub mod models;
 pub mod narx_settings;
-pub mod narx_settings_table;
 pub mod recordings;
 pub mod row;
 pub mod run;

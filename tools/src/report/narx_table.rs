@@ -1,9 +1,10 @@
-//! The Markdown table of the NARX settings study ([`super::narx_settings`]):
+//! The Markdown table of the NARX settings study
+//! ([`evflow_nodes::synth::study::narx_settings`]):
 //! written by `evflow report narx` and, from the shards' items, by `evflow
 //! merge`, so both write the same bytes.
 
-use super::narx_settings::{pareto, Scored};
-use super::setup::Cond;
+use evflow_nodes::synth::study::narx_settings::{pareto, Scored};
+use evflow_nodes::synth::study::setup::Cond;
 use std::fmt::Write as _;
 
 /// What the table shows.
@@ -77,8 +78,8 @@ pub fn markdown(t: &Table<'_>) -> String {
 
 #[cfg(test)]
 mod tests {
-    use super::super::narx_settings::{aggregate, Item, SeedScore, Setting};
     use super::*;
+    use evflow_nodes::synth::study::narx_settings::{aggregate, Item, SeedScore, Setting};
 
     fn table(times: bool) -> String {
         let settings: Vec<Setting> = ["default=5/1/10/lm", "slow=3/1/5/adam", "broken=5/1/1000/lm"]

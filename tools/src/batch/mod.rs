@@ -8,6 +8,7 @@
 pub mod merge;
 #[cfg(feature = "synth")]
 pub mod narx_shard;
+pub mod record_json;
 pub mod shard_record;
 pub mod tables;
 

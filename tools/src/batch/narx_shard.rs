@@ -7,7 +7,7 @@
 //! and read here, in one place. The figure of the report is drawn here too
 //! ([`figure`]), for the report and the merge alike.
 
-use super::shard_record::RecordError;
+use super::record_json::{count, field, list, read_doc, text, write_doc, Fault, RecordError};
 use crate::plot::{Plot, Series};
 use evflow_engine::batch::Shard;
 use evflow_nodes::synth::study::narx_settings::{Item, NarxConfig, Scored, SeedScore, Setting};
@@ -129,42 +129,15 @@ impl NarxRecord {
             "left_out": left_out,
             "items": items,
         });
-        let path = dir.join(NARX_RECORD);
-        let tmp = dir.join(format!(".{NARX_RECORD}.tmp"));
-        serde_json::to_string_pretty(&doc)
-            .map_err(std::io::Error::from)
-            .and_then(|text| std::fs::write(&tmp, text))
-            .and_then(|_| std::fs::rename(&tmp, &path))
-            .map_err(|source| RecordError::Write { path, source })
+        write_doc(dir, NARX_RECORD, &doc)
     }
 
     /// Reads the record in `dir`; errors name the file and what is wrong.
     pub fn read(dir: &Path) -> Result<NarxRecord, RecordError> {
-        let path = dir.join(NARX_RECORD);
-        let text = match std::fs::read_to_string(&path) {
-            Ok(text) => text,
-            Err(source) => return Err(RecordError::Read { path, source }),
-        };
-        let doc: Json = match serde_json::from_str(&text) {
-            Ok(doc) => doc,
-            Err(error) => return Err(RecordError::Json { path, error }),
-        };
-        parse(&doc).map_err(|what| RecordError::Invalid { path, what })
+        read_doc(dir, NARX_RECORD, parse)
     }
 }
 
-/// What is wrong inside a record, before the file's name is put to it.
-type Fault<T> = Result<T, String>;
-
-fn field<'a>(v: &'a Json, key: &str) -> Fault<&'a Json> {
-    v.get(key).ok_or_else(|| format!("missing `{key}`"))
-}
-fn text<'a>(v: &'a Json, key: &str) -> Fault<&'a str> {
-    field(v, key)?.as_str().ok_or_else(|| format!("`{key}` is not text"))
-}
-fn count(v: &Json, key: &str) -> Fault<u64> {
-    field(v, key)?.as_u64().ok_or_else(|| format!("`{key}` is not a whole number"))
-}
 fn float(v: &Json, key: &str) -> Fault<f64> {
     field(v, key)?.as_str().and_then(|s| s.parse().ok()).ok_or_else(|| format!("`{key}`: not a number written as text"))
 }
@@ -173,9 +146,6 @@ fn texts(v: &Json, key: &str) -> Fault<Vec<String>> {
         .as_array()
         .and_then(|l| l.iter().map(|x| x.as_str().map(str::to_string)).collect::<Option<Vec<_>>>())
         .ok_or_else(|| format!("`{key}` is not a list of text"))
-}
-fn list<'a>(v: &'a Json, key: &str) -> Fault<&'a Vec<Json>> {
-    field(v, key)?.as_array().ok_or_else(|| format!("`{key}` is not a list"))
 }
 
 fn parse_arguments(a: &Json) -> Fault<NarxArguments> {

@@ -4,6 +4,8 @@
 //! nanoseconds), so that `evflow merge` can rebuild the sweep's tables.
 //! Written and read here, in one place.
 
+pub use super::record_json::RecordError;
+use super::record_json::{count, field, list, read_doc, text, write_doc, Fault};
 use super::tables::Timings;
 use evflow_engine::batch::Shard;
 use evflow_engine::graph::parse_cli_value;
@@ -13,51 +15,11 @@ use evflow_engine::sweep::Point;
 use evflow_engine::{RunReport, Summary};
 use serde_json::{json, Value as Json};
 use std::ops::Range;
-use std::path::{Path, PathBuf};
+use std::path::Path;
 use std::time::Duration;
 
 /// The name of a shard's record in its output folder.
 pub const RECORD: &str = "shard.json";
-
-/// Why a shard's record could not be written or read; each names the file.
-#[derive(Debug, thiserror::Error)]
-pub enum RecordError {
-    /// The record could not be written.
-    #[error("{}: cannot write the shard's record", path.display())]
-    Write {
-        /// The record's path.
-        path: PathBuf,
-        /// What went wrong.
-        #[source]
-        source: std::io::Error,
-    },
-    /// The record could not be read (often: the folder is not a shard's).
-    #[error("{}: cannot read (is it the --out of `evflow run --shard`?)", path.display())]
-    Read {
-        /// The record's path.
-        path: PathBuf,
-        /// What went wrong.
-        #[source]
-        source: std::io::Error,
-    },
-    /// The record is not JSON.
-    #[error("{}: {error}", path.display())]
-    Json {
-        /// The record's path.
-        path: PathBuf,
-        /// Where and what the JSON fault is.
-        error: serde_json::Error,
-    },
-    /// The record is JSON but not a shard's record: a field is missing or
-    /// of the wrong kind.
-    #[error("{}: {what}", path.display())]
-    Invalid {
-        /// The record's path.
-        path: PathBuf,
-        /// Which field (and run) and what is wrong with it.
-        what: String,
-    },
-}
 
 /// What a shard ran and found: written by `evflow run --shard`, read by `evflow merge`.
 #[derive(Debug, Clone)]
@@ -163,47 +125,17 @@ impl ShardRecord {
             "runs": runs,
             "failures": failures,
         });
-        let path = dir.join(RECORD);
-        let tmp = dir.join(format!(".{RECORD}.tmp"));
-        serde_json::to_string_pretty(&doc)
-            .map_err(std::io::Error::from)
-            .and_then(|text| std::fs::write(&tmp, text))
-            .and_then(|_| std::fs::rename(&tmp, &path))
-            .map_err(|source| RecordError::Write { path, source })
+        write_doc(dir, RECORD, &doc)
     }
 
     /// Reads the record in `dir`; errors name the file and what is wrong.
     pub fn read(dir: &Path) -> Result<ShardRecord, RecordError> {
-        let path = dir.join(RECORD);
-        let text = match std::fs::read_to_string(&path) {
-            Ok(text) => text,
-            Err(source) => return Err(RecordError::Read { path, source }),
-        };
-        let doc: Json = match serde_json::from_str(&text) {
-            Ok(doc) => doc,
-            Err(error) => return Err(RecordError::Json { path, error }),
-        };
-        parse_record(&doc).map_err(|what| RecordError::Invalid { path, what })
+        read_doc(dir, RECORD, parse_record)
     }
 }
 
-/// What is wrong inside a record, before the file's name is put to it.
-type Fault<T> = Result<T, String>;
-
-fn field<'a>(v: &'a Json, key: &str) -> Fault<&'a Json> {
-    v.get(key).ok_or_else(|| format!("missing `{key}`"))
-}
-fn text<'a>(v: &'a Json, key: &str) -> Fault<&'a str> {
-    field(v, key)?.as_str().ok_or_else(|| format!("`{key}` is not text"))
-}
-fn count(v: &Json, key: &str) -> Fault<u64> {
-    field(v, key)?.as_u64().ok_or_else(|| format!("`{key}` is not a whole number"))
-}
 fn float(v: &Json, what: &str) -> Fault<f64> {
     v.as_str().and_then(|s| s.parse().ok()).ok_or_else(|| format!("{what}: not a number written as text"))
-}
-fn list<'a>(v: &'a Json, key: &str) -> Fault<&'a Vec<Json>> {
-    field(v, key)?.as_array().ok_or_else(|| format!("`{key}` is not a list"))
 }
 fn optional_text(v: &Json, key: &str) -> Fault<Option<String>> {
     match field(v, key)? {
@@ -428,7 +360,7 @@ pub(crate) mod tests {
         assert!(matches!(e, RecordError::Read { .. }));
         assert_eq!(
             e.to_string(),
-            format!("{}: cannot read (is it the --out of `evflow run --shard`?)", path.display())
+            format!("{}: cannot read (is it the --out of a run with `--shard`?)", path.display())
         );
 
         std::fs::write(&path, "{ not json").unwrap();

@@ -6,7 +6,7 @@
 //! merge` (`evflow_tools::batch::narx_shard`).
 
 use anyhow::{anyhow, bail, Context, Result};
-use evflow_engine::batch::{Failures, Shard};
+use evflow_engine::batch::Failures;
 use evflow_nodes::lab::texture::samples::NAMES;
 use evflow_nodes::synth::study::narx_settings::{self, NarxConfig, Setting, DEFAULT_SETTINGS};
 use evflow_nodes::synth::study::setup::Cond;
@@ -115,7 +115,7 @@ pub fn main(a: Args) -> Result<()> {
         bar.set_message(narx_settings::item_label(&cfg.settings, item));
     })?;
     bar.finish_and_clear();
-    if shard != Shard::ALL {
+    if a.batch.shard.is_some() {
         let record = NarxRecord {
             shard,
             arguments: NarxArguments::of(&cfg),

@@ -16,9 +16,15 @@
 //! | 6 | m_u used, g (after clamping) |
 //! | 7 | v_u used, cm/s (after clamping) |
 //! | 8 | generation (frame number f) |
-//! | 9 | scheme (0 basic, 1 improved) |
+//! | 9 | flags: 1 = improved scheme (else basic), + 2 = the table is a carrier's envelope |
 //! | 10 … 10+T+X−1 | the table U_{u,u}\[0 .. T+X\] |
 //! | rest | 0 |
+//!
+//! With flag 2 the table holds the envelope a of an actuation that rides a
+//! Nyquist-rate carrier, u = (−1)ⁿ·a (`interp` demodulated its cells):
+//! `playback` reads the envelope and multiplies by (−1)ᵐ at its own output
+//! sample m, so the carrier stays at the output's Nyquist rate whatever the
+//! re-sampling and the playhead did to the table.
 //!
 //! Sending the table as samples spreads its computation evenly over the
 //! ticks of the update period (stream_rate / base rate samples per tick)
@@ -52,9 +58,15 @@ pub mod at {
     pub const VELOCITY: usize = 7;
     /// Frame number.
     pub const GENERATION: usize = 8;
-    /// Scheme code.
-    pub const SCHEME: usize = 9;
+    /// Flags: [`super::IMPROVED`] + [`super::CARRIER`].
+    pub const FLAGS: usize = 9;
 }
+
+/// Flag: the table was computed by the improved scheme (Eq. 6.4).
+pub const IMPROVED: u32 = 1;
+
+/// Flag: the table is the envelope of a Nyquist-rate carrier.
+pub const CARRIER: u32 = 2;
 
 /// A received frame's header, checked.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -67,6 +79,8 @@ pub struct Header {
     pub loop_cm: f64,
     /// Table rate, Hz.
     pub rate: f64,
+    /// The table is a carrier's envelope: play it times (−1)ᵐ.
+    pub carrier: bool,
 }
 
 impl Header {
@@ -92,6 +106,10 @@ impl Header {
         if !f[HEADER..HEADER + len + overlap].iter().all(|v| v.is_finite()) {
             return None;
         }
-        Some(Header { len, overlap, loop_cm, rate })
+        let flags = f[at::FLAGS];
+        if !(whole(flags) && flags < 4.0) {
+            return None;
+        }
+        Some(Header { len, overlap, loop_cm, rate, carrier: flags as u32 & CARRIER != 0 })
     }
 }

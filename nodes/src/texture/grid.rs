@@ -13,6 +13,11 @@
 //! Every reachable cell must exist: a missing one is an error naming the
 //! condition and what was found, as are duplicates, a condition without load
 //! or velocity, a non-positive velocity, and cells at different rates.
+//!
+//! A cell may declare `condition.carrier = "nyquist"`: its actuation rides
+//! a Nyquist-rate carrier, u[n] = (−1)ⁿ·a[n] with a slowly varying
+//! envelope a (the optimized synthesis' cells, docs/synthesis.md). The
+//! grid records it ([`Grid::carrier`]); every reachable cell must agree.
 
 use crate::recording::format::{Recording, RecordingPaths};
 use std::path::{Path, PathBuf};
@@ -74,6 +79,14 @@ pub enum GridError {
         /// Reachable cells in all.
         total: usize,
     },
+    /// Cells that disagree on their carrier, or a carrier not known.
+    #[error("{}: {message}", path.display())]
+    Carrier {
+        /// The sidecar.
+        path: PathBuf,
+        /// What is wrong.
+        message: String,
+    },
     /// Cells at different sample rates.
     #[error("{}: recorded at {rate} Hz but {} at {first} Hz; every grid cell must have one rate", path.display(), first_path.display())]
     Rate {
@@ -106,6 +119,8 @@ pub struct CellInfo {
     pub channels: Vec<String>,
     /// Display gain of the condition (1 when absent).
     pub gain: f64,
+    /// Whether the cell rides a Nyquist-rate carrier (`condition.carrier`).
+    pub carrier: bool,
 }
 
 /// Where to find the cells and which to use.
@@ -140,6 +155,9 @@ pub struct Grid {
     pub cells: Vec<Vec<f64>>,
     /// The recordings, in the order of `cells`.
     pub paths: Vec<PathBuf>,
+    /// Whether the cells ride a Nyquist-rate carrier, u[n] = (−1)ⁿ·a[n]
+    /// (their sidecars' `condition.carrier = "nyquist"`).
+    pub carrier: bool,
 }
 
 impl Grid {
@@ -152,7 +170,7 @@ impl Grid {
     /// is U_ij at `rate`.
     pub fn from_signals(loads: Vec<f64>, velocities: Vec<f64>, rate: f64, cells: Vec<Vec<Vec<f64>>>) -> Self {
         let paths = vec![PathBuf::new(); loads.len() * velocities.len()];
-        Self { loads, velocities, rate, cells: cells.into_iter().flatten().collect(), paths }
+        Self { loads, velocities, rate, cells: cells.into_iter().flatten().collect(), paths, carrier: false }
     }
 
     /// Loads the reachable part of the grid described by `src`.
@@ -216,6 +234,7 @@ impl Grid {
             rate: 0.0,
             cells: Vec::new(),
             paths: Vec::new(),
+            carrier: false,
         };
         let mut first: Option<&CellInfo> = None;
         for i in i0..=i1 {
@@ -232,6 +251,18 @@ impl Grid {
                             first: f.rate,
                         })
                     }
+                    Some(f) if f.carrier != c.carrier => {
+                        let says = |x: bool| if x { "rides a Nyquist-rate carrier" } else { "has no carrier" };
+                        return Err(GridError::Carrier {
+                            path: RecordingPaths::new(&c.path).json,
+                            message: format!(
+                                "{} but {} {}; every cell of a grid must agree (condition.carrier)",
+                                says(c.carrier),
+                                f.path.display(),
+                                says(f.carrier)
+                            ),
+                        });
+                    }
                     Some(_) => {}
                 }
                 let channel = pick_channel(c, &src.channel)?;
@@ -247,6 +278,7 @@ impl Grid {
             }
         }
         grid.rate = first.map(|c| c.rate).unwrap_or(0.0);
+        grid.carrier = first.is_some_and(|c| c.carrier);
         Ok(grid)
     }
 }
@@ -333,7 +365,20 @@ fn read_cell(path: &Path, lenient: bool) -> Result<Option<Candidate>, GridError>
         .unwrap_or_default();
     let gain = num("gain").unwrap_or(1.0);
     let material = cond.and_then(|c| c.get("material")).and_then(|m| m.as_str()).map(String::from);
-    Ok(Some(Candidate { info: CellInfo { path: paths.wav, load, velocity, rate, channels, gain }, material }))
+    let carrier = match cond.and_then(|c| c.get("carrier")) {
+        None => false,
+        Some(c) => match c.as_str() {
+            Some("nyquist") => true,
+            Some("none") => false,
+            _ => {
+                return Err(GridError::Carrier {
+                    path: paths.json.clone(),
+                    message: format!("condition.carrier is {c}; give \"nyquist\" or \"none\""),
+                })
+            }
+        },
+    };
+    Ok(Some(Candidate { info: CellInfo { path: paths.wav, load, velocity, rate, channels, gain, carrier }, material }))
 }
 
 fn pick_channel(c: &CellInfo, wanted: &str) -> Result<String, GridError> {

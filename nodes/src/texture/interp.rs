@@ -1,7 +1,7 @@
 //! `interp`: the interpolated actuation signal for the user's load and
 //! velocity, recomputed at the update rate and sent to `playback` as frames.
 
-use super::frame::{at, HEADER, MAGIC};
+use super::frame::{at, CARRIER, HEADER, IMPROVED, MAGIC};
 use super::grid::{Grid, GridSource};
 use super::kernel::SincKernel;
 use super::scheme::{Geometry, Mix, Scheme};
@@ -90,14 +90,23 @@ single-column grids, a velocity ratio of 10, missing and duplicate cells (`nodes
     ParamSpec::float("overlap", 0.0, 1000.0, 10.0, "ms", "seam overlap read past the loop's end"),
     ParamSpec::int("half_width", 2, 64, 16, "1", "re-sampling kernel half-width W (zero crossings)"),
     ParamSpec::flag("apply_gain", false, "multiply each cell by its condition.gain (Table 5.1)"),
+    ParamSpec::choice(
+        "carrier",
+        &["auto", "nyquist", "none"],
+        "auto",
+        "cells riding a Nyquist-rate carrier are interpolated as envelopes (auto: as their condition.carrier says)",
+    ),
 ])
 .example("folder = \"recordings/grid\"\nscheme = \"improved\"\nupdate_rate = 10.0\nstream_rate = 20000.0");
 
 /// One texture's grid and the geometry of its tables.
 struct Texture {
+    /// The cells; a carrier's cells hold their envelopes (demodulated at load).
     grid: Grid,
     geo: Geometry,
     shown: String,
+    /// Whether the cells ride a Nyquist-rate carrier.
+    carrier: bool,
 }
 
 /// The state of `interp`.
@@ -193,7 +202,19 @@ fn build(p: &Params, ctx: &BuildContext) -> Result<Box<dyn Node>, NodeError> {
     let period = p.f64("period");
     let mut loaded: Vec<Texture> = Vec::with_capacity(sources.len());
     for (src, shown) in sources {
-        let grid = Grid::load(&src).map_err(|e| NodeError::Data(format!("grid {shown}: {e}")))?;
+        let mut grid = Grid::load(&src).map_err(|e| NodeError::Data(format!("grid {shown}: {e}")))?;
+        let carrier = match p.str("carrier") {
+            "nyquist" => true,
+            "none" => false,
+            _ => grid.carrier,
+        };
+        if carrier {
+            // u[n] = (−1)ⁿ·a[n]: interpolate the envelopes, which live far
+            // below the re-sampling's cutoff; playback puts the carrier back.
+            for cell in &mut grid.cells {
+                cell.iter_mut().skip(1).step_by(2).for_each(|x| *x = -*x);
+            }
+        }
         if let Some(first) = loaded.first() {
             if grid.rate != first.grid.rate {
                 return Err(NodeError::Data(format!(
@@ -218,7 +239,7 @@ fn build(p: &Params, ctx: &BuildContext) -> Result<Box<dyn Node>, NodeError> {
             }
             geo = geometry(whole * period)?;
         }
-        loaded.push(Texture { grid, geo, shown });
+        loaded.push(Texture { grid, geo, shown, carrier });
     }
     let scheme = if p.str("scheme") == "basic" { Scheme::Basic } else { Scheme::Improved };
     Ok(Box::new(Interp {
@@ -271,10 +292,13 @@ impl Interp {
             at::LOAD => mix.load,
             at::VELOCITY => mix.velocity,
             at::GENERATION => self.generation as f64,
-            _ => match mix.scheme {
-                Scheme::Basic => 0.0,
-                Scheme::Improved => 1.0,
-            },
+            _ => {
+                let scheme = match mix.scheme {
+                    Scheme::Basic => 0,
+                    Scheme::Improved => IMPROVED,
+                };
+                (scheme + if self.textures[self.current].carrier { CARRIER } else { 0 }) as f64
+            }
         }
     }
 }

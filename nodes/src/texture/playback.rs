@@ -180,9 +180,12 @@ impl Playback {
         }
     }
 
-    /// One output sample for signed velocity `v`.
+    /// One output sample, output sample number `o`, for signed velocity `v`.
     #[inline]
-    fn next(&mut self, v: f64) -> f64 {
+    fn next(&mut self, o: u64, v: f64) -> f64 {
+        // A carrier's envelope is played on (−1)^o, this output's Nyquist rate.
+        let parity = if o.is_multiple_of(2) { 1.0 } else { -1.0 };
+        let sign = |h: &Header| if h.carrier { parity } else { 1.0 };
         let v = if v.is_finite() { v } else { 0.0 };
         let target = if v.abs() >= self.rest_speed { 1.0 } else { 0.0 };
         if self.gate < target {
@@ -194,11 +197,11 @@ impl Playback {
         let h = cur.head;
         let step =
             if self.position { v / (self.out_rate * h.loop_cm) } else { h.rate / (self.out_rate * h.len as f64) };
-        let y_new = read(&self.bufs[cur.buf], &h, self.phase);
+        let y_new = sign(&h) * read(&self.bufs[cur.buf], &h, self.phase);
         let y = if self.fade < 1.0 {
             let w = (0.5 * std::f64::consts::PI * self.fade).sin().powi(2);
             let y_old = match self.prev {
-                Some(p) => read(&self.bufs[p.buf], &p.head, self.phase),
+                Some(p) => sign(&p.head) * read(&self.bufs[p.buf], &p.head, self.phase),
                 None => 0.0,
             };
             self.fade = (self.fade + self.xfade_step).min(1.0);
@@ -231,7 +234,7 @@ impl Node for Playback {
         for (q, y) in out.iter_mut().enumerate() {
             let o = self.written + q as u64;
             self.absorb(s_first, n_t, o + 1);
-            *y = self.next(self.scratch[1].get(q).copied().unwrap_or(0.0));
+            *y = self.next(o, self.scratch[1].get(q).copied().unwrap_or(0.0));
         }
         self.written += out.len() as u64;
         self.absorb(s_first, n_t, u64::MAX / 4);

@@ -17,10 +17,12 @@ pub fn name(sample: &str, c: &Cond) -> String {
 
 /// Writes channel `channel` of the graphs/synthesize.toml recording `from`
 /// (over its `steady` gate) as the cell of `sample` at `c` into `grid`, at
-/// `gain` (Table 5.1's, which `interp` applies). The `narx` node's output
-/// lags the force by its look-ahead; a grid cell is a texture loop, so that
-/// shift of a few samples does not matter. Returns the cell's path
-/// (without extension).
+/// `gain` (Table 5.1's, which `interp` applies), marked
+/// `condition.carrier = "nyquist"` when `carrier` (the method's actuation
+/// rides a Nyquist-rate carrier: [`super::row::Method::carrier`]). The
+/// `narx` node's output lags the force by its look-ahead; a grid cell is a
+/// texture loop, so that shift of a few samples does not matter. Returns
+/// the cell's path (without extension).
 pub fn write_actuation(
     from: &Path,
     channel_name: &str,
@@ -28,13 +30,14 @@ pub fn write_actuation(
     sample: &str,
     c: &Cond,
     gain: f64,
+    carrier: bool,
 ) -> Result<PathBuf, StudyError> {
     let (rate, u) = channel(from, channel_name)?;
     let (_, steady) = channel(from, "steady")?;
     let mut kept = Vec::new();
     open_runs(&[&steady], u.len().min(steady.len()), |a, b| kept.extend_from_slice(&u[a..b]));
     let source = format!("evflow study: graphs/synthesize.toml, `{channel_name}` over the constant-speed stretch");
-    write(&kept, rate, "1", grid, sample, c, gain, source, from)
+    write(&kept, rate, "1", grid, sample, c, gain, carrier, source, from)
 }
 
 /// Writes the recorded force (channel `force`, newtons) of the texture
@@ -47,7 +50,7 @@ pub fn write_force(from: &Path, grid: &Path, sample: &str, c: &Cond) -> Result<P
     let keep = gate(from, c.speed)?;
     let kept: Vec<f64> = f.iter().zip(&keep).filter(|(_, k)| **k).map(|(v, _)| *v).collect();
     let source = "evflow study: the recorded force over the constant-speed stretch".to_string();
-    write(&kept, rate, "N", grid, sample, c, 1.0, source, from)
+    write(&kept, rate, "N", grid, sample, c, 1.0, false, source, from)
 }
 
 #[allow(clippy::too_many_arguments)]
@@ -59,6 +62,7 @@ fn write(
     sample: &str,
     c: &Cond,
     gain: f64,
+    carrier: bool,
     source: String,
     from: &Path,
 ) -> Result<PathBuf, StudyError> {
@@ -71,6 +75,9 @@ fn write(
     meta.condition.velocity_cm_s = Some(c.speed);
     meta.condition.material = Some(sample.into());
     meta.condition.gain = Some(gain);
+    if carrier {
+        meta.condition.extra.insert("carrier".into(), "nyquist".into());
+    }
     meta.source = source;
     let path = grid.join(name(sample, c));
     let io =
@@ -99,7 +106,7 @@ mod tests {
         w.write_interleaved(&frames).unwrap();
         w.finish().unwrap();
         let c = Cond { mass: 60.0, speed: 3.0 };
-        let cell = write_actuation(&from, "u", &dir.path().join("grid"), "felt-fabric", &c, 0.8).unwrap();
+        let cell = write_actuation(&from, "u", &dir.path().join("grid"), "felt-fabric", &c, 0.8, false).unwrap();
         assert_eq!(cell, dir.path().join("grid/u-felt-fabric-60g-3cms"));
         let rec = Recording::open(&cell).unwrap();
         let u: Vec<f64> = rec.channel("u").unwrap().iter().map(|x| (x * 10.0).round()).collect();
@@ -107,6 +114,6 @@ mod tests {
         assert_eq!(rec.meta().condition.gain, Some(0.8));
         assert_eq!(rec.meta().condition.load_g, Some(60.0));
         // A recording without the channel, or with no steady sample, is an error.
-        assert!(write_actuation(&from, "nope", dir.path(), "felt-fabric", &c, 1.0).is_err());
+        assert!(write_actuation(&from, "nope", dir.path(), "felt-fabric", &c, 1.0, false).is_err());
     }
 }

@@ -210,9 +210,10 @@ pub fn run(cfg: &CrossvalConfig<'_>, progress: &mut dyn FnMut(usize, usize, Stri
             })?;
             let t = Trained { models: &built[i], row: r };
             let gain = t.gain(cfg.method)?;
-            let cell = write_actuation(&t.row.recording(gain), channel, &grid_dir(prefix), s, c, gain)?;
+            let cell =
+                write_actuation(&t.row.recording(gain), channel, &grid_dir(prefix), s, c, gain, cfg.method.carrier())?;
             let pg = t.gain(Method::Playback)?;
-            write_actuation(&t.row.recording(pg), "playback_u", &grid_dir("playback"), s, c, pg)?;
+            write_actuation(&t.row.recording(pg), "playback_u", &grid_dir("playback"), s, c, pg, false)?;
             write_force(&rep1, &grid_dir("forces"), s, c)?;
             above.push(share_above_cutoff(&cell)?);
             trained.push(t);

@@ -207,7 +207,7 @@ fn texture_cell(plan: &Plan, m: &Models, sample: &str, c: &Cond) -> Result<Json>
         let Some(res) = r.method(method) else { continue };
         let gain = res.chosen.table51.gain;
         let staged = partial.join("cells").join(format!("{folder}-{sample}"));
-        let written = write_actuation(&r.recording(gain), channel, &staged, sample, c, gain)?;
+        let written = write_actuation(&r.recording(gain), channel, &staged, sample, c, gain, method.carrier())?;
         let to_dir = plan.dir.join(format!("{folder}-{sample}"));
         std::fs::create_dir_all(&to_dir).map_err(|e| io(&to_dir, format!("cannot create: {e}")))?;
         let name = written.file_name().unwrap_or_default().to_string_lossy().into_owned();

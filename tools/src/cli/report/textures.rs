@@ -175,6 +175,7 @@ pub fn main(a: Args) -> Result<()> {
                     &r.sample,
                     &r.cond,
                     gain,
+                    m.carrier(),
                 )?;
             }
         }

@@ -57,9 +57,16 @@ wavelength, e.g. 1/slope of `evflow report freqvel`) rounds the loop down to a w
 seam that is not whole the main component jumps in phase, which a 1 Hz-bin spectrum (E_s, Eq. 5.2) sees as \
 a lower, split peak. Each table holds `overlap` ms more, which `playback` crossfades into the loop's \
 start so the loop has no seam click.\n\n\
+**Carrier.** Cells whose sidecars say `condition.carrier = \"nyquist\"` (the optimized synthesis' \
+cells, written by the texture study) ride a Nyquist-rate carrier, u[n] = (−1)ⁿ·a[n], with a slowly varying \
+envelope a. Re-sampling removes everything near the Nyquist rate, so such cells are demodulated when loaded \
+and their envelopes interpolated; the frame says so (flag 2) and `playback` multiplies the envelope by \
+(−1)ᵐ at its own output sample m. `carrier = \"nyquist\"` or `\"none\"` overrides the sidecars; the cells of \
+one grid must agree.\n\n\
 **Checked against:** the sine examples of §6.1–6.2 (10 and 20 Hz → 15 Hz: one full-power peak; basic: \
 two half-amplitude peaks; 19 Hz with weights 0.1/0.9 and 12 Hz with 0.8/0.2), clamping, single-row and \
-single-column grids, a velocity ratio of 10, missing and duplicate cells (`nodes/tests/texture_*.rs`).",
+single-column grids, a velocity ratio of 10, missing and duplicate cells, envelopes on a carrier \
+(`nodes/tests/texture_*.rs`).",
 )
 .ports(&[
     PortSpec::input("load", "g", "user's normal load m_u"),

@@ -31,6 +31,9 @@ loop's seam is hidden by crossfading the table's overlap (the samples after the 
 start. Between table samples the playhead reads by linear interpolation.\n\n\
 **Rest.** Below `rest_speed` (|velocity|) the output fades to 0 over `rest_fade` ms, and back when the \
 finger moves: a resting finger feels nothing, in both modes (0 disables this).\n\n\
+**Carrier.** A table flagged as a carrier's envelope (`interp`'s cells ride a Nyquist-rate carrier) is \
+read like any other and multiplied by (−1)ᵐ at output sample m, so the carrier stays at this node's \
+Nyquist rate through re-sampling, playhead steps and crossfades.\n\n\
 A frame whose header is not a valid table (wrong magic, length or frame size, non-finite samples) is \
 ignored and counted in the run's summary; until the first valid frame the output is 0. `update_rate` \
 must equal `interp`'s, so the frame length matches (a mismatch shows as rejected frames).\n\n\

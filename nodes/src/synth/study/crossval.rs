@@ -72,6 +72,9 @@ pub struct CrossvalConfig<'a> {
     pub grids: &'a Path,
     /// Where recordings and runs go.
     pub work: &'a Path,
+    /// The lab profile: its tribometer, display and sensor record, train and
+    /// play everything.
+    pub profile: &'a Profile,
 }
 
 /// One scheme's run at one condition.
@@ -162,7 +165,7 @@ pub fn run(cfg: &CrossvalConfig<'_>, progress: &mut dyn FnMut(usize, usize, Stri
     }
     let (channel, prefix) = grid_of(cfg.method);
     let recordings = cfg.work.join("textures");
-    let profile = Profile::nominal();
+    let profile = cfg.profile.clone();
     let plans: Vec<GridPlan> = cfg.samples.iter().map(|s| GridPlan::of(s)).collect();
     let conds = trained_conditions(&plans);
     let building = if cfg.given_models.is_some() { 0 } else { conds.len() };
@@ -275,6 +278,7 @@ fn cross_validate(x: &Ctx<'_>, c: &Cond, near: &Trained<'_>) -> Result<Run, Stud
             model: &near.models.narx,
             ff_gain: near.gain(Method::NarxBinary)?,
             band: cfg.band,
+            profile: cfg.profile,
             dir: cfg.work.join("xval").join(format!("{}-{}-{scheme}", x.sample, c.tag())),
         };
         let scores = xval::run(&inputs).map_err(at)?;
@@ -293,6 +297,7 @@ fn cross_validate(x: &Ctx<'_>, c: &Cond, near: &Trained<'_>) -> Result<Run, Stud
                     iterations: cfg.iterations,
                     objective: cfg.objective,
                     band: cfg.band,
+                    profile: cfg.profile,
                     dir: cfg.work.join("ff").join(format!("{}-{}-{scheme}", x.sample, c.tag())),
                 })
                 .map_err(at)?;

@@ -8,7 +8,7 @@
 //! scored against the real recording there.
 
 use super::graphs::{path, run_graph, text, value};
-use super::setup::Cond;
+use super::setup::{Cond, Profile};
 use super::StudyError;
 use std::path::{Path, PathBuf};
 
@@ -38,6 +38,8 @@ pub struct FfInputs<'a> {
     pub objective: &'a str,
     /// E_s band, Hz.
     pub band: [f64; 2],
+    /// The lab profile the actuation is played on.
+    pub profile: &'a Profile,
     /// Where the runs go.
     pub dir: PathBuf,
 }
@@ -82,6 +84,7 @@ pub fn optimized(i: &FfInputs<'_>) -> Result<FfScore, StudyError> {
         format!("speed={}", c.speed),
         format!("actuation={}", path(&actuation)),
         format!("gain={}", i.gain),
+        i.profile.set(),
     ];
     sets.push(format!("es.fmin={}", i.band[0]));
     sets.push(format!("es.fmax={}", i.band[1]));

@@ -7,7 +7,7 @@
 //! NARX model of the nearest trained condition).
 
 use super::graphs::{path, run_graph, text, value};
-use super::setup::Cond;
+use super::setup::{Cond, Profile};
 use super::StudyError;
 use std::path::{Path, PathBuf};
 
@@ -48,6 +48,8 @@ pub struct XvalInputs<'a> {
     pub ff_gain: f64,
     /// E_s band, Hz.
     pub band: [f64; 2],
+    /// The lab profile of the tribometer, displays and sensors.
+    pub profile: &'a Profile,
     /// Where the run's recording goes.
     pub dir: PathBuf,
 }
@@ -95,6 +97,7 @@ pub fn run(i: &XvalInputs<'_>) -> Result<Scores, StudyError> {
         format!("period={}", i.period),
         format!("model={}", path(i.model)),
         format!("ff_gain={}", i.ff_gain),
+        i.profile.set(),
     ];
     for node in ["narx_es", "playback_es", "repeat_es", "ff_es"] {
         sets.push(format!("{node}.fmin={}", i.band[0]));

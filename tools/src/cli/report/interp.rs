@@ -90,6 +90,10 @@ pub struct Args {
     /// The folder of the shipped graphs (synthesized cells).
     #[arg(long, default_value = "graphs")]
     pub(super) graphs: PathBuf,
+    /// The lab profile the synthesized cells are recorded, trained and
+    /// played on: `nominal`, a name of graphs/lab/*.toml, or a profile file.
+    #[arg(long, default_value = "nominal")]
+    pub(super) profile: String,
     /// Samples at once (--cells recorded; default: the cores available).
     #[command(flatten)]
     pub(super) jobs: JobsArg,

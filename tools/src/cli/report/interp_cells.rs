@@ -11,6 +11,7 @@ use anyhow::{anyhow, bail, Context, Result};
 use evflow_nodes::recording::format::Recording;
 use evflow_nodes::synth::study::crossval::{self, CrossvalConfig, Run};
 use evflow_nodes::synth::study::row::Method;
+use evflow_nodes::synth::study::setup::Profile;
 use evflow_nodes::synth::study::spectrum::gated;
 use evflow_nodes::synth::study::xval::GRAPH;
 use evflow_tools::plot::{Plot, Series};
@@ -90,6 +91,7 @@ pub(super) fn main(a: &Args, samples: &[String]) -> Result<()> {
             graphs.display()
         );
     }
+    let profile = Profile::resolve(&a.profile, &graphs).map_err(|e| anyhow!("--profile: {e}"))?;
     let started = Instant::now();
     let out = std::fs::canonicalize(&a.out).with_context(|| format!("{}: cannot open", a.out.display()))?;
     let tmp = tempfile::tempdir().context("cannot create a temporary folder")?;
@@ -106,6 +108,7 @@ pub(super) fn main(a: &Args, samples: &[String]) -> Result<()> {
         models_out: &out.join("models"),
         grids: &out.join("grids"),
         work: tmp.path(),
+        profile: &profile,
     };
     let found = crossval::run(&cfg, &mut |step, steps, what| eprintln!("[{step}/{steps}] {what} …"))
         .map_err(|e| anyhow!("{e}"))?;

@@ -35,8 +35,9 @@ pub(super) fn table(
     let mut md = String::new();
     let _ = write!(
         md,
-        "Cells: {}. Loops of whole main periods (`interp`'s `period`, measured on the trained recordings):",
-        method.label()
+        "Cells: {}, lab profile {}. Loops of whole main periods (`interp`'s `period`, measured on the trained recordings):",
+        method.label(),
+        a.profile
     );
     for (k, (s, p)) in periods.iter().enumerate() {
         let _ = write!(md, "{} {s} {:.4} mm", if k == 0 { "" } else { "," }, p * 10.0);

@@ -523,4 +523,23 @@ fn report_textures_shards_merged_equal_one_report() {
     // --grid needs every condition of a texture.
     let o = evflow(&["report", "textures", "--shard", "1/2", "--grid", "g", "--out", base.path().to_str().unwrap()]);
     assert!(String::from_utf8_lossy(&o.stderr).contains("--grid with --shard"));
+    // A folder that is no shard of the report among them is named.
+    let o = evflow(&["merge", base.path().join("m3").to_str().unwrap(), &dirs[0], one.to_str().unwrap(), &dirs[2]]);
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert!(
+        err.contains(&format!("{}", one.join("textures-shard.json").display())) && err.contains("--shard"),
+        "{err}"
+    );
+    // A step that failed in a shard is listed again by the merge, which
+    // still writes the tables of every row that ran, and exits 1.
+    let record = Path::new(&dirs[1]).join("textures-shard.json");
+    let mut doc: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(&record).unwrap()).unwrap();
+    doc["failures"] = serde_json::json!([{ "step": "stiff: felt-fabric at 60 g, 3 cm/s", "reason": "it broke" }]);
+    std::fs::write(&record, doc.to_string()).unwrap();
+    let m4 = base.path().join("m4");
+    let o = evflow(&["merge", m4.to_str().unwrap(), &dirs[0], &dirs[1], &dirs[2]]);
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert_eq!(o.status.code(), Some(1), "{err}");
+    assert!(err.contains("stiff: felt-fabric at 60 g, 3 cm/s (shard 2/3): it broke"), "{err}");
+    assert_eq!(std::fs::read(m4.join("rows.csv")).unwrap(), std::fs::read(one.join("rows.csv")).unwrap());
 }

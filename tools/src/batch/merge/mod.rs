@@ -51,7 +51,7 @@ pub enum Merged {
 }
 
 /// Merges the shard folders `dirs` (in any order) into `out`: a texture
-/// report's when every folder holds a study shard's record, a `report
+/// report's when a folder holds a study shard's record, a `report
 /// narx`'s when a folder holds its record ([`narx`]), a model
 /// library's when every folder is one (and none holds a sweep's shard
 /// record), else a sweep's.
@@ -60,7 +60,7 @@ pub fn merge(out: &Path, dirs: &[PathBuf]) -> Result<Merged, MergeError> {
         return Err(MergeError::NoShards);
     }
     #[cfg(feature = "synth")]
-    if dirs.iter().all(|d| evflow_nodes::synth::study::saved::SavedStudy::is_in(d)) {
+    if dirs.iter().any(|d| evflow_nodes::synth::study::saved::SavedStudy::is_in(d)) {
         return textures::merge_textures(out, dirs).map(Merged::Textures);
     }
     #[cfg(feature = "synth")]

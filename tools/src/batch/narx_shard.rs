@@ -4,13 +4,11 @@
 //! of its items' scores in full (floats as Rust's shortest exact text, so
 //! they read back bit for bit, NaN and infinities included), so that
 //! `evflow merge` can write the table one run would have written. Written
-//! and read here, in one place. The figure of the report is drawn here too
-//! ([`figure`]), for the report and the merge alike.
+//! and read here, in one place.
 
 use super::record_json::{count, field, list, read_doc, text, write_doc, Fault, RecordError};
-use crate::plot::{Plot, Series};
 use evflow_engine::batch::Shard;
-use evflow_nodes::synth::study::narx_settings::{Item, NarxConfig, Scored, SeedScore, Setting};
+use evflow_nodes::synth::study::narx_settings::{Item, NarxConfig, SeedScore, Setting};
 use evflow_nodes::synth::study::setup::Cond;
 use serde_json::{json, Value as Json};
 use std::path::Path;
@@ -214,23 +212,6 @@ fn parse(doc: &Json) -> Fault<NarxRecord> {
         .map(|v| Ok((text(v, "texture")?.to_string(), text(v, "reason")?.to_string())))
         .collect::<Fault<Vec<_>>>()?;
     Ok(NarxRecord { shard, textures: texts(doc, "textures")?, left_out, items, arguments })
-}
-
-/// The report's figure: mean E_s against training time, one point per
-/// setting that was scored.
-pub fn figure(condition: &Cond, scored: &[Scored]) -> Plot {
-    Plot {
-        title: format!("Inverse NARX: E_s against training time at {}", condition.label()),
-        x_label: "training time (s)".into(),
-        y_label: "mean E_s".into(),
-        log_x: true,
-        log_y: false,
-        series: scored
-            .iter()
-            .filter(|s| s.seeds > 0)
-            .map(|s| Series::points(format!("{} ({})", s.setting.name, s.setting.describe()), vec![(s.seconds, s.es)]))
-            .collect(),
-    }
 }
 
 #[cfg(test)]

@@ -1,8 +1,10 @@
 //! The Markdown table of the NARX settings study
 //! ([`evflow_nodes::synth::study::narx_settings`]):
 //! written by `evflow report narx` and, from the shards' items, by `evflow
-//! merge`, so both write the same bytes.
+//! merge`, so both write the same bytes; and the report's figure
+//! ([`figure`]).
 
+use crate::plot::{Plot, Series};
 use evflow_nodes::synth::study::narx_settings::{pareto, Scored};
 use evflow_nodes::synth::study::setup::Cond;
 use std::fmt::Write as _;
@@ -74,6 +76,23 @@ pub fn markdown(t: &Table<'_>) -> String {
         }
     }
     md
+}
+
+/// The report's figure: mean E_s against training time, one point per
+/// setting that was scored.
+pub fn figure(condition: &Cond, scored: &[Scored]) -> Plot {
+    Plot {
+        title: format!("Inverse NARX: E_s against training time at {}", condition.label()),
+        x_label: "training time (s)".into(),
+        y_label: "mean E_s".into(),
+        log_x: true,
+        log_y: false,
+        series: scored
+            .iter()
+            .filter(|s| s.seeds > 0)
+            .map(|s| Series::points(format!("{} ({})", s.setting.name, s.setting.describe()), vec![(s.seconds, s.es)]))
+            .collect(),
+    }
 }
 
 #[cfg(test)]

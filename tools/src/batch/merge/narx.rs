@@ -6,9 +6,9 @@
 
 use super::error::MergeError;
 use super::files::{copy_files, k_order, write};
-use crate::batch::narx_shard::{figure, NarxRecord, NARX_RECORD};
+use crate::batch::narx_shard::{NarxRecord, NARX_RECORD};
 use crate::plot::{write_png, PlotError, Written};
-use crate::report::narx_table::{markdown, Table};
+use crate::report::narx_table::{figure, markdown, Table};
 use evflow_engine::batch::Failures;
 use evflow_nodes::synth::study::narx_settings::{aggregate, item_label};
 use std::path::{Path, PathBuf};

@@ -12,6 +12,7 @@ use super::files::{copy_files, k_order, write};
 use crate::report::textures_table::{csv, markdown, Timings};
 use evflow_engine::batch::{Failures, Shard};
 use evflow_nodes::synth::study::saved::{SavedStudy, RECORD};
+use evflow_nodes::synth::study::StudyError;
 use std::path::{Path, PathBuf};
 
 /// What a merge of a texture report's shards did. Steps that failed in the
@@ -44,7 +45,7 @@ pub fn merge_textures(out: &Path, dirs: &[PathBuf]) -> Result<TexturesMerge, Mer
     let mut shards = Vec::new();
     for d in dirs {
         let saved = SavedStudy::read(d)?;
-        let shard = saved.slice().expect("a record read is checked to name its K/N");
+        let shard = saved.slice().map_err(|e| StudyError::Config(format!("{}: {e}", d.display())))?;
         shards.push((d.clone(), shard, saved));
     }
     shards.sort_by_key(|(_, s, _)| s.k);
@@ -75,10 +76,7 @@ pub fn merge_textures(out: &Path, dirs: &[PathBuf]) -> Result<TexturesMerge, Mer
     let (md_path, csv_path) = (out.join("textures.md"), out.join("rows.csv"));
     write(&md_path, &md)?;
     write(&csv_path, &csv(&study, timings))?;
-    let mut failures = Failures::new();
-    for (what, why) in &study.failures {
-        failures.push(what.clone(), why);
-    }
+    let failures = Failures { list: study.failures.clone() };
     let cells = saved[0].cells;
     Ok(TexturesMerge {
         shards: saved.len(),

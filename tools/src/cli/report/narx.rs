@@ -11,9 +11,9 @@ use evflow_nodes::lab::texture::samples::NAMES;
 use evflow_nodes::synth::study::narx_settings::{self, NarxConfig, Setting, DEFAULT_SETTINGS};
 use evflow_nodes::synth::study::setup::Cond;
 use evflow_tools::batch::merge::narx::{NARX_FIGURE, NARX_TABLE};
-use evflow_tools::batch::narx_shard::{figure, NarxArguments, NarxRecord, NARX_RECORD};
+use evflow_tools::batch::narx_shard::{NarxArguments, NarxRecord, NARX_RECORD};
 use evflow_tools::batch::{progress_bar, BatchArgs};
-use evflow_tools::report::narx_table::{markdown, Table};
+use evflow_tools::report::narx_table::{figure, markdown, Table};
 use std::path::PathBuf;
 
 /// Arguments of `evflow report narx`.
@@ -150,10 +150,7 @@ pub fn main(a: Args) -> Result<()> {
         }
     }
     if !study.failures.is_empty() {
-        let mut f = Failures::new();
-        for (what, why) in &study.failures {
-            f.push(what.clone(), why);
-        }
+        let f = Failures { list: study.failures };
         bail!("{}", f.summary(cfg.samples.len() + range.len(), "steps").trim_end());
     }
     Ok(())

@@ -182,10 +182,7 @@ pub fn main(a: Args) -> Result<()> {
         println!("wrote the grids under {}", g.display());
     }
     if !study.failures.is_empty() {
-        let mut f = evflow_engine::batch::Failures::new();
-        for (what, why) in &study.failures {
-            f.push(what.clone(), why);
-        }
+        let f = evflow_engine::batch::Failures { list: study.failures };
         anyhow::bail!("{}", f.summary(cells + cells * cfg.samples.len(), "steps").trim_end());
     }
     Ok(())

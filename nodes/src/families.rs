@@ -10,7 +10,7 @@ pub const OPTIONAL: &[(&str, &[&str])] = &[
     ("mesh", &["profile1d", "mesh.gradient", "mesh.edges", "grain", "mesh.path"]),
     ("narx", &["narx.train", "narx", "narx.grid"]),
     ("texture", &["interp", "playback"]),
-    ("synth", &["forward.train", "synth.optimize"]),
+    ("synth", &["forward.train", "synth.optimize", "synth.live"]),
     ("serial", &["serial.in", "serial.out"]),
 ];
 

@@ -85,9 +85,23 @@ fn fixtures(dir: &Path) {
         data_hash: String::new(),
         seconds: 0.0,
     };
-    ForwardModel::new(&fitted.model, 1000.0, &cfg.filter, Default::default(), fitted.noise, fitted.spectrum, training)
-        .save(&dir.join("models/forward.json"))
-        .expect("fixture forward model written");
+    let forward = ForwardModel::new(
+        &fitted.model,
+        1000.0,
+        &cfg.filter,
+        Default::default(),
+        fitted.noise,
+        fitted.spectrum,
+        training,
+    );
+    forward.save(&dir.join("models/forward.json")).expect("fixture forward model written");
+    // The same forward model at the four corners, for `synth.live`'s example.
+    for (m, v) in [(60.0, 3.0), (60.0, 7.0), (110.0, 3.0), (110.0, 7.0)] {
+        let mut at = forward.clone();
+        at.condition.mass_g = Some(m);
+        at.condition.speed_cm_s = Some(v);
+        at.save(&dir.join(format!("models/forward-{m}g-{v}cms.json"))).expect("fixture grid forward model written");
+    }
 }
 
 struct Case {

@@ -66,6 +66,26 @@ fn position_mode_at_the_tables_velocity_plays_like_time_mode() {
 }
 
 #[test]
+fn a_lookahead_plays_the_texture_that_many_samples_early() {
+    // At a constant velocity the playhead moves by equal steps: reading L
+    // samples ahead is the same signal L samples earlier, in both modes
+    // (after the first table's fade-in and away from table switches).
+    let dir = tempfile::tempdir().unwrap();
+    sine_grid(dir.path());
+    let n = 3000;
+    let l = 15;
+    for mode in ["time", "position"] {
+        let now = format!("mode = \"{mode}\"\ncrossfade = 0.0");
+        let ahead = format!("{now}\nlookahead = {l}");
+        let a = run_chain(dir.path(), INTERP, &now, &vec![85.0; n], &vec![13.0; n], n as u64, 64).unwrap();
+        let b = run_chain(dir.path(), INTERP, &ahead, &vec![85.0; n], &vec![13.0; n], n as u64, 64).unwrap();
+        let worst = (300..n - l).map(|k| (b[k] - a[k + l]).abs()).fold(0.0, f64::max);
+        assert!(worst < 1e-9, "{mode}: {worst}");
+        assert!(b.iter().any(|x| x.abs() > 0.1), "{mode}: something plays");
+    }
+}
+
+#[test]
 fn switching_tables_does_not_click() {
     let dir = tempfile::tempdir().unwrap();
     sine_grid(dir.path());

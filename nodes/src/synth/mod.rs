@@ -12,6 +12,7 @@
 
 pub mod error;
 pub mod lbfgsb;
+pub mod live;
 pub mod model_file;
 pub mod objective;
 pub mod optimize_node;
@@ -27,4 +28,4 @@ pub mod volterra_fit;
 use evflow_engine::NodeSpec;
 
 /// The node types of this family.
-pub static SPECS: &[&NodeSpec] = &[&train_node::SPEC, &optimize_node::SPEC];
+pub static SPECS: &[&NodeSpec] = &[&train_node::SPEC, &optimize_node::SPEC, &live::node::SPEC];

@@ -29,6 +29,10 @@ the new one with a raised-cosine weight (both tables read at the same place; con
 strongly correlated, so their linear mix keeps the level). The first table fades in from silence. The \
 loop's seam is hidden by crossfading the table's overlap (the samples after the loop's end) into its \
 start. Between table samples the playhead reads by linear interpolation.\n\n\
+**Look-ahead.** With `lookahead` = L > 0 each output sample is read L samples ahead of the playhead, \
+as far as the current step carries it — in position mode, where the finger will be after L samples at \
+its current velocity (its predicted path); in time mode, L samples later in the table. `synth.live` \
+takes the texture force this way, so that each tick it knows the force of its whole horizon.\n\n\
 **Rest.** Below `rest_speed` (|velocity|) the output fades to 0 over `rest_fade` ms, and back when the \
 finger moves: a resting finger feels nothing, in both modes (0 disables this).\n\n\
 **Carrier.** A table flagged as a carrier's envelope (`interp`'s cells ride a Nyquist-rate carrier) is \
@@ -51,6 +55,14 @@ position modes on known travel (forward, reversed, at rest), block ≡ tick proc
     ParamSpec::float("crossfade", 0.0, 5000.0, 20.0, "ms", "crossfade from one table to the next"),
     ParamSpec::float("rest_speed", 0.0, 1e3, 0.3, "cm/s", "below this speed the output fades to silence (0: never)"),
     ParamSpec::float("rest_fade", 0.1, 1000.0, 10.0, "ms", "fade time to and from silence at rest"),
+    ParamSpec::int(
+        "lookahead",
+        0,
+        10_000,
+        0,
+        "samples",
+        "play the texture this many samples ahead along the current velocity",
+    ),
 ])
 .example("mode = \"time\"\nupdate_rate = 10.0\ncrossfade = 20.0");
 
@@ -63,6 +75,7 @@ struct Slot {
 
 struct Playback {
     position: bool,
+    lookahead: f64,
     frame: usize,
     table_clock: Clock,
     out_clock: Clock,
@@ -106,6 +119,7 @@ fn build(p: &Params, ctx: &BuildContext) -> Result<Box<dyn Node>, NodeError> {
     }
     Ok(Box::new(Playback {
         position: p.str("mode") == "position",
+        lookahead: p.i64("lookahead") as f64,
         frame,
         table_clock: Clock::new(table_rate, ctx.base_rate, "table")?,
         out_clock: Clock::new(out_rate, ctx.base_rate, "out")?,
@@ -186,8 +200,9 @@ impl Playback {
     /// One output sample, output sample number `o`, for signed velocity `v`.
     #[inline]
     fn next(&mut self, o: u64, v: f64) -> f64 {
-        // A carrier's envelope is played on (−1)^o, this output's Nyquist rate.
-        let parity = if o.is_multiple_of(2) { 1.0 } else { -1.0 };
+        // A carrier's envelope is played on (−1)^o, this output's Nyquist rate
+        // (at the sample looked ahead to).
+        let parity = if (o + self.lookahead as u64).is_multiple_of(2) { 1.0 } else { -1.0 };
         let sign = |h: &Header| if h.carrier { parity } else { 1.0 };
         let v = if v.is_finite() { v } else { 0.0 };
         let target = if v.abs() >= self.rest_speed { 1.0 } else { 0.0 };
@@ -200,11 +215,22 @@ impl Playback {
         let h = cur.head;
         let step =
             if self.position { v / (self.out_rate * h.loop_cm) } else { h.rate / (self.out_rate * h.len as f64) };
-        let y_new = sign(&h) * read(&self.bufs[cur.buf], &h, self.phase);
+        let at = (self.phase + self.lookahead * step).rem_euclid(1.0);
+        let at = if at.is_finite() && at < 1.0 { at } else { 0.0 };
+        let y_new = sign(&h) * read(&self.bufs[cur.buf], &h, at);
         let y = if self.fade < 1.0 {
             let w = (0.5 * std::f64::consts::PI * self.fade).sin().powi(2);
             let y_old = match self.prev {
-                Some(p) => sign(&p.head) * read(&self.bufs[p.buf], &p.head, self.phase),
+                Some(p) => {
+                    let step_old = if self.position {
+                        v / (self.out_rate * p.head.loop_cm)
+                    } else {
+                        p.head.rate / (self.out_rate * p.head.len as f64)
+                    };
+                    let at = (self.phase + self.lookahead * step_old).rem_euclid(1.0);
+                    let at = if at.is_finite() && at < 1.0 { at } else { 0.0 };
+                    sign(&p.head) * read(&self.bufs[p.buf], &p.head, at)
+                }
                 None => 0.0,
             };
             self.fade = (self.fade + self.xfade_step).min(1.0);

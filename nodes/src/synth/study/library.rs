@@ -1,7 +1,8 @@
 //! The model library (issue 17, point 3): for every texture sample × every
 //! condition of a grid, the inverse NARX model of the condition and the
 //! actuation cells U_ij of each method (inverse NARX, optimized synthesis,
-//! fair playback) at their Table 5.1 gains, in the folder layout the
+//! fair playback) at their Table 5.1 gains and the recorded force itself
+//! (`forces-SAMPLE`, newtons: what forces first and `synth.live` render from), in the folder layout the
 //! texture-live grids read (`METHOD-SAMPLE/u-SAMPLE-TAG.{wav,json}`), with
 //! `index.json` saying, per texture and condition, which model and cells,
 //! the model's training scores and each method's E_s.
@@ -18,7 +19,7 @@
 //! says which shard it is; `evflow merge` joins the shards' folders into
 //! the library one build would have made.
 
-use super::cells::write_actuation;
+use super::cells::{write_actuation, write_force};
 use super::models::{self, Models};
 use super::recordings;
 use super::row::{self, Method, Row, RowInputs};
@@ -222,6 +223,19 @@ fn texture_cell(plan: &Plan, m: &Models, sample: &str, c: &Cond) -> Result<Json>
         es.insert(folder.into(), json!({ "rect": res.chosen.table51.rect, "welch": res.chosen.table51.welch }));
         gains.insert(folder.into(), json!(gain));
     }
+    // The recorded force itself (newtons, gain 1): the grid that forces
+    // first and the live synthesis (`synth.live`) render from.
+    let rep1 = rec_dir.join(recordings::name(sample, c, 1));
+    let staged = write_force(&rep1, &partial.join("cells").join(format!("forces-{sample}")), sample, c)?;
+    let to_dir = plan.dir.join(format!("forces-{sample}"));
+    std::fs::create_dir_all(&to_dir).map_err(|e| io(&to_dir, format!("cannot create: {e}")))?;
+    let name = staged.file_name().unwrap_or_default().to_string_lossy().into_owned();
+    for ext in ["wav", "json"] {
+        let from = staged.with_file_name(format!("{name}.{ext}"));
+        let to = to_dir.join(format!("{name}.{ext}"));
+        std::fs::rename(&from, &to).map_err(|e| io(&to, format!("cannot move into the library: {e}")))?;
+    }
+    cells.insert("forces".into(), json!(rel(&plan.dir, &to_dir.join(format!("{name}.json")))));
     let _ = std::fs::remove_dir_all(&partial);
     Ok(json!({
         "texture": sample,

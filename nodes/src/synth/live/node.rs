@@ -1,0 +1,263 @@
+//! `synth.live`: the actuation synthesized at every tick, through the
+//! display's forward model at the finger's condition, for the texture force
+//! the finger is about to meet.
+
+use super::envelope::{EnvelopeModel, ModelGrid};
+use super::horizon::Horizon;
+use super::window_min::WindowMin;
+use crate::synth::model_file::ForwardModel;
+use evflow_engine::{BuildContext, Io, Node, NodeError, NodeSpec, ParamSpec, Params, PortSpec, Role, Summary};
+use std::time::{Duration, Instant};
+
+/// Declaration of `synth.live`.
+pub static SPEC: NodeSpec = NodeSpec::new(
+    "synth.live",
+    "models",
+    Role::Filter,
+    "Live synthesis on a receding horizon: the carrier envelope whose force, through the forward models blended at the finger's load and speed, follows the texture force ahead.",
+    build,
+)
+.doc(
+    "Renders a texture by synthesizing the actuation at every tick for the force the finger is about to \
+     meet, instead of playing signals made beforehand for a condition the finger never holds \
+     (dissertation chapter 6 renders those; docs/texture.md §9 compares both). The target is the \
+     texture's force against travelled distance — e.g. `interp` over the recorded forces of the grid \
+     (improved scheme, Eq. 6.4) played position-locked by `playback` with the same `lookahead` L, so \
+     that at tick n this node receives the force of sample n + L along the finger's predicted path; \
+     the horizon H is L + 1 samples.\n\n\
+     **Model.** The forward models of `models` (written by `forward.train`, one per trained condition, \
+     covering every combination of their loads and speeds) are blended bilinearly at the finger's \
+     (`load`, |`velocity`|), clamped to the grid, `update_rate` times a second, and seen through a \
+     Nyquist-rate carrier: u[n] = (−1)ⁿ·a[n], the envelope a in [0, `bound`] \
+     (`nodes/src/synth/live/envelope.rs`).\n\n\
+     **Each tick** minimizes over the next H envelopes Σ(y − c − b − f)² + β·Σa², y the model's \
+     force, f the target, β the models' learned noise slope × `noise`, b the offset: `offset` × the \
+     least that renders every trough of the target seen over the last `window` ms (a square law only \
+     adds friction; the 10 Hz high-pass removes b). Starts: the previous solution shifted by one tick, \
+     and the square-law envelope √((f + b)/κ); then `iterations` projected gradient steps with the \
+     Barzilai–Borwein length, none of which raises the objective. The first envelope is played; below \
+     `rest_speed` nothing is, and up to `full_speed` it fades in (a resting finger feels nothing). \
+     Worst case per tick: `iterations` + 2 evaluations of H·(M² + 3M) multiply-adds (M the \
+     models' memory). **Fallback:** when the iterations (or the `budget` in µs, when set) run out, \
+     the best envelope found is played — never worse than the better start; a model without carrier \
+     gain plays nothing. Nothing is allocated while running (tests/live_alloc.rs).\n\n\
+     **Ports** (node rate, 1 kHz): in `force` (N, the target friction force `lookahead` samples \
+     ahead), `load` (g), `velocity` (cm/s, signed); out `u` (1 = 50 V), `target` (N, the target at \
+     this tick), `predicted` (N, the force change the model expects now, to set beside `target`), \
+     `iterations` (per tick). Non-finite inputs are read as 0 and counted. Summary: mean iterations, \
+     fallbacks, budget stops, the objective's mean reduction.",
+)
+.ports(&[
+    PortSpec::input("force", "N", "target friction force, `lookahead` samples ahead"),
+    PortSpec::input("load", "g", "finger's normal load"),
+    PortSpec::input("velocity", "cm/s", "finger's signed velocity"),
+    PortSpec::output("u", "1", "actuation: the envelope on a Nyquist-rate carrier"),
+    PortSpec::output("target", "N", "the target force at this tick"),
+    PortSpec::output("predicted", "N", "the force change the model expects from the actuation now"),
+    PortSpec::output("iterations", "1", "optimizer iterations made this tick"),
+])
+.params(&[
+    ParamSpec::text_list("models", "forward model files (forward.train), one per trained condition").required(),
+    ParamSpec::int("lookahead", 0, 63, 15, "samples", "how far ahead the target arrives (playback's lookahead); the horizon is one more"),
+    ParamSpec::int("iterations", 0, 200, 4, "1", "optimizer iterations per tick (the fixed worst case)"),
+    ParamSpec::float("offset", 0.0, 10.0, 1.0, "1", "offset, in units of the least that renders every trough"),
+    ParamSpec::float("window", 1.0, 10_000.0, 200.0, "ms", "how far back the target's troughs count for the offset"),
+    ParamSpec::float("bound", 1e-6, 2.0, 1.0, "1", "largest envelope |u| (1 = 50 V)"),
+    ParamSpec::float("noise", 0.0, 1e6, 1.0, "1", "scale on the models' learned noise slope β"),
+    ParamSpec::float("rest_speed", 0.0, 1e3, 0.3, "cm/s", "below this speed nothing is played"),
+    ParamSpec::float("full_speed", 0.0, 1e3, 1.0, "cm/s", "from this speed on the synthesis plays in full"),
+    ParamSpec::float("update_rate", 0.01, 1e6, 100.0, "Hz", "how often the models are blended at the finger's condition"),
+    ParamSpec::float("budget", 0.0, 1e6, 0.0, "µs", "stop iterating once a tick has taken this long (0: no deadline)"),
+])
+.example("models = [\"models/forward-60g-3cms.json\", \"models/forward-60g-7cms.json\", \"models/forward-110g-3cms.json\", \"models/forward-110g-7cms.json\"]\nlookahead = 15\niterations = 4");
+
+struct Live {
+    grid: ModelGrid,
+    model: EnvelopeModel,
+    horizon: Horizon,
+    troughs: WindowMin,
+    /// The targets of samples n … n+H−1.
+    ahead: Vec<f64>,
+    offset: f64,
+    bound: f64,
+    noise: f64,
+    rest: f64,
+    full: f64,
+    every: u64,
+    budget: Option<Duration>,
+    iterations: usize,
+    n: u64,
+    // Summary.
+    total_iterations: u64,
+    fallbacks: u64,
+    budget_stops: u64,
+    bad_inputs: u64,
+    reduction: f64,
+    optimized_ticks: u64,
+}
+
+fn build(p: &Params, ctx: &BuildContext) -> Result<Box<dyn Node>, NodeError> {
+    let names = p.text_list("models");
+    if names.is_empty() {
+        return Err(NodeError::param("models", "name at least one forward model file (written by forward.train)"));
+    }
+    let mut entries = Vec::with_capacity(names.len());
+    for name in names {
+        let path = ctx.path(name);
+        let fm = ForwardModel::load(&path)?;
+        if (fm.rate_hz - ctx.rate).abs() > 1e-9 * ctx.rate {
+            return Err(NodeError::file(
+                &path,
+                format!(
+                    "field `rate_hz`: the model was identified at {} Hz, the node runs at {} Hz",
+                    fm.rate_hz, ctx.rate
+                ),
+            ));
+        }
+        let (Some(mass), Some(speed)) = (fm.condition.mass_g, fm.condition.speed_cm_s) else {
+            return Err(NodeError::file(
+                &path,
+                "field `condition`: the model records no mass_g and speed_cm_s, so it has no place in the grid \
+                 (identify it with forward.train's mass_g and speed_cm_s set)",
+            ));
+        };
+        let volterra = fm.volterra().map_err(|e| NodeError::file(&path, e))?;
+        entries.push(((mass, speed.abs()), EnvelopeModel::of(&volterra, fm.noise.per_u2_n2)));
+    }
+    let grid = ModelGrid::new(entries, names).map_err(|e| NodeError::param("models", e.to_string()))?;
+    let (rest, full) = (p.f64("rest_speed"), p.f64("full_speed"));
+    if full < rest {
+        return Err(NodeError::param("full_speed", format!("{full} cm/s is below rest_speed = {rest} cm/s")));
+    }
+    let h = p.usize("lookahead") + 1;
+    let m = grid.memory();
+    let window = ((p.f64("window") * 1e-3 * ctx.rate).round() as usize).max(1);
+    let budget = p.f64("budget");
+    Ok(Box::new(Live {
+        model: EnvelopeModel::zeros(m),
+        horizon: Horizon::new(m, h),
+        troughs: WindowMin::new(window),
+        ahead: vec![0.0; h],
+        grid,
+        offset: p.f64("offset"),
+        bound: p.f64("bound"),
+        noise: p.f64("noise"),
+        rest,
+        full,
+        every: ((ctx.rate / p.f64("update_rate")).round() as u64).max(1),
+        budget: (budget > 0.0).then(|| Duration::from_secs_f64(budget * 1e-6)),
+        iterations: p.usize("iterations"),
+        n: 0,
+        total_iterations: 0,
+        fallbacks: 0,
+        budget_stops: 0,
+        bad_inputs: 0,
+        reduction: 0.0,
+        optimized_ticks: 0,
+    }))
+}
+
+impl Live {
+    fn finite(&mut self, x: f64) -> f64 {
+        if x.is_finite() {
+            x
+        } else {
+            self.bad_inputs += 1;
+            0.0
+        }
+    }
+
+    /// The share of the synthesis played at speed |v|: 0 at rest, 1 from
+    /// `full_speed`, a smoothstep between.
+    fn gate(&self, v: f64) -> f64 {
+        let v = v.abs();
+        if v < self.rest {
+            0.0
+        } else if v >= self.full || self.full <= self.rest {
+            1.0
+        } else {
+            let t = (v - self.rest) / (self.full - self.rest);
+            t * t * (3.0 - 2.0 * t)
+        }
+    }
+}
+
+impl Node for Live {
+    fn process(&mut self, io: &mut Io<'_>) -> Result<(), NodeError> {
+        let h = self.ahead.len();
+        for k in 0..io.len() {
+            let f = self.finite(io.input(0)[k]);
+            let load = self.finite(io.input(1)[k]);
+            let v = self.finite(io.input(2)[k]);
+            if self.n == 0 {
+                self.ahead.fill(f);
+            } else {
+                self.ahead.copy_within(1.., 0);
+                self.ahead[h - 1] = f;
+            }
+            let least = self.troughs.push(f);
+            let b = self.offset * (-least).max(0.0);
+            if self.n.is_multiple_of(self.every) {
+                self.grid.at(load, v, &mut self.model);
+                self.model.beta *= self.noise;
+            }
+            let deadline = self.budget.map(|d| Instant::now() + d);
+            let out = self.horizon.step(self.n, &self.ahead, b, &self.model, self.bound, self.iterations, deadline);
+            let a = (self.gate(v) * out.envelope).clamp(0.0, self.bound);
+            self.horizon.commit(a);
+            let sign = if self.n.is_multiple_of(2) { 1.0 } else { -1.0 };
+            io.output(0)[k] = sign * a;
+            io.output(1)[k] = self.ahead[0];
+            io.output(2)[k] = if out.predicted.is_finite() { out.predicted - b } else { 0.0 };
+            io.output(3)[k] = out.iterations as f64;
+            self.total_iterations += out.iterations as u64;
+            self.fallbacks += u64::from(out.fallback);
+            self.budget_stops += u64::from(out.budget_stop);
+            if !out.fallback && out.start_objective > 0.0 {
+                self.reduction += 1.0 - out.objective / out.start_objective;
+                self.optimized_ticks += 1;
+            }
+            self.n += 1;
+        }
+        Ok(())
+    }
+
+    fn reset(&mut self) {
+        self.horizon.reset();
+        self.troughs.reset();
+        self.ahead.fill(0.0);
+        self.n = 0;
+        self.total_iterations = 0;
+        self.fallbacks = 0;
+        self.budget_stops = 0;
+        self.bad_inputs = 0;
+        self.reduction = 0.0;
+        self.optimized_ticks = 0;
+    }
+
+    fn finish(&mut self) -> Result<Summary, NodeError> {
+        let ticks = self.n.max(1) as f64;
+        let (loads, speeds) = self.grid.axes();
+        let mut s = Summary::default()
+            .value("iterations_per_tick", self.total_iterations as f64 / ticks, "1")
+            .value("fallbacks", self.fallbacks as f64, "ticks")
+            .value("budget_stops", self.budget_stops as f64, "ticks")
+            .value("objective_reduction", self.reduction / self.optimized_ticks.max(1) as f64, "1")
+            .line(format!(
+                "{} ticks over a {}-sample horizon, models at {loads:?} g × {speeds:?} cm/s: {:.2} iterations a tick, \
+                 the objective {:.1} % below the better start on average, {} fallback(s), {} budget stop(s)",
+                self.n,
+                self.ahead.len(),
+                self.total_iterations as f64 / ticks,
+                100.0 * self.reduction / self.optimized_ticks.max(1) as f64,
+                self.fallbacks,
+                self.budget_stops
+            ));
+        if self.bad_inputs > 0 {
+            s = s
+                .value("bad_inputs", self.bad_inputs as f64, "samples")
+                .line(format!("{} non-finite input sample(s) were read as 0", self.bad_inputs));
+        }
+        Ok(s)
+    }
+}

@@ -3,6 +3,8 @@
 //! shards of a report (`--shard K/N`), with the same code.
 
 #[cfg(feature = "synth")]
+pub mod live_table;
+#[cfg(feature = "synth")]
 pub mod narx_table;
 #[cfg(feature = "synth")]
 pub mod textures_table;

@@ -68,11 +68,64 @@ scrunched-paper, rippled-paper, or generated-<seed> (a generated sample, seed 0�
 ])
 .example("sample = \"felt-fabric\"");
 
-struct SimTexture {
+/// A scan over a sample: the surface and its per-component gains, updated
+/// as the load moves — the force `sim.texture` outputs, sample by sample,
+/// for any code that needs the same numbers (the live study's stroke).
+#[derive(Debug, Clone)]
+pub struct TextureScan {
     surface: Surface,
     gains: Vec<f64>,
     /// The load the gains were computed for.
     gains_load: f64,
+}
+
+impl TextureScan {
+    /// A scan over `surface`, at rest.
+    pub fn new(surface: Surface) -> Self {
+        let gains = vec![1.0; surface.components.len()];
+        let mut scan = TextureScan { surface, gains, gains_load: f64::NAN };
+        scan.update_gains(0.0);
+        scan
+    }
+
+    /// The surface scanned.
+    pub fn surface(&self) -> &Surface {
+        &self.surface
+    }
+
+    /// Recomputes the patch attenuations when the load moved by more than
+    /// 0.1 % (they change with its cube root: an error below 0.03 %).
+    fn update_gains(&mut self, load: f64) {
+        let load = if load.is_finite() { load.max(0.0) } else { 0.0 };
+        if (load - self.gains_load).abs() > 1e-3 * self.gains_load.abs() || self.gains_load.is_nan() {
+            self.surface.gains(load, &mut self.gains);
+            self.gains_load = load;
+        }
+    }
+
+    /// The friction force at position `x` (m), velocity `v` (m/s) and load `load` (N).
+    pub fn force(&mut self, x: f64, v: f64, load: f64) -> f64 {
+        self.update_gains(load);
+        self.surface.force(x, v, load, &self.gains)
+    }
+
+    /// μ(x)·N at this load: the force's magnitude while sliding, its
+    /// direction left out.
+    pub fn magnitude(&mut self, x: f64, load: f64) -> f64 {
+        self.update_gains(load);
+        let n = if load.is_finite() { load.max(0.0) } else { 0.0 };
+        self.surface.mu_at(x, &self.gains).max(0.0) * n
+    }
+
+    /// Back to rest.
+    pub fn reset(&mut self) {
+        self.gains_load = f64::NAN;
+        self.update_gains(0.0);
+    }
+}
+
+struct SimTexture {
+    scan: TextureScan,
 }
 
 fn build(p: &Params, _ctx: &BuildContext) -> Result<Box<dyn Node>, NodeError> {
@@ -84,22 +137,7 @@ fn build(p: &Params, _ctx: &BuildContext) -> Result<Box<dyn Node>, NodeError> {
     if p.f64("contact") > 0.0 {
         surface.sigma_1n = p.f64("contact");
     }
-    let gains = vec![1.0; surface.components.len()];
-    let mut node = SimTexture { surface, gains, gains_load: f64::NAN };
-    node.update_gains(0.0);
-    Ok(Box::new(node))
-}
-
-impl SimTexture {
-    /// Recomputes the patch attenuations when the load moved by more than
-    /// 0.1 % (they change with its cube root: an error below 0.03 %).
-    fn update_gains(&mut self, load: f64) {
-        let load = if load.is_finite() { load.max(0.0) } else { 0.0 };
-        if (load - self.gains_load).abs() > 1e-3 * self.gains_load.abs() || self.gains_load.is_nan() {
-            self.surface.gains(load, &mut self.gains);
-            self.gains_load = load;
-        }
-    }
+    Ok(Box::new(SimTexture { scan: TextureScan::new(surface) }))
 }
 
 impl Node for SimTexture {
@@ -107,14 +145,12 @@ impl Node for SimTexture {
         let n = io.len();
         for k in 0..n {
             let (x, v, load) = (io.input(0)[k], io.input(1)[k], io.input(2)[k]);
-            self.update_gains(load);
-            io.output(0)[k] = self.surface.force(x, v, load, &self.gains);
+            io.output(0)[k] = self.scan.force(x, v, load);
         }
         Ok(())
     }
 
     fn reset(&mut self) {
-        self.gains_load = f64::NAN;
-        self.update_gains(0.0);
+        self.scan.reset();
     }
 }

@@ -208,6 +208,15 @@ impl Surface {
         self.mu * (1.0 + m)
     }
 
+    /// The force of the base friction alone, μ₀·N·tanh(v/v_s): what
+    /// [`Surface::force`] is without the texture's modulation.
+    pub fn base_force(&self, v: f64, n: f64) -> f64 {
+        if !(v.is_finite() && n.is_finite()) {
+            return 0.0;
+        }
+        self.mu * n.max(0.0) * (v / V_SIGN).tanh()
+    }
+
     /// The friction force at position `x` (m), velocity `v` (m/s) and load
     /// `n` (N), given the gains for that load. Finite for finite inputs;
     /// non-finite inputs give 0.

@@ -60,7 +60,7 @@ pub static SPEC: NodeSpec = NodeSpec::new(
     ParamSpec::text_list("models", "forward model files (forward.train), one per trained condition").required(),
     ParamSpec::int("lookahead", 0, 63, 15, "samples", "how far ahead the target arrives (playback's lookahead); the horizon is one more"),
     ParamSpec::int("iterations", 0, 200, 4, "1", "optimizer iterations per tick (the fixed worst case)"),
-    ParamSpec::float("offset", 0.0, 10.0, 1.0, "1", "offset, in units of the least that renders every trough"),
+    ParamSpec::float("offset", 0.0, 10.0, 0.25, "1", "offset, in units of the least that renders every trough"),
     ParamSpec::float("window", 1.0, 10_000.0, 200.0, "ms", "how far back the target's troughs count for the offset"),
     ParamSpec::float("bound", 1e-6, 2.0, 1.0, "1", "largest envelope |u| (1 = 50 V)"),
     ParamSpec::float("noise", 0.0, 1e6, 1.0, "1", "scale on the models' learned noise slope β"),

@@ -8,6 +8,11 @@ use std::path::Path;
 /// Runs the graph `file` with `sets` (`name=value` or `node.param=value`,
 /// TOML values) to its end, its outputs written under `out`.
 pub fn run_graph(file: &Path, sets: &[String], out: &Path) -> Result<RunReport, StudyError> {
+    run_graph_for(file, sets, out, None)
+}
+
+/// [`run_graph`] for `duration` seconds instead of the graph's own.
+pub fn run_graph_for(file: &Path, sets: &[String], out: &Path, duration: Option<f64>) -> Result<RunReport, StudyError> {
     let err = |m: String| StudyError::Graph { file: file.to_path_buf(), message: m };
     let overrides = sets
         .iter()
@@ -24,7 +29,7 @@ pub fn run_graph(file: &Path, sets: &[String], out: &Path) -> Result<RunReport, 
         mode: RunMode::Offline,
     };
     let mut plan = Plan::build(&checked, &opts).map_err(|e| err(e.to_string()))?;
-    run_offline(&mut plan, RunOptions::default()).map_err(|e| err(e.to_string()))
+    run_offline(&mut plan, RunOptions { duration, ..RunOptions::default() }).map_err(|e| err(e.to_string()))
 }
 
 /// The value `name` that node `node` reported in run `r`.

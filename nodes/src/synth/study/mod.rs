@@ -21,6 +21,7 @@ pub mod gains;
 pub mod graphs;
 pub mod grid_plan;
 pub mod library;
+pub mod live;
 pub mod models;
 pub mod narx_settings;
 pub mod recordings;

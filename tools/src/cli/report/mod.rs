@@ -12,6 +12,8 @@ pub mod interp_cells;
 pub mod interp_cells_table;
 #[cfg(feature = "synth")]
 pub mod lab_recording;
+#[cfg(feature = "synth")]
+pub mod live;
 #[cfg(feature = "mesh")]
 pub mod mesh;
 #[cfg(feature = "synth")]
@@ -93,6 +95,21 @@ enum Which {
     /// Example: cargo run --release -p evflow -- report narx --out report
     #[cfg(feature = "synth")]
     Narx(narx::Args),
+    /// Live texture rendering under virtual users (docs/texture.md §9):
+    /// per lab profile × texture sample × virtual user, every live chain —
+    /// nothing, record-and-playback, NARX and optimized cells, forces
+    /// first, the live synthesis (`synth.live`) — scored by E_s against
+    /// the force the finger meets on the real sample, at Table 5.1's gain
+    /// rule and its best gain, beside the display floor and the stroke's
+    /// achievable floor (the actuation optimized through the display's twin
+    /// knowing the user's path). Each profile's models and cells come from
+    /// a model library built on it (under OUT/work). A failed step does not
+    /// stop the others (exit 1). `--shard K/N` runs a slice of the items;
+    /// `evflow merge` joins the slices.
+    ///
+    /// Example: cargo run --release -p evflow -- report live --out report-live
+    #[cfg(feature = "synth")]
+    Live(live::Args),
 }
 
 /// Writes `plot` to `path` and says so (unlabelled without a font); a plot
@@ -133,5 +150,7 @@ pub fn main(a: ReportArgs) -> anyhow::Result<()> {
         Which::Textures(t) => textures::main(t),
         #[cfg(feature = "synth")]
         Which::Narx(n) => narx::main(n),
+        #[cfg(feature = "synth")]
+        Which::Live(l) => live::main(l),
     }
 }

@@ -45,7 +45,11 @@ pub static SPEC: NodeSpec = NodeSpec::new(
      u[n] = (−1)ⁿ·√(max(0, (f[n] + c)/κ)), κ the model's carrier gain, c = −min f; `narx`: the inverse \
      NARX model `narx_model` run closed loop on the force (§5.2.2); `zero`. When the forward model's carrier gain \
      κ is not positive (its fit explains almost nothing of the force), `carrier` starts from `narx_model` \
-     instead if one is given, and says so.\n\n\
+     instead if one is given, and says so. `best` (default): the optimization runs from every start there \
+     is — the carrier (when κ > 0) and the inverse model (when `narx_model` is given; else zero) — each with \
+     the whole iteration budget, and the one whose objective ends lowest is played: the objective decides, \
+     not a guess of which start suits the display (docs/synthesis.md §1: on displays unlike the nominal \
+     one the inverse model's start wins rows the carrier's loses).\n\n\
      **Timing.** The synthesis runs on the first block (offline only) and counts in the node's run \
      time. **Summary.** `objective_start`, `objective_end` (never above the start), `iterations`, \
      `evaluations`, `lambda`, `seconds` (with `record_time`), and why the optimizer stopped.",
@@ -58,7 +62,7 @@ pub static SPEC: NodeSpec = NodeSpec::new(
     ParamSpec::float("speed", 0.0, 1e4, 0.0, "cm/s", "count only the constant-speed samples at this speed (0 = all)"),
     ParamSpec::float("tolerance", 1e-6, 0.5, 0.02, "1", "largest relative deviation from `speed`"),
     ParamSpec::float("settle", 0.0, 60.0, 0.1, "s", "time the speed must have held"),
-    ParamSpec::choice("start", &["carrier", "narx", "zero"], "carrier", "starting actuation"),
+    ParamSpec::choice("start", &["best", "carrier", "narx", "zero"], "best", "starting actuation (best: every start, the lowest objective kept)"),
     ParamSpec::text("narx_model", "", "inverse NARX model for start = \"narx\""),
     ParamSpec::choice("objective", &["time", "spectral", "expected"], "time", "what to match"),
     ParamSpec::int("nfft", 0, 1 << 20, 0, "samples", "spectral objective: segment length (0 = the rate)"),
@@ -78,9 +82,8 @@ pub static SPEC: NodeSpec = NodeSpec::new(
 struct Optimize {
     force: Vec<f64>,
     keep: Vec<bool>,
-    start: Vec<f64>,
-    /// Which start was used (for the summary).
-    start_used: &'static str,
+    /// The starts to optimize from, each with its name (for the summary).
+    starts: Vec<(String, Vec<f64>)>,
     /// Which objective was used (for the summary).
     objective_used: &'static str,
     model: ForwardModel,
@@ -139,16 +142,30 @@ fn build(p: &Params, ctx: &BuildContext) -> Result<Box<dyn Node>, NodeError> {
     let kappa = model.carrier_gain_n;
     let kappa_positive = kappa.is_finite() && kappa > 0.0;
     let has_narx = !p.str("narx_model").is_empty();
-    let (start, start_used) = match p.str("start") {
-        "narx" => (narx_start("start = \"narx\"")?, "narx"),
-        "zero" => (vec![0.0; force.len()], "zero"),
+    let starts: Vec<(String, Vec<f64>)> = match p.str("start") {
+        "narx" => vec![("narx".into(), narx_start("start = \"narx\"")?)],
+        "zero" => vec![("zero".into(), vec![0.0; force.len()])],
+        // Every start there is; the objective picks.
+        "best" => {
+            let mut v = Vec::new();
+            if kappa_positive {
+                v.push(("carrier".into(), carrier(&force, &keep, kappa, bound)?));
+            }
+            if has_narx {
+                v.push(("narx".into(), narx_start("start = \"narx\"")?));
+            }
+            if v.is_empty() {
+                v.push(("zero (no carrier gain, no inverse model)".into(), vec![0.0; force.len()]));
+            }
+            v
+        }
         // A model whose carrier gain is not positive (a display whose force the
         // model hardly explains) gives the square-law start no meaning: start
         // from the inverse model when one is given.
         _ if has_narx && !kappa_positive => {
-            (narx_start("the fallback start")?, "narx (the model's carrier gain is not positive)")
+            vec![("narx (the model's carrier gain is not positive)".into(), narx_start("the fallback start")?)]
         }
-        _ => (carrier(&force, &keep, kappa, bound)?, "carrier"),
+        _ => vec![("carrier".into(), carrier(&force, &keep, kappa, bound)?)],
     };
     let nfft = match p.usize("nfft") {
         0 => ctx.rate.round() as usize,
@@ -187,8 +204,7 @@ fn build(p: &Params, ctx: &BuildContext) -> Result<Box<dyn Node>, NodeError> {
     Ok(Box::new(Optimize {
         force,
         keep,
-        start,
-        start_used,
+        starts,
         objective_used,
         model,
         cfg,
@@ -201,27 +217,45 @@ fn build(p: &Params, ctx: &BuildContext) -> Result<Box<dyn Node>, NodeError> {
 
 impl Optimize {
     fn run(&mut self) -> Result<(), NodeError> {
-        let s = synthesize(&self.model, &self.force, &self.keep, &self.start, &self.cfg)?;
-        self.summary = Summary::default()
+        let mut results = Vec::with_capacity(self.starts.len());
+        for (name, start) in &self.starts {
+            results.push((name.as_str(), synthesize(&self.model, &self.force, &self.keep, start, &self.cfg)?));
+        }
+        // The lowest objective wins (the first on a tie).
+        let kept = (0..results.len())
+            .min_by(|&a, &b| results[a].1.objective_end.total_cmp(&results[b].1.objective_end))
+            .unwrap_or(0);
+        let evaluations: usize = results.iter().map(|(_, r)| r.evaluations).sum();
+        let seconds: f64 = results.iter().map(|(_, r)| r.seconds).sum();
+        let mut summary = Summary::default();
+        for (name, r) in &results {
+            summary = summary.line(format!(
+                "from the {name} start, objective {}: {:.4} → {:.4} in {} iterations ({})",
+                self.objective_used,
+                r.objective_start,
+                r.objective_end,
+                r.history.len() - 1,
+                r.stop.describe()
+            ));
+        }
+        let (name, s) = results.swap_remove(kept);
+        summary = summary
             .value("objective_start", s.objective_start, "1")
             .value("objective_end", s.objective_end, "1")
             .value("iterations", (s.history.len() - 1) as f64, "1")
-            .value("evaluations", s.evaluations as f64, "1")
+            .value("evaluations", evaluations as f64, "1")
             .value("lambda", s.lambda, "1")
+            .value("starts", self.starts.len() as f64, "1")
             .line(format!(
-                "synthesized {} samples from the {} start, objective {}: {:.4} → {:.4} in {} iterations ({}), {:.3} s",
+                "synthesized {} samples: kept the {name} start's ({} of {} tried), {seconds:.3} s in all",
                 s.u.len(),
-                self.start_used,
-                self.objective_used,
-                s.objective_start,
-                s.objective_end,
-                s.history.len() - 1,
-                s.stop.describe(),
-                s.seconds
+                kept + 1,
+                self.starts.len()
             ));
         if self.record_time {
-            self.summary = std::mem::take(&mut self.summary).value("seconds", s.seconds, "s");
+            summary = summary.value("seconds", seconds, "s");
         }
+        self.summary = summary;
         self.u = Some(s.u);
         Ok(())
     }

@@ -64,6 +64,13 @@ fn wanted_taps(checked: &Checked) -> Vec<Tap> {
             "sim.display" => add(&n.name, "force"),
             "mesh.gradient" | "mesh.edges" => add(&n.name, "intensity"),
             "limit" => add(&n.name, "state"),
+            // The live synthesis: its target beside what it expects to render,
+            // and its running counts (the studio shows their rates).
+            "synth.live" => {
+                for port in ["target", "predicted", "iterations", "fallbacks"] {
+                    add(&n.name, port);
+                }
+            }
             _ => {}
         }
     }
@@ -147,7 +154,9 @@ pub(crate) fn taps_json(checked: Option<&Checked>, taps: &[(String, String, f64)
         .enumerate()
         .map(|(i, (node, port, rate))| {
             let is_state = limiters.iter().any(|l| l.state == Some(i));
-            let shown = !is_state && defaults.iter().any(|d| &d.node == node && &d.port == port)
+            // A running count is shown as its rate (the synthesis panel), not as a trace.
+            let count = port == "iterations" || port == "fallbacks";
+            let shown = !is_state && !count && defaults.iter().any(|d| &d.node == node && &d.port == port)
                 || limiters.iter().any(|l| l.output == Some(i))
                 || port == "velocity"
                 || port == "out" && checked.is_none();

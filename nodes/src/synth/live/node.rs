@@ -44,7 +44,9 @@ pub static SPEC: NodeSpec = NodeSpec::new(
      **Ports** (node rate, 1 kHz): in `force` (N, the target friction force `lookahead` samples \
      ahead), `load` (g), `velocity` (cm/s, signed); out `u` (1 = 50 V), `target` (N, the target at \
      this tick), `predicted` (N, the force change the model expects now, to set beside `target`), \
-     `iterations` (per tick). Non-finite inputs are read as 0 and counted. Summary: mean iterations, \
+     `iterations` and `fallbacks` (running counts since the start: their rates are the synthesis' \
+     iterations and fallbacks per second, which the studio shows). Non-finite inputs are read as 0 and \
+     counted. Summary: mean iterations, \
      fallbacks, budget stops, the objective's mean reduction.",
 )
 .ports(&[
@@ -54,7 +56,8 @@ pub static SPEC: NodeSpec = NodeSpec::new(
     PortSpec::output("u", "1", "actuation: the envelope on a Nyquist-rate carrier"),
     PortSpec::output("target", "N", "the target force at this tick"),
     PortSpec::output("predicted", "N", "the force change the model expects from the actuation now"),
-    PortSpec::output("iterations", "1", "optimizer iterations made this tick"),
+    PortSpec::output("iterations", "1", "optimizer iterations made since the start (a running count)"),
+    PortSpec::output("fallbacks", "1", "ticks played from a fallback since the start (a running count)"),
 ])
 .params(&[
     ParamSpec::text_list("models", "forward model files (forward.train), one per trained condition").required(),
@@ -209,9 +212,10 @@ impl Node for Live {
             io.output(0)[k] = sign * a;
             io.output(1)[k] = self.ahead[0];
             io.output(2)[k] = if out.predicted.is_finite() { out.predicted - b } else { 0.0 };
-            io.output(3)[k] = out.iterations as f64;
             self.total_iterations += out.iterations as u64;
             self.fallbacks += u64::from(out.fallback);
+            io.output(3)[k] = self.total_iterations as f64;
+            io.output(4)[k] = self.fallbacks as f64;
             self.budget_stops += u64::from(out.budget_stop);
             if !out.fallback && out.start_objective > 0.0 {
                 self.reduction += 1.0 - out.objective / out.start_objective;

@@ -48,6 +48,37 @@ const plot = (() => {
     g.fillStyle = "#556"; g.font = `${10 * r}px sans-serif`;
     g.fillText(fmt(yhi), 2, 10 * r); g.fillText(fmt(ylo), 2, h - 2);
   }
+  // Several min/max series on one shared scale, each as the line through
+  // its bands' middles, with a legend: [{ s, color, name }].
+  function overlay(canvas, list, t0, t1) {
+    const { g, w, h, r } = fit(canvas);
+    let ylo = Infinity, yhi = -Infinity;
+    for (const { s } of list) {
+      for (let i = 0; i < s.t.length; i++) {
+        if (s.t[i] < t0 || s.lo[i] === null) continue;
+        ylo = Math.min(ylo, s.lo[i]); yhi = Math.max(yhi, s.hi[i]);
+      }
+    }
+    [ylo, yhi] = range(ylo, yhi);
+    const X = t => (t - t0) / (t1 - t0) * w, Y = v => h - (v - ylo) / (yhi - ylo) * h;
+    g.lineWidth = r;
+    list.forEach(({ s, color, name }, k) => {
+      g.strokeStyle = color;
+      g.beginPath();
+      let open = false;
+      for (let i = 0; i < s.t.length; i++) {
+        if (s.t[i] < t0) continue;
+        if (s.lo[i] === null) { open = false; continue; }
+        const y = Y((s.lo[i] + s.hi[i]) / 2);
+        if (!open) { g.moveTo(X(s.t[i]), y); open = true; } else g.lineTo(X(s.t[i]), y);
+      }
+      g.stroke();
+      g.fillStyle = color; g.font = `${10 * r}px sans-serif`;
+      g.fillText(name, w - 160 * r, (12 + 12 * k) * r);
+    });
+    g.fillStyle = "#556"; g.font = `${10 * r}px sans-serif`;
+    g.fillText(fmt(yhi), 2, 10 * r); g.fillText(fmt(ylo), 2, h - 2);
+  }
   // Bars with labels under them; counts on a log scale.
   function bars(canvas, labels, counts, title) {
     const { g, w, h, r } = fit(canvas);
@@ -78,5 +109,5 @@ const plot = (() => {
     g.fillText(`${xl}: ${fmt(xr[0])} … ${fmt(xr[1])}`, 4, h - 2);
     g.fillText(`${yl}: ${fmt(yr[0])} … ${fmt(yr[1])}`, 4, 10 * r);
   }
-  return { band, bars, trail, fmt, range };
+  return { band, overlay, bars, trail, fmt, range };
 })();

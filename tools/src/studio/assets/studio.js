@@ -132,7 +132,8 @@ function synthsDraw(t0, t1) {
     const list = [];
     if (s.target >= 0) list.push({ s: S.series[s.target], color: "#1b7837", name: "target force (N)" });
     if (s.predicted >= 0) list.push({ s: S.series[s.predicted], color: "#c51b7d", name: "display, expected (N)" });
-    if (list.length) plot.overlay($(`synth-plot-${s.node}`), list, t0, t1);
+    // The last second of the span: long enough to compare the waveforms' shape.
+    if (list.length) plot.overlay($(`synth-plot-${s.node}`), list, Math.max(t0, t1 - 1.0), t1);
   }
 }
 

@@ -238,7 +238,7 @@ impl Mix {
     /// density increased"). Inside the grid, or for a non-finite m, nothing
     /// changes; a load ≤ 0 gives silence.
     pub fn proportional_beyond(mut self, m: f64) -> Self {
-        if m.is_finite() && (m < self.load || m > self.load) && self.load > 0.0 {
+        if m.is_finite() && m != self.load && self.load > 0.0 {
             self.scale = m.max(0.0) / self.load;
         }
         self

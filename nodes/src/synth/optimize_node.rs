@@ -47,9 +47,10 @@ pub static SPEC: NodeSpec = NodeSpec::new(
      κ is not positive (its fit explains almost nothing of the force), `carrier` starts from `narx_model` \
      instead if one is given, and says so. `best` (default): the optimization runs from every start there \
      is — the carrier (when κ > 0) and the inverse model (when `narx_model` is given; else zero) — each with \
-     the whole iteration budget, and the one whose objective ends lowest is played: the objective decides, \
-     not a guess of which start suits the display (docs/synthesis.md §1: on displays unlike the nominal \
-     one the inverse model's start wins rows the carrier's loses).\n\n\
+     the whole iteration budget, and the carrier's is played unless another's objective ends lower by more \
+     than `start_margin` (5 %): where the display is one the carrier start does not suit, the objective says \
+     so; where both end within a few per cent, the objective does not tell which plays better, and the \
+     carrier's was measured to (docs/synthesis.md §1).\n\n\
      **Timing.** The synthesis runs on the first block (offline only) and counts in the node's run \
      time. **Summary.** `objective_start`, `objective_end` (never above the start), `iterations`, \
      `evaluations`, `lambda`, `seconds` (with `record_time`), and why the optimizer stopped.",
@@ -63,6 +64,7 @@ pub static SPEC: NodeSpec = NodeSpec::new(
     ParamSpec::float("tolerance", 1e-6, 0.5, 0.02, "1", "largest relative deviation from `speed`"),
     ParamSpec::float("settle", 0.0, 60.0, 0.1, "s", "time the speed must have held"),
     ParamSpec::choice("start", &["best", "carrier", "narx", "zero"], "best", "starting actuation (best: every start, the lowest objective kept)"),
+    ParamSpec::float("start_margin", 0.0, 1.0, 0.05, "1", "start = best: another start is kept over the carrier's only when its objective ends lower by this fraction"),
     ParamSpec::text("narx_model", "", "inverse NARX model for start = \"narx\""),
     ParamSpec::choice("objective", &["time", "spectral", "expected"], "time", "what to match"),
     ParamSpec::int("nfft", 0, 1 << 20, 0, "samples", "spectral objective: segment length (0 = the rate)"),
@@ -84,6 +86,8 @@ struct Optimize {
     keep: Vec<bool>,
     /// The starts to optimize from, each with its name (for the summary).
     starts: Vec<(String, Vec<f64>)>,
+    /// How much lower another start's objective must end to be kept over the first's.
+    margin: f64,
     /// Which objective was used (for the summary).
     objective_used: &'static str,
     model: ForwardModel,
@@ -205,6 +209,7 @@ fn build(p: &Params, ctx: &BuildContext) -> Result<Box<dyn Node>, NodeError> {
         force,
         keep,
         starts,
+        margin: p.f64("start_margin"),
         objective_used,
         model,
         cfg,
@@ -221,10 +226,16 @@ impl Optimize {
         for (name, start) in &self.starts {
             results.push((name.as_str(), synthesize(&self.model, &self.force, &self.keep, start, &self.cfg)?));
         }
-        // The lowest objective wins (the first on a tie).
-        let kept = (0..results.len())
-            .min_by(|&a, &b| results[a].1.objective_end.total_cmp(&results[b].1.objective_end))
-            .unwrap_or(0);
+        // The first start (the carrier, when it is tried) is kept unless another
+        // ends lower by more than `start_margin`: objectives within a few per
+        // cent of each other do not tell which start plays better
+        // (docs/synthesis.md §1).
+        let mut kept = 0;
+        for k in 1..results.len() {
+            if results[k].1.objective_end < (1.0 - self.margin) * results[kept].1.objective_end {
+                kept = k;
+            }
+        }
         let evaluations: usize = results.iter().map(|(_, r)| r.evaluations).sum();
         let seconds: f64 = results.iter().map(|(_, r)| r.seconds).sum();
         let mut summary = Summary::default();

@@ -109,6 +109,7 @@ pub fn main(a: Args) -> Result<()> {
         iterations: b.iterations,
         jobs: b.batch.jobs(),
         shard: b.batch.shard(),
+        record_time: true,
     };
     let total = plan.shard.range(plan.conds.len()).len() * (1 + plan.samples.len());
     let bar = progress_bar(total, "items", false);

@@ -67,6 +67,20 @@ pub fn main(a: Args) -> Result<()> {
                 bail!("{}", m.failures.summary(m.samples + m.total, "steps").trim_end());
             }
         }
+        #[cfg(feature = "synth")]
+        Merged::Live(m) => {
+            print!("{}", m.markdown);
+            for f in &m.written {
+                println!("wrote {}", f.display());
+            }
+            println!(
+                "merged {} shards of a live report: {} rows of {} items, {} files the shards wrote",
+                m.shards, m.rows, m.items, m.files
+            );
+            if !m.failures.is_empty() {
+                bail!("{}", m.failures.summary(m.items, "steps").trim_end());
+            }
+        }
         Merged::Sweep(m) => {
             for table in &m.tables {
                 println!("wrote {}", table.display());

@@ -60,6 +60,9 @@ pub struct Plan {
     pub jobs: usize,
     /// The slice of the conditions this build makes.
     pub shard: Shard,
+    /// Write each model's training time into its file (without, two builds
+    /// write the same bytes: the live study's shards share their libraries).
+    pub record_time: bool,
 }
 
 /// The methods whose cells the library keeps: (method, recording channel, folder prefix).
@@ -155,7 +158,7 @@ fn condition_models(plan: &Plan, c: &Cond) -> Result<(Models, bool)> {
     }
     let partial = plan.dir.join(".partial").join(format!("models-{}", c.tag()));
     let _ = std::fs::remove_dir_all(&partial);
-    let built = models::build(&plan.graphs, &plan.profile, c, plan.epochs, false, true, &partial)?;
+    let built = models::build(&plan.graphs, &plan.profile, c, plan.epochs, false, plan.record_time, &partial)?;
     std::fs::create_dir_all(&final_dir).map_err(|e| io(&final_dir, format!("cannot create: {e}")))?;
     // The forward model first: `given` needs both, so a crash between the
     // two moves leaves an item that is redone.

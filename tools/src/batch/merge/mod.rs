@@ -13,7 +13,8 @@
 //! joined in the library's order.
 //!
 //! A texture report run in shards (`evflow report textures --shard K/N`)
-//! merges into its tables ([`textures`]).
+//! merges into its tables ([`textures`]), a live report's into its own
+//! ([`live`]).
 //!
 //! One file per kind of shard; [`error`] and [`files`] are what they share.
 
@@ -21,6 +22,8 @@ pub mod error;
 pub mod files;
 #[cfg(feature = "synth")]
 pub mod library;
+#[cfg(feature = "synth")]
+pub mod live;
 #[cfg(feature = "synth")]
 pub mod narx;
 pub mod sweep;
@@ -48,6 +51,9 @@ pub enum Merged {
     /// The shards of `evflow report narx --shard`.
     #[cfg(feature = "synth")]
     Narx(narx::NarxMerge),
+    /// The shards of `evflow report live --shard`.
+    #[cfg(feature = "synth")]
+    Live(live::LiveMerge),
 }
 
 /// Merges the shard folders `dirs` (in any order) into `out`: a texture
@@ -62,6 +68,10 @@ pub fn merge(out: &Path, dirs: &[PathBuf]) -> Result<Merged, MergeError> {
     #[cfg(feature = "synth")]
     if dirs.iter().any(|d| evflow_nodes::synth::study::saved::SavedStudy::is_in(d)) {
         return textures::merge_textures(out, dirs).map(Merged::Textures);
+    }
+    #[cfg(feature = "synth")]
+    if dirs.iter().any(|d| live::is_live_shard(d)) {
+        return live::merge_live(out, dirs).map(Merged::Live);
     }
     #[cfg(feature = "synth")]
     if dirs.iter().any(|d| narx::is_narx_shard(d)) {

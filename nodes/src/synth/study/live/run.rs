@@ -131,6 +131,7 @@ pub fn run(cfg: &LiveConfig, progress: &mut dyn FnMut(Progress<'_>)) -> Result<L
             iterations: s.iterations,
             jobs: cfg.jobs,
             shard: Shard::ALL,
+            record_time: false,
         };
         match library::build(&plan, &|_| {}) {
             Ok(out) if out.failures.is_empty() => ready[p] = true,

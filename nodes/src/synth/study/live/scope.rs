@@ -113,8 +113,6 @@ pub struct LiveScope {
     pub floor_iterations: usize,
     /// The live synthesis' settings.
     pub live: LiveSettings,
-    /// Whether the tables show times.
-    pub times: bool,
 }
 
 impl LiveScope {
@@ -143,7 +141,6 @@ impl LiveScope {
             floor: true,
             floor_iterations: 100,
             live: LiveSettings::default(),
-            times: true,
         }
     }
 

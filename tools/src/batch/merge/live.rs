@@ -1,0 +1,95 @@
+//! The merge of a live report's shards (`evflow report live --shard K/N`):
+//! each shard saved the rows of its slice of the (profile, sample, user)
+//! items ([`evflow_nodes::synth::study::live::saved`]); the merge checks
+//! that the shards are the N slices of one report, copies their files
+//! (libraries, runs, floors), joins the rows in item order and writes
+//! live.md, rows.csv and the figures with the code `evflow report live`
+//! uses — one run's, byte for byte.
+
+use super::error::MergeError;
+use super::files::{copy_files, k_order, write};
+use crate::report::live_table::{csv, figures, markdown};
+use evflow_engine::batch::Failures;
+use evflow_nodes::synth::study::live::saved::{LiveRecord, RECORD};
+use evflow_nodes::synth::study::StudyError;
+use std::path::{Path, PathBuf};
+
+/// What a merge of a live report's shards did.
+#[derive(Debug)]
+pub struct LiveMerge {
+    /// Shards merged.
+    pub shards: usize,
+    /// Rows over all shards.
+    pub rows: usize,
+    /// Items of the whole report.
+    pub items: usize,
+    /// Files copied from the shards.
+    pub files: usize,
+    /// The tables and figures written.
+    pub written: Vec<PathBuf>,
+    /// The report's Markdown, as `evflow report live` prints it.
+    pub markdown: String,
+    /// The steps that failed in the shards, labelled with their shard.
+    pub failures: Failures,
+}
+
+/// Whether `dir` holds a live report shard's record.
+pub fn is_live_shard(dir: &Path) -> bool {
+    LiveRecord::is_in(dir)
+}
+
+/// Merges the shards of `evflow report live --shard` in `dirs` (in any
+/// order) into `out`.
+pub fn merge_live(out: &Path, dirs: &[PathBuf]) -> Result<LiveMerge, MergeError> {
+    if dirs.is_empty() {
+        return Err(MergeError::NoShards);
+    }
+    let mut shards = Vec::new();
+    for d in dirs {
+        let saved = LiveRecord::read(d)?;
+        let shard = saved.slice().map_err(|e| StudyError::Config(format!("{}: {e}", d.display())))?;
+        shards.push((d.clone(), shard, saved));
+    }
+    shards.sort_by_key(|(_, s, _)| s.k);
+    let (first_dir, first_shard, first) = &shards[0];
+    for (dir, shard, s) in &shards {
+        let differs = |what| MergeError::NotOneBatch { first: first_dir.clone(), other: dir.clone(), what };
+        if shard.n != first_shard.n {
+            return Err(differs("the shard counts N"));
+        }
+        if s.scope != first.scope || s.items != first.items {
+            return Err(differs(
+                "the reports' settings: profiles, samples, users, gains, grid, epochs, iterations, seconds, floor \
+                 or the live synthesis' settings",
+            ));
+        }
+    }
+    let shards = k_order(shards)?;
+    let folders: Vec<&Path> = shards.iter().map(|(d, _, _)| d.as_path()).collect();
+    let files = copy_files(out, &folders, &[PathBuf::from(RECORD)])?;
+    std::fs::create_dir_all(out).map_err(|source| MergeError::Create { dir: out.to_path_buf(), source })?;
+    let base = std::fs::canonicalize(out).map_err(|source| MergeError::Create { dir: out.to_path_buf(), source })?;
+    let saved: Vec<LiveRecord> = shards.into_iter().map(|(_, _, s)| s).collect();
+    let study = LiveRecord::join(&saved, &base);
+    let scope = &saved[0].scope;
+    let md = markdown(&study, scope);
+    let (md_path, csv_path) = (out.join("live.md"), out.join("rows.csv"));
+    write(&md_path, &md)?;
+    write(&csv_path, &csv(&study))?;
+    let mut written = vec![md_path, csv_path];
+    for (name, plot) in figures(&study, scope) {
+        // A figure that cannot be drawn is not a failed merge (as in the report).
+        if let Ok(w) = crate::plot::write_png(&plot, &out.join(name)) {
+            written.push(w.path);
+        }
+    }
+    Ok(LiveMerge {
+        shards: saved.len(),
+        rows: study.rows.len(),
+        items: saved[0].items,
+        files,
+        written,
+        markdown: md,
+        failures: Failures { list: study.failures.clone() },
+    })
+}

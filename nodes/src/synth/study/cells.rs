@@ -19,9 +19,10 @@ pub fn name(sample: &str, c: &Cond) -> String {
 /// (over its `steady` gate) as the cell of `sample` at `c` into `grid`, at
 /// `gain` (Table 5.1's, which `interp` applies), marked
 /// `condition.carrier = "nyquist"` when `carrier` (the method's actuation
-/// rides a Nyquist-rate carrier: [`super::row::Method::carrier`]) and the
-/// cell does ([`rides_carrier`]: an optimized synthesis kept from the
-/// inverse model's start need not). The
+/// rides a Nyquist-rate carrier: [`super::row::Method::carrier`]; every
+/// cell of a grid must agree, so an optimized cell kept from the inverse
+/// model's start — where the forward model has no carrier gain — is marked
+/// too). The
 /// `narx` node's output lags the force by its look-ahead; a grid cell is a
 /// texture loop, so that shift of a few samples does not matter. Returns
 /// the cell's path (without extension).
@@ -38,25 +39,8 @@ pub fn write_actuation(
     let (_, steady) = channel(from, "steady")?;
     let mut kept = Vec::new();
     open_runs(&[&steady], u.len().min(steady.len()), |a, b| kept.extend_from_slice(&u[a..b]));
-    let carrier = carrier && rides_carrier(&kept);
     let source = format!("evflow study: graphs/synthesize.toml, `{channel_name}` over the constant-speed stretch");
     write(&kept, rate, "1", grid, sample, c, gain, carrier, source, from)
-}
-
-/// Whether `u` rides a Nyquist-rate carrier, u[n] = (−1)ⁿ·a[n] with an
-/// envelope a smoother than u itself: Σ(Δa)² < Σ(Δu)² — most of u's
-/// power lies near the Nyquist frequency, and most of a's near 0 Hz (a
-/// signal whose power sits in the lower half of the band has the
-/// opposite).
-pub fn rides_carrier(u: &[f64]) -> bool {
-    let (mut du, mut da) = (0.0, 0.0);
-    for n in 1..u.len() {
-        let a1 = if n % 2 == 0 { u[n] } else { -u[n] };
-        let a0 = if n % 2 == 0 { -u[n - 1] } else { u[n - 1] };
-        du += (u[n] - u[n - 1]).powi(2);
-        da += (a1 - a0).powi(2);
-    }
-    da < du
 }
 
 /// Writes the recorded force (channel `force`, newtons) of the texture
@@ -111,16 +95,6 @@ fn write(
 mod tests {
     use super::*;
     use crate::recording::format::Recording;
-
-    #[test]
-    fn a_carrier_is_told_from_a_baseband_signal() {
-        let env: Vec<f64> = (0..500).map(|n| 0.5 + 0.3 * (n as f64 * 0.05).sin()).collect();
-        let on_carrier: Vec<f64> = env.iter().enumerate().map(|(n, a)| if n % 2 == 0 { *a } else { -a }).collect();
-        assert!(rides_carrier(&on_carrier));
-        assert!(!rides_carrier(&env));
-        let force_shaped: Vec<f64> = (0..500).map(|n| (n as f64 * 0.2).sin()).collect();
-        assert!(!rides_carrier(&force_shaped));
-    }
 
     #[test]
     fn an_actuation_cell_keeps_the_steady_stretch_and_names_its_condition() {

@@ -271,8 +271,8 @@ pub fn figures(study: &LiveStudy, scope: &LiveScope) -> Vec<(String, crate::plot
         out.push((
             format!("live-{p}.png"),
             Plot {
-                title: format!("{p}: E_s under the virtual users (Welch, mean over users) — {}", names.join(", ")),
-                x_label: "sample".into(),
+                title: format!("{p}: E_s under the virtual users (Welch, mean over users)"),
+                x_label: format!("sample: {}", names.join(", ")),
                 y_label: "E_s".into(),
                 log_x: false,
                 log_y: false,

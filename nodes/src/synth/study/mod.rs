@@ -29,6 +29,7 @@ pub mod row;
 pub mod run;
 pub mod saved;
 pub mod setup;
+pub mod shard_file;
 pub mod spectrum;
 pub mod summary;
 pub mod twin;

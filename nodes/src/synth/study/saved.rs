@@ -166,32 +166,15 @@ impl SavedStudy {
     /// Writes the record into `dir` (through a temporary file, so a record
     /// is whole or absent).
     pub fn write(&self, dir: &Path) -> Result<(), StudyError> {
-        let path = dir.join(RECORD);
-        let tmp = dir.join(format!(".{RECORD}.tmp"));
-        let io = |e: std::io::Error| StudyError::Io { path: path.clone(), message: e.to_string() };
-        let text = serde_json::to_string_pretty(self).map_err(|e| io(e.into()))?;
-        std::fs::write(&tmp, text).and_then(|_| std::fs::rename(&tmp, &path)).map_err(io)
+        super::shard_file::write(dir, RECORD, self)
     }
 
     /// Reads the record in `dir`; errors name the file and, for a malformed
     /// record, the line and column.
     pub fn read(dir: &Path) -> Result<Self, StudyError> {
-        let path = dir.join(RECORD);
-        let text = std::fs::read_to_string(&path).map_err(|e| StudyError::Io {
-            path: path.clone(),
-            message: format!("{e} (is it the --out of `evflow report textures --shard`?)"),
-        })?;
-        let saved: Self = serde_json::from_str(&text)
-            .map_err(|e| StudyError::Io { path: path.clone(), message: format!("not a study shard's record: {e}") })?;
-        let bad = |m: String| StudyError::Io { path: path.clone(), message: m };
-        let shard = saved.slice().map_err(|e| bad(e.to_string()))?;
-        let expected = shard.range(saved.cells);
-        if saved.range != [expected.start, expected.end] {
-            return Err(bad(format!(
-                "shard {shard} of {} cells should hold cells {expected:?}, not {:?}",
-                saved.cells, saved.range
-            )));
-        }
+        let saved: Self =
+            super::shard_file::read(dir, RECORD, "evflow report textures --shard", "a study shard's record")?;
+        super::shard_file::slice(dir, RECORD, &saved.shard, saved.cells, saved.range, "cells")?;
         Ok(saved)
     }
 

@@ -23,6 +23,37 @@ pub fn k_order<T>(mut shards: Vec<(PathBuf, Shard, T)>) -> Result<Vec<(PathBuf, 
     Ok(shards)
 }
 
+/// Reads every shard folder of `dirs` with `read` (its slice and record),
+/// puts them in K order and checks that they are the N slices of one batch:
+/// the same N, and records `same` as the first's (else `what` differs).
+pub fn one_batch<T>(
+    dirs: &[PathBuf],
+    read: impl Fn(&Path) -> Result<(Shard, T), MergeError>,
+    same: impl Fn(&T, &T) -> bool,
+    what: &'static str,
+) -> Result<Vec<(PathBuf, Shard, T)>, MergeError> {
+    if dirs.is_empty() {
+        return Err(MergeError::NoShards);
+    }
+    let mut shards = Vec::with_capacity(dirs.len());
+    for d in dirs {
+        let (shard, record) = read(d)?;
+        shards.push((d.clone(), shard, record));
+    }
+    shards.sort_by_key(|(_, s, _)| s.k);
+    let (first_dir, first_shard, first) = &shards[0];
+    for (dir, shard, s) in &shards {
+        let differs = |what| MergeError::NotOneBatch { first: first_dir.clone(), other: dir.clone(), what };
+        if shard.n != first_shard.n {
+            return Err(differs("the shard counts N"));
+        }
+        if !same(s, first) {
+            return Err(differs(what));
+        }
+    }
+    k_order(shards)
+}
+
 /// Every file under `dir`, as paths relative to it, sorted.
 fn files_under(dir: &Path) -> Result<Vec<PathBuf>, MergeError> {
     let mut out = Vec::new();

@@ -7,9 +7,9 @@
 //! uses — one run's, byte for byte.
 
 use super::error::MergeError;
-use super::files::{copy_files, k_order, write};
+use super::files::{copy_files, one_batch, write};
 use crate::report::live_table::{csv, figures, markdown};
-use evflow_engine::batch::Failures;
+use evflow_engine::batch::{Failures, Shard};
 use evflow_nodes::synth::study::live::saved::{LiveRecord, RECORD};
 use evflow_nodes::synth::study::StudyError;
 use std::path::{Path, PathBuf};
@@ -41,30 +41,18 @@ pub fn is_live_shard(dir: &Path) -> bool {
 /// Merges the shards of `evflow report live --shard` in `dirs` (in any
 /// order) into `out`.
 pub fn merge_live(out: &Path, dirs: &[PathBuf]) -> Result<LiveMerge, MergeError> {
-    if dirs.is_empty() {
-        return Err(MergeError::NoShards);
-    }
-    let mut shards = Vec::new();
-    for d in dirs {
+    let read = |d: &Path| -> Result<(Shard, LiveRecord), MergeError> {
         let saved = LiveRecord::read(d)?;
         let shard = saved.slice().map_err(|e| StudyError::Config(format!("{}: {e}", d.display())))?;
-        shards.push((d.clone(), shard, saved));
-    }
-    shards.sort_by_key(|(_, s, _)| s.k);
-    let (first_dir, first_shard, first) = &shards[0];
-    for (dir, shard, s) in &shards {
-        let differs = |what| MergeError::NotOneBatch { first: first_dir.clone(), other: dir.clone(), what };
-        if shard.n != first_shard.n {
-            return Err(differs("the shard counts N"));
-        }
-        if s.scope != first.scope || s.items != first.items {
-            return Err(differs(
-                "the reports' settings: profiles, samples, users, gains, grid, epochs, iterations, seconds, floor \
-                 or the live synthesis' settings",
-            ));
-        }
-    }
-    let shards = k_order(shards)?;
+        Ok((shard, saved))
+    };
+    let shards = one_batch(
+        dirs,
+        read,
+        |a, b| a.scope == b.scope && a.items == b.items,
+        "the reports' settings: profiles, samples, users, gains, grid, epochs, iterations, seconds, floor or the \
+         live synthesis' settings",
+    )?;
     let folders: Vec<&Path> = shards.iter().map(|(d, _, _)| d.as_path()).collect();
     let files = copy_files(out, &folders, &[PathBuf::from(RECORD)])?;
     std::fs::create_dir_all(out).map_err(|source| MergeError::Create { dir: out.to_path_buf(), source })?;

@@ -8,7 +8,7 @@
 //! on the shards they are byte for byte one run's.
 
 use super::error::MergeError;
-use super::files::{copy_files, k_order, write};
+use super::files::{copy_files, one_batch, write};
 use crate::report::textures_table::{csv, markdown, Timings};
 use evflow_engine::batch::{Failures, Shard};
 use evflow_nodes::synth::study::saved::{SavedStudy, RECORD};
@@ -39,30 +39,18 @@ pub struct TexturesMerge {
 /// Merges the shards of `evflow report textures --shard` in `dirs` (in any
 /// order) into `out`.
 pub fn merge_textures(out: &Path, dirs: &[PathBuf]) -> Result<TexturesMerge, MergeError> {
-    if dirs.is_empty() {
-        return Err(MergeError::NoShards);
-    }
-    let mut shards = Vec::new();
-    for d in dirs {
+    let read = |d: &Path| -> Result<(Shard, SavedStudy), MergeError> {
         let saved = SavedStudy::read(d)?;
         let shard = saved.slice().map_err(|e| StudyError::Config(format!("{}: {e}", d.display())))?;
-        shards.push((d.clone(), shard, saved));
-    }
-    shards.sort_by_key(|(_, s, _)| s.k);
-    let (first_dir, first_shard, first) = &shards[0];
-    for (dir, shard, s) in &shards {
-        let differs = |what| MergeError::NotOneBatch { first: first_dir.clone(), other: dir.clone(), what };
-        if shard.n != first_shard.n {
-            return Err(differs("the shard counts N"));
-        }
-        if s.scope != first.scope || s.cells != first.cells {
-            return Err(differs(
-                "the reports' settings: samples, conditions, profiles, gains, epochs, iterations, objective, \
-                 floor, multilevel or --no-times",
-            ));
-        }
-    }
-    let shards = k_order(shards)?;
+        Ok((shard, saved))
+    };
+    let shards = one_batch(
+        dirs,
+        read,
+        |a, b| a.scope == b.scope && a.cells == b.cells,
+        "the reports' settings: samples, conditions, profiles, gains, epochs, iterations, objective, floor, \
+         multilevel or --no-times",
+    )?;
     let folders: Vec<&Path> = shards.iter().map(|(d, _, _)| d.as_path()).collect();
     let files = copy_files(out, &folders, &[PathBuf::from(RECORD)])?;
     std::fs::create_dir_all(out).map_err(|source| MergeError::Create { dir: out.to_path_buf(), source })?;

@@ -9,6 +9,7 @@ use super::row::LiveRow;
 use super::run::{LiveConfig, LiveStudy};
 use super::scope::LiveScope;
 use crate::synth::study::saved::SavedFailure;
+use crate::synth::study::shard_file;
 use crate::synth::study::StudyError;
 use evflow_engine::batch::Shard;
 use serde::{Deserialize, Serialize};
@@ -59,33 +60,13 @@ impl LiveRecord {
 
     /// Writes the record into `dir` (through a temporary file: whole or absent).
     pub fn write(&self, dir: &Path) -> Result<(), StudyError> {
-        let path = dir.join(RECORD);
-        let tmp = dir.join(format!(".{RECORD}.tmp"));
-        let io = |e: std::io::Error| StudyError::Io { path: path.clone(), message: e.to_string() };
-        let text = serde_json::to_string_pretty(self).map_err(|e| io(e.into()))?;
-        std::fs::write(&tmp, text).and_then(|_| std::fs::rename(&tmp, &path)).map_err(io)
+        shard_file::write(dir, RECORD, self)
     }
 
     /// Reads the record in `dir`; errors name the file and what is wrong.
     pub fn read(dir: &Path) -> Result<Self, StudyError> {
-        let path = dir.join(RECORD);
-        let text = std::fs::read_to_string(&path).map_err(|e| StudyError::Io {
-            path: path.clone(),
-            message: format!("{e} (is it the --out of `evflow report live --shard`?)"),
-        })?;
-        let saved: Self = serde_json::from_str(&text).map_err(|e| StudyError::Io {
-            path: path.clone(),
-            message: format!("not a live study shard's record: {e}"),
-        })?;
-        let bad = |m: String| StudyError::Io { path: path.clone(), message: m };
-        let shard = saved.slice().map_err(|e| bad(e.to_string()))?;
-        let expected = shard.range(saved.items);
-        if saved.range != [expected.start, expected.end] {
-            return Err(bad(format!(
-                "shard {shard} of {} items should hold items {expected:?}, not {:?}",
-                saved.items, saved.range
-            )));
-        }
+        let saved: Self = shard_file::read(dir, RECORD, "evflow report live --shard", "a live study shard's record")?;
+        shard_file::slice(dir, RECORD, &saved.shard, saved.items, saved.range, "items")?;
         Ok(saved)
     }
 

@@ -1,0 +1,50 @@
+//! A study shard's record as a file: written as JSON through a temporary
+//! file (whole or absent), read back with the file named in every error,
+//! and its slice checked against the range it says it holds. The texture
+//! study's ([`super::saved`]) and the live study's
+//! ([`super::live::saved`]) records share it.
+
+use super::StudyError;
+use evflow_engine::batch::Shard;
+use serde::de::DeserializeOwned;
+use serde::Serialize;
+use std::path::Path;
+
+/// Writes `value` to `dir/name` as JSON, through `dir/.name.tmp`.
+pub fn write<T: Serialize>(dir: &Path, name: &str, value: &T) -> Result<(), StudyError> {
+    let path = dir.join(name);
+    let tmp = dir.join(format!(".{name}.tmp"));
+    let io = |e: std::io::Error| StudyError::Io { path: path.clone(), message: e.to_string() };
+    let text = serde_json::to_string_pretty(value).map_err(|e| io(e.into()))?;
+    std::fs::write(&tmp, text).and_then(|_| std::fs::rename(&tmp, &path)).map_err(io)
+}
+
+/// Reads `dir/name`: `command` is what writes it (named when the file is
+/// missing), `what` what it should be (named when it is not that).
+pub fn read<T: DeserializeOwned>(dir: &Path, name: &str, command: &str, what: &str) -> Result<T, StudyError> {
+    let path = dir.join(name);
+    let text = std::fs::read_to_string(&path).map_err(|e| StudyError::Io {
+        path: path.clone(),
+        message: format!("{e} (is it the --out of `{command}`?)"),
+    })?;
+    serde_json::from_str(&text).map_err(|e| StudyError::Io { path, message: format!("not {what}: {e}") })
+}
+
+/// The slice `shard` (`K/N`) of a record in `dir/name` over `total`
+/// `unit`s, checked to hold exactly `range`.
+pub fn slice(
+    dir: &Path,
+    name: &str,
+    shard: &str,
+    total: usize,
+    range: [usize; 2],
+    unit: &str,
+) -> Result<Shard, StudyError> {
+    let bad = |m: String| StudyError::Io { path: dir.join(name), message: m };
+    let s = Shard::parse(shard).map_err(|e| bad(e.to_string()))?;
+    let expected = s.range(total);
+    if range != [expected.start, expected.end] {
+        return Err(bad(format!("shard {s} of {total} {unit} should hold {unit} {expected:?}, not {range:?}")));
+    }
+    Ok(s)
+}

@@ -36,5 +36,5 @@ pub use node::{BuildContext, Io, Node, NodeError, PrepareContext, Refused, RunMo
 pub use params::{Params, Value};
 pub use plan::{Plan, PlanOptions};
 pub use registry::Registry;
-pub use run::{run_offline, RunOptions, RunReport};
+pub use run::{check_duration, run_offline, RunOptions, RunReport};
 pub use spec::{Direction, NodeSpec, ParamSpec, PortSpec, RateSpec, Role};

@@ -11,6 +11,12 @@ use crate::spec::NodeSpec;
 use std::path::PathBuf;
 use std::time::{Duration, Instant};
 
+/// The most samples one buffer of a plan may hold: 2²⁴ (128 MiB of f64).
+pub const MAX_BUFFER_SAMPLES: usize = 1 << 24;
+
+/// The most samples all the buffers of a plan may hold together: 2²⁷ (1 GiB).
+pub const MAX_POOL_SAMPLES: usize = 1 << 27;
+
 /// A node that failed to build, prepare, process or finish.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
 #[error("{}{}: node `{node}` ({kind}): {error}", file.display(), if loc.line > 0 { format!(":{}", loc.line) } else { String::new() })]
@@ -226,7 +232,46 @@ impl Plan {
                 unit = lcm(unit, p.ratio.div);
             }
         }
-        let mut max_block = (opts.max_block.max(1) as u64).div_ceil(unit) * unit;
+        // …and no larger than memory allows: every buffer holds one block of
+        // its port's rate, so a port at many samples per base tick (a fast node
+        // in a graph of a slow base rate) or a huge `--block` would ask for
+        // gigabytes. The block shrinks to fit (down to `unit`); a graph whose
+        // smallest block does not fit is refused, naming the fastest node.
+        let requested = (opts.max_block.max(1) as u64).div_ceil(unit).saturating_mul(unit);
+        let per_tick = |r: &Ratio| if r.div == 1 { r.mul as f64 } else { 1.0 / r.div as f64 };
+        let (mut widest, mut total) = (None::<(usize, f64)>, 0.0);
+        for &i in &order {
+            for p in checked.nodes[i].outputs() {
+                let w = per_tick(&checked.nodes[i].ports[p].ratio);
+                total += w;
+                if widest.is_none_or(|(_, x)| w > x) {
+                    widest = Some((i, w));
+                }
+            }
+        }
+        let fits = |samples_per_tick: f64, limit: usize| {
+            if samples_per_tick > 0.0 {
+                (limit as f64 / samples_per_tick).floor()
+            } else {
+                f64::INFINITY
+            }
+        };
+        let by_memory = fits(widest.map_or(0.0, |w| w.1), MAX_BUFFER_SAMPLES).min(fits(total, MAX_POOL_SAMPLES));
+        let by_memory = (by_memory.min(u64::MAX as f64) as u64) / unit * unit;
+        if by_memory < unit {
+            let (i, w) = widest.unwrap_or((order.first().copied().unwrap_or(0), 0.0));
+            return Err(fail(
+                i,
+                NodeError::Other(format!(
+                    "this node makes {w} samples per base tick of the graph's {} Hz, and the smallest block the \
+                     graph's rates allow is {unit} base ticks: its buffers would need {:.3e} samples, more than the \
+                     {MAX_BUFFER_SAMPLES} (128 MiB) a buffer may hold ({MAX_POOL_SAMPLES} for all); raise [graph] rate",
+                    g.rate,
+                    w * unit as f64
+                )),
+            ));
+        }
+        let mut max_block = requested.min(by_memory);
 
         // Slots: one per output of each node in the plan.
         let mut slot_of = vec![Vec::new(); n_nodes];

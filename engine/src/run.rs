@@ -14,6 +14,9 @@ pub enum RunError {
     /// A node failed.
     #[error(transparent)]
     Node(#[from] Box<NodeFailure>),
+    /// A run length that is not a positive number of seconds up to [`MAX_DURATION_S`].
+    #[error("a run of {0} s: {why}", why = duration_problem(*.0))]
+    Duration(f64),
     /// Stopped by the caller (e.g. Ctrl-C); sinks were not finished, so no
     /// partial output was kept.
     #[error("interrupted after {0} base ticks; no output was written")]
@@ -60,9 +63,35 @@ pub struct RunOptions<'a> {
     pub progress: Option<&'a mut dyn FnMut(u64, u64) -> bool>,
 }
 
+/// The longest run length the engine takes, s (as the graph file's `duration`).
+pub const MAX_DURATION_S: f64 = 1e7;
+
+fn duration_problem(d: f64) -> &'static str {
+    if d.is_nan() {
+        "not a number"
+    } else if d <= 0.0 {
+        "a run length must be positive"
+    } else {
+        "a run length must be at most 1e7 s (116 days)"
+    }
+}
+
+/// `d` if it is a run length the engine takes — a positive, finite number of
+/// seconds up to [`MAX_DURATION_S`] — else why not (for `--duration`).
+pub fn check_duration(d: f64) -> Result<f64, String> {
+    if d.is_finite() && d > 0.0 && d <= MAX_DURATION_S {
+        Ok(d)
+    } else {
+        Err(format!("{d} s: {}", duration_problem(d)))
+    }
+}
+
 /// Runs a plan from t = 0 to the end of its shortest finite source (or the
 /// duration), then finishes every node.
 pub fn run_offline(plan: &mut Plan, mut opts: RunOptions<'_>) -> Result<RunReport, RunError> {
+    if let Some(d) = opts.duration {
+        check_duration(d).map_err(|_| RunError::Duration(d))?;
+    }
     let by_duration = opts.duration.or(plan.duration()).map(|d| (d * plan.base_rate()).round() as u64);
     let total = match (plan.remaining_ticks(), by_duration) {
         (Some(a), Some(b)) => a.min(b),
@@ -153,6 +182,22 @@ mod tests {
             FINISH_NS.store(took.as_nanos() as u64, Ordering::SeqCst);
             Ok(Summary::default())
         }
+    }
+
+    #[test]
+    fn a_run_length_must_be_a_positive_finite_number_of_seconds() {
+        for bad in [f64::INFINITY, 1e308, 0.0, -1.0, f64::NAN] {
+            assert!(check_duration(bad).is_err(), "{bad}");
+        }
+        assert_eq!(check_duration(2.5), Ok(2.5));
+        let doc = "[graph]\nformat = 1\nname = \"t\"\nrate = 1000.0\nconnections = [\"f.out -> t.in\"]\n\
+                   [nodes.f]\ntype = \"harness.feed\"\nvalues = [1.0, 2.0, 3.0]\n[nodes.t]\ntype = \"test.trainer\"\n";
+        let mut reg = Registry::new();
+        reg.add(&FEED).add(&TRAINER);
+        let checked = check(&parse_graph(Path::new("t.toml"), doc).unwrap(), &reg, &[]).unwrap();
+        let mut plan = Plan::build(&checked, &PlanOptions::default()).unwrap();
+        let e = run_offline(&mut plan, RunOptions { duration: Some(f64::INFINITY), progress: None }).unwrap_err();
+        assert!(e.to_string().contains("at most 1e7 s"), "{e}");
     }
 
     #[test]

@@ -55,3 +55,10 @@ impl GraphArgs {
         load_with(&self.file, &self.set)
     }
 }
+
+/// `--duration`: a positive, finite number of seconds up to 1e7 (what the
+/// engine runs; `inf` or `1e308` would run until killed).
+pub fn parse_duration(s: &str) -> Result<f64, String> {
+    let d: f64 = s.trim().parse().map_err(|_| format!("`{s}` is not a number of seconds"))?;
+    evflow_engine::check_duration(d)
+}

@@ -25,7 +25,7 @@ pub struct Args {
     /// Session length in seconds (default: the graph's `duration`, else
     /// until Ctrl-C or a finite source ends). The safety limiters then fade
     /// out (10 ms) before the session ends.
-    #[arg(long)]
+    #[arg(long, value_parser = super::graph_args::parse_duration)]
     duration: Option<f64>,
     /// Ignore the graph's `duration` and run until stopped.
     #[arg(long, conflicts_with = "duration")]

@@ -34,7 +34,7 @@ pub struct Args {
     seed: Option<u64>,
     /// Run length in seconds, for graphs with endless sources (finite
     /// sources still end the run early).
-    #[arg(long)]
+    #[arg(long, value_parser = super::graph_args::parse_duration)]
     duration: Option<f64>,
     /// Block size in base ticks (larger is faster offline; results do not
     /// depend on it).

@@ -543,3 +543,35 @@ fn report_textures_shards_merged_equal_one_report() {
     assert!(err.contains("stiff: felt-fabric at 60 g, 3 cm/s (shard 2/3): it broke"), "{err}");
     assert_eq!(std::fs::read(m4.join("rows.csv")).unwrap(), std::fs::read(one.join("rows.csv")).unwrap());
 }
+
+/// The README's main job in shards (issue 27, point 8): a shard draws no
+/// plot of the sweep (it holds part of it), and `evflow merge` draws them
+/// from every run, so the merge is one run's output, PNGs included, byte
+/// for byte.
+#[test]
+fn the_main_job_in_shards_merges_into_one_run_plots_included() {
+    let base = tempfile::tempdir().unwrap();
+    let dir = |n: &str| base.path().join(n).to_str().unwrap().to_string();
+    let o = evflow(&["run", "graphs/characterize.toml", "-q", "--out", &dir("one")]);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    for k in 1..=2 {
+        let o = evflow(&[
+            "run",
+            "graphs/characterize.toml",
+            "-q",
+            "--shard",
+            &format!("{k}/2"),
+            "--out",
+            &dir(&format!("s{k}")),
+        ]);
+        assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+        assert!(String::from_utf8_lossy(&o.stdout).contains("plots: drawn by `evflow merge`"));
+        assert!(!base.path().join(format!("s{k}/characterize-static.png")).exists());
+    }
+    let o = evflow(&["merge", &dir("m"), &dir("s2"), &dir("s1")]);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    for png in ["characterize-static.png", "characterize-vibratory.png"] {
+        let one = std::fs::read(base.path().join("one").join(png)).unwrap();
+        assert_eq!(one, std::fs::read(base.path().join("m").join(png)).unwrap(), "{png}");
+    }
+}

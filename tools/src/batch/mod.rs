@@ -10,6 +10,7 @@ pub mod merge;
 pub mod narx_shard;
 pub mod record_json;
 pub mod shard_record;
+pub mod sweep_plots;
 pub mod tables;
 
 use evflow_engine::batch::{default_jobs, Shard};

@@ -12,7 +12,7 @@ use evflow_engine::graph::parse_cli_value;
 use evflow_engine::params::Value;
 use evflow_engine::plan::NodeTime;
 use evflow_engine::sweep::Point;
-use evflow_engine::{RunReport, Summary};
+use evflow_engine::{Override, RunReport, Summary};
 use serde_json::{json, Value as Json};
 use std::ops::Range;
 use std::path::Path;
@@ -46,6 +46,8 @@ pub struct ShardRecord {
     pub csv: Option<String>,
     /// The JSON results' path relative to the output folder, if written.
     pub json: Option<String>,
+    /// The `--set` values the runs took (the plots read variables through them).
+    pub sets: Vec<Override>,
 }
 
 /// `path` relative to `dir` when it lies inside it, else as given.
@@ -122,6 +124,7 @@ impl ShardRecord {
             "times": self.timings == Timings::Show,
             "csv": self.csv,
             "json": self.json,
+            "sets": self.sets.iter().map(|o| json!([o.key, exact_text(&o.value)])).collect::<Vec<_>>(),
             "runs": runs,
             "failures": failures,
         });
@@ -229,6 +232,19 @@ fn parse_record(doc: &Json) -> Fault<ShardRecord> {
         timings: if flag("times")? { Timings::Show } else { Timings::Leave },
         csv: optional_text(doc, "csv")?,
         json: optional_text(doc, "json")?,
+        sets: match doc.get("sets") {
+            // Records written before `sets` was: no --set to read.
+            None => Vec::new(),
+            Some(_) => list(doc, "sets")?
+                .iter()
+                .map(|v| match v.as_array().map(Vec::as_slice) {
+                    Some([Json::String(k), Json::String(t)]) => {
+                        Ok(Override { key: k.clone(), value: parse_cli_value(t) })
+                    }
+                    _ => Err("a `sets` entry is not [name, text]".to_string()),
+                })
+                .collect::<Fault<Vec<_>>>()?,
+        },
     })
 }
 
@@ -280,6 +296,7 @@ pub(crate) mod tests {
             timings: Timings::Show,
             csv: Some("t.csv".into()),
             json: None,
+            sets: vec![Override::parse("mass=85.5").unwrap(), Override::parse("sample=\"felt\"").unwrap()],
         }
     }
 
@@ -300,6 +317,7 @@ pub(crate) mod tests {
             (back.sweep, back.timings, back.csv.clone(), back.json.clone()),
             (true, Timings::Show, rec.csv, None)
         );
+        assert_eq!(back.sets, rec.sets);
         for ((p, r), (q, s)) in rec.runs.iter().zip(&back.runs) {
             assert_eq!(p.label(), q.label());
             assert_eq!(r.base_rate.to_bits(), s.base_rate.to_bits());

@@ -85,6 +85,13 @@ pub fn main(a: Args) -> Result<()> {
             for table in &m.tables {
                 println!("wrote {}", table.display());
             }
+            for l in &m.plots.0 {
+                println!("{l}");
+            }
+            // A figure that cannot be drawn does not undo the merge: say why and go on.
+            for e in &m.plots.1 {
+                eprintln!("warning: {e}");
+            }
             println!(
                 "merged {} shards of {}: {} of {} runs, {} files the graphs wrote",
                 m.shards, m.graph, m.runs, m.total, m.files

@@ -15,7 +15,6 @@ pub mod nodes;
 pub mod replay;
 pub mod report;
 pub mod run;
-pub mod run_plots;
 pub mod run_report;
 #[cfg(feature = "studio")]
 pub mod studio;

@@ -169,13 +169,19 @@ pub fn main(a: Args) -> Result<()> {
     if let Some(path) = &a.json {
         write(path, &report_json(&reports, is_sweep, timings), "results")?;
     }
-    let (lines, errors) = super::run_plots::draw_plots(&graph, &reports, &overrides, &a.out);
-    for l in lines {
-        println!("{l}");
-    }
-    // A figure that cannot be drawn does not undo the runs: say why and go on.
-    for e in errors {
-        eprintln!("warning: {e}");
+    // A shard holds part of the sweep: its plots are drawn by `evflow merge`
+    // from every run, so that the merge equals one run, plots included.
+    if a.batch.shard.is_none() {
+        let (lines, errors) = evflow_tools::batch::sweep_plots::draw_plots(&graph, &reports, &overrides, &a.out);
+        for l in lines {
+            println!("{l}");
+        }
+        // A figure that cannot be drawn does not undo the runs: say why and go on.
+        for e in errors {
+            eprintln!("warning: {e}");
+        }
+    } else if !graph.plots.is_empty() {
+        println!("plots: drawn by `evflow merge` from the whole sweep");
     }
     if let Some(path) = &a.csv {
         write(path, &sweep_csv(&reports, timings), "table")?;
@@ -193,6 +199,7 @@ pub fn main(a: Args) -> Result<()> {
             timings,
             csv: a.csv.as_deref().map(|p| relative_to(p, &a.out)),
             json: a.json.as_deref().map(|p| relative_to(p, &a.out)),
+            sets: overrides.clone(),
         };
         record.write(&a.out)?;
     }

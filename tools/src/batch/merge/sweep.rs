@@ -27,6 +27,9 @@ pub struct SweepMerge {
     pub tables: Vec<PathBuf>,
     /// The runs that failed in the shards, labelled with their shard.
     pub failures: Failures,
+    /// The graph's plots of the whole sweep, drawn from every run: lines for
+    /// people (files written, fits), and why a plot could not be drawn.
+    pub plots: (Vec<String>, Vec<String>),
 }
 /// Merges the shards of a sweep (`evflow run --shard`) in `dirs` into `out`.
 pub fn merge_sweep(out: &Path, dirs: &[PathBuf]) -> Result<SweepMerge, MergeError> {
@@ -73,7 +76,15 @@ pub fn merge_sweep(out: &Path, dirs: &[PathBuf]) -> Result<SweepMerge, MergeErro
         write(&path, &report_json(&runs, first.sweep, first.timings))?;
         tables.push(path);
     }
+    // A plot of the whole sweep is drawn here, from every run (the shards
+    // draw none), as `evflow run` draws it.
+    let plots = match evflow_engine::read_graph(Path::new(&first.graph)) {
+        Ok(g) if !g.plots.is_empty() => crate::batch::sweep_plots::draw_plots(&g, &runs, &first.sets, out),
+        Ok(_) => (Vec::new(), Vec::new()),
+        Err(e) => (Vec::new(), vec![format!("the plots of {} are not drawn: {e}", first.graph)]),
+    };
     Ok(SweepMerge {
+        plots,
         shards: shards.len(),
         graph: first.graph,
         runs: runs.len(),

@@ -1,11 +1,13 @@
-//! Draws a graph's `[[plot]]` figures from the results of its runs.
+//! Draws a graph's `[[plot]]` figures from the results of its runs: `evflow
+//! run` after a sweep, and `evflow merge` after joining a sweep's shards (a
+//! plot of the whole sweep is drawn from every run, never by a shard).
 
+use crate::fit::polyfit;
+use crate::plot::{write_png, Plot, Series};
 use evflow_engine::check::interpolate::text_of;
 use evflow_engine::graph::{Fit, Graph, PlotDecl};
 use evflow_engine::sweep::Point;
 use evflow_engine::{Override, RunReport, Value};
-use evflow_tools::fit::polyfit;
-use evflow_tools::plot::{write_png, Plot, Series};
 use std::path::Path;
 
 /// A quantity of one run: a variable, a reported value, a node's run time

@@ -17,10 +17,11 @@ impl PolyFit {
         self.coef.iter().rev().fold(0.0, |acc, c| acc * x + c)
     }
 
-    /// `y = a + b·x + c·x²` with the coefficients written out.
+    /// `y = a + b·x + c·x²` with the coefficients written out (a power a
+    /// restricted fit leaves out, exactly 0, is not written).
     pub fn formula(&self) -> String {
         let mut s = format!("y = {:.6}", self.coef[0]);
-        for (k, c) in self.coef.iter().enumerate().skip(1) {
+        for (k, c) in self.coef.iter().enumerate().skip(1).filter(|(_, c)| **c != 0.0) {
             let sign = if *c < 0.0 { '−' } else { '+' };
             let pow = if k == 1 { "x".to_string() } else { format!("x^{k}") };
             s.push_str(&format!(" {sign} {:.6}·{pow}", c.abs()));
@@ -100,6 +101,20 @@ pub fn polyfit(points: &[(f64, f64)], degree: usize) -> Option<PolyFit> {
     Some(PolyFit { r2, ..fit })
 }
 
+/// The square law y = a + b·x² by least squares (the law of
+/// electrovibration's static friction increase and vibration against the
+/// input intensity, dissertation §3.1.2: no linear term). `None` with fewer
+/// than two distinct x² values or non-finite points.
+pub fn square_law(points: &[(f64, f64)]) -> Option<PolyFit> {
+    if points.iter().any(|(x, y)| !x.is_finite() || !y.is_finite()) {
+        return None;
+    }
+    // A straight line through (x², y).
+    let squared: Vec<(f64, f64)> = points.iter().map(|&(x, y)| (x * x, y)).collect();
+    let line = polyfit(&squared, 1)?;
+    Some(PolyFit { coef: vec![line.coef[0], 0.0, line.coef[1]], r2: line.r2 })
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -113,6 +128,24 @@ mod tests {
             assert!((got - want).abs() < 1e-12, "{:?}", f.coef);
         }
         assert!((f.r2 - 1.0).abs() < 1e-12);
+    }
+
+    #[test]
+    fn the_square_law_has_no_linear_term_and_recovers_its_coefficients() {
+        let pts: Vec<(f64, f64)> = (1..=10).map(|k| k as f64 / 10.0).map(|x| (x, 0.1 + 0.07 * x * x)).collect();
+        let f = square_law(&pts).unwrap();
+        assert!(
+            (f.coef[0] - 0.1).abs() < 1e-12 && f.coef[1] == 0.0 && (f.coef[2] - 0.07).abs() < 1e-12,
+            "{:?}",
+            f.coef
+        );
+        assert!((f.r2 - 1.0).abs() < 1e-12);
+        assert_eq!(f.formula(), "y = 0.100000 + 0.070000·x^2");
+        // Data with a dip (a floor, then the law) fit worse than a free quadratic.
+        let dip: Vec<(f64, f64)> =
+            (1..=10).map(|k| k as f64 / 10.0).map(|x| (x, 0.115 - 0.133 * x + 0.201 * x * x)).collect();
+        assert!(square_law(&dip).unwrap().r2 < polyfit(&dip, 2).unwrap().r2);
+        assert!(square_law(&[(1.0, 1.0), (-1.0, 2.0)]).is_none(), "one distinct x²");
     }
 
     #[test]

@@ -32,10 +32,12 @@ fn static_friction_increase_is_quadratic_in_intensity() {
     for png in ["characterize-vibratory.png", "characterize-static.png"] {
         assert!(dir.path().join(png).exists(), "{png} missing:\n{stdout}");
     }
-    // The quadratic fit of the static increase is reported with its R².
-    let line = stdout.lines().find(|l| l.contains("static.increase: quadratic fit")).expect("fit line");
+    // The square law y = a + b·x² of the static increase is reported with
+    // its R², with no linear term.
+    let line = stdout.lines().find(|l| l.contains("static.increase: square fit")).expect("fit line");
     let r2: f64 = line.rsplit("R² = ").next().unwrap().trim().parse().unwrap();
     assert!(r2 > 0.99, "{line}");
+    assert!(line.contains("·x^2") && !line.contains("·x ") && !line.contains("·x,"), "{line}");
 
     let table = std::fs::read_to_string(&csv).unwrap();
     let head: Vec<&str> = table.lines().next().unwrap().split(',').collect();

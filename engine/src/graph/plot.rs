@@ -11,11 +11,13 @@ pub enum Fit {
     Linear,
     /// y = a + b·x + c·x², least squares.
     Quadratic,
+    /// y = a + b·x², least squares: the square law of electrovibration.
+    Square,
 }
 
 impl Fit {
     /// The names accepted in a graph file.
-    pub const NAMES: [&'static str; 3] = ["none", "linear", "quadratic"];
+    pub const NAMES: [&'static str; 4] = ["none", "linear", "quadratic", "square"];
 
     /// The fit of that name.
     pub fn from_name(s: &str) -> Option<Self> {
@@ -23,6 +25,7 @@ impl Fit {
             "none" => Some(Fit::None),
             "linear" => Some(Fit::Linear),
             "quadratic" => Some(Fit::Quadratic),
+            "square" => Some(Fit::Square),
             _ => None,
         }
     }
@@ -33,6 +36,7 @@ impl Fit {
             Fit::None => "none",
             Fit::Linear => "linear",
             Fit::Quadratic => "quadratic",
+            Fit::Square => "square",
         }
     }
 }

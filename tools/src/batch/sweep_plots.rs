@@ -2,7 +2,7 @@
 //! run` after a sweep, and `evflow merge` after joining a sweep's shards (a
 //! plot of the whole sweep is drawn from every run, never by a shard).
 
-use crate::fit::polyfit;
+use crate::fit::{polyfit, square_law};
 use crate::plot::{write_png, Plot, Series};
 use evflow_engine::check::interpolate::text_of;
 use evflow_engine::graph::{Fit, Graph, PlotDecl};
@@ -105,12 +105,13 @@ fn draw(
     let mut series = Vec::new();
     for (name, mut pts) in groups {
         pts.sort_by(|a, b| a.0.total_cmp(&b.0));
-        let degree = match p.fit {
+        let fitted = match p.fit {
             Fit::None => None,
-            Fit::Linear => Some(1),
-            Fit::Quadratic => Some(2),
+            Fit::Linear => Some((1, polyfit(&pts, 1))),
+            Fit::Quadratic => Some((2, polyfit(&pts, 2))),
+            Fit::Square => Some((2, square_law(&pts))),
         };
-        match degree.map(|d| (d, polyfit(&pts, d))) {
+        match fitted {
             Some((_, Some(f))) => {
                 lines.push(format!("plot {}: {name}: {} fit {}, R² = {:.5}", p.file, p.fit.name(), f.formula(), f.r2));
                 let (lo, hi) = (pts[0].0, pts[pts.len() - 1].0);

@@ -77,6 +77,8 @@ fn a_session_killed_with_sigkill_leaves_readable_recordings_that_replay_exactly(
     let (ok, text) = replay(&s, &["--check", "-q"]);
     assert!(ok, "{text}");
     assert!(text.contains("limit.out: identical to the live session, bit for bit"), "{text}");
+    // What a killed session cannot prove is said.
+    assert!(text.contains("could not check that the recordings are whole: the session did not end"), "{text}");
 }
 
 #[test]
@@ -123,6 +125,92 @@ fn replay_reproduces_a_session_with_changes_bit_for_bit_and_the_stop_fades_to_ze
     let (ok, text) = replay(&s, &[graph().to_str().unwrap(), "--set", "gain=0.5", "--check", "-q"]);
     assert!(!ok, "{text}");
     assert!(text.contains("limit.out: differs from sample"), "{text}");
+}
+
+/// A copy of the session folder `from` at `to`, every file copied.
+fn copy_session(from: &Path, to: &Path) {
+    for sub in ["", "inputs", "outputs"] {
+        std::fs::create_dir_all(to.join(sub)).unwrap();
+        for e in std::fs::read_dir(from.join(sub)).unwrap() {
+            let e = e.unwrap();
+            if e.file_type().unwrap().is_file() {
+                std::fs::copy(e.path(), to.join(sub).join(e.file_name())).unwrap();
+            }
+        }
+    }
+}
+
+#[test]
+fn replay_check_proves_the_whole_session_and_names_every_tampering() {
+    // Issue 27, point 4: a file cut short, a changed input that feeds no
+    // recorded output, another seed, another graph.toml — each fails the
+    // check with its reason; the untouched session passes.
+    let tmp = tempfile::tempdir().unwrap();
+    let s = tmp.path().join("whole");
+    let out = live(&s, &["--duration", "1.0"]).output().expect("evflow live");
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    let (ok, text) = replay(&s, &["--check", "-q"]);
+    assert!(ok && !text.contains("could not check"), "{text}");
+    type Tamper = Box<dyn Fn(&Path)>;
+    let wav_len = |p: &Path| std::fs::metadata(p).unwrap().len();
+    let cases: Vec<(&str, Tamper, &str)> = vec![
+        (
+            "cut by 1001 bytes",
+            Box::new(move |d: &Path| {
+                let p = d.join("outputs/limit.out.wav");
+                let f = std::fs::OpenOptions::new().write(true).open(&p).unwrap();
+                f.set_len(wav_len(&p) - 1001).unwrap();
+            }),
+            "outputs/limit.out: holds",
+        ),
+        (
+            "cut to half",
+            Box::new(move |d: &Path| {
+                let p = d.join("outputs/limit.out.wav");
+                let f = std::fs::OpenOptions::new().write(true).open(&p).unwrap();
+                f.set_len(44 + (wav_len(&p) - 44) / 2).unwrap();
+            }),
+            "(cut short)",
+        ),
+        (
+            "an input's last byte changed",
+            Box::new(|d: &Path| {
+                let p = d.join("inputs/tribometer.wav");
+                let mut b = std::fs::read(&p).unwrap();
+                let n = b.len();
+                b[n - 9] ^= 1;
+                std::fs::write(&p, b).unwrap();
+            }),
+            "inputs/tribometer: its samples changed",
+        ),
+        (
+            "another seed",
+            Box::new(|d: &Path| {
+                let p = d.join("session.json");
+                let mut v: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(&p).unwrap()).unwrap();
+                v["seed"] = serde_json::json!(v["seed"].as_u64().unwrap() + 1);
+                std::fs::write(&p, v.to_string()).unwrap();
+            }),
+            "session.json: its seed",
+        ),
+        (
+            "graph.toml edited",
+            Box::new(|d: &Path| {
+                let p = d.join("graph.toml");
+                let t = std::fs::read_to_string(&p).unwrap() + "\n# edited\n";
+                std::fs::write(&p, t).unwrap();
+            }),
+            "graph.toml: changed since the session ran it",
+        ),
+    ];
+    for (what, tamper, said) in cases {
+        let t = tmp.path().join(what.replace(' ', "-"));
+        copy_session(&s, &t);
+        tamper(&t);
+        let (ok, text) = replay(&t, &["--check", "-q"]);
+        assert!(!ok, "{what}: the check passed:\n{text}");
+        assert!(text.contains(said), "{what}: {text}");
+    }
 }
 
 #[test]

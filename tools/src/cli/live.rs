@@ -1,5 +1,6 @@
 //! `evflow live FILE`: run a graph in real time, recording the session.
 
+pub mod integrity;
 mod recorder;
 pub mod session;
 mod steal;
@@ -146,8 +147,12 @@ pub fn main(a: Args) -> Result<()> {
     }
     std::fs::create_dir_all(&dir).map_err(|e| anyhow!("{}: cannot create the session folder: {e}", dir.display()))?;
     std::fs::write(dir.join("graph.toml"), &graph_text)?;
+    let graph_hash = integrity::file_hash(&dir.join("graph.toml"))
+        .map_err(|e| anyhow!("{}: cannot read back: {e}", dir.join("graph.toml").display()))?;
     let graph_path = std::fs::canonicalize(&a.graph.file).unwrap_or_else(|_| a.graph.file.clone());
     let manifest = Manifest {
+        identity: Some(integrity::identity(&graph_hash, seed, &a.graph.set, lp.plan().base_rate(), &inputs, &outputs)),
+        graph_hash: Some(graph_hash),
         name: checked.graph.name.clone(),
         base_dir: graph_path.parent().map(Path::to_path_buf).unwrap_or_default(),
         graph_source: graph_path,
@@ -353,7 +358,11 @@ pub fn main(a: Args) -> Result<()> {
     let files: Vec<_> = rec
         .files
         .iter()
-        .map(|(f, n, gap, err)| json!({ "file": f, "frames": n, "gap_frames": gap, "error": err }))
+        .map(|(f, n, gap, err)| {
+            // The fingerprint of the samples as written: `evflow replay --check` holds the file to it.
+            let hash = integrity::file_hash(&dir.join(format!("{f}.wav"))).ok();
+            json!({ "file": f, "frames": n, "gap_frames": gap, "error": err, "hash": hash })
+        })
         .collect();
     let end = json!({
         "ticks": exit.ticks,

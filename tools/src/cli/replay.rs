@@ -6,7 +6,10 @@
 //! the session's own, or another one — runs offline in large blocks. The
 //! outputs are compared with the recorded ones: with the session's own
 //! graph they are identical bit for bit, because the live tick and the
-//! offline step are the same code.
+//! offline step are the same code. With the session's own graph the folder
+//! is also held to what the session recorded of itself (`live::integrity`):
+//! its graph file, seed and files, each as long and as written as when it
+//! ended — or the replay says what it could not check.
 //!
 //! Several sessions (`evflow replay S1 S2 … [GRAPH]`) replay on `--jobs`
 //! threads, each into its own folder under `--out`, printed in the order
@@ -76,7 +79,11 @@ pub fn main(a: Args) -> Result<()> {
     if let [session] = sessions.as_slice() {
         let (text, ok) = replay_one(session, graph.as_deref(), &a.out, &a)?;
         print!("{text}");
-        return if ok || !a.check { Ok(()) } else { Err(anyhow!("the replay does not reproduce the live outputs")) };
+        return if ok || !a.check {
+            Ok(())
+        } else {
+            Err(anyhow!("the replay does not prove the live session (above: what differs)"))
+        };
     }
     let mut outs: Vec<PathBuf> = Vec::with_capacity(sessions.len());
     for s in &sessions {
@@ -103,7 +110,7 @@ pub fn main(a: Args) -> Result<()> {
             Ok((text, ok)) => {
                 print!("{text}");
                 if a.check && !ok {
-                    failures.push(sessions[k].display().to_string(), "the replay does not reproduce the live outputs");
+                    failures.push(sessions[k].display().to_string(), "the replay does not prove the live session");
                 }
             }
             Err(e) => {
@@ -125,7 +132,7 @@ pub fn main(a: Args) -> Result<()> {
 /// output was reproduced bit for bit.
 fn replay_one(session: &Path, graph: Option<&Path>, out: &Path, a: &Args) -> Result<(String, bool)> {
     let mut shown = String::new();
-    let m = Manifest::read(session)?;
+    let (m, raw) = Manifest::read_raw(session)?;
     let own = graph.is_none();
     let (graph_file, base_dir) = match graph {
         Some(g) => (g.to_path_buf(), g.parent().map(Path::to_path_buf).unwrap_or_default()),
@@ -283,6 +290,14 @@ fn replay_one(session: &Path, graph: Option<&Path>, out: &Path, a: &Args) -> Res
     if exact_until < ticks {
         let _ =
             writeln!(shown, "compared up to tick {exact_until} (the session lost samples or replaced its plan there)");
+    }
+    // The folder held to what the session recorded of itself: its graph,
+    // seed and files, every file as long and as written as it ended.
+    if own {
+        for f in super::live::integrity::check(&session_dir, &m, &raw) {
+            let _ = writeln!(shown, "{}{}", if f.ok { "" } else { "not the session's: " }, f.what);
+            all_same &= f.ok;
+        }
     }
     Ok((shown, all_same))
 }

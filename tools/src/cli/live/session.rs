@@ -101,6 +101,12 @@ pub struct Manifest {
     pub outputs: Vec<FileSpec>,
     /// Unix time the session started.
     pub started: u64,
+    /// The fingerprint of `graph.toml` as the session wrote it (None in a
+    /// session recorded before fingerprints).
+    pub graph_hash: Option<String>,
+    /// The fingerprint of what a replay takes from this manifest
+    /// ([`super::integrity::identity`]).
+    pub identity: Option<String>,
 }
 
 impl Manifest {
@@ -118,6 +124,8 @@ impl Manifest {
             "seed": self.seed,
             "base_rate": self.base_rate,
             "started_unix": self.started,
+            "graph_hash": self.graph_hash,
+            "identity": self.identity,
             "inputs": self.inputs.iter().map(FileSpec::json).collect::<Vec<_>>(),
             "outputs": self.outputs.iter().map(FileSpec::json).collect::<Vec<_>>(),
             "events": "events.jsonl",
@@ -132,6 +140,15 @@ impl Manifest {
         std::fs::write(&tmp, text).with_context(|| format!("{}: cannot write", tmp.display()))?;
         std::fs::rename(&tmp, dir.join("session.json"))
             .with_context(|| format!("{}: cannot write", dir.join("session.json").display()))
+    }
+
+    /// Reads `SESSION/session.json`, and the JSON as it is.
+    pub fn read_raw(dir: &Path) -> Result<(Manifest, Value)> {
+        let m = Self::read(dir)?;
+        let path = dir.join("session.json");
+        let text = std::fs::read_to_string(&path).with_context(|| format!("{}: cannot read", path.display()))?;
+        let v: Value = serde_json::from_str(&text).with_context(|| format!("{}: not valid JSON", path.display()))?;
+        Ok((m, v))
     }
 
     /// Reads `SESSION/session.json`.
@@ -191,6 +208,8 @@ impl Manifest {
             inputs: files("inputs")?,
             outputs: files("outputs")?,
             started: v["started_unix"].as_u64().unwrap_or(0),
+            graph_hash: v["graph_hash"].as_str().map(str::to_string),
+            identity: v["identity"].as_str().map(str::to_string),
         })
     }
 }

@@ -1,0 +1,183 @@
+//! What proves a recorded session whole, and the check of it.
+//!
+//! A session records, when it starts, a fingerprint of the graph file it
+//! runs (`graph_hash`) and of everything the replay takes from its manifest
+//! — the graph's fingerprint, the seed, the overrides, the rate, the files
+//! and their ports (`identity`) — and, when it ends, every recording's frame
+//! count and a fingerprint of its samples (`end.files[].hash`). `evflow
+//! replay --check` holds the folder to them: a file cut short, a changed
+//! input (whether or not it feeds a recorded output), another seed or
+//! graph is a failure, named; what cannot be checked (a session killed
+//! before it ended has no end) is said. Fingerprints are FNV-1a, 64 bits —
+//! they catch accidents and careless edits, not a forger.
+
+use super::session::{FileSpec, Manifest};
+use serde_json::Value;
+use std::io::Read;
+use std::path::Path;
+
+/// FNV-1a, 64 bits, over `bytes` continuing from `h`.
+fn fnv(mut h: u64, bytes: &[u8]) -> u64 {
+    for b in bytes {
+        h ^= *b as u64;
+        h = h.wrapping_mul(0x0100_0000_01b3);
+    }
+    h
+}
+
+const FNV_START: u64 = 0xcbf2_9ce4_8422_2325;
+
+/// The fingerprint of a file's bytes, read in pieces.
+pub fn file_hash(path: &Path) -> std::io::Result<String> {
+    let mut f = std::fs::File::open(path)?;
+    let mut buf = vec![0u8; 1 << 16];
+    let mut h = FNV_START;
+    loop {
+        let n = f.read(&mut buf)?;
+        if n == 0 {
+            break;
+        }
+        h = fnv(h, &buf[..n]);
+    }
+    Ok(format!("fnv1a64:{h:016x}"))
+}
+
+/// The fingerprint of what a replay takes from the manifest.
+pub fn identity(
+    graph_hash: &str,
+    seed: u64,
+    overrides: &[String],
+    base_rate: f64,
+    inputs: &[FileSpec],
+    outputs: &[FileSpec],
+) -> String {
+    let mut text = format!("{graph_hash}\nseed {seed}\nrate {:?}\n", base_rate);
+    for o in overrides {
+        text.push_str(&format!("set {o}\n"));
+    }
+    for f in inputs.iter().chain(outputs) {
+        text.push_str(&format!("file {} {} {:?} {}\n", f.file, f.node, f.rate, f.ports.join(",")));
+    }
+    format!("fnv1a64:{:016x}", fnv(FNV_START, text.as_bytes()))
+}
+
+/// One thing the check found.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Finding {
+    /// Whether it holds (false: the check fails).
+    pub ok: bool,
+    /// What, for people.
+    pub what: String,
+}
+
+fn bad(what: String) -> Finding {
+    Finding { ok: false, what }
+}
+
+/// Holds the session folder `dir` (its manifest `m`, read as `raw`) to what
+/// it recorded: the graph file and the manifest's fingerprints, then, for a
+/// session that ended, every recording's frames and fingerprint.
+pub fn check(dir: &Path, m: &Manifest, raw: &Value) -> Vec<Finding> {
+    let mut out = Vec::new();
+    match (&m.graph_hash, &m.identity) {
+        (Some(g), Some(id)) => {
+            match file_hash(&dir.join("graph.toml")) {
+                Ok(now) if now == *g => {}
+                Ok(_) => out.push(bad("graph.toml: changed since the session ran it".into())),
+                Err(e) => out.push(bad(format!("graph.toml: cannot read: {e}"))),
+            }
+            let now = identity(g, m.seed, &m.overrides, m.base_rate, &m.inputs, &m.outputs);
+            if now != *id {
+                out.push(bad(
+                    "session.json: its seed, overrides, rate or files are not those the session recorded".into()
+                ));
+            }
+        }
+        _ => out.push(Finding {
+            ok: true,
+            what: "could not check the graph and the seed: the session was recorded without fingerprints".into(),
+        }),
+    }
+    let status = raw["status"].as_str().unwrap_or("");
+    let Some(files) = raw["end"]["files"].as_array() else {
+        out.push(Finding {
+            ok: true,
+            what: format!(
+                "could not check that the recordings are whole: the session did not end (status `{status}`: \
+                 killed?), so it recorded neither their lengths nor their fingerprints; what they hold was compared"
+            ),
+        });
+        return out;
+    };
+    let ticks = raw["end"]["ticks"].as_u64();
+    for f in m.inputs.iter().chain(&m.outputs) {
+        let Some(rec) = files.iter().find(|x| x["file"].as_str() == Some(f.file.as_str())) else {
+            out.push(bad(format!("{}: not among the files the session ended with", f.file)));
+            continue;
+        };
+        let wav = dir.join(format!("{}.wav", f.file));
+        let frames = rec["frames"].as_u64().unwrap_or(0);
+        match evflow_nodes::recording::format::Recording::open(&dir.join(&f.file)) {
+            Ok(r) if r.frames() as u64 != frames => out.push(bad(format!(
+                "{}: holds {} frames, the session wrote {frames}{}",
+                f.file,
+                r.frames(),
+                if (r.frames() as u64) < frames { " (cut short)" } else { "" }
+            ))),
+            Ok(_) => {}
+            Err(e) => out.push(bad(format!("{}: cannot read: {e}", f.file))),
+        }
+        match (rec["hash"].as_str(), file_hash(&wav)) {
+            (Some(want), Ok(now)) if want != now => {
+                out.push(bad(format!("{}: its samples changed since the session wrote them", f.file)))
+            }
+            (None, _) => out.push(Finding {
+                ok: true,
+                what: format!("could not check the samples of {}: the session recorded no fingerprint", f.file),
+            }),
+            _ => {}
+        }
+        // The session's length: every stream as long as its ticks say, bar the gaps it logged.
+        if let Some(t) = ticks {
+            let want = f.ratio.count(0, t);
+            let gaps = rec["gap_frames"].as_u64().unwrap_or(0);
+            if frames + gaps != want {
+                out.push(bad(format!(
+                    "{}: the session wrote {frames} frames and lost {gaps} over {t} ticks, where {want} were due",
+                    f.file
+                )));
+            }
+        }
+    }
+    out
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn fingerprints_see_every_byte_and_every_field() {
+        let dir = tempfile::tempdir().unwrap();
+        let p = dir.path().join("x");
+        std::fs::write(&p, vec![7u8; 200_000]).unwrap();
+        let a = file_hash(&p).unwrap();
+        let mut bytes = vec![7u8; 200_000];
+        bytes[150_000] = 8;
+        std::fs::write(&p, &bytes).unwrap();
+        assert_ne!(file_hash(&p).unwrap(), a);
+        let f = |rate: f64| FileSpec {
+            file: "inputs/user".into(),
+            node: "user".into(),
+            ports: vec!["x".into()],
+            ratio: evflow_engine::rate::Ratio::of(rate, 1000.0).unwrap(),
+            rate,
+        };
+        let base = identity("g", 7, &["gain=1".into()], 1000.0, &[f(1000.0)], &[]);
+        assert_ne!(identity("g", 8, &["gain=1".into()], 1000.0, &[f(1000.0)], &[]), base, "seed");
+        assert_ne!(identity("h", 7, &["gain=1".into()], 1000.0, &[f(1000.0)], &[]), base, "graph");
+        assert_ne!(identity("g", 7, &[], 1000.0, &[f(1000.0)], &[]), base, "overrides");
+        assert_ne!(identity("g", 7, &["gain=1".into()], 1000.0, &[f(40.0)], &[]), base, "files");
+        assert_eq!(identity("g", 7, &["gain=1".into()], 1000.0, &[f(1000.0)], &[]), base);
+    }
+}

@@ -129,3 +129,51 @@ fn ten_khz_recordings_train_models_and_synthesize_cells() {
     assert!(u.iter().all(|v| v.is_finite()), "non-finite actuation");
     assert!(u.iter().any(|v| v.abs() > 0.1), "the cell is silent");
 }
+
+#[test]
+fn a_sidecar_field_cannot_write_outside_the_output_folder() {
+    // Issue 27, point 2: a recording whose `material` climbs out of the
+    // output folder (`x/../../../../tmp/ESCAPED`) reaches the cell's path
+    // through `${material}`; the sink refuses it, naming its parameter, and
+    // nothing is written outside `out`.
+    let dir = tempfile::tempdir().unwrap();
+    let (tex, out) = (dir.path().join("tex"), dir.path().join("a/b/out"));
+    std::fs::create_dir_all(&tex).unwrap();
+    std::fs::create_dir_all(&out).unwrap();
+    let from = evflow_tests::root().join("graphs/data/textures/plastic-sheet-85g-5cms-r1");
+    std::fs::copy(from.with_extension("wav"), tex.join("evil-85g-5cms-r1.wav")).unwrap();
+    let mut meta: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(from.with_extension("json")).unwrap()).unwrap();
+    meta["condition"]["material"] = serde_json::json!("x/../../../../ESCAPED");
+    std::fs::write(tex.join("evil-85g-5cms-r1.json"), meta.to_string()).unwrap();
+    let path = evflow_tests::root().join("graphs/synthesize-recordings.toml");
+    let g = parse_graph(&path, &std::fs::read_to_string(&path).unwrap()).unwrap();
+    let models = evflow_tests::root().join("graphs/data/models");
+    let o: Vec<Override> = [format!("textures={}", tex.display()), format!("models={}", models.display())]
+        .iter()
+        .map(|s| Override::parse(s).unwrap())
+        .collect();
+    let axes = sweep_files::expand(&g, &o, &sweep_fields).unwrap();
+    let points = sweep::points(&axes, &[], &o);
+    assert_eq!(points.len(), 1);
+    let mut all = o.clone();
+    all.extend(points[0].overrides());
+    let c = check(&g, &evflow_nodes::registry(), &all).unwrap();
+    let e = Plan::build(&c, &PlanOptions { out_dir: Some(out.clone()), ..Default::default() }).err().expect("refused");
+    let e = e.to_string();
+    assert!(e.contains("`path`") && e.contains("outside the output folder"), "{e}");
+    // Nothing escaped: the only files under the temporary folder are the recording's.
+    let mut found = Vec::new();
+    let mut stack = vec![dir.path().to_path_buf()];
+    while let Some(d) = stack.pop() {
+        for entry in std::fs::read_dir(&d).unwrap() {
+            let p = entry.unwrap().path();
+            if p.is_dir() {
+                stack.push(p);
+            } else {
+                found.push(p);
+            }
+        }
+    }
+    assert!(found.iter().all(|p| p.starts_with(&tex)), "{found:?}");
+}

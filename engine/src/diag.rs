@@ -88,3 +88,29 @@ impl LineIndex {
         Loc { line: line + 1, col }
     }
 }
+
+/// `s` for a message: whole when it is at most `max` characters, else its
+/// first `max` and how long it was (a bad value of a megabyte must not fill
+/// a terminal).
+pub fn cut(s: &str, max: usize) -> String {
+    let n = s.chars().count();
+    if n <= max {
+        s.to_string()
+    } else {
+        let head: String = s.chars().take(max).collect();
+        format!("{head}… ({n} characters)")
+    }
+}
+
+#[cfg(test)]
+mod cut_tests {
+    use super::cut;
+
+    #[test]
+    fn long_values_are_cut_and_say_how_long_they_were() {
+        assert_eq!(cut("short", 10), "short");
+        let long = "é".repeat(1_000_000);
+        let c = cut(&long, 8);
+        assert_eq!(c, format!("{}… (1000000 characters)", "é".repeat(8)));
+    }
+}

@@ -1,6 +1,6 @@
 //! The node trait and what a node sees while it runs.
 
-use std::path::{Path, PathBuf};
+use std::path::{Component, Path, PathBuf};
 
 /// An error raised by a node: at construction (bad file, inconsistent
 /// parameters), at `prepare`, while processing (I/O) or at `finish`.
@@ -78,7 +78,60 @@ impl BuildContext {
         }
     }
 
-    /// An output path parameter resolved against the run's output folder.
+    /// A file the run writes, parameter `param` = `p`, resolved inside the
+    /// run's output folder — and refused, naming the parameter, when it would
+    /// land outside it: an absolute path, a `..` (a sidecar field or a sweep
+    /// value spliced into a name can carry one), or a link in the output
+    /// folder that points out of it. Choose the folder with `--out`.
+    pub fn output_path(&self, param: &str, p: &str) -> Result<PathBuf, NodeError> {
+        let shown = crate::diag::cut(p, 120);
+        let rel = Path::new(p);
+        let escapes = rel.components().any(|c| !matches!(c, Component::Normal(_) | Component::CurDir));
+        if p.is_empty() || escapes {
+            return Err(NodeError::param(
+                param,
+                format!(
+                    "`{shown}` would be written outside the output folder {}: output paths are relative to it and \
+                     hold no `..` (choose the folder with --out)",
+                    self.out_dir.display()
+                ),
+            ));
+        }
+        let full = self.out_dir.join(rel);
+        // A link on the way (a folder of the output folder that points out of
+        // it): the deepest part of the path that exists must resolve inside.
+        if let Ok(root) = std::fs::canonicalize(&self.out_dir) {
+            let mut at = full.parent().map(Path::to_path_buf);
+            while let Some(a) = at {
+                if let Ok(real) = std::fs::canonicalize(&a) {
+                    if !real.starts_with(&root) {
+                        return Err(NodeError::param(
+                            param,
+                            format!(
+                                "`{shown}` would be written through {}, a link out of the output folder {}",
+                                a.display(),
+                                root.display()
+                            ),
+                        ));
+                    }
+                    break;
+                }
+                at = a.parent().map(Path::to_path_buf);
+            }
+            if let Ok(meta) = std::fs::symlink_metadata(&full) {
+                if meta.file_type().is_symlink() {
+                    return Err(NodeError::param(
+                        param,
+                        format!("`{shown}` is a link in the output folder; it would be written wherever it points"),
+                    ));
+                }
+            }
+        }
+        Ok(full)
+    }
+
+    /// A path parameter for the node's own working files (e.g. a cache),
+    /// resolved against the run's output folder; not checked to stay in it.
     pub fn out_path(&self, p: &str) -> PathBuf {
         let p = Path::new(p);
         if p.is_absolute() {
@@ -345,5 +398,53 @@ pub trait Node: Send {
     /// is built; `evflow check --build` prints them.
     fn notes(&self) -> Vec<String> {
         Vec::new()
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn ctx(out: &Path) -> BuildContext {
+        BuildContext {
+            node: "sink".into(),
+            base_rate: 1000.0,
+            rate: 1000.0,
+            port_rates: Vec::new(),
+            base_dir: out.to_path_buf(),
+            out_dir: out.to_path_buf(),
+            seed: 1,
+        }
+    }
+
+    #[test]
+    fn output_paths_stay_in_the_output_folder_or_are_refused_by_name() {
+        let dir = tempfile::tempdir().unwrap();
+        let out = dir.path().join("out");
+        std::fs::create_dir_all(out.join("cells")).unwrap();
+        let c = ctx(&out);
+        assert_eq!(c.output_path("path", "cells/u-felt").unwrap(), out.join("cells/u-felt"));
+        assert_eq!(c.output_path("path", "./a/b/c").unwrap(), out.join("./a/b/c"), "folders to be made are fine");
+        for bad in ["../x", "narx-x/../../../../tmp/ESCAPED/u", "/tmp/abs", "a/../../b", ""] {
+            let e = c.output_path("path", bad).unwrap_err().to_string();
+            assert!(e.contains("`path`") && e.contains("outside the output folder"), "{bad}: {e}");
+        }
+        // A link in the output folder that points out of it.
+        #[cfg(unix)]
+        {
+            std::os::unix::fs::symlink(dir.path(), out.join("away")).unwrap();
+            let e = c.output_path("path", "away/evil").unwrap_err().to_string();
+            assert!(e.contains("a link out of the output folder"), "{e}");
+            std::os::unix::fs::symlink(dir.path().join("target"), out.join("file-link")).unwrap();
+            let e = c.output_path("path", "file-link").unwrap_err().to_string();
+            assert!(e.contains("is a link"), "{e}");
+            // A link that stays inside is fine.
+            std::os::unix::fs::symlink(out.join("cells"), out.join("inside")).unwrap();
+            assert!(c.output_path("path", "inside/u").is_ok());
+        }
+        // A huge name is cut in the message.
+        let long = "x/".repeat(100_000) + "../y";
+        let e = c.output_path("path", &long).unwrap_err().to_string();
+        assert!(e.len() < 1000, "{} bytes", e.len());
     }
 }

@@ -173,7 +173,7 @@ fn build(p: &Params, ctx: &BuildContext) -> Result<Box<dyn Node>, NodeError> {
         return Err(NodeError::param("path", "name the model file to write"));
     }
     Ok(Box::new(Train {
-        path: ctx.out_path(path),
+        path: ctx.output_path("path", path)?,
         shown: path.to_string(),
         node: ctx.node.clone(),
         cfg,

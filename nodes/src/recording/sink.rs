@@ -99,7 +99,7 @@ fn build(p: &Params, ctx: &BuildContext) -> Result<Box<dyn Node>, NodeError> {
         .collect();
     let meta = RecordingMeta { rate: ctx.rate, channels, condition, source };
     let path = p.str("path");
-    let writer = RecordingWriter::create(&ctx.out_path(path), meta)?;
+    let writer = RecordingWriter::create(&ctx.output_path("path", path)?, meta)?;
     let shown = RecordingPaths::new(Path::new(path)).wav.display().to_string();
     Ok(Box::new(RecordingOut {
         writer: Some(writer),

@@ -97,7 +97,7 @@ fn build(p: &Params, ctx: &BuildContext) -> Result<Box<dyn Node>, NodeError> {
     let window = (p.f64("noise_window") * ctx.rate).round().max(1.0) as usize;
     let set = |v: f64| (v != 0.0).then_some(v);
     Ok(Box::new(Train {
-        path: ctx.out_path(path),
+        path: ctx.output_path("path", path)?,
         shown: path.to_string(),
         cfg: FitConfig {
             memory: p.usize("memory"),

@@ -137,6 +137,7 @@ impl Single<'_> {
             out_dir: Some(self.base_dir.to_path_buf()),
             timing: false,
             mode: RunMode::Offline,
+            check_only: false,
         };
         // The node under test always runs: never replaced by a constant.
         let plan = Plan::build_with(&checked, &opts, Folding::Off).map_err(|e| e.to_string())?;

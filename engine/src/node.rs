@@ -65,6 +65,11 @@ pub struct BuildContext {
     /// The run's seed; nodes that draw random numbers derive their stream from
     /// it and their name, so runs are reproducible.
     pub seed: u64,
+    /// The plan is built only to be checked (`evflow check`) and will never
+    /// run: a node validates its files as a run would, but need not keep
+    /// what only running needs (a recording's samples are checked while
+    /// streaming through the file, not loaded).
+    pub check_only: bool,
 }
 
 impl BuildContext {
@@ -414,6 +419,7 @@ mod tests {
             base_dir: out.to_path_buf(),
             out_dir: out.to_path_buf(),
             seed: 1,
+            check_only: false,
         }
     }
 

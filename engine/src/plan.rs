@@ -50,11 +50,23 @@ pub struct PlanOptions {
     /// Offline (the default, whatever the block size) or live: only a live
     /// plan lets hardware nodes open their devices.
     pub mode: RunMode,
+    /// Built only to be checked (`evflow check`), never run: nodes validate
+    /// their files as a run would but may leave out what only running needs
+    /// ([`BuildContext::check_only`]).
+    pub check_only: bool,
 }
 
 impl Default for PlanOptions {
     fn default() -> Self {
-        Self { max_block: 4096, seed: None, base_dir: None, out_dir: None, timing: true, mode: RunMode::Offline }
+        Self {
+            max_block: 4096,
+            seed: None,
+            base_dir: None,
+            out_dir: None,
+            timing: true,
+            mode: RunMode::Offline,
+            check_only: false,
+        }
     }
 }
 
@@ -203,6 +215,7 @@ impl Plan {
                 base_dir: base_dir.clone(),
                 out_dir: opts.out_dir.clone().unwrap_or_default(),
                 seed,
+                check_only: opts.check_only,
             };
             let started = Instant::now();
             let node = (n.spec.build)(&n.params, &ctx).map_err(|e| fail(i, e))?;

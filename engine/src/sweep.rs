@@ -7,9 +7,12 @@
 //! variable fixed with `--set` is not swept. Combined with `${var}` in text
 //! parameters each run names its own outputs.
 
-use crate::check::Override;
-use crate::graph::{parse_cli_value, Axis};
+use crate::check::{check, Checked, Override};
+use crate::diag::Diagnostics;
+use crate::graph::{parse_cli_value, Axis, Graph};
 use crate::params::Value;
+use crate::registry::Registry;
+use std::ops::Range;
 
 /// One run of a sweep: the variable values it sets, in axis order.
 #[derive(Debug, Clone, PartialEq)]
@@ -69,18 +72,8 @@ pub fn parse_axis(s: &str) -> Result<Axis, String> {
 /// variables linked to its value (after the axis' own, so they win over a
 /// `--set` of the same name: the file's metadata describes the file).
 pub fn points(graph_axes: &[Axis], extra: &[Axis], pinned: &[Override]) -> Vec<Point> {
-    let mut axes: Vec<&Axis> = Vec::new();
-    for a in graph_axes {
-        axes.push(extra.iter().find(|e| e.name == a.name).unwrap_or(a));
-    }
-    for e in extra {
-        if !graph_axes.iter().any(|a| a.name == e.name) && !axes.iter().any(|a| a.name == e.name) {
-            axes.push(e);
-        }
-    }
-    axes.retain(|a| !pinned.iter().any(|o| o.key == a.name));
     let mut out = vec![Point { values: Vec::new() }];
-    for a in axes {
+    for a in effective_axes(graph_axes, extra, pinned) {
         out = out
             .into_iter()
             .flat_map(|p| {
@@ -96,6 +89,70 @@ pub fn points(graph_axes: &[Axis], extra: &[Axis], pinned: &[Override]) -> Vec<P
             .collect();
     }
     out
+}
+
+/// The axes [`points`] runs over, in order: `graph_axes` (each replaced
+/// by an `extra` axis of its name), then the other `extra` axes, less the
+/// axes of variables `pinned` fixes.
+pub fn effective_axes<'a>(graph_axes: &'a [Axis], extra: &'a [Axis], pinned: &[Override]) -> Vec<&'a Axis> {
+    let mut axes: Vec<&Axis> = Vec::new();
+    for a in graph_axes {
+        axes.push(extra.iter().find(|e| e.name == a.name).unwrap_or(a));
+    }
+    for e in extra {
+        if !graph_axes.iter().any(|a| a.name == e.name) && !axes.iter().any(|a| a.name == e.name) {
+            axes.push(e);
+        }
+    }
+    axes.retain(|a| !pinned.iter().any(|o| o.key == a.name));
+    axes
+}
+
+/// Refuses a command-line axis (`--sweep NAME=…`) that names no variable
+/// of `graph`, with the nearest names.
+pub fn check_axes(graph: &Graph, axes: &[Axis]) -> Result<(), String> {
+    for ax in axes {
+        if !graph.vars.iter().any(|v| v.name == ax.name) {
+            let help = crate::suggest::help(&ax.name, graph.vars.iter().map(|v| v.name.as_str()));
+            return Err(format!("--sweep {}: the graph has no variable `{}`; {help}", ax.name, ax.name));
+        }
+    }
+    Ok(())
+}
+
+/// One run of a sweep, validated as `evflow run` runs it.
+#[derive(Debug)]
+pub struct Validated {
+    /// Its place in the whole sweep (from 0).
+    pub index: usize,
+    /// The variable values it sets.
+    pub point: Point,
+    /// The graph with `pinned` and the point applied, or why it does not
+    /// validate.
+    pub checked: Result<Checked, Diagnostics>,
+}
+
+/// Validates the runs `range` of `all` (from [`points`]): `graph` with
+/// `pinned` (`--set`) and then each point's values applied. The graph's
+/// `[vars]` defaults are not validated on their own where the sweep sets
+/// them: `evflow check` and `evflow run` both see only the runs.
+pub fn validate(
+    graph: &Graph,
+    registry: &Registry,
+    pinned: &[Override],
+    all: Vec<Point>,
+    range: Range<usize>,
+) -> Vec<Validated> {
+    all.into_iter()
+        .enumerate()
+        .skip(range.start)
+        .take(range.len())
+        .map(|(index, point)| {
+            let mut o = pinned.to_vec();
+            o.extend(point.overrides());
+            Validated { index, checked: check(graph, registry, &o), point }
+        })
+        .collect()
 }
 
 #[cfg(test)]

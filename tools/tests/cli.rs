@@ -230,3 +230,75 @@ fn dot_prints_graphviz() {
     assert!(out.starts_with("digraph"), "{out}");
     assert!(out.contains("tribometer") && out.contains("->"), "{out}");
 }
+
+/// A sine into stats with its frequency `$f` swept, optionally recorded.
+fn sweep_graph(dir: &Path, default: &str, values: &str, record: &str) -> PathBuf {
+    let g = dir.join("sweep.toml");
+    let (conn, node) = if record.is_empty() {
+        (String::new(), String::new())
+    } else {
+        (
+            ", \"s.out -> r.x\"".to_string(),
+            format!("[nodes.r]\ntype = \"recording.out\"\npath = \"{record}\"\nchannels = [\"x\"]\n"),
+        )
+    };
+    std::fs::write(
+        &g,
+        format!(
+            "[graph]\nformat = 1\nname = \"g\"\nrate = 1000\nconnections = [\"s.out -> k.in\"{conn}]\n\
+             [vars]\nf = {default}\n[sweep]\nf = {values}\n\
+             [nodes.s]\ntype = \"sine\"\nfrequency = \"$f\"\n[nodes.k]\ntype = \"stats\"\n{node}"
+        ),
+    )
+    .unwrap();
+    g
+}
+
+#[test]
+fn check_and_run_agree_on_every_run_of_a_sweep() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("out");
+    let out = out.to_str().unwrap();
+    // A default no run uses may be out of range: both pass.
+    let g = sweep_graph(dir.path(), "-1.0", "[10.0, 20.0]", "");
+    let g = g.to_str().unwrap();
+    let o = evflow(&["check", g]);
+    let (stdout, stderr) = text(&o);
+    assert!(o.status.success(), "{stderr}");
+    assert!(
+        stdout.contains("f (2 values) → 2 runs") && stdout.contains("built every run of the sweep (2)"),
+        "{stdout}"
+    );
+    assert!(stdout.contains("execution order, the first run's: f=10"), "{stdout}");
+    let o = evflow(&["run", g, "--duration", "0.01", "--out", out]);
+    assert!(o.status.success(), "{}", text(&o).1);
+    // A swept value out of range: both fail, naming the run.
+    let g = sweep_graph(dir.path(), "10.0", "[10.0, -3.0]", "");
+    let g = g.to_str().unwrap();
+    let o = evflow(&["check", g]);
+    let (_, stderr) = text(&o);
+    assert_eq!(o.status.code(), Some(1), "{stderr}");
+    assert!(stderr.contains("1 of 2 sweep runs would fail") && stderr.contains("f=-3:"), "{stderr}");
+    assert!(stderr.contains("`frequency`"), "{stderr}");
+    let o = evflow(&["run", g, "--duration", "0.01", "--out", out]);
+    assert!(!o.status.success() && text(&o).1.contains("f=-3"), "{}", text(&o).1);
+    // A value above Nyquist validates but fails when built: check builds every run.
+    let g = sweep_graph(dir.path(), "10.0", "[10.0, 700.0]", "");
+    let o = evflow(&["check", g.to_str().unwrap()]);
+    let (_, stderr) = text(&o);
+    assert_eq!(o.status.code(), Some(1), "{stderr}");
+    assert!(stderr.contains("f=700:"), "{stderr}");
+    // --sweep replaces the graph's axis, as in run.
+    let o = evflow(&["check", g.to_str().unwrap(), "--sweep", "f=1,2,3"]);
+    assert!(o.status.success(), "{}", text(&o).1);
+    let o = evflow(&["check", g.to_str().unwrap(), "--sweep", "nope=1,2"]);
+    assert!(!o.status.success() && text(&o).1.contains("no variable `nope`"), "{}", text(&o).1);
+    // Runs that would write one file are refused by both, before anything runs.
+    let g = sweep_graph(dir.path(), "10.0", "[10.0, 20.0]", "same.wav");
+    let o = evflow(&["check", g.to_str().unwrap()]);
+    let (_, stderr) = text(&o);
+    assert_eq!(o.status.code(), Some(1), "{stderr}");
+    assert!(stderr.contains("same.wav"), "{stderr}");
+    let o = evflow(&["run", g.to_str().unwrap(), "--duration", "0.01", "--out", out]);
+    assert!(!o.status.success() && text(&o).1.contains("same.wav"), "{}", text(&o).1);
+}

@@ -34,10 +34,16 @@ impl Failures {
     /// failure (`  item: reason`, a reason of several lines indented under
     /// it); empty when nothing failed.
     pub fn summary(&self, total: usize, what: &str) -> String {
+        self.summary_as(total, what, "failed")
+    }
+
+    /// [`Failures::summary`] saying `N of M {what} {verb}:` (`would
+    /// fail`, for a check that runs nothing).
+    pub fn summary_as(&self, total: usize, what: &str, verb: &str) -> String {
         if self.list.is_empty() {
             return String::new();
         }
-        let mut s = format!("{} of {total} {what} failed:\n", self.list.len());
+        let mut s = format!("{} of {total} {what} {verb}:\n", self.list.len());
         for (item, reason) in &self.list {
             let mut lines = reason.lines();
             s.push_str(&format!("  {item}: {}\n", lines.next().unwrap_or("")));

@@ -242,6 +242,7 @@ mod tests {
                     timing: false,
                     out_dir: None,
                     mode: evflow_engine::RunMode::Offline,
+                    check_only: false,
                 };
                 let mut plan = Plan::build(&checked, &opts).unwrap();
                 // The cycle limits blocks to the delay.

@@ -64,6 +64,7 @@ fn run(text: &str, ticks: usize) -> (Vec<f64>, Vec<f64>) {
         timing: false,
         out_dir: None,
         mode: evflow_engine::RunMode::Offline,
+        check_only: false,
     };
     let mut plan = Plan::build(&checked, &opts).unwrap();
     let (mut force, mut pos) = (Vec::new(), Vec::new());

@@ -182,6 +182,7 @@ mod tests {
             out_dir: Some(lab_dir()),
             timing: false,
             mode: RunMode::Offline,
+            check_only: false,
         };
         let mut plan = Plan::build(&checked, &opts).unwrap();
         let (mut fa, mut fb) = (Vec::new(), Vec::new());

@@ -141,6 +141,7 @@ fn a_nan_input_is_an_error_naming_the_sample() {
         base_dir: ".".into(),
         out_dir: ".".into(),
         seed: 0,
+        check_only: false,
     };
     let params = evflow_engine::Params::from_map(
         [("passband", 0.8), ("attenuation", 100.0), ("rate", 250.0)]

@@ -21,6 +21,8 @@
 mod error;
 mod reader;
 #[cfg(test)]
+mod stream_tests;
+#[cfg(test)]
 mod tests;
 mod wav;
 mod writer;

@@ -19,9 +19,11 @@ pub static SPEC: NodeSpec = NodeSpec::new(
      The node's rate is `rate`, which must equal the recording's rate (the validator resolves rates \
      before any file is opened, so the rate is written in the graph and checked against the file at \
      construction). Only the listed channels are decoded and kept in memory.\n\n\
-     The whole recording is validated when the node is built: a missing or foreign sidecar, a newer \
+     The whole recording is validated when the node is built (`evflow check` streams through the \
+     file to do so, keeping no sample, so checking a large recording takes no memory): a missing or foreign sidecar, a newer \
      format version, a WAV that is not 64-bit float, a channel-count mismatch or a NaN/Inf sample \
-     is an error naming the file (and the channel and frame). A WAV cut short by a crash is played \
+     is an error naming the file (and the channel and frame); so is a WAV or sidecar that is not a \
+     regular file (a link to `/dev/zero`, a FIFO). A WAV cut short by a crash is played \
      up to its last whole frame and the run's summary says how many frames were missing.\n\n\
      Used to replay tribometer force recordings (dissertation §5.1: lateral force at 1 kHz under \
      load × velocity conditions; §3.1: 10 kHz) and recorded sessions through any graph. Checked \
@@ -54,7 +56,9 @@ fn build(p: &Params, ctx: &BuildContext) -> Result<Box<dyn Node>, NodeError> {
     if names.is_empty() {
         return Err(NodeError::param("channels", "list at least one channel to play"));
     }
-    let rec = Recording::open_channels(&ctx.path(&shown), names).map_err(|e| match e {
+    // `evflow check` streams through the samples to validate them, keeping none.
+    let read = if ctx.check_only { Recording::scan_channels } else { Recording::open_channels };
+    let rec = read(&ctx.path(&shown), names).map_err(|e| match e {
         RecordingError::UnknownChannel { .. } => NodeError::param("channels", e.to_string()),
         e => e.into(),
     })?;
@@ -72,7 +76,10 @@ fn build(p: &Params, ctx: &BuildContext) -> Result<Box<dyn Node>, NodeError> {
     }
     let frames = rec.frames();
     let shortfall = rec.shortfall();
-    Ok(Box::new(RecordingIn { channels: rec.into_channels(), frames, pos: 0, shown, shortfall }))
+    let mut channels = rec.into_channels();
+    // A checked plan never runs; its ports still get their (empty) channels.
+    channels.resize(names.len(), Vec::new());
+    Ok(Box::new(RecordingIn { channels, frames, pos: 0, shown, shortfall }))
 }
 
 impl Node for RecordingIn {
@@ -82,7 +89,7 @@ impl Node for RecordingIn {
         for (o, data) in self.channels.iter().enumerate() {
             let out = io.output(o);
             n = out.len();
-            let avail = &data[start..];
+            let avail = data.get(start..).unwrap_or(&[]);
             let k = n.min(avail.len());
             out[..k].copy_from_slice(&avail[..k]);
             out[k..].fill(0.0);

@@ -172,6 +172,7 @@ mod tests {
             base_dir: PathBuf::from("."),
             out_dir: PathBuf::from("."),
             seed: 0,
+            check_only: false,
         };
         build(&Params::from_map(m), &ctx)
     }

@@ -26,6 +26,7 @@ pub fn run_with(file: &Path, sets: &[impl AsRef<str>], out: &Path) -> Result<Run
         out_dir: Some(out.to_path_buf()),
         timing: false,
         mode: evflow_engine::RunMode::Offline,
+        check_only: false,
     };
     let mut plan = Plan::build(&checked, &opts).map_err(|e| anyhow!("{}: {e}", file.display()))?;
     run_offline(&mut plan, RunOptions { duration: None, progress: None })

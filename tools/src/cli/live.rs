@@ -125,6 +125,7 @@ pub fn main(a: Args) -> Result<()> {
         out_dir: Some(a.out.clone()),
         timing: false,
         mode: evflow_engine::RunMode::Live,
+        check_only: false,
     };
     let plan = Plan::build(&checked, &opts).map_err(|e| anyhow!("{e}"))?;
     #[allow(unused_mut)]

@@ -211,6 +211,7 @@ fn replay_one(session: &Path, graph: Option<&Path>, out: &Path, a: &Args) -> Res
         out_dir: Some(out.to_path_buf()),
         timing: true,
         mode: evflow_engine::RunMode::Offline,
+        check_only: false,
     };
     // The session's parameter changes apply: no constant may rest on a live parameter.
     let mut plan =

@@ -6,8 +6,8 @@ use super::graph_args::GraphArgs;
 use super::run_report::print_report;
 use anyhow::{anyhow, bail, Result};
 use evflow_engine::batch::{check_outputs, for_each_ordered, output_files, Failures};
-use evflow_engine::sweep::{parse_axis, points, Point};
-use evflow_engine::{check, read_graph, run_offline, Checked, Plan, PlanOptions, RunOptions, RunReport};
+use evflow_engine::sweep::{check_axes, parse_axis, points, validate, Point};
+use evflow_engine::{read_graph, run_offline, Checked, Plan, PlanOptions, RunOptions, RunReport};
 use evflow_tools::batch::shard_record::{relative_to, ShardRecord};
 use evflow_tools::batch::tables::{report_json, sweep_csv, sweep_table, Timings};
 use evflow_tools::batch::{progress_bar, BatchArgs};
@@ -66,12 +66,7 @@ pub fn main(a: Args) -> Result<()> {
     let axes = a.sweep.iter().map(|s| parse_axis(s).map_err(|e| anyhow!("--sweep {e}"))).collect::<Result<Vec<_>>>()?;
     let graph = read_graph(&a.graph.file).map_err(|e| anyhow!("{e}"))?;
     let registry = evflow_nodes::registry();
-    for ax in &axes {
-        if !graph.vars.iter().any(|v| v.name == ax.name) {
-            let help = evflow_engine::suggest::help(&ax.name, graph.vars.iter().map(|v| v.name.as_str()));
-            bail!("--sweep {}: the graph has no variable `{}`; {help}", ax.name, ax.name);
-        }
-    }
+    check_axes(&graph, &axes).map_err(|e| anyhow!("{e}"))?;
 
     // Validate every run of the sweep before anything is built or written.
     // A run that does not validate is a failure of that run only; when none
@@ -85,13 +80,11 @@ pub fn main(a: Args) -> Result<()> {
     let slice = shard.range(total);
     let is_sweep = total > 1;
     let mut items: Vec<(usize, Point, Result<Checked, String>)> = Vec::with_capacity(slice.len());
-    for (i, p) in all.into_iter().enumerate().skip(slice.start).take(slice.len()) {
-        let mut o = overrides.clone();
-        o.extend(p.overrides());
-        match check(&graph, &registry, &o) {
-            Ok(c) => items.push((i, p, Ok(c))),
+    for v in validate(&graph, &registry, &overrides, all, slice.clone()) {
+        match v.checked {
+            Ok(c) => items.push((v.index, v.point, Ok(c))),
             Err(e) if !is_sweep => bail!("{e}"),
-            Err(e) => items.push((i, p, Err(e.to_string()))),
+            Err(e) => items.push((v.index, v.point, Err(e.to_string()))),
         }
     }
     if is_sweep && !items.iter().any(|(_, _, c)| c.is_ok()) {
@@ -230,6 +223,7 @@ fn run_one(checked: &Checked, a: &Args, stop: &AtomicBool, show_ticks: bool) -> 
         out_dir: Some(a.out.clone()),
         timing: true,
         mode: evflow_engine::RunMode::Offline,
+        check_only: false,
     };
     let mut plan = Plan::build(checked, &opts).map_err(|e| anyhow!("{e}"))?;
     let bar = ProgressBar::with_draw_target(None, ProgressDrawTarget::hidden());

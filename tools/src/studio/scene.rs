@@ -24,6 +24,7 @@ fn context(checked: &Checked, k: usize, base_dir: &Path) -> BuildContext {
         base_dir: base_dir.to_path_buf(),
         out_dir: std::env::temp_dir(),
         seed: checked.graph.seed,
+        check_only: false,
     }
 }
 

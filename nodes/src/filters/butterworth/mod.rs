@@ -240,6 +240,7 @@ mod tests {
             base_dir: ".".into(),
             out_dir: ".".into(),
             seed: 0,
+            check_only: false,
         };
         let params = Params::from_map(
             [

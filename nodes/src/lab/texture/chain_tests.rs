@@ -66,6 +66,7 @@ type = "harness.tap"
         timing: false,
         out_dir: None,
         mode: evflow_engine::RunMode::Offline,
+        check_only: false,
     };
     let mut plan = Plan::build(&checked, &opts).unwrap();
     let mut out = Vec::new();
@@ -192,6 +193,7 @@ type = "harness.tap"
         timing: false,
         out_dir: None,
         mode: evflow_engine::RunMode::Offline,
+        check_only: false,
     };
     let mut plan = Plan::build(&checked, &opts).unwrap();
     // μ per 25 µm of position: (min, max, count) over the strokes.

@@ -40,6 +40,15 @@ pub enum RecordingError {
         /// The sidecar.
         json: PathBuf,
     },
+    /// A recording's file is not a regular file (a folder, a device such as
+    /// `/dev/zero`, a FIFO), which is refused before it is read.
+    #[error("{}: is {what}, not a regular file; a recording is a NAME.wav and NAME.json pair of files", path.display())]
+    NotAFile {
+        /// The file named.
+        path: PathBuf,
+        /// What it is.
+        what: String,
+    },
     /// The sidecar is not JSON.
     #[error("{}: sidecar is not valid JSON: {message}", path.display())]
     SidecarNotJson {
@@ -211,6 +220,7 @@ impl RecordingError {
             | WrongFormat { path, .. }
             | NewerVersion { path, .. }
             | BadSidecar { path, .. }
+            | NotAFile { path, .. }
             | NotWav { path, .. }
             | NotFloat64 { path, .. }
             | ChannelMismatch { path, .. }

@@ -2,7 +2,43 @@
 
 use super::wav::{self, WavProblem, SAMPLE_BYTES};
 use super::{RecordingError, RecordingMeta, RecordingPaths, SidecarIn, FORMAT_NAME, FORMAT_VERSION};
+use std::io::{Read, Seek, SeekFrom};
 use std::path::Path;
+
+/// Bytes read from a WAV at a time.
+const READ_CHUNK: usize = 1 << 16;
+
+/// The largest sidecar read (a sidecar is a few hundred bytes; its condition
+/// may hold notes, not megabytes).
+pub(crate) const MAX_SIDECAR_BYTES: u64 = 1 << 20;
+
+/// Opens `path` for reading if it is a regular file (a link is followed),
+/// with its length: a device, a FIFO or a folder is refused before it is
+/// opened (opening a FIFO would wait for a writer; `/dev/zero` never ends).
+fn open_regular(path: &Path) -> Result<(std::fs::File, u64), RecordingError> {
+    let not_file = |what: &str| RecordingError::NotAFile { path: path.to_path_buf(), what: what.to_string() };
+    let kind = |m: &std::fs::Metadata| {
+        let t = m.file_type();
+        if t.is_dir() {
+            "a folder"
+        } else if t.is_file() {
+            "a file"
+        } else {
+            "a device, FIFO or socket"
+        }
+    };
+    let m = std::fs::metadata(path).map_err(|e| RecordingError::io(path, e))?;
+    if !m.is_file() {
+        return Err(not_file(kind(&m)));
+    }
+    let file = std::fs::File::open(path).map_err(|e| RecordingError::io(path, e))?;
+    // Checked again on the open file: the name may have been swapped.
+    let m = file.metadata().map_err(|e| RecordingError::io(path, e))?;
+    if !m.is_file() {
+        return Err(not_file(kind(&m)));
+    }
+    Ok((file, m.len()))
+}
 
 /// Frames missing from a truncated recording.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -45,7 +81,24 @@ impl Recording {
         Self::open_impl(path, Some(&names))
     }
 
+    /// Validates the recording as [`Recording::open_channels`] does — the
+    /// sidecar, the header, every sample of the named channels finite — by
+    /// streaming through the file, keeping none of the samples: what `evflow
+    /// check` does, in memory that does not grow with the file.
+    /// [`Recording::frames`] and [`Recording::shortfall`] are those of the
+    /// file; no channel is loaded ([`Recording::loaded`] is empty).
+    pub fn scan_channels(path: &Path, names: &[impl AsRef<str>]) -> Result<Self, RecordingError> {
+        let names: Vec<&str> = names.iter().map(AsRef::as_ref).collect();
+        Self::read(path, Some(&names), false)
+    }
+
     fn open_impl(path: &Path, names: Option<&[&str]>) -> Result<Self, RecordingError> {
+        Self::read(path, names, true)
+    }
+
+    /// Reads the recording, decoding the `names` channels (all if `None`) in
+    /// chunks of [`READ_CHUNK`] bytes; `keep` keeps their samples.
+    fn read(path: &Path, names: Option<&[&str]>, keep: bool) -> Result<Self, RecordingError> {
         let paths = RecordingPaths::new(path);
         match (paths.wav.exists(), paths.json.exists()) {
             (false, false) => {
@@ -73,10 +126,12 @@ impl Recording {
                 .collect::<Result<_, _>>()?,
         };
 
-        let bytes = std::fs::read(&paths.wav).map_err(|e| RecordingError::io(&paths.wav, e))?;
-        let info = wav::parse(&bytes).map_err(|p| match p {
+        let (file, len) = open_regular(&paths.wav)?;
+        let mut file = std::io::BufReader::with_capacity(READ_CHUNK, file);
+        let info = wav::parse(&mut file, len).map_err(|p| match p {
             WavProblem::Broken(message) => RecordingError::NotWav { path: paths.wav.clone(), message },
             WavProblem::NotFloat64(found) => RecordingError::NotFloat64 { path: paths.wav.clone(), found },
+            WavProblem::Io(e) => RecordingError::io(&paths.wav, e),
         })?;
         if info.channels != meta.channels.len() {
             return Err(RecordingError::ChannelMismatch {
@@ -90,8 +145,10 @@ impl Recording {
             return Err(RecordingError::RateMismatch { path: paths.wav.clone(), header: info.rate, rate: meta.rate });
         }
 
+        // Whole frames in the file as its size says when opened: what is
+        // read never passes it, whatever the header claims.
         let block = info.channels * SAMPLE_BYTES;
-        let in_file = ((bytes.len() - info.data_offset.min(bytes.len())) / block) as u64;
+        let in_file = len.saturating_sub(info.data_offset) / block as u64;
         let present = info.claimed_frames.min(in_file);
         let claimed = info.claimed_frames.max(sidecar_frames);
         let shortfall = (present < claimed).then_some(Shortfall { claimed, present });
@@ -100,26 +157,41 @@ impl Recording {
             message: format!("{present} frames do not fit in memory on this machine"),
         })?;
 
-        let samples = &bytes[info.data_offset..info.data_offset + frames * block];
-        let mut data = Vec::with_capacity(wanted.len());
-        for &c in &wanted {
-            let mut v = Vec::with_capacity(frames);
-            for (k, frame) in samples.chunks_exact(block).enumerate() {
-                let at = c * SAMPLE_BYTES;
-                let mut le = [0u8; SAMPLE_BYTES];
-                le.copy_from_slice(&frame[at..at + SAMPLE_BYTES]);
-                let x = f64::from_le_bytes(le);
-                if !x.is_finite() {
-                    return Err(RecordingError::NonFinite {
-                        path: paths.wav.clone(),
-                        channel: meta.channels[c].name.clone(),
-                        frame: k as u64,
-                        what: non_finite_word(x),
-                    });
+        let mut data: Vec<(usize, Vec<f64>)> =
+            wanted.iter().map(|&c| (c, Vec::with_capacity(if keep { frames } else { 0 }))).collect();
+        if !wanted.is_empty() {
+            file.seek(SeekFrom::Start(info.data_offset)).map_err(|e| RecordingError::io(&paths.wav, e))?;
+            let per_read = (READ_CHUNK / block).max(1);
+            let mut buf = vec![0u8; per_read * block];
+            let mut done = 0usize;
+            while done < frames {
+                let n = per_read.min(frames - done);
+                let bytes = &mut buf[..n * block];
+                file.read_exact(bytes).map_err(|e| RecordingError::io(&paths.wav, e))?;
+                for (c, v) in &mut data {
+                    let at = *c * SAMPLE_BYTES;
+                    for (k, frame) in bytes.chunks_exact(block).enumerate() {
+                        let mut le = [0u8; SAMPLE_BYTES];
+                        le.copy_from_slice(&frame[at..at + SAMPLE_BYTES]);
+                        let x = f64::from_le_bytes(le);
+                        if !x.is_finite() {
+                            return Err(RecordingError::NonFinite {
+                                path: paths.wav.clone(),
+                                channel: meta.channels[*c].name.clone(),
+                                frame: (done + k) as u64,
+                                what: non_finite_word(x),
+                            });
+                        }
+                        if keep {
+                            v.push(x);
+                        }
+                    }
                 }
-                v.push(x);
+                done += n;
             }
-            data.push((c, v));
+        }
+        if !keep {
+            data.clear();
         }
         Ok(Recording { paths, meta, data, frames, shortfall })
     }
@@ -181,7 +253,15 @@ pub(crate) fn non_finite_word(x: f64) -> &'static str {
 
 /// Reads and checks the sidecar: format name, then version, then fields.
 fn read_sidecar(path: &Path) -> Result<(RecordingMeta, u64), RecordingError> {
-    let text = std::fs::read_to_string(path).map_err(|e| RecordingError::io(path, e))?;
+    let (file, len) = open_regular(path)?;
+    if len > MAX_SIDECAR_BYTES {
+        return Err(RecordingError::BadSidecar {
+            path: path.to_path_buf(),
+            message: format!("{len} bytes; a sidecar holds at most {MAX_SIDECAR_BYTES} bytes"),
+        });
+    }
+    let mut text = String::new();
+    file.take(MAX_SIDECAR_BYTES).read_to_string(&mut text).map_err(|e| RecordingError::io(path, e))?;
     let value: serde_json::Value = serde_json::from_str(&text)
         .map_err(|e| RecordingError::SidecarNotJson { path: path.to_path_buf(), message: e.to_string() })?;
     let bad = |message: String| RecordingError::BadSidecar { path: path.to_path_buf(), message };

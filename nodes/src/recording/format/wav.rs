@@ -5,6 +5,8 @@
 //! float data: `RIFF` size `WAVE`, an 18-byte `fmt ` chunk (tag 3, cbSize 0),
 //! a `fact` chunk (frames), and the `data` chunk last so it can grow.
 
+use std::io::{Read, Seek, SeekFrom};
+
 /// Bytes before the first sample.
 pub(crate) const HEADER_LEN: u64 = 58;
 /// Offset of the RIFF size field (file length − 8).
@@ -71,7 +73,7 @@ pub(crate) struct WavInfo {
     /// Header rate in Hz.
     pub rate: u32,
     /// Offset of the first sample.
-    pub data_offset: usize,
+    pub data_offset: u64,
     /// Whole frames the `data` chunk claims.
     pub claimed_frames: u64,
 }
@@ -84,54 +86,74 @@ fn u32_at(b: &[u8], at: usize) -> u32 {
     u32::from_le_bytes([b[at], b[at + 1], b[at + 2], b[at + 3]])
 }
 
-/// Why a header cannot be read: broken RIFF, or another sample type.
-#[derive(Debug, Clone, PartialEq)]
+/// Why a header cannot be read: broken RIFF, another sample type, or the
+/// file could not be read.
+#[derive(Debug)]
 pub(crate) enum WavProblem {
     /// The RIFF structure is broken (message for people).
     Broken(String),
     /// Well-formed, but the samples are not 64-bit float (what they are).
     NotFloat64(String),
+    /// The operating system refused a read or a seek.
+    Io(std::io::Error),
 }
 
-/// Reads the header of a WAV file held in `b`. Walks the chunks in the
-/// file (not trusting the RIFF size, which a crashed writer may have left
-/// stale) up to the `data` chunk.
-pub(crate) fn parse(b: &[u8]) -> Result<WavInfo, WavProblem> {
+/// The largest `fmt ` body read: the 40 bytes of `WAVE_FORMAT_EXTENSIBLE`
+/// are all that is looked at.
+const FMT_READ: u64 = 64;
+
+/// Reads the header of the WAV file `r` of `len` bytes, reading only the
+/// chunk headers and the `fmt ` body (never the samples, never past `len`).
+/// Walks the chunks in the file (not trusting the RIFF size, which a crashed
+/// writer may have left stale) up to the `data` chunk.
+pub(crate) fn parse<R: Read + Seek>(r: &mut R, len: u64) -> Result<WavInfo, WavProblem> {
     let broken = |m: &str| WavProblem::Broken(m.to_string());
-    if b.len() < 12 {
-        return Err(broken(&format!("{} bytes, shorter than a RIFF header (12)", b.len())));
+    if len < 12 {
+        return Err(broken(&format!("{len} bytes, shorter than a RIFF header (12)")));
     }
-    if &b[0..4] != b"RIFF" {
+    let mut head = [0u8; 12];
+    read_at(r, 0, &mut head)?;
+    if &head[0..4] != b"RIFF" {
         return Err(broken("does not start with `RIFF`"));
     }
-    if &b[8..12] != b"WAVE" {
+    if &head[8..12] != b"WAVE" {
         return Err(broken("RIFF file of another type than `WAVE`"));
     }
     let mut fmt: Option<(usize, u32)> = None;
-    let mut pos = 12usize;
+    let mut pos = 12u64;
     loop {
-        if pos + 8 > b.len() {
+        if pos + 8 > len {
             return Err(broken(if fmt.is_some() { "no `data` chunk" } else { "no `fmt ` chunk" }));
         }
-        let id = &b[pos..pos + 4];
-        let size = u32_at(b, pos + 4);
+        let mut chunk = [0u8; 8];
+        read_at(r, pos, &mut chunk)?;
+        let id = &chunk[0..4];
+        let size = u64::from(u32_at(&chunk, 4));
         let body = pos + 8;
         if id == b"data" {
             let Some((channels, rate)) = fmt else {
                 return Err(broken("`data` chunk before the `fmt ` chunk"));
             };
-            let claimed_frames = u64::from(size) / (channels * SAMPLE_BYTES) as u64;
+            let claimed_frames = size / (channels * SAMPLE_BYTES) as u64;
             return Ok(WavInfo { channels, rate, data_offset: body, claimed_frames });
         }
         if id == b"fmt " {
-            if size < 16 || body + 16 > b.len() {
+            if size < 16 || body + 16 > len {
                 return Err(broken("`fmt ` chunk shorter than 16 bytes"));
             }
-            fmt = Some(read_fmt(&b[body..(body + size as usize).min(b.len())])?);
+            let mut f = vec![0u8; size.min(len - body).min(FMT_READ) as usize];
+            read_at(r, body, &mut f)?;
+            fmt = Some(read_fmt(&f)?);
         }
         // Chunks are padded to an even length.
-        pos = body.saturating_add(size as usize).saturating_add(size as usize & 1);
+        pos = body + size + (size & 1);
     }
+}
+
+/// Fills `buf` from offset `at` of `r`.
+fn read_at<R: Read + Seek>(r: &mut R, at: u64, buf: &mut [u8]) -> Result<(), WavProblem> {
+    r.seek(SeekFrom::Start(at)).map_err(WavProblem::Io)?;
+    r.read_exact(buf).map_err(WavProblem::Io)
 }
 
 /// Checks the `fmt ` chunk body: 64-bit IEEE float, consistent block size.
@@ -168,4 +190,53 @@ fn read_fmt(f: &[u8]) -> Result<(usize, u32), WavProblem> {
         )));
     }
     Ok((channels, rate))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use std::io::Cursor;
+
+    /// A reader that counts the bytes read from it.
+    struct Counting<R> {
+        inner: R,
+        read: u64,
+    }
+    impl<R: Read> Read for Counting<R> {
+        fn read(&mut self, buf: &mut [u8]) -> std::io::Result<usize> {
+            let n = self.inner.read(buf)?;
+            self.read += n as u64;
+            Ok(n)
+        }
+    }
+    impl<R: Seek> Seek for Counting<R> {
+        fn seek(&mut self, pos: SeekFrom) -> std::io::Result<u64> {
+            self.inner.seek(pos)
+        }
+    }
+
+    #[test]
+    fn the_header_is_read_without_the_samples() {
+        // 2 channels, a million frames: 16 MB of samples, 58 bytes of header.
+        let mut file = header(2, 1000, 1_000_000).to_vec();
+        file.resize(file.len() + 16_000_000, 0);
+        let len = file.len() as u64;
+        let mut r = Counting { inner: Cursor::new(file), read: 0 };
+        let info = parse(&mut r, len).unwrap();
+        assert_eq!((info.channels, info.rate, info.data_offset, info.claimed_frames), (2, 1000, 58, 1_000_000));
+        assert!(r.read <= 12 + 3 * 8 + FMT_READ, "{} bytes read for the header", r.read);
+    }
+
+    #[test]
+    fn a_chunk_size_past_the_end_stops_the_walk() {
+        // A `LIST` chunk claiming 4 GiB before the `fmt `: no data chunk in reach.
+        let mut b = b"RIFF\0\0\0\0WAVELIST".to_vec();
+        b.extend_from_slice(&u32::MAX.to_le_bytes());
+        b.extend_from_slice(&[0; 100]);
+        let len = b.len() as u64;
+        match parse(&mut Cursor::new(b), len) {
+            Err(WavProblem::Broken(m)) => assert_eq!(m, "no `fmt ` chunk"),
+            other => panic!("{other:?}"),
+        }
+    }
 }

@@ -402,7 +402,7 @@ pub fn read(src: &Path, opts: &ImportOptions) -> Result<Imported, ImportError> {
             })
         }
     };
-    let bytes = std::fs::read(src).map_err(|source| ImportError::Io { path: src.to_path_buf(), source })?;
+    let bytes = read_regular(src)?;
     let mut notes = Vec::new();
     let table = match kind {
         Kind::Npy => {
@@ -488,6 +488,30 @@ struct Columns {
     /// The file line of each row (text), for messages.
     lines: Option<Vec<usize>>,
     description: String,
+}
+
+/// The whole of `src`, which must be a regular file: a link to a device
+/// (`/dev/zero`), a FIFO or a folder is refused before a byte is read, and
+/// checked again on the open handle (the name may have been swapped).
+fn read_regular(src: &Path) -> Result<Vec<u8>, ImportError> {
+    use std::io::Read;
+    let io = |source| ImportError::Io { path: src.to_path_buf(), source };
+    let refuse = |m: &std::fs::Metadata| ImportError::UnsupportedKind {
+        path: src.to_path_buf(),
+        what: if m.is_dir() { "a folder".into() } else { "a device, FIFO or socket (not a regular file)".into() },
+    };
+    let m = std::fs::metadata(src).map_err(io)?;
+    if !m.is_file() {
+        return Err(refuse(&m));
+    }
+    let mut file = std::fs::File::open(src).map_err(io)?;
+    let m = file.metadata().map_err(io)?;
+    if !m.is_file() {
+        return Err(refuse(&m));
+    }
+    let mut bytes = Vec::with_capacity(usize::try_from(m.len()).unwrap_or(0));
+    file.read_to_end(&mut bytes).map_err(io)?;
+    Ok(bytes)
 }
 
 /// Names, units, time column and rate: the recording's metadata.

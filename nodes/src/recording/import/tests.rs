@@ -627,3 +627,24 @@ mod hostile {
         }
     }
 }
+
+#[cfg(unix)]
+#[test]
+fn a_source_that_is_not_a_regular_file_is_refused_before_it_is_read() {
+    let dir = tempfile::tempdir().unwrap();
+    // A .csv link to /dev/zero would otherwise be read until memory runs out.
+    let zero = dir.path().join("zero.csv");
+    std::os::unix::fs::symlink("/dev/zero", &zero).unwrap();
+    let e = read(&zero, &ImportOptions::default()).unwrap_err().to_string();
+    assert!(e.contains("zero.csv") && e.contains("not a regular file"), "{e}");
+    let folder = dir.path().join("folder.csv");
+    fs::create_dir(&folder).unwrap();
+    let e = read(&folder, &ImportOptions::default()).unwrap_err().to_string();
+    assert!(e.contains("cannot import a folder"), "{e}");
+    // A link to a regular file is followed.
+    let real = dir.path().join("real.csv");
+    fs::write(&real, "t,force\n0,1\n0.001,2\n0.002,3\n").unwrap();
+    let link = dir.path().join("link.csv");
+    std::os::unix::fs::symlink(&real, &link).unwrap();
+    assert_eq!(read(&link, &ImportOptions::default()).unwrap().frames, 3);
+}

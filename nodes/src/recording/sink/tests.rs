@@ -48,6 +48,7 @@ fn plan(dir: &Path, doc: &str, block: usize) -> Result<Plan, String> {
         out_dir: Some(dir.to_path_buf()),
         timing: false,
         mode: evflow_engine::RunMode::Offline,
+        check_only: false,
     };
     Plan::build(&checked, &opts).map_err(|e| e.to_string())
 }

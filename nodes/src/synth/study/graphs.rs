@@ -27,6 +27,7 @@ pub fn run_graph_for(file: &Path, sets: &[String], out: &Path, duration: Option<
         out_dir: Some(out.to_path_buf()),
         timing: true,
         mode: RunMode::Offline,
+        check_only: false,
     };
     let mut plan = Plan::build(&checked, &opts).map_err(|e| err(e.to_string()))?;
     run_offline(&mut plan, RunOptions { duration, ..RunOptions::default() }).map_err(|e| err(e.to_string()))

@@ -4,7 +4,7 @@
 //! construction.
 //!
 //! **Deterministic by default.** `cargo test` draws the property tests'
-//! cases from a fixed seed ([`CI_SEED`]), so a run fails or passes the same
+//! cases from a fixed seed (`fuzz_common.rs`, `CI_SEED`), so a run fails or passes the same
 //! way every time, and it replays every file of `tests/fuzz_corpus/` — each
 //! case that ever failed, plus hand-picked nasty inputs — with a plain test
 //! (`tests/fuzz_corpus/README.md` says how to add one).
@@ -17,71 +17,20 @@
 
 use evflow_engine::{check, graph::parse_graph, Plan, PlanOptions};
 use proptest::prelude::*;
-use proptest::test_runner::{RngAlgorithm, RngSeed, TestRunner};
+use proptest::test_runner::TestRunner;
 use std::cell::RefCell;
 use std::path::{Path, PathBuf};
 use std::sync::OnceLock;
 
-/// The seed of the deterministic run (any fixed value; changing it draws
-/// another fixed set of cases).
-const CI_SEED: u64 = 0x00E7_F10A;
+#[path = "fuzz_common.rs"]
+mod common;
 
 /// Cases per property in the deterministic run (about 1.5 s for all three).
 const CI_CASES: u32 = 400;
 
-/// The deterministic configuration of `cargo test`: fixed seed and
-/// algorithm (set here, so no `PROPTEST_*` variable can change the draw),
-/// and no failure file written into the source tree — the corpus keeps
-/// failures instead.
-fn ci_config() -> ProptestConfig {
-    ProptestConfig {
-        cases: CI_CASES,
-        max_shrink_iters: 200,
-        rng_algorithm: RngAlgorithm::ChaCha,
-        rng_seed: RngSeed::Fixed(CI_SEED),
-        failure_persistence: None,
-        ..ProptestConfig::default()
-    }
-}
-
-/// The opt-in open-ended run, from `EVFLOW_FUZZ_CASES` / `EVFLOW_FUZZ_SEED`:
-/// `Some((seed, cases))` when either is set. One seed per test process, so
-/// one printed seed replays the whole run.
-fn fuzz_env() -> Option<(u64, u32)> {
-    static RUN: OnceLock<Option<(u64, u32)>> = OnceLock::new();
-    *RUN.get_or_init(|| {
-        let var = |name: &str| std::env::var(name).ok().filter(|v| !v.trim().is_empty());
-        let (cases, seed) = (var("EVFLOW_FUZZ_CASES"), var("EVFLOW_FUZZ_SEED"));
-        if cases.is_none() && seed.is_none() {
-            return None;
-        }
-        let cases = cases.map_or(CI_CASES, |v| {
-            v.trim().parse().unwrap_or_else(|_| panic!("EVFLOW_FUZZ_CASES={v}: expected a whole number of cases"))
-        });
-        let seed = seed.map_or_else(fresh_seed, |v| {
-            v.trim().parse().unwrap_or_else(|_| panic!("EVFLOW_FUZZ_SEED={v}: expected an unsigned 64-bit integer"))
-        });
-        eprintln!("fuzz_loader: seed {seed}, {cases} cases per property (EVFLOW_FUZZ_SEED={seed} replays this run)");
-        Some((seed, cases))
-    })
-}
-
-/// A seed that differs from run to run (std's per-process hash keys mixed
-/// with the clock).
-fn fresh_seed() -> u64 {
-    use std::hash::{BuildHasher, Hasher};
-    let mut h = std::collections::hash_map::RandomState::new().build_hasher();
-    h.write_u128(std::time::SystemTime::now().duration_since(std::time::UNIX_EPOCH).map_or(0, |d| d.as_nanos()));
-    h.finish()
-}
-
-/// The configuration the property tests run with: the deterministic one
-/// unless open-ended fuzzing was asked for.
+/// The configuration the property tests run with.
 fn config() -> ProptestConfig {
-    match fuzz_env() {
-        Some((seed, cases)) => ProptestConfig { cases, rng_seed: RngSeed::Fixed(seed), ..ci_config() },
-        None => ci_config(),
-    }
+    common::config("fuzz_loader", CI_CASES)
 }
 
 /// The corpus folder: one file per case, every file but README.md.
@@ -160,23 +109,9 @@ fn load(text: &str) -> Outcome {
 }
 
 /// [`load`] for a property test: on a panic the text is saved to
-/// `<target>/tmp/fuzz_loader/<property>.toml` (overwritten, so after
-/// shrinking it holds the minimal case) before the panic goes on.
+/// `<target>/tmp/fuzz_loader/<property>.toml` for the corpus.
 fn load_or_save(property: &str, text: &str) {
-    if let Err(panic) = std::panic::catch_unwind(|| load(text)) {
-        let dir = Path::new(env!("CARGO_TARGET_TMPDIR")).join("fuzz_loader");
-        let path = dir.join(format!("{property}.toml"));
-        static TOLD: std::sync::Mutex<Vec<String>> = std::sync::Mutex::new(Vec::new());
-        if std::fs::create_dir_all(&dir).and_then(|()| std::fs::write(&path, text)).is_ok() {
-            // Once per property: shrinking panics many times into one file.
-            let mut told = TOLD.lock().unwrap_or_else(|e| e.into_inner());
-            if !told.iter().any(|p| p == property) {
-                told.push(property.to_string());
-                eprintln!("fuzz_loader: the failing text is in {} (add it to tests/fuzz_corpus/)", path.display());
-            }
-        }
-        std::panic::resume_unwind(panic);
-    }
+    common::or_save("fuzz_loader", property, "toml", text, || load(text));
 }
 
 #[derive(Debug, Clone, PartialEq)]
@@ -400,18 +335,26 @@ fn same_draws<T: PartialEq>(what: &str, a: &[T], b: &[T]) {
 
 /// The deterministic run is deterministic: two runners on the CI
 /// configuration draw the same cases, case for case, for each property's
-/// strategy — so a random seed slipping into `ci_config` fails here — and
+/// strategy — so a random seed slipping into `common::ci_config` fails here — and
 /// `cargo test` uses that configuration unless fuzzing was asked for.
 #[test]
 fn the_ci_configuration_draws_the_same_cases_every_run() {
-    let texts = || drawn(ci_config(), mutated_case().prop_map(|(b, m)| mutated_text(b, &m)));
+    let texts = || drawn(common::ci_config(CI_CASES), mutated_case().prop_map(|(b, m)| mutated_text(b, &m)));
     let first = texts();
     assert_eq!(first.len(), CI_CASES as usize);
     assert!(first.iter().any(|t| t != &first[0]), "the cases vary");
     same_draws("mutated graphs", &first, &texts());
-    same_draws("arbitrary text", &drawn(ci_config(), TEXT_CASE), &drawn(ci_config(), TEXT_CASE));
-    same_draws("arbitrary bytes", &drawn(ci_config(), bytes_case()), &drawn(ci_config(), bytes_case()));
-    if fuzz_env().is_none() {
-        assert_eq!(config(), ci_config());
+    same_draws(
+        "arbitrary text",
+        &drawn(common::ci_config(CI_CASES), TEXT_CASE),
+        &drawn(common::ci_config(CI_CASES), TEXT_CASE),
+    );
+    same_draws(
+        "arbitrary bytes",
+        &drawn(common::ci_config(CI_CASES), bytes_case()),
+        &drawn(common::ci_config(CI_CASES), bytes_case()),
+    );
+    if common::fuzz_env("fuzz_loader", CI_CASES).is_none() {
+        assert_eq!(config(), common::ci_config(CI_CASES));
     }
 }

@@ -122,6 +122,44 @@ fn a_loopback_studio_refuses_foreign_hosts_and_origins() {
     s.stop();
 }
 
+/// The status line's code of a raw request `head` sent to `host`.
+fn raw_status(host: &str, head: &str) -> String {
+    use std::io::{Read, Write};
+    let mut s = std::net::TcpStream::connect(host).unwrap();
+    s.set_read_timeout(Some(Duration::from_secs(10))).unwrap();
+    s.write_all(head.as_bytes()).unwrap();
+    let mut r = String::new();
+    let _ = s.read_to_string(&mut r);
+    r.lines().next().unwrap_or("").to_string()
+}
+
+#[test]
+fn odd_or_doubled_host_headers_are_refused_and_idle_connections_do_not_starve_a_page() {
+    let tmp = tempfile::tempdir().unwrap();
+    let s = common::start("texture-live.toml", tmp.path(), &["127.0.0.1:0"], &["--endless"]);
+    let host = s.host();
+    let port = host.rsplit(':').next().unwrap().to_string();
+    let get = |h: &str| raw_status(&host, &format!("GET / HTTP/1.1\r\n{h}Connection: close\r\n\r\n"));
+    assert_eq!(get(&format!("Host: 127.0.0.1:{port}\r\n")), "HTTP/1.1 200 OK");
+    for bad in [
+        format!("Host: 127.0.0.1:{port}@evil.com\r\n"),
+        format!("Host: 127.0.0.1:{port}\r\nHost: evil.example\r\n"),
+        format!("Host: 127.0.0.1:{port}\r\nHost: 127.0.0.1:{port}\r\n"),
+        "Host: 127.0.0.1:\r\n".to_string(),
+        String::new(),
+    ] {
+        assert_eq!(get(&bad), "HTTP/1.1 400 Bad Request", "{bad:?}");
+    }
+    // 40 connections that never send a byte, held open: a page still loads.
+    let idle: Vec<std::net::TcpStream> = (0..40).map(|_| std::net::TcpStream::connect(&host).unwrap()).collect();
+    std::thread::sleep(Duration::from_millis(100));
+    for k in 0..3 {
+        assert_eq!(get(&format!("Host: 127.0.0.1:{port}\r\n")), "HTTP/1.1 200 OK", "request {k} beside 40 idle ones");
+    }
+    drop(idle);
+    s.stop();
+}
+
 /// A TCP connection to `host` whose receive buffer is a few kilobytes
 /// from the start (set before connecting), so a peer that is not read
 /// from fills it within a second.

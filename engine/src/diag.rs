@@ -35,11 +35,11 @@ impl fmt::Display for Diagnostic {
         }
         write!(f, ": ")?;
         if let Some(n) = &self.node {
-            write!(f, "node `{n}`: ")?;
+            write!(f, "node `{}`: ", cut_words(n, MAX_WORD))?;
         }
-        write!(f, "{}", self.message)?;
+        write!(f, "{}", cut_words(&self.message, MAX_WORD))?;
         if let Some(h) = &self.help {
-            write!(f, "\n  help: {h}")?;
+            write!(f, "\n  help: {}", cut_words(h, MAX_WORD))?;
         }
         Ok(())
     }
@@ -102,9 +102,59 @@ pub fn cut(s: &str, max: usize) -> String {
     }
 }
 
+/// The longest run of characters without a space that a message prints
+/// whole (a long path still fits; a megabyte of value does not).
+pub const MAX_WORD: usize = 600;
+
+/// `message` with every run of more than `max` characters without white
+/// space shortened to its first and last `max / 3` characters and how long
+/// it was: the guard every error message passes on its way to a person
+/// (the CLI's error printer, [`Diagnostic`]'s display), whatever value
+/// reached it.
+pub fn cut_words(message: &str, max: usize) -> std::borrow::Cow<'_, str> {
+    let long = |w: &str| w.chars().count() > max;
+    if !message.split(char::is_whitespace).any(long) {
+        return std::borrow::Cow::Borrowed(message);
+    }
+    let keep = (max / 3).max(1);
+    let mut out = String::with_capacity(message.len().min(64 * 1024));
+    let mut word = String::new();
+    let flush = |word: &mut String, out: &mut String| {
+        let n = word.chars().count();
+        if n > max {
+            let head: String = word.chars().take(keep).collect();
+            let tail: String = word.chars().skip(n - keep).collect();
+            out.push_str(&format!("{head}…{tail} ({n} characters)"));
+        } else {
+            out.push_str(word);
+        }
+        word.clear();
+    };
+    for c in message.chars() {
+        if c.is_whitespace() {
+            flush(&mut word, &mut out);
+            out.push(c);
+        } else {
+            word.push(c);
+        }
+    }
+    flush(&mut word, &mut out);
+    std::borrow::Cow::Owned(out)
+}
+
 #[cfg(test)]
 mod cut_tests {
-    use super::cut;
+    use super::{cut, cut_words};
+
+    #[test]
+    fn long_words_are_cut_in_the_middle_and_the_rest_kept() {
+        assert_eq!(cut_words("a short message", 7), "a short message");
+        let m = format!("bad value \"{}\" at line 3\n  help: {}", "x".repeat(1_000_000), "y".repeat(10));
+        let c = cut_words(&m, 30);
+        let x9 = "x".repeat(9);
+        assert_eq!(c, format!("bad value \"{x9}…{x9}\" (1000002 characters) at line 3\n  help: yyyyyyyyyy"));
+        assert!(c.len() < 200, "{c}");
+    }
 
     #[test]
     fn long_values_are_cut_and_say_how_long_they_were() {

@@ -12,6 +12,7 @@ pub mod batch;
 pub mod check;
 pub mod diag;
 pub mod dot;
+pub mod files;
 pub mod graph;
 pub mod harness;
 pub mod live;

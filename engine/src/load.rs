@@ -30,7 +30,8 @@ pub fn load_file(path: &Path, registry: &Registry, overrides: &[Override]) -> Re
 
 /// Reads and parses a graph file (syntax only; [`check`] validates it).
 pub fn read_graph(path: &Path) -> Result<Graph, LoadError> {
-    let bytes = std::fs::read(path).map_err(|source| LoadError::Read { path: path.display().to_string(), source })?;
+    let bytes = crate::files::read_regular(path)
+        .map_err(|source| LoadError::Read { path: path.display().to_string(), source })?;
     let text = match String::from_utf8(bytes) {
         Ok(t) => t,
         Err(e) => {

@@ -96,9 +96,13 @@ impl BuildContext {
             return Err(NodeError::param(
                 param,
                 format!(
-                    "`{shown}` would be written outside the output folder {}: output paths are relative to it and \
+                    "`{shown}` would be written outside the output folder{}: output paths are relative to it and \
                      hold no `..` (choose the folder with --out)",
-                    self.out_dir.display()
+                    if self.out_dir.as_os_str().is_empty() {
+                        String::new()
+                    } else {
+                        format!(" {}", self.out_dir.display())
+                    }
                 ),
             ));
         }

@@ -108,6 +108,22 @@ pub fn effective_axes<'a>(graph_axes: &'a [Axis], extra: &'a [Axis], pinned: &[O
     axes
 }
 
+/// The most runs a sweep may have: each is validated, and its point and
+/// checked graph kept, before the first runs.
+pub const MAX_RUNS: usize = 100_000;
+
+/// The number of runs of [`points`] over these axes, refused (with the
+/// axes' sizes) past [`MAX_RUNS`] before any point is made: a few long
+/// `--sweep` lists multiply into more runs than memory holds.
+pub fn count(graph_axes: &[Axis], extra: &[Axis], pinned: &[Override]) -> Result<usize, String> {
+    let axes = effective_axes(graph_axes, extra, pinned);
+    let total = axes.iter().try_fold(1usize, |n, a| n.checked_mul(a.values.len()).filter(|&n| n <= MAX_RUNS));
+    total.ok_or_else(|| {
+        let sizes: Vec<String> = axes.iter().map(|a| format!("{} ({})", a.name, a.values.len())).collect();
+        format!("the sweep {} has more than {MAX_RUNS} runs; split it (e.g. with --set or --shard)", sizes.join(" × "))
+    })
+}
+
 /// Refuses a command-line axis (`--sweep NAME=…`) that names no variable
 /// of `graph`, with the nearest names.
 pub fn check_axes(graph: &Graph, axes: &[Axis]) -> Result<(), String> {
@@ -161,6 +177,22 @@ mod tests {
 
     fn axis(s: &str) -> Axis {
         parse_axis(s).unwrap()
+    }
+
+    #[test]
+    fn a_sweep_past_max_runs_is_refused_before_its_points_are_made() {
+        let big =
+            |name: &str| axis(&format!("{name}={}", (0..1000).map(|k| k.to_string()).collect::<Vec<_>>().join(",")));
+        assert_eq!(
+            count(&[big("a"), big("b")], &[], &[]),
+            Err(format!(
+                "the sweep a (1000) × b (1000) has more than {MAX_RUNS} runs; split it (e.g. with --set or --shard)"
+            ))
+        );
+        let many: Vec<Axis> = (0..20).map(|k| big(&format!("v{k}"))).collect();
+        assert!(count(&many, &[], &[]).is_err(), "1000^20 overflows and is refused, not wrapped");
+        assert_eq!(count(&[big("a"), axis("b=1,2")], &[], &[]), Ok(2000));
+        assert_eq!(count(&[], &[], &[]), Ok(1));
     }
 
     #[test]

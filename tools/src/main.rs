@@ -165,7 +165,8 @@ fn main() -> ExitCode {
     match result {
         Ok(()) => ExitCode::SUCCESS,
         Err(e) => {
-            eprintln!("{e:#}");
+            // Whatever value reached the message, a person reads it cut.
+            eprintln!("{}", evflow_engine::diag::cut_words(&format!("{e:#}"), evflow_engine::diag::MAX_WORD));
             ExitCode::FAILURE
         }
     }

@@ -1,6 +1,7 @@
 //! `evflow check` streams through a recording instead of loading it (issue
 //! 27, point 3): a 600 MB recording is checked in a process that may not
-//! map 400 MB, and a WAV that is a link to `/dev/zero` is refused at once.
+//! map 400 MB, and a WAV, a mesh or a graph file that is a link to
+//! `/dev/zero` is refused at once.
 
 #![cfg(unix)]
 
@@ -75,4 +76,29 @@ fn a_recording_linked_to_dev_zero_is_refused_by_name() {
     let err = String::from_utf8_lossy(&o.stderr);
     assert_eq!(o.status.code(), Some(1), "{err}");
     assert!(err.contains("z.wav") && err.contains("not a regular file"), "{err}");
+}
+
+#[test]
+fn a_mesh_or_a_graph_file_linked_to_a_device_is_refused_by_name() {
+    let dir = tempfile::tempdir().unwrap();
+    std::os::unix::fs::symlink("/dev/zero", dir.path().join("scene.obj")).unwrap();
+    let g = dir.path().join("mesh.toml");
+    std::fs::write(
+        &g,
+        "[graph]\nformat = 1\nname = \"m\"\nrate = 1000\nconnections = [\"p.x -> s.x\", \"p.y -> s.y\", \"s.z -> k.in\"]\n\
+         [nodes.p]\ntype = \"mesh.path\"\n[nodes.s]\ntype = \"mesh.gradient\"\nfile = \"scene.obj\"\n\
+         [nodes.k]\ntype = \"stats\"\n",
+    )
+    .unwrap();
+    let o = check_limited(&g, 400 * 1024);
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert_eq!(o.status.code(), Some(1), "{err}");
+    assert!(err.contains("scene.obj") && err.contains("not a regular file"), "{err}");
+    // The graph file itself.
+    let z = dir.path().join("zero.toml");
+    std::os::unix::fs::symlink("/dev/zero", &z).unwrap();
+    let o = check_limited(&z, 400 * 1024);
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert_eq!(o.status.code(), Some(1), "{err}");
+    assert!(err.contains("zero.toml") && err.contains("not a regular file"), "{err}");
 }

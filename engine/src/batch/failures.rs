@@ -44,11 +44,26 @@ impl Failures {
             return String::new();
         }
         let mut s = format!("{} of {total} {what} {verb}:\n", self.list.len());
+        // Three or more items that failed for one reason (a mistake every
+        // run of a sweep shares) share one line, the reason once.
+        let mut reasons: Vec<(&str, Vec<&str>)> = Vec::new();
         for (item, reason) in &self.list {
+            match reasons.iter_mut().find(|(r, _)| *r == reason.as_str()) {
+                Some((_, items)) => items.push(item),
+                None => reasons.push((reason, vec![item])),
+            }
+        }
+        let mut line = |who: &str, reason: &str| {
             let mut lines = reason.lines();
-            s.push_str(&format!("  {item}: {}\n", lines.next().unwrap_or("")));
+            s.push_str(&format!("  {who}: {}\n", lines.next().unwrap_or("")));
             for l in lines {
                 s.push_str(&format!("      {l}\n"));
+            }
+        };
+        for (reason, items) in reasons {
+            match items.len() {
+                n if n >= 3 => line(&format!("{} … {} ({n} items)", items[0], items[n - 1]), reason),
+                _ => items.iter().for_each(|who| line(who, reason)),
             }
         }
         s
@@ -69,6 +84,20 @@ mod tests {
         assert_eq!(
             f.summary(9, "runs"),
             "2 of 9 runs failed:\n  mass=5000: `display.mass`: 5000 is above 300\n        at g.toml:4\n  mass=7: no such file\n"
+        );
+    }
+
+    #[test]
+    fn items_failing_for_one_reason_share_its_line() {
+        let mut f = Failures::new();
+        for m in [1, 2, 3, 4] {
+            f.push(format!("m={m}"), "bad type");
+        }
+        f.push("m=5", "other");
+        f.push("m=6", "other");
+        assert_eq!(
+            f.summary_as(6, "sweep runs", "would fail"),
+            "6 of 6 sweep runs would fail:\n  m=1 … m=4 (4 items): bad type\n  m=5: other\n  m=6: other\n"
         );
     }
 }

@@ -113,7 +113,7 @@ impl Reader<'_> {
 impl LabProfile {
     /// Reads a profile file. Keys not given keep their nominal value.
     pub fn load(path: &Path) -> Result<LabProfile, ProfileError> {
-        let text = std::fs::read_to_string(path).map_err(|e| ProfileError {
+        let text = evflow_engine::files::read_regular_to_string(path).map_err(|e| ProfileError {
             file: path.to_path_buf(),
             issues: vec![ProfileIssue {
                 line: 0,

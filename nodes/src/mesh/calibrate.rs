@@ -155,7 +155,7 @@ pub fn calibrate(
 }
 
 fn read_cache(path: &Path, key: u64) -> Option<Range> {
-    let text = std::fs::read_to_string(path).ok()?;
+    let text = evflow_engine::files::read_regular_to_string(path).ok()?;
     let v: serde_json::Value = serde_json::from_str(&text).ok()?;
     if v.get("version")?.as_u64()? != CACHE_VERSION || v.get("key")?.as_str()? != format!("{key:016x}") {
         return None;

@@ -36,7 +36,8 @@ const MAX_DEPTH: usize = 256;
 /// Loads a `.gltf` or `.glb` file (by content: a file starting with
 /// `glTF` is a GLB).
 pub fn load_gltf(path: &Path, weld: f64) -> Result<Mesh, MeshError> {
-    let bytes = std::fs::read(path).map_err(|e| MeshError::Io { path: path.into(), message: e.to_string() })?;
+    let bytes = evflow_engine::files::read_regular(path)
+        .map_err(|e| MeshError::Io { path: path.into(), message: e.to_string() })?;
     let glb = path.extension().is_some_and(|e| e.eq_ignore_ascii_case("glb"));
     parse_gltf(path, &bytes, glb, weld)
 }
@@ -286,7 +287,7 @@ fn fetch_buffers<'a>(
             }
             ::gltf::buffer::Source::Uri(uri) => {
                 let file = path.parent().unwrap_or(Path::new("")).join(percent_decode(uri));
-                let data = std::fs::read(&file).map_err(|e| MeshError::Io {
+                let data = evflow_engine::files::read_regular(&file).map_err(|e| MeshError::Io {
                     path: file.clone(),
                     message: format!("buffers[{k}] of {}: {e}", path.display()),
                 })?;

@@ -13,8 +13,8 @@ use std::path::Path;
 
 /// Loads an OBJ file.
 pub fn load_obj(path: &Path, weld: f64) -> Result<Mesh, MeshError> {
-    let text =
-        std::fs::read_to_string(path).map_err(|e| MeshError::Io { path: path.into(), message: e.to_string() })?;
+    let text = evflow_engine::files::read_regular_to_string(path)
+        .map_err(|e| MeshError::Io { path: path.into(), message: e.to_string() })?;
     parse_obj(path, &text, weld)
 }
 

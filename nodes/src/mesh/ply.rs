@@ -20,7 +20,8 @@ use std::path::Path;
 
 /// Loads a PLY file.
 pub fn load_ply(path: &Path, weld: f64) -> Result<Mesh, MeshError> {
-    let bytes = std::fs::read(path).map_err(|e| MeshError::Io { path: path.into(), message: e.to_string() })?;
+    let bytes = evflow_engine::files::read_regular(path)
+        .map_err(|e| MeshError::Io { path: path.into(), message: e.to_string() })?;
     parse_ply(path, &bytes, weld)
 }
 

@@ -27,7 +27,8 @@ const RECORD: usize = 50;
 
 /// Loads an STL file (ASCII or binary).
 pub fn load_stl(path: &Path, weld: f64) -> Result<Mesh, MeshError> {
-    let bytes = std::fs::read(path).map_err(|e| MeshError::Io { path: path.into(), message: e.to_string() })?;
+    let bytes = evflow_engine::files::read_regular(path)
+        .map_err(|e| MeshError::Io { path: path.into(), message: e.to_string() })?;
     parse_stl(path, &bytes, weld)
 }
 

@@ -240,7 +240,7 @@ impl Model {
 
     /// Reads and checks a model file.
     pub fn load(path: &Path) -> Result<Self, NarxError> {
-        let text = std::fs::read_to_string(path)
+        let text = evflow_engine::files::read_regular_to_string(path)
             .map_err(|e| NarxError::Io { path: path.into(), message: format!("cannot read the model: {e}") })?;
         let value: serde_json::Value =
             serde_json::from_str(&text).map_err(|e| NarxError::Parse { path: path.into(), message: e.to_string() })?;

@@ -37,6 +37,14 @@ use std::path::{Path, PathBuf};
 /// The sidecar's `format` value.
 pub const FORMAT_NAME: &str = "evflow-recording";
 
+/// The rates a recording may have for `recording.in` to play it, in Hz:
+/// 0.001 Hz … 10 MHz. `evflow import` refuses a rate outside them (given
+/// or read from a time column), so what it writes is what a graph reads.
+pub const MIN_RATE_HZ: f64 = 1e-3;
+
+/// The highest rate of [`MIN_RATE_HZ`]'s range, in Hz.
+pub const MAX_RATE_HZ: f64 = 1e7;
+
 /// The newest sidecar version this evflow reads and the one it writes.
 pub const FORMAT_VERSION: u64 = 1;
 

@@ -35,7 +35,11 @@ pub static SPEC: NodeSpec = NodeSpec::new(
     ParamSpec::text("path", "", "the recording: NAME.wav, NAME.json or NAME (relative to the graph file's folder)")
         .required(),
     ParamSpec::text_list("channels", "channels to play, each on an output port of its name").required(),
-    ParamSpec::float("rate", 1e-3, 1e7, 1000.0, "Hz", "the recording's sample rate (must match the file)"),
+    ParamSpec::float(
+        "rate",
+        super::format::MIN_RATE_HZ,
+        super::format::MAX_RATE_HZ,
+        1000.0, "Hz", "the recording's sample rate (must match the file)"),
 ])
 .rate_param("rate")
 .example("path = \"recordings/felt.wav\"\nchannels = [\"force\"]\nrate = 1000.0");

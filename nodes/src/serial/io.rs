@@ -156,6 +156,11 @@ impl Io {
             Err(e) => {
                 let why = format!("cannot open {}: {e}", self.config.port);
                 if self.report.last_error.as_deref() != Some(why.as_str()) {
+                    // Said once per new reason: a session started without
+                    // its device (`wait = 0`) shows why it is unconnected.
+                    let msg = format!("{why}; trying again every {} s", self.config.retry.as_secs_f64());
+                    self.say(&msg);
+                    self.report.event(msg);
                     self.report.last_error = Some(why);
                 }
                 Err(())

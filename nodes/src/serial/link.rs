@@ -222,8 +222,13 @@ impl Link {
         end
     }
 
-    /// Waits up to `config.wait` for the link to come up.
+    /// Waits up to `config.wait` for the link to come up; a `wait` of 0
+    /// starts unconnected at once (the I/O thread keeps trying, and says
+    /// why each attempt fails when the reason changes).
     pub fn wait_connected(&self) -> Result<(), String> {
+        if self.config.wait.is_zero() {
+            return Ok(());
+        }
         let until = Instant::now() + self.config.wait;
         loop {
             if self.state.connected.load(Ordering::Acquire) {

@@ -272,6 +272,22 @@ fn errors_name_the_port_and_the_reason() {
 }
 
 #[test]
+fn wait_zero_starts_unconnected_and_says_why() {
+    // Before: `wait = 0` failed at once with "the device did not answer
+    // HELLO", hiding that the port does not exist.
+    let mut p = plan("/nonexistent/evflow-tty-wait0", 0.0).expect("starts without its device");
+    let rows = run(&mut p, 100);
+    assert!(rows.iter().all(|(r, out)| r[5] == 0.0 && r[6] == 1.0 && *out == 0.0), "unconnected, faulted, silent");
+    let s = p.finish().unwrap();
+    let dev = &s.iter().find(|(n, _)| n == "dev").unwrap().1;
+    assert!(
+        dev.lines.iter().any(|l| l.contains("cannot open /nonexistent/evflow-tty-wait0") && l.contains("No such file")),
+        "{:?}",
+        dev.lines
+    );
+}
+
+#[test]
 fn offline_runs_never_open_the_port_whatever_their_block_size() {
     // Blocks of 4096 (`evflow run`, a replay) and of one tick (`evflow run
     // --block 1`, a replay with --block 1): offline is offline.

@@ -207,7 +207,7 @@ impl ForwardModel {
 
     /// Reads and checks a model file.
     pub fn load(path: &Path) -> Result<Self, SynthError> {
-        let text = std::fs::read_to_string(path)
+        let text = evflow_engine::files::read_regular_to_string(path)
             .map_err(|e| SynthError::Io { path: path.into(), message: format!("cannot read the model: {e}") })?;
         let value: serde_json::Value =
             serde_json::from_str(&text).map_err(|e| SynthError::Parse { path: path.into(), message: e.to_string() })?;

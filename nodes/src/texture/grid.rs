@@ -337,7 +337,7 @@ struct Candidate {
 fn read_cell(path: &Path, lenient: bool) -> Result<Option<Candidate>, GridError> {
     let paths = RecordingPaths::new(path);
     let bad = |message: String| GridError::Sidecar { path: paths.json.clone(), message };
-    let text = std::fs::read_to_string(&paths.json).map_err(|e| {
+    let text = evflow_engine::files::read_regular_to_string(&paths.json).map_err(|e| {
         bad(if e.kind() == std::io::ErrorKind::NotFound { "no such recording sidecar".into() } else { e.to_string() })
     })?;
     let v: serde_json::Value = serde_json::from_str(&text).map_err(|e| bad(format!("not valid JSON: {e}")))?;

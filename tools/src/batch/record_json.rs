@@ -85,7 +85,7 @@ pub fn write_doc(dir: &Path, name: &str, doc: &Json) -> Result<(), RecordError> 
 /// is wrong.
 pub fn read_doc<T>(dir: &Path, name: &str, parse: impl Fn(&Json) -> Fault<T>) -> Result<T, RecordError> {
     let path = dir.join(name);
-    let text = match std::fs::read_to_string(&path) {
+    let text = match evflow_engine::files::read_regular_to_string(&path) {
         Ok(text) => text,
         Err(source) => return Err(RecordError::Read { path, source }),
     };

@@ -44,6 +44,7 @@ pub fn main(a: Args) -> Result<()> {
     let sweep =
         evflow_engine::sweep_files::expand(&graph, &overrides, &evflow_nodes::recording::sweep_fields::sweep_fields)
             .map_err(|e| anyhow!("{}: {e}", graph.file.display()))?;
+    evflow_engine::sweep::count(&sweep, &axes, &overrides).map_err(|e| anyhow!("{}: {e}", graph.file.display()))?;
     let all = points(&sweep, &axes, &overrides);
     let total = all.len();
     let is_sweep = total > 1;
@@ -58,7 +59,7 @@ pub fn main(a: Args) -> Result<()> {
         }
     }
     let Some((first, c)) = runs.first() else {
-        bail!("no run of the sweep validates: {}", failures.summary(total, "sweep runs").trim_end());
+        bail!("no run of the sweep validates: {}", failures.summary_as(total, "sweep runs", "fail").trim_end());
     };
     let g = &c.graph;
     println!("graph `{}` ({}), format {}, base rate {} Hz", g.name, a.graph.file.display(), g.format, g.rate);

@@ -6,6 +6,8 @@
 use anyhow::Result;
 use evflow_nodes::recording::import::{self, Delimiter, ImportOptions};
 use std::path::PathBuf;
+use std::sync::atomic::{AtomicBool, Ordering};
+use std::sync::Arc;
 
 /// Arguments of `evflow import`.
 #[derive(clap::Args, Debug)]
@@ -79,8 +81,16 @@ pub fn main(a: Args) -> Result<()> {
     for entry in &a.condition {
         opts.add_condition(entry)?;
     }
+    // Ctrl-C, SIGTERM or SIGHUP stop the write between pieces, and the
+    // temporary files go with it (the flag is read before writing starts,
+    // so a signal while reading stops there too).
+    let stop = Arc::new(AtomicBool::new(false));
+    {
+        let stop = stop.clone();
+        let _ = ctrlc::set_handler(move || stop.store(true, Ordering::SeqCst));
+    }
     let imported = import::read(&a.src, &opts)?;
-    let written = imported.write(&import::destination(&a.src, a.out.as_deref()), opts.force)?;
+    let written = imported.write_until(&import::destination(&a.src, a.out.as_deref()), opts.force, &stop)?;
 
     let m = &imported.meta;
     println!("wrote {} + {}", written.paths.wav.display(), written.paths.json.display());

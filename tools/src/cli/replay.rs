@@ -138,8 +138,8 @@ fn replay_one(session: &Path, graph: Option<&Path>, out: &Path, a: &Args) -> Res
         Some(g) => (g.to_path_buf(), g.parent().map(Path::to_path_buf).unwrap_or_default()),
         None => (session.join("graph.toml"), m.base_dir.clone()),
     };
-    let text =
-        std::fs::read_to_string(&graph_file).with_context(|| format!("{}: cannot read", graph_file.display()))?;
+    let text = evflow_engine::files::read_regular_to_string(&graph_file)
+        .with_context(|| format!("{}: cannot read", graph_file.display()))?;
     let mut graph = parse_graph(&graph_file, &text).map_err(|e| anyhow!("{e}"))?;
 
     // Recorded inputs replace the sources of the same names.

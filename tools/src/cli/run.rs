@@ -74,6 +74,7 @@ pub fn main(a: Args) -> Result<()> {
     let sweep =
         evflow_engine::sweep_files::expand(&graph, &overrides, &evflow_nodes::recording::sweep_fields::sweep_fields)
             .map_err(|e| anyhow!("{}: {e}", graph.file.display()))?;
+    evflow_engine::sweep::count(&sweep, &axes, &overrides).map_err(|e| anyhow!("{}: {e}", graph.file.display()))?;
     let all = points(&sweep, &axes, &overrides);
     let total = all.len();
     let shard = a.batch.shard();

@@ -40,7 +40,7 @@ pub fn studio_addr(text: &str) -> Result<std::net::SocketAddr> {
 /// Every line of `events.jsonl` as JSON; a last line cut short by a crash
 /// is left out.
 fn events(path: &Path) -> Result<Vec<Value>> {
-    let text = match std::fs::read_to_string(path) {
+    let text = match evflow_engine::files::read_regular_to_string(path) {
         Ok(t) => t,
         Err(e) if e.kind() == std::io::ErrorKind::NotFound => return Ok(Vec::new()),
         Err(e) => return Err(anyhow!("{}: {e}", path.display())),

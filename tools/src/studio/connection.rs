@@ -17,8 +17,14 @@ use tungstenite::Message;
 
 /// Connections (page loads and WebSockets) served at once.
 pub(crate) const MAX_CONNECTIONS: usize = 32;
+/// Connections still waiting for their request head; past it, the oldest
+/// of them is closed to make room (an idle connection must not hold the
+/// place of a browser's real request).
+pub(crate) const MAX_PENDING: usize = 8;
 /// Largest request head accepted.
 const MAX_HEAD: usize = 8192;
+/// How long a connection may take to send its request head.
+const HEAD_DEADLINE: Duration = Duration::from_secs(3);
 /// The kernel's send buffer per browser (about a second of frames): a
 /// browser that stops reading is found out within seconds, not after
 /// megabytes of stale frames, and then loses frames in its queue.
@@ -51,19 +57,62 @@ pub(crate) struct Ctx {
     pub(crate) stop: Arc<AtomicBool>,
     pub(crate) public: bool,
     pub(crate) active: AtomicUsize,
+    /// Connections that have not sent their head yet, oldest first: an id
+    /// and the flag that closes it.
+    pub(crate) pending: Mutex<std::collections::VecDeque<(u64, Arc<AtomicBool>)>>,
 }
 
-/// Reads (without consuming) a whole request head.
-fn peek_head(s: &TcpStream) -> Option<Vec<u8>> {
-    let mut buf = vec![0u8; MAX_HEAD];
-    let deadline = Instant::now() + Duration::from_secs(3);
-    while Instant::now() < deadline {
-        let n = s.peek(&mut buf).ok()?;
-        if n == 0 {
-            return None;
+impl Ctx {
+    /// Notes a new connection as waiting for its head (closing the oldest
+    /// waiting one when [`MAX_PENDING`] are); returns its flag.
+    pub(crate) fn admit(&self, id: u64) -> Arc<AtomicBool> {
+        let flag = Arc::new(AtomicBool::new(false));
+        let mut p = self.pending.lock().unwrap_or_else(|e| e.into_inner());
+        while p.len() >= MAX_PENDING {
+            if let Some((_, old)) = p.pop_front() {
+                old.store(true, Ordering::Release);
+            }
         }
+        p.push_back((id, flag.clone()));
+        flag
+    }
+
+    /// Whether a connection waits for its head that could be closed to
+    /// make room for a new one.
+    pub(crate) fn any_pending(&self) -> bool {
+        !self.pending.lock().unwrap_or_else(|e| e.into_inner()).is_empty()
+    }
+
+    /// Closes the oldest connection still waiting for its head.
+    pub(crate) fn evict_oldest(&self) {
+        if let Some((_, old)) = self.pending.lock().unwrap_or_else(|e| e.into_inner()).pop_front() {
+            old.store(true, Ordering::Release);
+        }
+    }
+
+    /// The connection `id` has its head (or is done): no longer waiting.
+    pub(crate) fn settled(&self, id: u64) {
+        self.pending.lock().unwrap_or_else(|e| e.into_inner()).retain(|(i, _)| *i != id);
+    }
+}
+
+/// Reads (without consuming) a whole request head, giving up after
+/// [`HEAD_DEADLINE`] or as soon as `closed` is set.
+fn peek_head(s: &TcpStream, closed: &AtomicBool) -> Option<Vec<u8>> {
+    let mut buf = vec![0u8; MAX_HEAD];
+    let deadline = Instant::now() + HEAD_DEADLINE;
+    // Short reads, so that `closed` is seen within milliseconds.
+    let _ = s.set_read_timeout(Some(Duration::from_millis(10)));
+    while Instant::now() < deadline && !closed.load(Ordering::Acquire) {
+        let n = match s.peek(&mut buf) {
+            Ok(0) => return None,
+            Ok(n) => n,
+            Err(e) if matches!(e.kind(), std::io::ErrorKind::WouldBlock | std::io::ErrorKind::TimedOut) => continue,
+            Err(_) => return None,
+        };
         if let Some(end) = buf[..n].windows(4).position(|w| w == b"\r\n\r\n") {
             buf.truncate(end + 4);
+            let _ = s.set_read_timeout(Some(Duration::from_secs(3)));
             return Some(buf);
         }
         if n == MAX_HEAD {
@@ -88,22 +137,51 @@ fn header<'a>(req: &'a httparse::Request, name: &str) -> Option<&'a str> {
     req.headers.iter().find(|h| h.name.eq_ignore_ascii_case(name)).and_then(|h| std::str::from_utf8(h.value).ok())
 }
 
-/// True for `127.0.0.1`, `[::1]`, `localhost` (with any port).
+/// The host name of a `Host` header value, `NAME` or `NAME:PORT` (an
+/// IPv6 address in brackets), or `None` when it is anything else
+/// (`127.0.0.1:8798@evil.com`, a path, a user, spaces, an empty port).
+fn host_name(host: &str) -> Option<&str> {
+    let (name, port) = if let Some(rest) = host.strip_prefix('[') {
+        let (addr, after) = rest.split_once(']')?;
+        addr.parse::<std::net::Ipv6Addr>().ok()?;
+        (addr, if after.is_empty() { None } else { Some(after.strip_prefix(':')?) })
+    } else {
+        match host.split_once(':') {
+            Some((n, p)) => (n, Some(p)),
+            None => (host, None),
+        }
+    };
+    if let Some(p) = port {
+        if p.is_empty() || p.len() > 5 || !p.bytes().all(|b| b.is_ascii_digit()) {
+            return None;
+        }
+    }
+    let plain = |b: u8| b.is_ascii_alphanumeric() || b == b'-' || b == b'.';
+    if name.is_empty() || !(host.starts_with('[') || name.bytes().all(plain)) {
+        return None;
+    }
+    Some(name)
+}
+
+/// True for `127.0.0.1`, `[::1]`, `localhost` (with any port), and
+/// nothing malformed ([`host_name`]).
 fn loopback_host(host: &str) -> bool {
-    let h = if host.starts_with('[') { host.split(']').next().map(|h| &h[1..]) } else { host.split(':').next() };
-    match h {
-        Some("localhost") => true,
+    match host_name(host) {
+        Some(h) if h.eq_ignore_ascii_case("localhost") => true,
         Some(h) => h.parse::<std::net::IpAddr>().is_ok_and(|ip| ip.is_loopback()),
         None => false,
     }
 }
 
 /// Serves one connection: a file, a refusal, or a browser's WebSocket.
-pub(crate) fn connection(mut s: TcpStream, ctx: &Ctx) {
+/// `id` and `closed` are its place among the connections waiting for
+/// their head ([`Ctx::admit`]).
+pub(crate) fn connection(mut s: TcpStream, ctx: &Ctx, id: u64, closed: &AtomicBool) {
     let _ = s.set_nonblocking(false);
-    let _ = s.set_read_timeout(Some(Duration::from_secs(3)));
     let _ = s.set_write_timeout(Some(Duration::from_secs(3)));
-    let Some(head) = peek_head(&s) else { return };
+    let head = peek_head(&s, closed);
+    ctx.settled(id);
+    let Some(head) = head else { return };
     let mut headers = [httparse::EMPTY_HEADER; 32];
     let mut req = httparse::Request::new(&mut headers);
     if !matches!(req.parse(&head), Ok(httparse::Status::Complete(_))) {
@@ -111,6 +189,7 @@ pub(crate) fn connection(mut s: TcpStream, ctx: &Ctx) {
         return respond(&mut s, "400 Bad Request", "text/plain", b"malformed request\n");
     }
     let target = req.path.unwrap_or("/").to_string();
+    let hosts = req.headers.iter().filter(|h| h.name.eq_ignore_ascii_case("host")).count();
     let host = header(&req, "host").unwrap_or("").to_string();
     let origin = header(&req, "origin").map(str::to_string);
     let upgrade = header(&req, "upgrade").is_some_and(|u| u.eq_ignore_ascii_case("websocket"));
@@ -121,6 +200,9 @@ pub(crate) fn connection(mut s: TcpStream, ctx: &Ctx) {
     };
     if method != "GET" {
         return refuse(&mut s, "405 Method Not Allowed", "only GET\n");
+    }
+    if hosts != 1 || host_name(&host).is_none() {
+        return refuse(&mut s, "400 Bad Request", "one Host header, NAME or NAME:PORT\n");
     }
     if !ctx.public && !loopback_host(&host) {
         return refuse(&mut s, "403 Forbidden", "this studio serves loopback host names only\n");
@@ -214,8 +296,32 @@ mod tests {
         for h in ["127.0.0.1:8080", "localhost:1", "[::1]:99", "127.0.0.2"] {
             assert!(loopback_host(h), "{h}");
         }
-        for h in ["evil.example:8080", "192.168.1.2:1", "", "[fe80::1]:2"] {
+        for h in [
+            "evil.example:8080",
+            "192.168.1.2:1",
+            "",
+            "[fe80::1]:2",
+            "127.0.0.1:8798@evil.com",
+            "127.0.0.1@evil.com",
+            "localhost:80:81",
+            "127.0.0.1:",
+            "127.0.0.1:123456",
+            "[::1]x",
+            "127.0.0.1 :80",
+            "127.0.0.1/evil",
+        ] {
             assert!(!loopback_host(h), "{h}");
+        }
+    }
+
+    #[test]
+    fn host_names_are_name_or_name_and_port() {
+        assert_eq!(host_name("studio.lab:8798"), Some("studio.lab"));
+        assert_eq!(host_name("[::1]"), Some("::1"));
+        assert_eq!(host_name("LOCALHOST"), Some("LOCALHOST"));
+        assert!(loopback_host("LOCALHOST:1"));
+        for h in ["a@b", "a:b", "[x]:1", "a b", "", ":80"] {
+            assert_eq!(host_name(h), None, "{h}");
         }
     }
 }

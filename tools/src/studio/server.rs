@@ -128,22 +128,32 @@ impl Bound {
             stop: stop.clone(),
             public,
             active: AtomicUsize::new(0),
+            pending: Mutex::new(std::collections::VecDeque::new()),
         });
         let ctx2 = ctx.clone();
         let acceptor = std::thread::Builder::new().name("evflow-studio".into()).spawn(move || {
+            let mut next_id = 0u64;
             while !ctx.stop.load(Ordering::Acquire) {
                 match listener.accept() {
                     Ok((s, _)) => {
                         if ctx.active.load(Ordering::Acquire) >= MAX_CONNECTIONS {
-                            continue; // dropped: closes the connection
+                            if !ctx.any_pending() {
+                                continue; // dropped: closes the connection
+                            }
+                            // Full of connections that have sent nothing:
+                            // the oldest makes room (it ends within ms).
+                            ctx.evict_oldest();
                         }
                         ctx.active.fetch_add(1, Ordering::AcqRel);
+                        next_id += 1;
+                        let (id, closed) = (next_id, ctx.admit(next_id));
                         let c = ctx.clone();
                         let spawned = std::thread::Builder::new().name("evflow-studio-conn".into()).spawn(move || {
-                            connection(s, &c);
+                            connection(s, &c, id, &closed);
                             c.active.fetch_sub(1, Ordering::AcqRel);
                         });
                         if spawned.is_err() {
+                            ctx.settled(id);
                             ctx.active.fetch_sub(1, Ordering::AcqRel);
                         }
                     }

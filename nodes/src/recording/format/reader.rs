@@ -16,28 +16,12 @@ pub(crate) const MAX_SIDECAR_BYTES: u64 = 1 << 20;
 /// with its length: a device, a FIFO or a folder is refused before it is
 /// opened (opening a FIFO would wait for a writer; `/dev/zero` never ends).
 fn open_regular(path: &Path) -> Result<(std::fs::File, u64), RecordingError> {
-    let not_file = |what: &str| RecordingError::NotAFile { path: path.to_path_buf(), what: what.to_string() };
-    let kind = |m: &std::fs::Metadata| {
-        let t = m.file_type();
-        if t.is_dir() {
-            "a folder"
-        } else if t.is_file() {
-            "a file"
-        } else {
-            "a device, FIFO or socket"
+    evflow_engine::files::open_regular(path).map_err(|e| match e {
+        evflow_engine::files::OpenError::Io(e) => RecordingError::io(path, e),
+        evflow_engine::files::OpenError::NotAFile { what } => {
+            RecordingError::NotAFile { path: path.to_path_buf(), what: what.to_string() }
         }
-    };
-    let m = std::fs::metadata(path).map_err(|e| RecordingError::io(path, e))?;
-    if !m.is_file() {
-        return Err(not_file(kind(&m)));
-    }
-    let file = std::fs::File::open(path).map_err(|e| RecordingError::io(path, e))?;
-    // Checked again on the open file: the name may have been swapped.
-    let m = file.metadata().map_err(|e| RecordingError::io(path, e))?;
-    if !m.is_file() {
-        return Err(not_file(kind(&m)));
-    }
-    Ok((file, m.len()))
+    })
 }
 
 /// Frames missing from a truncated recording.

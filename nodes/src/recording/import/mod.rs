@@ -36,7 +36,9 @@ mod tests;
 pub use super::format::Written;
 pub use csv::Delimiter;
 
-use super::format::{Channel, Condition, RecordingError, RecordingMeta, RecordingPaths, RecordingWriter};
+use super::format::{
+    Channel, Condition, RecordingError, RecordingMeta, RecordingPaths, RecordingWriter, MAX_RATE_HZ, MIN_RATE_HZ,
+};
 use std::path::{Path, PathBuf};
 
 /// Why an import failed. Every message starts with the file it concerns
@@ -198,6 +200,13 @@ pub enum ImportError {
     /// nothing was left there.
     #[error(transparent)]
     Write(#[from] RecordingError),
+    /// The import was stopped (Ctrl-C, SIGTERM) while writing; nothing was
+    /// left at the destination.
+    #[error("{}: import interrupted; nothing was written", path.display())]
+    Interrupted {
+        /// The destination's `NAME.wav`.
+        path: PathBuf,
+    },
 }
 
 /// How to import: everything the source does not say.
@@ -325,6 +334,20 @@ impl Imported {
     /// `force`. On any error nothing is left at the destination (folders it
     /// created are removed again).
     pub fn write(&self, dest: &Path, force: bool) -> Result<Written, ImportError> {
+        self.write_until(dest, force, &std::sync::atomic::AtomicBool::new(false))
+    }
+
+    /// [`Imported::write`], stopping with [`ImportError::Interrupted`] (and
+    /// nothing at the destination) when `stop` is set: the CLI sets it on
+    /// SIGINT, SIGTERM or SIGHUP. Frames are written in pieces of
+    /// [`WRITE_FRAMES`], `stop` checked before each and before the renames.
+    pub fn write_until(
+        &self,
+        dest: &Path,
+        force: bool,
+        stop: &std::sync::atomic::AtomicBool,
+    ) -> Result<Written, ImportError> {
+        use std::sync::atomic::Ordering;
         let paths = RecordingPaths::new(dest);
         let existed = [&paths.wav, &paths.json].map(|p| p.exists());
         if !force {
@@ -335,25 +358,39 @@ impl Imported {
             }
         }
         let created = create_folders(paths.wav.parent())?;
-        let result = RecordingWriter::create(dest, self.meta.clone()).and_then(|mut w| {
-            w.write_interleaved(&self.samples)?;
-            w.finish()
-        });
-        result.map_err(|e| {
+        let interrupted = || ImportError::Interrupted { path: paths.wav.clone() };
+        let result = (|| {
+            let mut w = RecordingWriter::create(dest, self.meta.clone())?;
+            let per = WRITE_FRAMES * self.meta.channels.len().max(1);
+            for piece in self.samples.chunks(per) {
+                if stop.load(Ordering::SeqCst) {
+                    return Err(interrupted());
+                }
+                w.write_interleaved(piece)?;
+            }
+            if stop.load(Ordering::SeqCst) {
+                return Err(interrupted());
+            }
+            Ok(w.finish()?)
+        })();
+        result.inspect_err(|_| {
             // The writer removes its temporary files; should it fail between
             // its two renames, the one that landed goes too.
-            for (p, e) in [&paths.wav, &paths.json].into_iter().zip(existed) {
-                if !e {
+            for (p, was) in [&paths.wav, &paths.json].into_iter().zip(existed) {
+                if !was {
                     let _ = std::fs::remove_file(p);
                 }
             }
             for dir in created.iter().rev() {
                 let _ = std::fs::remove_dir(dir);
             }
-            ImportError::Write(e)
         })
     }
 }
+
+/// Frames written at a time by [`Imported::write_until`] between checks
+/// of its stop flag.
+pub const WRITE_FRAMES: usize = 1 << 16;
 
 /// Creates `dir` and its missing parents; returns the ones it created,
 /// outermost first.
@@ -494,22 +531,17 @@ struct Columns {
 /// (`/dev/zero`), a FIFO or a folder is refused before a byte is read, and
 /// checked again on the open handle (the name may have been swapped).
 fn read_regular(src: &Path) -> Result<Vec<u8>, ImportError> {
+    use evflow_engine::files::{open_regular, OpenError};
     use std::io::Read;
     let io = |source| ImportError::Io { path: src.to_path_buf(), source };
-    let refuse = |m: &std::fs::Metadata| ImportError::UnsupportedKind {
-        path: src.to_path_buf(),
-        what: if m.is_dir() { "a folder".into() } else { "a device, FIFO or socket (not a regular file)".into() },
-    };
-    let m = std::fs::metadata(src).map_err(io)?;
-    if !m.is_file() {
-        return Err(refuse(&m));
-    }
-    let mut file = std::fs::File::open(src).map_err(io)?;
-    let m = file.metadata().map_err(io)?;
-    if !m.is_file() {
-        return Err(refuse(&m));
-    }
-    let mut bytes = Vec::with_capacity(usize::try_from(m.len()).unwrap_or(0));
+    let (mut file, len) = open_regular(src).map_err(|e| match e {
+        OpenError::Io(e) => io(e),
+        OpenError::NotAFile { what } => ImportError::UnsupportedKind {
+            path: src.to_path_buf(),
+            what: if what == "a folder" { what.into() } else { format!("{what} (not a regular file)") },
+        },
+    })?;
+    let mut bytes = Vec::with_capacity(usize::try_from(len).unwrap_or(0));
     file.read_to_end(&mut bytes).map_err(io)?;
     Ok(bytes)
 }
@@ -603,6 +635,14 @@ fn assemble(src: &Path, t: Columns, opts: &ImportOptions, mut notes: Vec<String>
     let rate = match (opts.rate, &inferred) {
         (Some(r), _) if !(r.is_finite() && r > 0.0) => {
             return Err(ImportError::Usage(format!("--rate {r}: not a positive number of Hz")))
+        }
+        (Some(r), _) if !(MIN_RATE_HZ..=MAX_RATE_HZ).contains(&r) => {
+            return Err(ImportError::Usage(format!(
+                "--rate {}: outside the {} … {} Hz a recording may have for `recording.in` to play it",
+                short(r),
+                MIN_RATE_HZ,
+                MAX_RATE_HZ
+            )))
         }
         (Some(r), Some((i, name))) => {
             if (r - i).abs() > opts.time_tolerance * r {
@@ -708,8 +748,31 @@ fn infer_rate(src: &Path, t: &Columns, k: usize, name: &str, scale: f64, tol: f6
             message: format!("time column `{name}` steps by {mean} s, which gives no usable rate"),
         });
     }
+    if !(MIN_RATE_HZ..=MAX_RATE_HZ).contains(&rate) {
+        return Err(ImportError::Options {
+            path: src.to_path_buf(),
+            message: format!(
+                "time column `{name}` steps by {} s: {} Hz is outside the {} … {} Hz a recording may have \
+                 for `recording.in` to play it (are the times in another unit? name it in the header, `t [ms]`)",
+                short(mean),
+                short(rate),
+                MIN_RATE_HZ,
+                MAX_RATE_HZ
+            ),
+        });
+    }
     let whole = rate.round();
     Ok(if (rate - whole).abs() <= 1e-6 * rate { whole } else { rate })
+}
+
+/// `x` for a message: as Rust prints it, or in exponent form when that
+/// would take hundreds of digits (1e308, 1e-300).
+fn short(x: f64) -> String {
+    if x != 0.0 && !(1e-6..1e12).contains(&x.abs()) {
+        format!("{x:e}")
+    } else {
+        format!("{x}")
+    }
 }
 
 /// Seconds per unit of a time column: `s` (or none), `ms`, `us`/`µs`, `ns`.

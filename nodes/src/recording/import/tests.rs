@@ -400,6 +400,23 @@ fn names_units_and_rate_from_the_options() {
         )
     );
     assert_eq!(err(&with_rate(-3.0)), "--rate -3: not a positive number of Hz");
+    // A rate `recording.in` would refuse is refused here, given or inferred.
+    for (r, shown) in [(1e308, "1e308"), (2e7, "20000000"), (1e-4, "0.0001")] {
+        assert_eq!(
+            err(&with_rate(r)),
+            format!(
+                "--rate {shown}: outside the 0.001 … 10000000 Hz a recording may have for `recording.in` to play it"
+            )
+        );
+    }
+    let tiny = src.with_file_name("tiny-steps.csv");
+    fs::write(&tiny, "t,force\n0,1\n1e-300,2\n2e-300,3\n").unwrap();
+    let e = read(&tiny, &ImportOptions::default()).unwrap_err().to_string();
+    assert!(
+        e.contains("time column `t` steps by 1e-300 s: 9.999999999999999e299 Hz is outside")
+            && e.contains("outside the 0.001 … 10000000 Hz"),
+        "{e}"
+    );
     assert_eq!(
         err(&ImportOptions { time_tolerance: -0.1, ..ImportOptions::default() }),
         "--time-tolerance -0.1: a fraction of the time step, at least 0 and below 1 (e.g. 0.01)"

@@ -92,7 +92,7 @@ fn index_path(dir: &Path) -> PathBuf {
 /// The index's entries from an earlier build (none when there is no index).
 fn read_index(dir: &Path) -> Result<Vec<Json>> {
     let p = index_path(dir);
-    let text = match std::fs::read_to_string(&p) {
+    let text = match evflow_engine::files::read_regular_to_string(&p) {
         Ok(t) => t,
         Err(e) if e.kind() == std::io::ErrorKind::NotFound => return Ok(Vec::new()),
         Err(e) => return Err(io(&p, format!("cannot read: {e}"))),
@@ -172,7 +172,7 @@ fn condition_models(plan: &Plan, c: &Cond) -> Result<(Models, bool)> {
 
 /// Reads a model file's `training` section (its scores).
 fn training(path: &Path) -> Json {
-    std::fs::read_to_string(path)
+    evflow_engine::files::read_regular_to_string(path)
         .ok()
         .and_then(|t| serde_json::from_str::<Json>(&t).ok())
         .and_then(|d| d.get("training").cloned())
@@ -367,7 +367,7 @@ pub struct ShardIndex {
 
 /// Whether `dir` holds a library (its index.json).
 pub fn is_library(dir: &Path) -> bool {
-    std::fs::read_to_string(index_path(dir))
+    evflow_engine::files::read_regular_to_string(&index_path(dir))
         .ok()
         .and_then(|t| serde_json::from_str::<Json>(&t).ok())
         .is_some_and(|d| d.get("format").and_then(Json::as_str) == Some(FORMAT))
@@ -376,9 +376,10 @@ pub fn is_library(dir: &Path) -> bool {
 /// Reads a sharded library's index; errors name the file.
 pub fn read_shard(dir: &Path) -> Result<ShardIndex> {
     let p = index_path(dir);
-    let doc: Json =
-        serde_json::from_str(&std::fs::read_to_string(&p).map_err(|e| io(&p, format!("cannot read: {e}")))?)
-            .map_err(|e| io(&p, e))?;
+    let doc: Json = serde_json::from_str(
+        &evflow_engine::files::read_regular_to_string(&p).map_err(|e| io(&p, format!("cannot read: {e}")))?,
+    )
+    .map_err(|e| io(&p, e))?;
     let texts = |k: &str| -> Result<Vec<String>> {
         doc.get(k)
             .and_then(Json::as_array)

@@ -23,7 +23,7 @@ pub fn write<T: Serialize>(dir: &Path, name: &str, value: &T) -> Result<(), Stud
 /// missing), `what` what it should be (named when it is not that).
 pub fn read<T: DeserializeOwned>(dir: &Path, name: &str, command: &str, what: &str) -> Result<T, StudyError> {
     let path = dir.join(name);
-    let text = std::fs::read_to_string(&path).map_err(|e| StudyError::Io {
+    let text = evflow_engine::files::read_regular_to_string(&path).map_err(|e| StudyError::Io {
         path: path.clone(),
         message: format!("{e} (is it the --out of `{command}`?)"),
     })?;

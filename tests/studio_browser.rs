@@ -239,6 +239,9 @@ fn the_page_shows_a_recorded_session_with_its_events_and_replay_check() {
     assert!((t0("faded").as_f64().unwrap() - 1.5).abs() < 1e-9, "{states:?}");
     assert!((t0("armed").as_f64().unwrap() - 2.0).abs() < 1e-9, "{states:?}");
     assert_eq!(states.last(), Some(&"faded"), "the stop fades the limiter out: {states:?}");
+    // The traces' heading says what they show (it read "last scrub s").
+    let heading = cdp.eval("document.getElementById('traces-window').textContent");
+    assert!(heading.as_str().is_some_and(|h| h.contains("whole session") && !h.contains("last")), "{heading}");
     // Scrubbing: a narrower span shows fewer pairs.
     cdp.eval("document.getElementById('scrub-span').value = 0.5; document.getElementById('scrub-span').dispatchEvent(new Event('input'))");
     assert_eq!(cdp.eval("studio.view[1] - studio.view[0] < 0.51"), json!(true));
@@ -252,9 +255,14 @@ fn the_page_shows_a_recorded_session_with_its_events_and_replay_check() {
 fn the_page_shows_and_steers_a_live_session_in_chromium() {
     let Some(exe) = browser_or_skip() else { return };
     let tmp = tempfile::tempdir().unwrap();
-    let session = common::start("texture-live.toml", tmp.path(), &["127.0.0.1:0"], &["--endless"]);
+    let session =
+        common::start("texture-live.toml", tmp.path(), &["127.0.0.1:0"], &["--endless", "--change", "0.5:gain=0.8"]);
     let browser = launch(&exe, &session.url);
     let mut cdp = Cdp::attach(&browser, &session.url);
+
+    // A scripted change shows in the Steer field of its variable (the field
+    // kept the graph's value before).
+    cdp.until("document.getElementById('var-gain') && document.getElementById('var-gain').value === '0.8'", 30);
 
     // Traces arrive and move.
     cdp.until("!!(window.studio && studio.hello && studio.frames > 5)", 60);

@@ -404,7 +404,7 @@ pub trait Node: Send {
 
     /// Lines for people about what the node loaded and how it will use it
     /// (e.g. a mesh's bounds, up axis and scale), asked right after the node
-    /// is built; `evflow check --build` prints them.
+    /// is built; `evflow check` prints them (unless `--no-build`).
     fn notes(&self) -> Vec<String> {
         Vec::new()
     }

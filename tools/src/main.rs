@@ -54,7 +54,9 @@ enum Command {
     /// Validate a graph and print its plan: execution order, rates, buffer
     /// block size, and which nodes were left out and why.
     ///
-    /// Nothing is constructed, no file is read or written besides the graph.
+    /// Then, unless --no-build, the plan of every run is built as `run`
+    /// builds it — files are opened and checked, meshes loaded — but nothing
+    /// is run and nothing is written.
     ///
     /// Example: evflow check graphs/excitation.toml
     Check(cli::check::Args),

@@ -302,3 +302,57 @@ fn check_and_run_agree_on_every_run_of_a_sweep() {
     let o = evflow(&["run", g.to_str().unwrap(), "--duration", "0.01", "--out", out]);
     assert!(!o.status.success() && text(&o).1.contains("same.wav"), "{}", text(&o).1);
 }
+
+#[test]
+fn deadline_misses_stop_a_session_by_default_only_when_it_drives_hardware() {
+    let dir = tempfile::tempdir().unwrap();
+    let live = |graph: &str, name: &str, extra: &[&str]| {
+        let s = dir.path().join(name);
+        let mut args = vec!["live", graph, "--no-realtime", "--duration", "0.2", "--session", s.to_str().unwrap()];
+        args.extend_from_slice(extra);
+        let o = evflow(&args);
+        // The rig's session may stop on a loaded machine's misses: that is
+        // the point; the others never stop for them.
+        assert!(o.status.success() || name == "rig", "{}", text(&o).1);
+        text(&o).1
+    };
+    // The simulated lab: a loaded machine's misses are counted, never fatal.
+    let e = live("graphs/texture-live.toml", "sim", &[]);
+    assert!(e.contains("without hardware they never stop the session"), "{e}");
+    let e = live("graphs/texture-live.toml", "sim3", &["--miss-streak", "1000"]);
+    assert!(e.contains("1000 deadline misses in a row stop the session"), "{e}");
+    // A graph with a hardware output (here without its device).
+    let e = live("graphs/texture-serial.toml", "rig", &["--set", "wait=0"]);
+    assert!(e.contains("10 deadline misses in a row stop the session"), "{e}");
+}
+
+#[test]
+fn check_refuses_a_recording_folder_whose_recordings_lack_a_channel_the_graph_reads() {
+    // Before: check said ok; run then failed (issue 27, point 11).
+    let dir = tempfile::tempdir().unwrap();
+    let mut csv = String::from("u,force\n");
+    for i in 0..2000 {
+        csv += &format!("{},{}\n", if i % 7 < 3 { 1 } else { -1 }, 0.01 * f64::from(i % 11));
+    }
+    std::fs::write(dir.path().join("x.csv"), csv).unwrap();
+    let rec = dir.path().join("prbs-85g-5cms");
+    let o = evflow(&[
+        "import",
+        dir.path().join("x.csv").to_str().unwrap(),
+        "--rate",
+        "1000",
+        "--load-g",
+        "85",
+        "--velocity-cm-s",
+        "5",
+        "--out",
+        rec.to_str().unwrap(),
+    ]);
+    assert!(o.status.success(), "{}", text(&o).1);
+    std::fs::remove_file(dir.path().join("x.csv")).unwrap();
+    let set = format!("recordings={}", dir.path().display());
+    let o = evflow(&["check", "graphs/model-build-recordings.toml", "--set", &set]);
+    let (_, stderr) = text(&o);
+    assert_eq!(o.status.code(), Some(1), "{stderr}");
+    assert!(stderr.contains("prbs-85g-5cms") && stderr.contains("no channel `velocity`"), "{stderr}");
+}

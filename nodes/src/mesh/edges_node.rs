@@ -103,14 +103,15 @@ fn build(p: &Params, ctx: &BuildContext) -> Result<Box<dyn Node>, NodeError> {
     let scenes: Vec<MeshEdges> = scenes;
     let notes = scenes
         .iter()
-        .map(|s| {
+        .flat_map(|s| {
             let c = &s.census;
-            format!(
+            let note = format!(
                 "{}; {} convex edges sharper than {max_angle}° (θ_min {:.1}°)",
                 placement_note(&s.placed, p),
                 c.convex,
                 c.theta_min
-            )
+            );
+            std::iter::once(note).chain(s.placed.warnings.iter().cloned())
         })
         .collect();
     Ok(Box::new(EdgesNode { scenes, current: initial, initial, max_angle, notes }))

@@ -37,6 +37,17 @@ impl Format {
         EXTENSIONS.iter().find(|(e, _)| e.eq_ignore_ascii_case(ext)).map(|(_, f)| *f)
     }
 
+    /// The format's name for people: `OBJ`, `STL`, `PLY`, `glTF`, `GLB`.
+    pub fn name(self) -> &'static str {
+        match self {
+            Format::Obj => "OBJ",
+            Format::Stl => "STL",
+            Format::Ply => "PLY",
+            Format::Gltf => "glTF",
+            Format::Glb => "GLB",
+        }
+    }
+
     /// The up axis `up = "auto"` takes for this format.
     pub fn default_up(self) -> Up {
         match self {

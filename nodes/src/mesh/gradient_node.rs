@@ -215,13 +215,16 @@ fn build(p: &Params, ctx: &BuildContext) -> Result<Box<dyn Node>, NodeError> {
         .into_iter()
         .map(|placed| build_state(p, ctx, placed))
         .collect::<Result<Vec<_>, _>>()?;
-    let notes = scenes.iter().map(|s| placement_note(&s.placed, p)).collect();
+    let notes = scenes
+        .iter()
+        .flat_map(|s| std::iter::once(placement_note(&s.placed, p)).chain(s.placed.warnings.iter().cloned()))
+        .collect();
     let initial = p.usize("scene");
     let fade_len = (p.f64("switch_fade") * 1e-3 * ctx.rate).round() as usize;
     Ok(Box::new(GradientNode { scenes, current: initial, initial, fade: None, fade_len, notes, on: 0, off: 0 }))
 }
 
-/// What `evflow check --build` says about a loaded mesh (the build note of
+/// What `evflow check` says about a loaded mesh (the build note of
 /// every node that loads one): its size, its bounds in its own units after
 /// `up` was turned to height, the axis taken as up and why, the scale, and
 /// where it lands on the screen in metres.
@@ -275,10 +278,11 @@ impl MeshGradient {
     fn summary(&self, s: Summary, prefix: &str) -> Summary {
         let on = self.hits as f64 / (self.hits + self.misses).max(1) as f64;
         let s = if prefix.is_empty() {
-            s.value("f_min", self.range.f_min, "sqrt(N)")
-                .value("f_max", self.range.f_max, "sqrt(N)")
-                .value("triangles", self.placed.mesh.triangles.len() as f64, "1")
-                .value("on_mesh", on, "1")
+            s.value("f_min", self.range.f_min, "sqrt(N)").value("f_max", self.range.f_max, "sqrt(N)").value(
+                "triangles",
+                self.placed.mesh.triangles.len() as f64,
+                "1",
+            )
         } else {
             s.line(format!(
                 "{prefix}{}: F^sq range [{:.4}, {:.4}] √N, {} triangles, on the mesh {:.3} of its ticks",
@@ -289,6 +293,7 @@ impl MeshGradient {
                 on
             ))
         };
+        let s = self.placed.warnings.iter().fold(s, |s, w| s.line(format!("{prefix}{w}")));
         match &self.cache {
             CacheStatus::Hit(p) => s.line(format!("{prefix}F^sq range from the cache {}", p.display())),
             CacheStatus::Written(p) => s.line(format!("{prefix}F^sq range calibrated, cached in {}", p.display())),
@@ -367,7 +372,8 @@ impl Node for GradientNode {
     }
 }
 
-/// The fraction of ticks the finger was off the mesh felt, as the value
+/// The fractions of the session's ticks the finger was on and off the mesh
+/// felt (whichever scene that was), as the values `on_mesh` and
 /// `off_mesh`, and a warning line when it was off for most of them (more
 /// than half): the mesh is probably not where the finger goes.
 fn off_mesh_warning(s: Summary, on: u64, off: u64) -> Summary {
@@ -376,13 +382,13 @@ fn off_mesh_warning(s: Summary, on: u64, off: u64) -> Summary {
         return s;
     }
     let fraction = off as f64 / total as f64;
-    let s = s.value("off_mesh", fraction, "1");
+    let s = s.value("on_mesh", on as f64 / total as f64, "1").value("off_mesh", fraction, "1");
     if 2 * off <= total {
         return s;
     }
     s.line(format!(
         "warning: the finger was off the mesh on {:.1} % of the ticks ({off} of {total}); check where the mesh \
-         lies (offset_x/y, unit or fit; `evflow check --build` prints its place on the screen)",
+         lies (offset_x/y, unit or fit; `evflow check` prints its place on the screen)",
         100.0 * fraction
     ))
 }
@@ -395,13 +401,12 @@ impl GradientNode {
         if self.scenes.len() == 1 {
             return first.summary(Summary::default(), "");
         }
-        // The starting scene's figures as values, every scene's as a line.
-        let on = first.hits as f64 / (first.hits + first.misses).max(1) as f64;
+        // The starting scene's figures as values, every scene's as a line
+        // (the session's on/off the mesh: `off_mesh_warning`).
         let mut s = Summary::default()
             .value("f_min", first.range.f_min, "sqrt(N)")
             .value("f_max", first.range.f_max, "sqrt(N)")
-            .value("triangles", first.placed.mesh.triangles.len() as f64, "1")
-            .value("on_mesh", on, "1");
+            .value("triangles", first.placed.mesh.triangles.len() as f64, "1");
         for (k, sc) in self.scenes.iter().enumerate() {
             s = sc.summary(s, &format!("scene {k}: "));
         }
@@ -417,11 +422,16 @@ mod tests {
 
     /// `on` ticks on a 1 cm plate, then `off` ticks beside it.
     fn summary(dir: &std::path::Path, on: usize, off: usize) -> Summary {
+        summary_with(dir, on, off, "file = \"plate.obj\"")
+    }
+
+    /// [`summary`] with the mesh chosen by `mesh` (`file = …` or `scenes = […]`).
+    fn summary_with(dir: &std::path::Path, on: usize, off: usize, mesh: &str) -> Summary {
         let n = on + off;
         let x: Vec<f64> = (0..n).map(|i| if i < on { 0.002 + 0.001 * i as f64 % 0.006 } else { 0.05 }).collect();
         Single {
             spec: &SPEC,
-            params: "file = \"plate.obj\"\nup = \"+z\"\nrange = \"fixed\"",
+            params: &format!("{mesh}\nup = \"+z\"\nrange = \"fixed\""),
             inputs: vec![("x", x, 1000.0), ("y", vec![0.005; n], 1000.0)],
             outputs: vec!["tri"],
             base_rate: 1000.0,
@@ -449,5 +459,17 @@ mod tests {
         // 1 tick on, 2 off: 66.7 %.
         let s = summary(dir.path(), 1, 2);
         assert!(s.lines.iter().any(|l| l.contains("66.7 % of the ticks (2 of 3)")), "{:?}", s.lines);
+    }
+
+    #[test]
+    fn on_and_off_the_mesh_are_the_session_s_figures_with_several_scenes() {
+        // Before: `on_mesh` was scene 0's own figure beside the session's
+        // `off_mesh` (issue 27, point 9).
+        let dir = tempfile::tempdir().unwrap();
+        std::fs::write(dir.path().join("plate.obj"), "v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nf 1 2 3 4\n").unwrap();
+        for mesh in ["file = \"plate.obj\"", "scenes = [\"plate.obj\", \"plate.obj\"]"] {
+            let s = summary_with(dir.path(), 3, 7, mesh);
+            assert_eq!((s.get("on_mesh"), s.get("off_mesh")), (Some(0.3), Some(0.7)), "{mesh}");
+        }
     }
 }

@@ -122,6 +122,10 @@ pub struct Placed {
     pub offset: [f64; 2],
     /// File name or scene description, for reports.
     pub name: String,
+    /// What looks wrong with the placement ([`placement_warnings`]), each a
+    /// line starting `warning:`; shown by `evflow check` and in the run's
+    /// summary.
+    pub warnings: Vec<String>,
 }
 
 impl Placed {
@@ -174,8 +178,16 @@ pub fn load_scenes(p: &Params, ctx: &BuildContext) -> Result<Vec<Placed>, NodeEr
 /// config word, turned by `up` and placed by `unit`/`offset_x/y` or `fit`.
 fn load_entry(p: &Params, ctx: &BuildContext, entry: &str) -> Result<Placed, NodeError> {
     let (mesh, floor, name, up) = load_mesh(p, ctx, entry)?;
-    let mut placed =
-        Placed { mesh, up, floor, z0: 0.0, unit: p.f64("unit"), offset: [p.f64("offset_x"), p.f64("offset_y")], name };
+    let mut placed = Placed {
+        mesh,
+        up,
+        floor,
+        z0: 0.0,
+        unit: p.f64("unit"),
+        offset: [p.f64("offset_x"), p.f64("offset_y")],
+        name,
+        warnings: Vec::new(),
+    };
     if p.str("fit") == "footprint" {
         let footprint = place::footprint(&placed.mesh)
             .ok_or_else(|| NodeError::param("fit", format!("{}: the mesh has no triangles", placed.name)))?;
@@ -185,7 +197,71 @@ fn load_entry(p: &Params, ctx: &BuildContext, entry: &str) -> Result<Placed, Nod
         placed.offset = fitted.offset;
         placed.z0 = placed.floor;
     }
+    let auto = (p.str("up") == "auto").then(|| Format::of(entry)).flatten();
+    placed.warnings = placement_warnings(&placed, auto, p.str("fit") == "footprint");
     Ok(placed)
+}
+
+/// The largest footprint side, m, that fits a display evflow drives
+/// without `fit` (tablet-sized electrostatic displays are 10–25 cm).
+pub const MAX_SCREEN_SIDE_M: f64 = 0.3;
+/// The smallest footprint side, m, a finger can explore.
+pub const MIN_SCREEN_SIDE_M: f64 = 0.002;
+
+/// Warnings about a placed mesh: a file whose `up` was taken by
+/// convention (`auto`, the file's `format`) but that stands taller than it
+/// is thin across — a relief lying on its side, e.g. a z-up OBJ — with the
+/// file axis to set instead; and, without `fit`, a footprint larger than a
+/// display or smaller than a fingertip explores.
+pub fn placement_warnings(placed: &Placed, auto: Option<Format>, fitted: bool) -> Vec<String> {
+    let mut out = Vec::new();
+    let b = placed.mesh.bounds();
+    let ext = [b.max[0] - b.min[0], b.max[1] - b.min[1], b.max[2] - b.min[2]];
+    if !ext.iter().all(|e| e.is_finite()) {
+        return out;
+    }
+    if let Some(format) = auto {
+        let thin = if ext[0] <= ext[1] { 0 } else { 1 };
+        if ext[thin] < 0.5 * ext[2] {
+            // The file axis that was turned to the thin horizontal one.
+            let mut unit = [0.0; 3];
+            let file_axis = (0..3)
+                .find(|&k| {
+                    unit = [0.0; 3];
+                    unit[k] = 1.0;
+                    placed.up.to_z_up(unit)[thin].abs() > 0.5
+                })
+                .unwrap_or(2);
+            let g = |x: f64| format!("{:.4}", x);
+            out.push(format!(
+                "warning: {}: up {} (auto: the {} convention) stands the mesh {} units tall on a {} × {} footprint; \
+                 a relief is thinnest along its up axis — if it lies on its side, set up = \"+{}\" (or \"-{}\")",
+                placed.name,
+                placed.up.word(),
+                format.name(),
+                g(ext[2]),
+                g(ext[0]),
+                g(ext[1]),
+                ["x", "y", "z"][file_axis],
+                ["x", "y", "z"][file_axis],
+            ));
+        }
+    }
+    let side = ext[0].max(ext[1]) * placed.unit;
+    if !fitted && !(MIN_SCREEN_SIDE_M..=MAX_SCREEN_SIDE_M).contains(&side) {
+        out.push(format!(
+            "warning: {}: its footprint is {:.1} cm × {:.1} cm on the screen ({} m per mesh unit), {} than a display \
+             shows ({} … {} cm); set fit = \"footprint\" (its larger side becomes fit_size) or `unit`",
+            placed.name,
+            ext[0] * placed.unit * 100.0,
+            ext[1] * placed.unit * 100.0,
+            placed.unit,
+            if side > MAX_SCREEN_SIDE_M { "larger" } else { "smaller" },
+            MIN_SCREEN_SIDE_M * 100.0,
+            MAX_SCREEN_SIDE_M * 100.0,
+        ));
+    }
+    out
 }
 
 /// The mesh of one entry turned so that its up axis is +z, with its floor
@@ -306,6 +382,48 @@ mod tests {
         }
         // A z-up file read with the OBJ default (+y) stands on its side: another surface.
         assert_ne!(run(dir.path(), "file = \"z.obj\"", x.clone(), y.clone())[3], reference[3]);
+    }
+
+    /// The warning lines of `mesh.gradient`'s summary after a short scan.
+    fn warnings(dir: &Path, params: &str) -> Vec<String> {
+        let params = format!("{params}\nrange = \"fixed\"");
+        let s = Single {
+            spec: &gradient_node::SPEC,
+            params: &params,
+            inputs: vec![("x", vec![0.001; 4], 1000.0), ("y", vec![0.001; 4], 1000.0)],
+            outputs: vec!["tri"],
+            base_rate: 1000.0,
+            ticks: 4,
+            block: 4,
+            base_dir: dir,
+        }
+        .summary()
+        .unwrap();
+        s.lines.into_iter().filter(|l| l.starts_with("warning:") && !l.contains("off the mesh")).collect()
+    }
+
+    #[test]
+    fn a_relief_on_its_side_or_a_footprint_no_display_shows_is_warned_of() {
+        let dir = tempfile::tempdir().unwrap();
+        // A z-up relief, 8 × 6 units, read with the OBJ default (+y up):
+        // it stands 8 units tall on a 8 × 1 footprint.
+        std::fs::write(dir.path().join("z.obj"), grid_obj(8, 6, 1.0, 0.0, |p| p)).unwrap();
+        let w = warnings(dir.path(), "file = \"z.obj\"");
+        assert_eq!(w.len(), 1, "{w:?}");
+        assert!(w[0].contains("up +y (auto: the OBJ convention)") && w[0].contains("set up = \"+z\""), "{w:?}");
+        assert!(warnings(dir.path(), "file = \"z.obj\"\nup = \"+z\"").is_empty());
+        // 60 units at 1 cm per unit: 60 cm wide, wider than any display.
+        std::fs::write(dir.path().join("wide.obj"), grid_obj(60, 40, 1.0, 0.0, |p| p)).unwrap();
+        let w = warnings(dir.path(), "file = \"wide.obj\"\nup = \"+z\"");
+        assert_eq!(w.len(), 1, "{w:?}");
+        assert!(w[0].contains("60.0 cm × 40.0 cm") && w[0].contains("larger") && w[0].contains("fit"), "{w:?}");
+        assert!(warnings(dir.path(), "file = \"wide.obj\"\nup = \"+z\"\nfit = \"footprint\"").is_empty());
+        assert!(warnings(dir.path(), "file = \"wide.obj\"\nup = \"+z\"\nunit = 0.002").is_empty());
+        // A millimetre-sized mesh in metres: too small to feel.
+        let w = warnings(dir.path(), "file = \"z.obj\"\nup = \"+z\"\nunit = 0.0001");
+        assert!(w.len() == 1 && w[0].contains("smaller"), "{w:?}");
+        // Generated scenes never warn.
+        assert!(warnings(dir.path(), "config = \"4B0H\"").is_empty());
     }
 
     #[test]

@@ -18,6 +18,9 @@ use std::sync::atomic::{AtomicBool, AtomicU32, Ordering};
 use std::sync::Arc;
 use std::time::{Duration, Instant};
 
+/// Deadline misses in a row that stop a session driving hardware.
+const DEFAULT_MISS_STREAK: u64 = 10;
+
 /// Arguments of `evflow live`.
 #[derive(clap::Args, Debug)]
 pub struct Args {
@@ -66,8 +69,11 @@ pub struct Args {
     #[arg(long, default_value_t = 100)]
     spin_us: u64,
     /// Consecutive deadline misses that stop the session (0: never).
-    #[arg(long, default_value_t = 10)]
-    miss_streak: u64,
+    /// Default: 10 when the graph drives hardware (a late actuation reaches
+    /// a person), 0 on the simulated lab, where a loaded machine's misses
+    /// are only counted.
+    #[arg(long, value_name = "N")]
+    miss_streak: Option<u64>,
     /// Print only the final report.
     #[arg(long, short)]
     quiet: bool,
@@ -76,7 +82,8 @@ pub struct Args {
     json: Option<PathBuf>,
     /// Serve the studio: a web page showing the session as it runs and
     /// steering its live parameters (docs/studio.md). ADDR is `PORT` or
-    /// `HOST:PORT` (default 127.0.0.1:8737; port 0 picks a free one).
+    /// `HOST:PORT` (default 127.0.0.1:8737; port 0 picks a free one);
+    /// `evflow studio SESSION` takes the same `--studio ADDR` (or `--addr`).
     #[cfg(feature = "studio")]
     #[arg(long, value_name = "ADDR", num_args = 0..=1, default_missing_value = "127.0.0.1:8737")]
     studio: Option<String>,
@@ -173,13 +180,10 @@ pub fn main(a: Args) -> Result<()> {
     } else {
         RealtimeRequest { priority: Some(a.priority), lock_memory: true, cpu: Some(a.cpu.unwrap_or(last_cpu)) }
     };
-    let cfg = LiveConfig {
-        duration,
-        realtime,
-        spin: Duration::from_micros(a.spin_us),
-        miss_streak: a.miss_streak,
-        ..LiveConfig::default()
-    };
+    let hardware = checked.nodes.iter().any(|n| n.spec.hardware);
+    let miss_streak = a.miss_streak.unwrap_or(if hardware { DEFAULT_MISS_STREAK } else { 0 });
+    let cfg =
+        LiveConfig { duration, realtime, spin: Duration::from_micros(a.spin_us), miss_streak, ..LiveConfig::default() };
     let vars = live::live_vars(&checked);
     #[cfg(feature = "studio")]
     let description = a.studio.is_some().then(|| {
@@ -304,6 +308,16 @@ pub fn main(a: Args) -> Result<()> {
             checked.graph.name,
             duration.map(|d| format!(" for {d} s")).unwrap_or_default(),
             dir.display()
+        );
+        eprintln!(
+            "{}",
+            match (miss_streak, hardware) {
+                (0, false) => "deadline misses are counted; without hardware they never stop the session \
+                               (--miss-streak N stops it after N in a row)"
+                    .to_string(),
+                (0, true) => "deadline misses are counted and never stop the session (--miss-streak 0)".to_string(),
+                (n, _) => format!("{n} deadline misses in a row stop the session (--miss-streak)"),
+            }
         );
         eprintln!("type node.param=value and Enter to change a live parameter, `stop` or Ctrl-C to stop");
         if !vars_line.is_empty() {

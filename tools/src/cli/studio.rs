@@ -14,11 +14,13 @@ pub struct Args {
     /// The session folder written by `evflow live`.
     session: PathBuf,
     /// Where to serve: `PORT` or `HOST:PORT` (port 0 picks a free one).
-    #[arg(long, value_name = "ADDR", default_value = "127.0.0.1:8737")]
+    /// Also spelled `--studio ADDR`, as `evflow live` takes it.
+    #[arg(long, visible_alias = "studio", value_name = "ADDR", default_value = "127.0.0.1:8737")]
     addr: String,
     /// Allow a non-loopback address; the page then needs the one-time
-    /// token printed at start.
-    #[arg(long)]
+    /// token printed at start. Also spelled `--studio-public`, as `evflow
+    /// live` takes it.
+    #[arg(long, visible_alias = "studio-public")]
     public: bool,
     /// Do not run the replay check.
     #[arg(long)]

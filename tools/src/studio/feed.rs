@@ -126,6 +126,9 @@ pub(crate) struct FeedState {
     window_misses: u64,
     last_tick: u64,
     events: Vec<Value>,
+    /// The value each parameter last took (`node.param`), sent in every
+    /// frame: a browser that joins after a change shows it.
+    values: std::collections::BTreeMap<String, f64>,
     steal_s: Option<f64>,
     shared: Option<Arc<Shared>>,
 }
@@ -144,6 +147,7 @@ impl FeedState {
             window_misses: 0,
             last_tick: 0,
             events: Vec::new(),
+            values: std::collections::BTreeMap::new(),
             steal_s: None,
             shared,
         }
@@ -176,6 +180,7 @@ impl FeedState {
                         l.set_enable(value != 0.0);
                     }
                 }
+                self.values.insert(format!("{}.{param}", name(node)), value);
                 json!({ "tick": e.tick, "t": t, "event": "set", "node": name(node), "param": param, "value": value })
             }
             EventKind::Refused { node, param, value } => {
@@ -229,6 +234,7 @@ impl FeedState {
             "taps": taps,
             "limiters": limiters,
             "events": std::mem::take(&mut self.events),
+            "values": self.values,
             "timing": {
                 "jitter_us": p(self.metrics.jitter.percentiles()),
                 "compute_us": p(self.metrics.compute.percentiles()),

@@ -5,7 +5,7 @@
 const $ = id => document.getElementById(id);
 const S = {
   hello: null, taps: [], series: [], frames: 0, t: 0, tick: 0, windowS: 10, keepS: 120,
-  replies: [], events: [], limiters: {}, compute: { t: [], lo: [], hi: [] }, nextId: 1, ended: false,
+  replies: [], events: [], values: {}, limiters: {}, compute: { t: [], lo: [], hi: [] }, nextId: 1, ended: false,
   recorded: false, view: null,
 };
 window.studio = S;
@@ -71,6 +71,14 @@ function frame(f) {
   }
   for (const l of f.limiters) limiterShow(l);
   for (const e of f.events) eventShow(e);
+  // The value each parameter last took: a browser that joined after a
+  // change (scripted, from the console or another browser) shows it too.
+  for (const [k, value] of Object.entries(f.values || {})) {
+    if (S.values[k] === value) continue;
+    S.values[k] = value;
+    const [node, param] = [k.slice(0, k.lastIndexOf(".")), k.slice(k.lastIndexOf(".") + 1)];
+    steerFollow({ node, param, value });
+  }
   if (f.timing) timingShow(f);
   if (f.studio) { $("drops-all").textContent = f.studio.frames_dropped; $("browsers").textContent = f.studio.browsers; }
   if (f.limiter_timelines) S.timelines = f.limiter_timelines;
@@ -179,6 +187,16 @@ function steerInit(h) {
   sel.onchange = show; show();
   $("param-set").onclick = () => send(sel.value, $("param-value").value);
   if (S.recorded) $("param-set").disabled = true;
+}
+// A change that landed — from this page, another browser, the console or
+// a script (`--change`) — shows in the field of every variable that sets
+// that parameter (unless someone is typing in it).
+function steerFollow(e) {
+  for (const v of (S.hello && S.hello.vars) || []) {
+    if (!v.uses.includes(`${e.node}.${e.param}`)) continue;
+    const input = $("var-" + v.name);
+    if (input && document.activeElement !== input) input.value = String(e.value);
+  }
 }
 function send(target, value) {
   const id = S.nextId++;
@@ -333,7 +351,7 @@ function graphDraw(g) {
 function eventShow(e) {
   S.events.push(e);
   let text = `${e.t.toFixed(3)} s (tick ${e.tick}) `;
-  if (e.event === "set") text += `${e.node}.${e.param} = ${e.value}`;
+  if (e.event === "set") { text += `${e.node}.${e.param} = ${e.value}`; steerFollow(e); }
   else if (e.event === "refused") text += `REFUSED by the node: ${e.node}.${e.param} = ${e.value}`;
   else if (e.event === "stop") { text += `stop: ${e.reason}`; S.ended = true; }
   else if (e.event === "gap") text += `gap: ${e.ticks} ticks of samples lost`;
@@ -344,7 +362,7 @@ function eventShow(e) {
 // --- recorded sessions ---
 function recordedInit(h) {
   const r = h.recording;
-  $("window-s").textContent = "scrub";
+  $("traces-window").textContent = "(the whole session: choose the span to show with the sliders; min/max per 5 ms)";
   const from = el("input", { type: "range", id: "scrub-from", min: 0, max: r.seconds, step: r.seconds / 1000, value: 0 });
   const span = el("input", { type: "range", id: "scrub-span", min: Math.min(0.05, r.seconds), max: r.seconds, step: r.seconds / 1000, value: r.seconds });
   const upd = () => { const a = +from.value, w = +span.value; S.view = [a, Math.min(a + w, Math.max(r.seconds, a + 0.01))]; draw(); };

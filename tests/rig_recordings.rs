@@ -177,3 +177,38 @@ fn a_sidecar_field_cannot_write_outside_the_output_folder() {
     }
     assert!(found.iter().all(|p| p.starts_with(&tex)), "{found:?}");
 }
+
+#[test]
+fn a_model_is_scored_on_a_second_recording_it_was_not_trained_on() {
+    // Issue 27, point 11: a second excitation per condition, in a folder of
+    // its own, scored through the model trained on the first.
+    let dir = tempfile::tempdir().unwrap();
+    let (prbs, validate, models) = (dir.path().join("prbs"), dir.path().join("validate"), dir.path().join("models"));
+    for d in [&prbs, &validate, &models] {
+        std::fs::create_dir(d).unwrap();
+    }
+    record(&prbs, "a-85g-5cms", 85.0, 5.0, 1);
+    record(&validate, "b-85g-5cms", 85.0, 5.0, 7);
+    assert_eq!(run_sweep("model-build-recordings.toml", &[("recordings", prbs.to_str().unwrap())], &models), 1);
+    let path = evflow_tests::root().join("graphs/model-validate-recordings.toml");
+    let g = parse_graph(&path, &std::fs::read_to_string(&path).unwrap()).unwrap_or_else(|e| panic!("{e}"));
+    let o: Vec<Override> = [("validation", &validate), ("models", &models)]
+        .iter()
+        .map(|(k, v)| Override::parse(&format!("{k}={}", v.display())).unwrap())
+        .collect();
+    let axes = sweep_files::expand(&g, &o, &sweep_fields).unwrap_or_else(|e| panic!("{e}"));
+    let points = sweep::points(&axes, &[], &o);
+    assert_eq!(points.len(), 1);
+    let mut all = o.clone();
+    all.extend(points[0].overrides());
+    let c = check(&g, &evflow_nodes::registry(), &all).unwrap_or_else(|e| panic!("{e}"));
+    let out = dir.path().join("out");
+    let mut plan = Plan::build(&c, &PlanOptions { out_dir: Some(out), ..Default::default() }).unwrap();
+    let r = run_offline(&mut plan, RunOptions::default()).unwrap();
+    let v = |k: &str| r.value("score", k).unwrap_or_else(|| panic!("no score.{k}"));
+    // Another PRBS than the one trained on, well above chance; with the
+    // force replaced by noise, near chance.
+    let (held_out, noise) = (v("transition_agreement"), v("noise_force_transition_agreement"));
+    assert!(held_out > 0.6 && held_out > noise + 0.05, "held out {held_out}, noise force {noise}");
+    assert!(v("samples") > 1000.0, "{}", v("samples"));
+}

@@ -8,7 +8,7 @@
 pub const OPTIONAL: &[(&str, &[&str])] = &[
     ("lab", &["sim.display", "sim.tribometer", "sim.forcesensor", "sim.texture", "sim.user"]),
     ("mesh", &["profile1d", "mesh.gradient", "mesh.edges", "grain", "mesh.path"]),
-    ("narx", &["narx.train", "narx", "narx.grid"]),
+    ("narx", &["narx.train", "narx.score", "narx", "narx.grid"]),
     ("texture", &["interp", "playback"]),
     ("synth", &["forward.train", "synth.optimize", "synth.live"]),
     ("serial", &["serial.in", "serial.out"]),

@@ -17,6 +17,7 @@ pub mod nearest;
 pub mod net;
 pub mod node;
 pub mod packed;
+pub mod score_node;
 pub mod taps;
 pub mod train;
 pub mod train_node;
@@ -24,4 +25,4 @@ pub mod train_node;
 use evflow_engine::NodeSpec;
 
 /// The node types of this family.
-pub static SPECS: &[&NodeSpec] = &[&train_node::SPEC, &node::SPEC, &grid_node::SPEC];
+pub static SPECS: &[&NodeSpec] = &[&train_node::SPEC, &score_node::SPEC, &node::SPEC, &grid_node::SPEC];

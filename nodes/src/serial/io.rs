@@ -6,7 +6,7 @@
 //! only sees the rings and the atomics of [`LinkState`].
 
 use super::host::{HostConfig, HostSession, Inbound, Notice, Phase};
-use super::link::{LinkConfig, LinkReport, LinkState};
+use super::link_state::{LinkConfig, LinkReport, LinkState, ACTUATION_RING};
 use super::message::{fault_names, Touch};
 use serialport::{ClearBuffer, SerialPort};
 use std::io::{ErrorKind, Read, Write};
@@ -61,7 +61,7 @@ impl Io {
         let mut port: Option<Box<dyn SerialPort>> = None;
         let mut next_open = Instant::now();
         let mut rbuf = vec![0u8; 4096];
-        let mut samples: Vec<f32> = Vec::with_capacity(crate::serial::link::ACTUATION_RING);
+        let mut samples: Vec<f32> = Vec::with_capacity(ACTUATION_RING);
         let mut backlog: Vec<u8> = Vec::with_capacity(BACKLOG_MAX);
         let mut was_up = false;
         while !self.state.stop.load(Ordering::Acquire) {

@@ -26,6 +26,7 @@ mod io;
 pub use io::set_notices;
 #[cfg(feature = "serial")]
 pub mod link;
+pub mod link_state;
 #[cfg(feature = "serial")]
 pub mod output;
 #[cfg(feature = "serial")]

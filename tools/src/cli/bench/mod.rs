@@ -9,8 +9,6 @@ pub mod mesh;
 pub mod mesh_prune;
 #[cfg(feature = "narx")]
 pub mod narx;
-#[cfg(feature = "narx")]
-pub mod narx_export;
 #[cfg(any(feature = "mesh", feature = "texture"))]
 pub mod stats;
 #[cfg(feature = "texture")]

@@ -7,10 +7,6 @@ pub mod freqvel;
 #[cfg(feature = "synth")]
 pub mod interp;
 #[cfg(feature = "synth")]
-pub mod interp_cells;
-#[cfg(feature = "synth")]
-pub mod interp_cells_table;
-#[cfg(feature = "synth")]
 pub mod lab_recording;
 #[cfg(feature = "synth")]
 pub mod live;

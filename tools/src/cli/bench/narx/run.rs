@@ -1,21 +1,8 @@
-//! `evflow bench narx`: training time and closed-loop inference throughput
-//! of the default inverse NARX model (dissertation §5.2.1, docs/narx.md)
-//! on data recorded on the simulated lab, with the closed-loop error it
-//! reaches on a held-out recording — error against run time.
-//!
-//! Training data: `--samples` (3066, the dissertation's six periods of
-//! PRBS9) of a random binary sequence (or an order-20 PRBS) through the
-//! nominal virtual display and force sensor at 85 g and 5 cm/s,
-//! high-passed at 10 Hz (`narx::labdata`). Held-out data: another random
-//! binary sequence recorded with other lab noise. Network: 15-10-5 tanh,
-//! one feedback tap, ten input taps, look-ahead from the cross-correlation,
-//! Levenberg–Marquardt with early stopping on the last 15 % (the defaults
-//! of `narx.train`), seeded. `--export DIR` writes the data, the set-up
-//! (including the initial weights) and the results as CSV and JSON, for
-//! `bench/narx_peer.py`, which trains the same network in Python on the
-//! same data.
+//! The run of `evflow bench narx`: the lab data, training, scoring,
+//! the throughput and the table (the module doc says what is measured).
 
-use super::narx_export::{self, Curve};
+use super::export;
+use super::{Curve, Excitation, Measured, KNOWN};
 use anyhow::{anyhow, Result};
 use evflow_nodes::narx::eval;
 use evflow_nodes::narx::fit::{fit, FitConfig};
@@ -26,22 +13,10 @@ use std::hint::black_box;
 use std::path::PathBuf;
 use std::time::Instant;
 
-/// Samples at the start of the held-out run fed back with the true u (the
-/// loop's initial states, as MATLAB's `preparets`); not scored.
-pub const KNOWN: usize = 60;
 /// Seed of the held-out excitation.
 const HELDOUT_SEED: u64 = 77;
 /// Seed of the lab noise of the held-out recording (training: the default, 11).
 const HELDOUT_LAB_SEED: u64 = 99;
-
-/// The training excitation.
-#[derive(clap::ValueEnum, Clone, Copy, Debug, PartialEq, Eq)]
-pub enum Excitation {
-    /// Random binary sequence (independent ±1 coin flips, seeded).
-    Rbs,
-    /// PRBS of order 20 (as graphs/model-build.toml).
-    Prbs20,
-}
 
 /// Arguments of `evflow bench narx`.
 #[derive(clap::Args, Debug)]
@@ -72,22 +47,6 @@ pub struct Args {
     /// Write the data, the set-up and the results here (CSV and JSON).
     #[arg(long, value_name = "DIR")]
     export: Option<PathBuf>,
-}
-
-/// What one run measured.
-pub struct Measured {
-    /// The trained model.
-    pub model: Model,
-    /// Wall time of the whole fit (alignment, regressors, training, scoring), s.
-    pub fit_seconds: f64,
-    /// Seconds since training started at the end of each epoch.
-    pub epoch_seconds: Vec<f64>,
-    /// Closed-loop score on the held-out recording.
-    pub heldout: ClosedLoopScore,
-    /// Closed-loop samples timed and their seconds.
-    pub inference: (usize, f64),
-    /// Closed-loop error per epoch budget (with `--curve`).
-    pub curve: Vec<Curve>,
 }
 
 /// Runs the benchmark and prints a Markdown table.
@@ -127,11 +86,7 @@ pub fn main(a: Args) -> Result<()> {
     let m = Measured { model, fit_seconds, epoch_seconds, heldout, inference, curve };
     print_table(&a, &m);
     if let Some(dir) = &a.export {
-        narx_export::write(
-            dir,
-            &narx_export::Setup { x: &x, u: &u, xh: &xh, uh: &uh, cfg: &cfg, excitation: a.excitation },
-            &m,
-        )?;
+        export::write(dir, &export::Setup { x: &x, u: &u, xh: &xh, uh: &uh, cfg: &cfg, excitation: a.excitation }, &m)?;
         eprintln!("wrote {}", dir.display());
     }
     Ok(())

@@ -3,10 +3,10 @@
 //! both orders (the actuations interpolated; the forces interpolated, then
 //! synthesized). The study module runs it
 //! (`evflow_nodes::synth::study::crossval`); this file parses, calls,
-//! prints the table ([`super::interp_cells_table`]) and draws the spectra.
+//! prints the table ([`super::cells_table`]) and draws the spectra.
 
-use super::interp::{Args, Cells};
-use super::interp_cells_table::table;
+use super::cells_table::table;
+use super::{Args, Cells};
 use anyhow::{anyhow, bail, Context, Result};
 use evflow_nodes::recording::format::Recording;
 use evflow_nodes::synth::study::crossval::{self, CrossvalConfig, Run};
@@ -115,10 +115,10 @@ pub(super) fn main(a: &Args, samples: &[String]) -> Result<()> {
     let md = table(a, method, &found.periods, &found.cells, &found.rows, started.elapsed().as_secs_f64());
     print!("{md}");
     let prefix = crossval::grid_of(method).1;
-    super::save_markdown(&out.join(format!("interp-{prefix}.md")), &md)?;
+    super::super::save_markdown(&out.join(format!("interp-{prefix}.md")), &md)?;
     for (_, run) in &found.rows {
         let name = format!("interp-{prefix}-{}-{}.png", run.sample, run.cond.tag());
-        super::save_png(&spectra_plot(run, method)?, &out.join(name));
+        super::super::save_png(&spectra_plot(run, method)?, &out.join(name));
     }
     Ok(())
 }

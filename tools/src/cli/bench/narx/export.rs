@@ -14,25 +14,14 @@
 //! Weights are laid out layer after layer, each weight matrix row-major
 //! (one row per neuron) followed by its biases, as in the model file.
 
-use super::narx::{Excitation, Measured, KNOWN};
+use super::{Excitation, Measured, KNOWN};
 use anyhow::{Context, Result};
 use evflow_nodes::narx::fit::FitConfig;
-use evflow_nodes::narx::model::ClosedLoopScore;
 use evflow_nodes::narx::net::Mlp;
 use evflow_nodes::rng::Rng;
 use serde_json::json;
 use std::fmt::Write as _;
 use std::path::Path;
-
-/// The closed-loop error of the model an epoch budget gives.
-pub struct Curve {
-    /// Epoch budget (0 = the initial weights).
-    pub epoch: usize,
-    /// Seconds of training the budget took (in the timed run).
-    pub seconds: f64,
-    /// Held-out closed-loop score.
-    pub score: ClosedLoopScore,
-}
 
 /// The data and configuration of a run.
 pub struct Setup<'a> {

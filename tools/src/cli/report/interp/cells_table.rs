@@ -1,8 +1,8 @@
 //! The Markdown report of `evflow report interp --cells narx|optimized|playback`
-//! ([`super::interp_cells`]): the trained cells with their control, then
+//! ([`super::cells`]): the trained cells with their control, then
 //! the cross-validation in both orders.
 
-use super::interp::Args;
+use super::Args;
 use evflow_nodes::synth::study::crossval::{Cell, Run, SchemeRun};
 use evflow_nodes::synth::study::row::Method;
 use evflow_nodes::synth::study::xval::GRAPH;

@@ -17,6 +17,7 @@ pub mod nearest;
 pub mod net;
 pub mod node;
 pub mod packed;
+pub mod pairs;
 pub mod score_node;
 pub mod taps;
 pub mod train;

@@ -4,6 +4,7 @@
 
 use super::fit::closed_loop_score;
 use super::model::Model;
+use super::pairs::GatedPairs;
 use crate::filters::segment::Gates;
 use evflow_engine::{
     BuildContext, Io, Node, NodeError, NodeSpec, ParamSpec, Params, PortSpec, PrepareContext, Role, Summary,
@@ -52,9 +53,7 @@ struct Score {
     model: Model,
     shown: String,
     seed: u64,
-    gates: Gates,
-    x: Vec<f64>,
-    y: Vec<f64>,
+    pairs: GatedPairs,
 }
 
 fn build(p: &Params, ctx: &BuildContext) -> Result<Box<dyn Node>, NodeError> {
@@ -71,59 +70,45 @@ fn build(p: &Params, ctx: &BuildContext) -> Result<Box<dyn Node>, NodeError> {
             ),
         ));
     }
-    Ok(Box::new(Score {
-        model,
-        shown,
-        seed: p.i64("seed") as u64,
-        gates: Gates::from_params(p, 2)?,
-        x: Vec::new(),
-        y: Vec::new(),
-    }))
+    Ok(Box::new(Score { model, shown, seed: p.i64("seed") as u64, pairs: GatedPairs::new(Gates::from_params(p, 2)?) }))
 }
 
 impl Node for Score {
     fn prepare(&mut self, ctx: &PrepareContext) -> Result<(), NodeError> {
-        self.x.reserve(ctx.max_block.max(1 << 16));
-        self.y.reserve(ctx.max_block.max(1 << 16));
+        self.pairs.reserve(ctx.max_block);
         Ok(())
     }
 
     fn process(&mut self, io: &mut Io<'_>) -> Result<(), NodeError> {
-        // Offline only: the buffers grow with the recording.
-        let (x, y) = (io.input(0), io.input(1));
-        let (bx, by) = (&mut self.x, &mut self.y);
-        self.gates.open_runs(io, |a, b| {
-            bx.extend_from_slice(&x[a..b]);
-            by.extend_from_slice(&y[a..b]);
-        });
+        self.pairs.push(io, 0, usize::MAX);
         Ok(())
     }
 
     fn reset(&mut self) {
-        self.x.clear();
-        self.y.clear();
+        self.pairs.clear();
     }
 
     fn finish(&mut self) -> Result<Summary, NodeError> {
-        if let Some(k) = self.x.iter().chain(&self.y).position(|v| !v.is_finite()) {
-            let (what, i) = if k < self.x.len() { ("force", k) } else { ("actuation", k - self.x.len()) };
+        let (x, y) = (&self.pairs.x, &self.pairs.y);
+        if let Some(k) = x.iter().chain(y).position(|v| !v.is_finite()) {
+            let (what, i) = if k < x.len() { ("force", k) } else { ("actuation", k - x.len()) };
             return Err(NodeError::Data(format!("the {what} sample {i} is not finite")));
         }
         let warm = self.model.delays.input + self.model.delays.feedback + 50;
         let too_short = || {
             NodeError::Data(format!(
                 "{} samples to score: at least {} are needed (a warm-up of {warm}, then one)",
-                self.x.len(),
+                x.len(),
                 warm + 1
             ))
         };
-        if self.x.len() <= warm {
+        if x.len() <= warm {
             return Err(too_short());
         }
-        let with = closed_loop_score(&self.model, &self.x, &self.y, warm, None)
+        let with = closed_loop_score(&self.model, x, y, warm, None)
             .map_err(|e| NodeError::Data(e.to_string()))?
             .ok_or_else(too_short)?;
-        let noise = closed_loop_score(&self.model, &self.x, &self.y, warm, Some(self.seed))
+        let noise = closed_loop_score(&self.model, x, y, warm, Some(self.seed))
             .map_err(|e| NodeError::Data(e.to_string()))?
             .ok_or_else(too_short)?;
         Ok(Summary::default()

@@ -3,6 +3,7 @@
 
 use super::fit::{fit, Algorithm, FitConfig};
 use super::model::Condition;
+use super::pairs::GatedPairs;
 use super::train::Options;
 use crate::filters::segment::Gates;
 use evflow_engine::{
@@ -108,10 +109,7 @@ struct Train {
     take: usize,
     progress: bool,
     record_time: bool,
-    seen: usize,
-    gates: Gates,
-    x: Vec<f64>,
-    y: Vec<f64>,
+    pairs: GatedPairs,
 }
 
 fn build(p: &Params, ctx: &BuildContext) -> Result<Box<dyn Node>, NodeError> {
@@ -184,41 +182,23 @@ fn build(p: &Params, ctx: &BuildContext) -> Result<Box<dyn Node>, NodeError> {
         },
         progress: p.bool("progress"),
         record_time: p.bool("record_time"),
-        seen: 0,
-        gates,
-        x: Vec::new(),
-        y: Vec::new(),
+        pairs: GatedPairs::new(gates),
     }))
 }
 
 impl Node for Train {
     fn prepare(&mut self, ctx: &PrepareContext) -> Result<(), NodeError> {
-        self.x.reserve(ctx.max_block.max(1 << 16));
-        self.y.reserve(ctx.max_block.max(1 << 16));
+        self.pairs.reserve(ctx.max_block);
         Ok(())
     }
 
     fn process(&mut self, io: &mut Io<'_>) -> Result<(), NodeError> {
-        // Offline only: the buffers grow with the recording.
-        let (x, y) = (io.input(0), io.input(1));
-        let (start, skip, take) = (self.seen, self.skip, self.take);
-        let (bx, by) = (&mut self.x, &mut self.y);
-        self.gates.open_runs(io, |a, b| {
-            for i in a..b {
-                if start + i >= skip && bx.len() < take {
-                    bx.push(x[i]);
-                    by.push(y[i]);
-                }
-            }
-        });
-        self.seen += io.len();
+        self.pairs.push(io, self.skip, self.take);
         Ok(())
     }
 
     fn reset(&mut self) {
-        self.x.clear();
-        self.y.clear();
-        self.seen = 0;
+        self.pairs.clear();
     }
 
     fn finish(&mut self) -> Result<Summary, NodeError> {
@@ -231,7 +211,7 @@ impl Node for Train {
                 );
             }
         };
-        let mut model = fit(&self.x, &self.y, &self.cfg, &mut report).map_err(|e| match e {
+        let mut model = fit(&self.pairs.x, &self.pairs.y, &self.cfg, &mut report).map_err(|e| match e {
             super::error::NarxError::Data(m) => NodeError::Data(format!(
                 "{m}{}{}",
                 if self.skip > 0 {
@@ -239,8 +219,8 @@ impl Node for Train {
                 } else {
                     String::new()
                 },
-                if self.gates.any() {
-                    format!(" (the gates kept {} of {} samples)", self.x.len(), self.seen)
+                if self.pairs.gates.any() {
+                    format!(" (the gates kept {} of {} samples)", self.pairs.x.len(), self.pairs.seen)
                 } else {
                     String::new()
                 }

@@ -134,7 +134,7 @@ fn left_out_lines(plan: &Plan) -> Vec<String> {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::check::check;
+    use crate::check::{check, Checked};
     use crate::graph::parse_graph;
     use crate::harness::FEED;
     use crate::node::{BuildContext, Io, Node, NodeError};
@@ -184,17 +184,22 @@ mod tests {
         }
     }
 
+    /// Three samples fed to the test trainer.
+    fn trainer_graph() -> Checked {
+        let doc = "[graph]\nformat = 1\nname = \"t\"\nrate = 1000.0\nconnections = [\"f.out -> t.in\"]\n\
+                   [nodes.f]\ntype = \"harness.feed\"\nvalues = [1.0, 2.0, 3.0]\n[nodes.t]\ntype = \"test.trainer\"\n";
+        let mut reg = Registry::new();
+        reg.add(&FEED).add(&TRAINER);
+        check(&parse_graph(Path::new("t.toml"), doc).unwrap(), &reg, &[]).unwrap()
+    }
+
     #[test]
     fn a_run_length_must_be_a_positive_finite_number_of_seconds() {
         for bad in [f64::INFINITY, 1e308, 0.0, -1.0, f64::NAN] {
             assert!(check_duration(bad).is_err(), "{bad}");
         }
         assert_eq!(check_duration(2.5), Ok(2.5));
-        let doc = "[graph]\nformat = 1\nname = \"t\"\nrate = 1000.0\nconnections = [\"f.out -> t.in\"]\n\
-                   [nodes.f]\ntype = \"harness.feed\"\nvalues = [1.0, 2.0, 3.0]\n[nodes.t]\ntype = \"test.trainer\"\n";
-        let mut reg = Registry::new();
-        reg.add(&FEED).add(&TRAINER);
-        let checked = check(&parse_graph(Path::new("t.toml"), doc).unwrap(), &reg, &[]).unwrap();
+        let checked = trainer_graph();
         let mut plan = Plan::build(&checked, &PlanOptions::default()).unwrap();
         let e = run_offline(&mut plan, RunOptions { duration: Some(f64::INFINITY), progress: None }).unwrap_err();
         assert!(e.to_string().contains("at most 1e7 s"), "{e}");
@@ -202,11 +207,7 @@ mod tests {
 
     #[test]
     fn work_done_when_the_run_ends_is_charged_to_the_node() {
-        let doc = "[graph]\nformat = 1\nname = \"t\"\nrate = 1000.0\nconnections = [\"f.out -> t.in\"]\n\
-                   [nodes.f]\ntype = \"harness.feed\"\nvalues = [1.0, 2.0, 3.0]\n[nodes.t]\ntype = \"test.trainer\"\n";
-        let mut reg = Registry::new();
-        reg.add(&FEED).add(&TRAINER);
-        let checked = check(&parse_graph(Path::new("t.toml"), doc).unwrap(), &reg, &[]).unwrap();
+        let checked = trainer_graph();
         let mut plan = Plan::build(&checked, &PlanOptions::default()).unwrap();
         let report = run_offline(&mut plan, RunOptions::default()).unwrap();
         let t = report.times.iter().find(|t| t.node == "t").unwrap();

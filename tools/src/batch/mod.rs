@@ -11,6 +11,7 @@ pub mod narx_shard;
 pub mod record_json;
 pub mod shard_record;
 pub mod sweep_plots;
+pub mod sweep_runs;
 pub mod tables;
 
 use evflow_engine::batch::{default_jobs, Shard};

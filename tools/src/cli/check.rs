@@ -6,8 +6,9 @@ use anyhow::{anyhow, bail, Result};
 use evflow_engine::batch::{check_outputs, output_files, Failures};
 use evflow_engine::check::prune::{Folded, Pruning};
 use evflow_engine::check::Pruned;
-use evflow_engine::sweep::{check_axes, parse_axis, points, validate, Point};
-use evflow_engine::{read_graph, Checked, Direction, Plan, PlanOptions};
+use evflow_engine::sweep::{validate, Point};
+use evflow_engine::{Checked, Direction, Plan, PlanOptions};
+use evflow_tools::batch::sweep_runs::sweep_runs;
 
 /// Arguments of `evflow check`.
 #[derive(clap::Args, Debug)]
@@ -38,14 +39,7 @@ pub struct Args {
 /// exits 1.
 pub fn main(a: Args) -> Result<()> {
     let overrides = a.graph.overrides()?;
-    let axes = a.sweep.iter().map(|s| parse_axis(s).map_err(|e| anyhow!("--sweep {e}"))).collect::<Result<Vec<_>>>()?;
-    let graph = read_graph(&a.graph.file).map_err(|e| anyhow!("{e}"))?;
-    check_axes(&graph, &axes).map_err(|e| anyhow!("{e}"))?;
-    let sweep =
-        evflow_engine::sweep_files::expand(&graph, &overrides, &evflow_nodes::recording::sweep_fields::sweep_fields)
-            .map_err(|e| anyhow!("{}: {e}", graph.file.display()))?;
-    evflow_engine::sweep::count(&sweep, &axes, &overrides).map_err(|e| anyhow!("{}: {e}", graph.file.display()))?;
-    let all = points(&sweep, &axes, &overrides);
+    let (graph, swept, all) = sweep_runs(&a.graph.file, &overrides, &a.sweep).map_err(|e| anyhow!("{e}"))?;
     let total = all.len();
     let is_sweep = total > 1;
     let registry = evflow_nodes::registry();
@@ -106,7 +100,6 @@ pub fn main(a: Args) -> Result<()> {
         let names: Vec<&str> = c.in_cycle.iter().map(|&i| c.nodes[i].name.as_str()).collect();
         println!("\nfeedback cycles broken by: {}", names.join(", "));
     }
-    let swept = evflow_engine::sweep::effective_axes(&sweep, &axes, &overrides);
     if !swept.is_empty() {
         let shown: Vec<String> = swept
             .iter()

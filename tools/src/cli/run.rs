@@ -6,9 +6,10 @@ use super::graph_args::GraphArgs;
 use super::run_report::print_report;
 use anyhow::{anyhow, bail, Result};
 use evflow_engine::batch::{check_outputs, for_each_ordered, output_files, Failures};
-use evflow_engine::sweep::{check_axes, parse_axis, points, validate, Point};
-use evflow_engine::{read_graph, run_offline, Checked, Plan, PlanOptions, RunOptions, RunReport};
+use evflow_engine::sweep::{validate, Point};
+use evflow_engine::{run_offline, Checked, Plan, PlanOptions, RunOptions, RunReport};
 use evflow_tools::batch::shard_record::{relative_to, ShardRecord};
+use evflow_tools::batch::sweep_runs::sweep_runs;
 use evflow_tools::batch::tables::{report_json, sweep_csv, sweep_table, Timings};
 use evflow_tools::batch::{progress_bar, BatchArgs};
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
@@ -63,19 +64,12 @@ pub struct Args {
 /// Runs `evflow run`.
 pub fn main(a: Args) -> Result<()> {
     let overrides = a.graph.overrides()?;
-    let axes = a.sweep.iter().map(|s| parse_axis(s).map_err(|e| anyhow!("--sweep {e}"))).collect::<Result<Vec<_>>>()?;
-    let graph = read_graph(&a.graph.file).map_err(|e| anyhow!("{e}"))?;
+    let (graph, _, all) = sweep_runs(&a.graph.file, &overrides, &a.sweep).map_err(|e| anyhow!("{e}"))?;
     let registry = evflow_nodes::registry();
-    check_axes(&graph, &axes).map_err(|e| anyhow!("{e}"))?;
 
     // Validate every run of the sweep before anything is built or written.
     // A run that does not validate is a failure of that run only; when none
     // validates, nothing is written.
-    let sweep =
-        evflow_engine::sweep_files::expand(&graph, &overrides, &evflow_nodes::recording::sweep_fields::sweep_fields)
-            .map_err(|e| anyhow!("{}: {e}", graph.file.display()))?;
-    evflow_engine::sweep::count(&sweep, &axes, &overrides).map_err(|e| anyhow!("{}: {e}", graph.file.display()))?;
-    let all = points(&sweep, &axes, &overrides);
     let total = all.len();
     let shard = a.batch.shard();
     let slice = shard.range(total);

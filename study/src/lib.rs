@@ -6,3 +6,5 @@
 //! prints); the CLI, the tests and the benchmarks share it
 //! (docs/architecture.md).
 #![deny(missing_docs)]
+
+pub mod precision;

@@ -5,8 +5,9 @@
 //! trajectory and error against lag for every estimator (PNG figures).
 
 use anyhow::{Context, Result};
-use evflow_nodes::filters::foaw::compare::{sample, score, Estimator, TRAJECTORIES};
+use evflow_nodes::filters::foaw::compare::{sample, Estimator, TRAJECTORIES};
 use evflow_nodes::filters::foaw::estimator::Fit;
+use evflow_study::precision::foaw::{estimators, family, table};
 use evflow_tools::plot::{Plot, Series};
 use std::path::PathBuf;
 
@@ -25,23 +26,6 @@ pub struct Args {
     /// Seconds of each trajectory (the first 0.5 s are not scored).
     #[arg(long, default_value_t = 6.0)]
     seconds: f64,
-}
-
-/// The estimators compared: the baselines, then FOAW over noise bounds and windows.
-fn estimators(step_m: f64) -> Vec<Estimator> {
-    let mut v = vec![
-        Estimator::FiniteDifference,
-        Estimator::MovingAverage(3),
-        Estimator::MovingAverage(5),
-        Estimator::MovingAverage(8),
-    ];
-    for d in [0.5, 0.6, 0.8, 1.0, 1.5] {
-        for n in [4, 8, 16] {
-            v.push(Estimator::Foaw(Fit::Best, d * step_m, n));
-            v.push(Estimator::Foaw(Fit::End, d * step_m, n));
-        }
-    }
-    v
 }
 
 /// Runs `evflow report foaw`.
@@ -63,23 +47,17 @@ pub fn main(a: Args) -> Result<()> {
     println!(" mean RMS (cm/s) |");
     println!("|---|{}---:|", "---:|---:|".repeat(TRAJECTORIES.len()));
     let mut scatter: Vec<(String, Vec<(f64, f64)>)> = Vec::new();
-    for e in &ests {
+    for (e, scores) in ests.iter().zip(table(&ests, a.rate, a.seconds, step)) {
         print!("| {} |", e.label());
         let mut total = 0.0;
         let mut points = Vec::new();
-        for tr in &TRAJECTORIES {
-            let s = score(tr, e, a.rate, a.seconds, step, 0.5);
+        for s in &scores {
             print!(" {:.2} | {:.0} |", s.rms * 100.0, s.lag * 1e3);
             total += s.rms * 100.0;
             points.push((s.lag * 1e3, s.rms * 100.0));
         }
         println!(" {:.2} |", total / TRAJECTORIES.len() as f64);
-        let family = match e {
-            Estimator::FiniteDifference => "finite difference",
-            Estimator::MovingAverage(_) => "moving average",
-            Estimator::Foaw(Fit::Best, ..) => "FOAW best-fit",
-            Estimator::Foaw(Fit::End, ..) => "FOAW end-fit",
-        };
+        let family = family(e);
         match scatter.iter_mut().find(|(n, _)| n == family) {
             Some((_, p)) => p.extend(points),
             None => scatter.push((family.to_string(), points)),

@@ -14,6 +14,7 @@ pub mod live;
 pub mod mesh;
 #[cfg(feature = "synth")]
 pub mod narx;
+pub mod precision;
 #[cfg(feature = "texture")]
 pub mod resample;
 #[cfg(feature = "synth")]
@@ -106,6 +107,16 @@ enum Which {
     /// Example: cargo run --release -p evflow -- report live --out report-live
     #[cfg(feature = "synth")]
     Live(live::Args),
+    /// Error against run time of every computation with a tolerance or a
+    /// discretization (issue 26, point 2): the lab's integrators,
+    /// `butterworth`, `decimate`, `resample`, `interp`'s kernel, FOAW and the
+    /// mesh gradient, each against an exact reference (or one ≥ 10× more
+    /// precise): a log-log PNG each with the shipped default marked,
+    /// table.md (default, its error and cost, the cheapest setting within
+    /// 10 % of the best error) and rows.csv. `--size ci` runs in seconds.
+    ///
+    /// Example: cargo run --release -p evflow -- report precision --out report-precision
+    Precision(precision::Args),
 }
 
 /// Writes `plot` to `path` and says so (unlabelled without a font); a plot
@@ -148,5 +159,6 @@ pub fn main(a: ReportArgs) -> anyhow::Result<()> {
         Which::Narx(n) => narx::main(n),
         #[cfg(feature = "synth")]
         Which::Live(l) => live::main(l),
+        Which::Precision(p) => precision::main(p),
     }
 }

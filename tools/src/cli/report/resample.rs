@@ -6,11 +6,8 @@
 //! signal whose re-sampled version is known exactly.
 
 use anyhow::{Context, Result};
-use evflow_nodes::rate::resampler::Quality;
-use evflow_nodes::texture::rs::RsMethod;
-use evflow_nodes::texture::rs_precision::{measure, tones};
+use evflow_study::precision::resample::{measure_method, methods, signal, RATIOS};
 use evflow_tools::plot::{Plot, Series};
-use rubato::PolynomialDegree;
 use std::path::PathBuf;
 
 /// Arguments of `evflow report resample`.
@@ -27,33 +24,11 @@ pub struct Args {
     repeats: usize,
 }
 
-/// Velocity ratios v_j/v_u of a 3–7 cm/s grid (p/q of 𝓡𝓢).
-const RATIOS: [(f64, f64); 4] = [(3.0, 3.5), (5.0, 4.5), (7.0, 5.5), (3.0, 6.5)];
-
-fn methods() -> Vec<(&'static str, RsMethod)> {
-    let mut v = Vec::new();
-    for n in [16, 32, 64, 128, 256] {
-        v.push(("rubato sinc", RsMethod::RubatoSinc(n)));
-    }
-    for d in [PolynomialDegree::Linear, PolynomialDegree::Cubic, PolynomialDegree::Quintic, PolynomialDegree::Septic] {
-        v.push(("rubato polynomial", RsMethod::RubatoPoly(d)));
-    }
-    v.push(("rubato FFT", RsMethod::RubatoFft));
-    for w in [4, 8, 16, 32] {
-        v.push(("interp kernel (live)", RsMethod::Kernel(w)));
-    }
-    for q in Quality::ALL {
-        v.push(("resample node (streaming)", RsMethod::Node(q)));
-    }
-    v
-}
-
 /// Runs `evflow report resample`.
 pub fn main(a: Args) -> Result<()> {
     anyhow::ensure!(a.samples >= 1000, "--samples {}: needs at least 1000", a.samples);
     std::fs::create_dir_all(&a.out).with_context(|| format!("{}: cannot create", a.out.display()))?;
-    // Content up to 0.2 × the rate stays below the new Nyquist frequency at every ratio (≥ 0.46).
-    let signal = tones(12, 0.2, 11);
+    let signal = signal();
     println!(
         "𝓡𝓢 of {} samples of a 12-tone signal (5 Hz … 0.2·f_s) by v_j/v_u = {}; error: RMS after the best \
          constant delay, relative; time: best of {} runs, per output sample.\n",
@@ -65,20 +40,11 @@ pub fn main(a: Args) -> Result<()> {
     println!("|---|---:|---:|---:|");
     let mut families: Vec<(&str, Vec<(f64, f64)>)> = Vec::new();
     for (family, m) in methods() {
-        let (mut worst, mut ns, mut delay) = (0.0f64, 0.0f64, 0.0f64);
-        for &(p, q) in &RATIOS {
-            let r =
-                measure(&signal, a.samples, p, q, m, a.repeats).map_err(|e| anyhow::anyhow!("{}: {e}", m.label()))?;
-            worst = worst.max(r.error);
-            ns += r.seconds * 1e9 / r.samples.max(1) as f64 / RATIOS.len() as f64;
-            if r.delay.abs() > delay.abs() {
-                delay = r.delay;
-            }
-        }
-        println!("| {} | {:.2e} | {:.1} ns | {:+.2} |", m.label(), worst, ns, delay);
+        let r = measure_method(&signal, family, m, a.samples, a.repeats).map_err(|e| anyhow::anyhow!("{e}"))?;
+        println!("| {} | {:.2e} | {:.1} ns | {:+.2} |", m.label(), r.worst, r.ns, r.delay);
         match families.iter_mut().find(|(f, _)| *f == family) {
-            Some((_, pts)) => pts.push((ns, worst)),
-            None => families.push((family, vec![(ns, worst)])),
+            Some((_, pts)) => pts.push((r.ns, r.worst)),
+            None => families.push((family, vec![(r.ns, r.worst)])),
         }
     }
     let plot = Plot {

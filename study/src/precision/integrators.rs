@@ -1,0 +1,81 @@
+//! The simulated lab's integrators (issue 3, point 6): the shipped graph
+//! `graphs/lab-work-precision.toml` run at every integrator and sub-step
+//! count; each of its three lab nodes (display, force sensor, tribometer)
+//! is one curve, its error the graph's `error` sink against the same node
+//! integrated exactly with many sub-steps, its cost the node's processing
+//! time per sample. The reference's own error is measured by running the
+//! exact integrator at the reference's sub-steps against a reference 2.4×
+//! finer (10 000 sub-steps, the parameter's limit).
+
+use super::curve::{Curve, WorkPoint};
+use super::{graph, PrecisionError, Size};
+use std::path::Path;
+
+/// The graph, relative to the graphs folder.
+pub const GRAPH: &str = "lab-work-precision.toml";
+
+/// The lab nodes the graph compares: (node, its error sink, curve name, computation).
+const NODES: [(&str, &str, &str, &str); 3] = [
+    ("display", "err_display", "lab-display", "sim.display (force on the finger)"),
+    ("sensor", "err_sensor", "lab-forcesensor", "sim.forcesensor"),
+    ("tribometer", "err_trib", "lab-tribometer", "sim.tribometer (load)"),
+];
+
+/// The shipped default of every lab node (`integrator`, `substeps`).
+pub const DEFAULT: (&str, usize) = ("exact", 4);
+
+fn setting(integrator: &str, substeps: usize) -> String {
+    format!("{integrator} × {substeps}")
+}
+
+fn ref_sets(substeps: usize) -> Vec<String> {
+    ["display_ref", "trib_ref", "sensor_ref"].iter().map(|n| format!("{n}.substeps={substeps}")).collect()
+}
+
+/// The three curves, one per lab node; `graphs` is the shipped graphs' folder.
+pub fn curves(graphs: &Path, size: Size) -> Result<Vec<Curve>, PrecisionError> {
+    let file = graphs.join(GRAPH);
+    // CI: 0.6 s of signal (the force sensor sees no force before 0.3 s) against 1024 sub-steps; full: the graph's own length and reference.
+    let (duration, substeps, reference): (Option<f64>, &[usize], usize) = match size {
+        Size::Ci => (Some(0.6), &[1, 4, 16, 64], 1024),
+        Size::Full => (None, &[1, 4, 16, 64, 256, 1024], 4096),
+    };
+    let mut points: Vec<Vec<WorkPoint>> = vec![Vec::new(); NODES.len()];
+    for integrator in ["exact", "rk4", "euler"] {
+        for &s in substeps {
+            let mut sets = vec![format!("integrator=\"{integrator}\""), format!("substeps={s}")];
+            sets.extend(ref_sets(reference));
+            let r = graph::run(&file, &sets, duration)?;
+            for (k, &(node, sink, _, _)) in NODES.iter().enumerate() {
+                points[k].push(WorkPoint {
+                    setting: setting(integrator, s),
+                    series: integrator.into(),
+                    error: graph::value(&r, &file, sink, "rel_rms")?,
+                    cost: graph::seconds_per_tick(&r, &file, node)?,
+                    // RK4 evaluates four stages per sub-step.
+                    work: (s * if integrator == "rk4" { 4 } else { 1 }) as f64,
+                });
+            }
+        }
+    }
+    let mut sets = vec!["integrator=\"exact\"".to_string(), format!("substeps={reference}")];
+    sets.extend(ref_sets(10_000));
+    let check = graph::run(&file, &sets, duration)?;
+    NODES
+        .iter()
+        .zip(points)
+        .map(|(&(_, sink, name, computation), points)| {
+            Ok(Curve {
+                name: name.into(),
+                computation: computation.into(),
+                knob: "integrator × substeps".into(),
+                error_unit: "relative RMS".into(),
+                cost_unit: "sample (1 kHz)".into(),
+                reference: format!("exact × {reference} sub-steps"),
+                reference_error: graph::value(&check, &file, sink, "rel_rms")?,
+                default: setting(DEFAULT.0, DEFAULT.1),
+                points,
+            })
+        })
+        .collect()
+}

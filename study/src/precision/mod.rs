@@ -1,0 +1,119 @@
+//! Error against run time of every computation with a tolerance or a
+//! discretization (issue 26, point 2; `evflow report precision`): each a
+//! work-precision [`Curve`] of settings against a reference that is exact
+//! or an order of magnitude more precise, with its shipped default marked,
+//! and one summary [`table::Row`] — the default's error and cost, and the
+//! cheapest setting within 10 % of the best error.
+//!
+//! The computations reuse the code of the reports that drew them first
+//! (`report resample`, `foaw`, `mesh`, the graph `lab-work-precision.toml`).
+
+pub mod butterworth;
+pub mod curve;
+pub mod decimate;
+pub mod foaw;
+pub mod graph;
+#[cfg(feature = "lab")]
+pub mod integrators;
+#[cfg(feature = "mesh")]
+pub mod mesh;
+#[cfg(feature = "texture")]
+pub mod resample;
+pub mod table;
+
+pub use curve::{Curve, WorkPoint};
+use std::path::Path;
+use std::time::Instant;
+
+/// How much each curve measures.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Size {
+    /// Few settings and short signals: the whole report in seconds (tests, CI).
+    Ci,
+    /// Every setting, full-length signals, the best of several timed runs.
+    Full,
+}
+
+impl Size {
+    /// From `ci` or `full`.
+    pub fn from_word(w: &str) -> Option<Self> {
+        match w {
+            "ci" => Some(Size::Ci),
+            "full" => Some(Size::Full),
+            _ => None,
+        }
+    }
+
+    /// Timed runs per setting (the fastest is kept).
+    pub fn repeats(self) -> usize {
+        match self {
+            Size::Ci => 1,
+            Size::Full => 5,
+        }
+    }
+}
+
+/// Why a curve could not be measured.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum PrecisionError {
+    /// A method refused its setting.
+    #[error("{0}")]
+    Method(String),
+    /// A graph could not be loaded or run.
+    #[error("{file}: {message}")]
+    Graph {
+        /// The graph file.
+        file: String,
+        /// What went wrong.
+        message: String,
+    },
+    /// `--only` named no computation.
+    #[error("no computation `{0}`; the computations are: {list}", list = names().join(", "))]
+    Unknown(String),
+}
+
+/// The computations, in the report's order. Each gives one curve, except
+/// `lab`, which gives one per lab node.
+pub fn names() -> Vec<&'static str> {
+    let mut v = Vec::new();
+    #[cfg(feature = "lab")]
+    v.push("lab");
+    v.extend(["butterworth", "decimate"]);
+    #[cfg(feature = "texture")]
+    v.extend(["resample", "interp-kernel"]);
+    v.push("foaw");
+    #[cfg(feature = "mesh")]
+    v.push("mesh-gradient");
+    v
+}
+
+/// Measures computation `name` (one of [`names`]); `graphs` is the folder
+/// of the shipped graphs.
+pub fn run(name: &str, graphs: &Path, size: Size) -> Result<Vec<Curve>, PrecisionError> {
+    let _ = graphs;
+    match name {
+        #[cfg(feature = "lab")]
+        "lab" => integrators::curves(graphs, size),
+        "butterworth" => Ok(vec![butterworth::curve(size)?]),
+        "decimate" => Ok(vec![decimate::curve(size)?]),
+        #[cfg(feature = "texture")]
+        "resample" => Ok(vec![resample::curve(size)?]),
+        #[cfg(feature = "texture")]
+        "interp-kernel" => Ok(vec![resample::interp_curve(size)?]),
+        "foaw" => Ok(vec![foaw::curve(size)?]),
+        #[cfg(feature = "mesh")]
+        "mesh-gradient" => Ok(vec![mesh::curve(size)?]),
+        other => Err(PrecisionError::Unknown(other.to_string())),
+    }
+}
+
+/// The fastest of `repeats` (at least one) runs of `f`, s.
+pub fn time_best(repeats: usize, mut f: impl FnMut()) -> f64 {
+    let mut best = f64::INFINITY;
+    for _ in 0..repeats.max(1) {
+        let t = Instant::now();
+        f();
+        best = best.min(t.elapsed().as_secs_f64());
+    }
+    best
+}

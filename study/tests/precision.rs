@@ -124,6 +124,15 @@ fn mesh_gradient_converges_with_resolution() {
     assert!(gap(&c) < 2.0, "{}", gap(&c));
 }
 
+#[cfg(feature = "synth")]
+#[test]
+fn the_volterra_model_improves_with_memory() {
+    let c = one("volterra-memory");
+    let e = c.errors_of("second-order Volterra");
+    assert!(e.last().unwrap() * 1.5 < e[0], "{e:?}");
+    assert!(gap(&c) < 1.5, "{}", gap(&c));
+}
+
 #[test]
 fn an_unknown_computation_is_named_in_the_error() {
     let e = precision::run("nonsense", &graphs(), Size::Ci).unwrap_err().to_string();

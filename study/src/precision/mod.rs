@@ -20,6 +20,8 @@ pub mod mesh;
 #[cfg(feature = "texture")]
 pub mod resample;
 pub mod table;
+#[cfg(feature = "synth")]
+pub mod volterra;
 
 pub use curve::{Curve, WorkPoint};
 use std::path::Path;
@@ -84,6 +86,8 @@ pub fn names() -> Vec<&'static str> {
     v.push("foaw");
     #[cfg(feature = "mesh")]
     v.push("mesh-gradient");
+    #[cfg(feature = "synth")]
+    v.push("volterra-memory");
     v
 }
 
@@ -103,6 +107,8 @@ pub fn run(name: &str, graphs: &Path, size: Size) -> Result<Vec<Curve>, Precisio
         "foaw" => Ok(vec![foaw::curve(size)?]),
         #[cfg(feature = "mesh")]
         "mesh-gradient" => Ok(vec![mesh::curve(size)?]),
+        #[cfg(feature = "synth")]
+        "volterra-memory" => Ok(vec![volterra::curve(size)?]),
         other => Err(PrecisionError::Unknown(other.to_string())),
     }
 }

@@ -18,7 +18,8 @@ pub struct Args {
     /// `ci` (few settings, short signals: seconds) or `full`.
     #[arg(long, default_value = "full")]
     size: String,
-    /// Run one computation only (lab, butterworth, decimate, resample, interp-kernel, foaw, mesh-gradient).
+    /// Run one computation only (lab, butterworth, decimate, resample, interp-kernel, foaw, mesh-gradient,
+    /// volterra-memory).
     #[arg(long)]
     only: Option<String>,
     /// The folder of the shipped graphs (the lab's curves run lab-work-precision.toml).

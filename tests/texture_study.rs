@@ -7,10 +7,10 @@
 //! found by optimizing through the display itself — is never above the
 //! best method (by its definition) nor below the repeat baseline.
 
-use evflow_nodes::synth::study::row::Method;
-use evflow_nodes::synth::study::run::{run, StudyConfig};
-use evflow_nodes::synth::study::setup::{Cond, Profile};
-use evflow_nodes::synth::study::summary::{es, Basis};
+use evflow_study::row::Method;
+use evflow_study::run::{run, StudyConfig};
+use evflow_study::setup::{Cond, Profile};
+use evflow_study::summary::{es, Basis};
 
 #[test]
 fn the_best_method_beats_fair_playback_on_two_profiles() {

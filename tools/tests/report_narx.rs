@@ -139,13 +139,9 @@ fn shards_merged_out_of_order_give_the_table_of_one_run() {
 
 /// The study as the library runs it: setting `a` (5 hidden, taps 1/10, LM)
 /// with 2 seeds at 60 g, 5 cm/s on `samples`, in `work`.
-fn study(
-    samples: &[&str],
-    out: &Path,
-    work: &Path,
-) -> Result<evflow_nodes::synth::study::narx_settings::NarxStudy, String> {
-    use evflow_nodes::synth::study::narx_settings::{run, NarxConfig, Setting};
-    use evflow_nodes::synth::study::setup::Cond;
+fn study(samples: &[&str], out: &Path, work: &Path) -> Result<evflow_study::narx_settings::NarxStudy, String> {
+    use evflow_study::narx_settings::{run, NarxConfig, Setting};
+    use evflow_study::setup::Cond;
     let cfg = NarxConfig {
         condition: Cond { mass: 60.0, speed: 5.0 },
         settings: vec![Setting::parse("a=5/1/10/lm").unwrap()],

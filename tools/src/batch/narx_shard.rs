@@ -8,8 +8,8 @@
 
 use super::record_json::{count, field, list, read_doc, text, write_doc, Fault, RecordError};
 use evflow_engine::batch::Shard;
-use evflow_nodes::synth::study::narx_settings::{Item, NarxConfig, SeedScore, Setting};
-use evflow_nodes::synth::study::setup::Cond;
+use evflow_study::narx_settings::{Item, NarxConfig, SeedScore, Setting};
+use evflow_study::setup::Cond;
 use serde_json::{json, Value as Json};
 use std::path::Path;
 

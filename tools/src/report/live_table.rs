@@ -2,10 +2,10 @@
 //! everything else, from a live study or from the shards `evflow merge`
 //! joins (the same code, so a merge writes what one run writes).
 
-use evflow_nodes::synth::study::gains::AtGain;
-use evflow_nodes::synth::study::live::row::{Chain, LiveRow};
-use evflow_nodes::synth::study::live::run::LiveStudy;
-use evflow_nodes::synth::study::live::scope::LiveScope;
+use evflow_study::gains::AtGain;
+use evflow_study::live::row::{Chain, LiveRow};
+use evflow_study::live::run::LiveStudy;
+use evflow_study::live::scope::LiveScope;
 use std::fmt::Write as _;
 
 /// The factor of the stroke's floor the best chain is held to (issue 24, point 5).

@@ -7,9 +7,9 @@
 use evflow_nodes::lab::texture::samples::NAMES;
 use evflow_nodes::narx::model::Model;
 use evflow_nodes::synth::model_file::ForwardModel;
-use evflow_nodes::synth::study::row::{Method, Row};
-use evflow_nodes::synth::study::run::{Study, StudyConfig};
-use evflow_nodes::synth::study::summary::{es, standing, Basis};
+use evflow_study::row::{Method, Row};
+use evflow_study::run::{Study, StudyConfig};
+use evflow_study::summary::{es, standing, Basis};
 
 pub use crate::batch::tables::Timings;
 use std::fmt::Write as _;

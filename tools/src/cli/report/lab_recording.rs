@@ -55,7 +55,7 @@ pub fn record(graph: &Path, c: &Condition<'_>, dir: &Path) -> Result<(f64, Vec<f
 /// The rate and the constant-speed force (see [`record`]) of `rec`, a
 /// recording of graphs/record-textures.toml at `speed_cm_s` read from `what`.
 pub fn constant_speed_force(rec: &Recording, speed_cm_s: f64, what: &Path) -> Result<(f64, Vec<f64>)> {
-    evflow_nodes::synth::study::constant_speed::of_recording(rec, speed_cm_s, what).map_err(|e| anyhow!("{e}"))
+    evflow_study::constant_speed::of_recording(rec, speed_cm_s, what).map_err(|e| anyhow!("{e}"))
 }
 
 /// The only recording a graph run wrote into `dir`.

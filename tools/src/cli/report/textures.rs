@@ -1,18 +1,18 @@
 //! `evflow report textures`: dissertation Fig. 5.7/5.8 and Table 5.1, and
 //! beyond them — every synthesis method on every lab profile, scored the
 //! same way (docs/synthesis.md). The study itself is library code
-//! (`evflow_nodes::synth::study`); this command parses, calls, prints and
+//! (`evflow_study`); this command parses, calls, prints and
 //! draws.
 
 use anyhow::{anyhow, Context, Result};
 use evflow_nodes::lab::texture::samples::{self, NAMES};
 use evflow_nodes::recording::format::Recording;
-use evflow_nodes::synth::study::cells::write_actuation;
-use evflow_nodes::synth::study::row::{Method, Row};
-use evflow_nodes::synth::study::run::{run_on, Progress, StudyConfig};
-use evflow_nodes::synth::study::saved::{SavedStudy, RECORD};
-use evflow_nodes::synth::study::setup::{Cond, Profile};
-use evflow_nodes::synth::study::spectrum::gated;
+use evflow_study::cells::write_actuation;
+use evflow_study::row::{Method, Row};
+use evflow_study::run::{run_on, Progress, StudyConfig};
+use evflow_study::saved::{SavedStudy, RECORD};
+use evflow_study::setup::{Cond, Profile};
+use evflow_study::spectrum::gated;
 use evflow_tools::batch::{progress_bar, BatchArgs};
 use evflow_tools::plot::{Plot, Series};
 use evflow_tools::report::textures_table::Timings;

@@ -1,9 +1,9 @@
 //! One row of the live study: one lab profile, texture sample and virtual
 //! user, every live chain and the floors beside them.
 
-use crate::synth::study::exact;
-use crate::synth::study::gains::{AtGain, Chosen};
-use crate::synth::study::row::Reading;
+use crate::exact;
+use crate::gains::{AtGain, Chosen};
+use crate::row::Reading;
 use serde::{Deserialize, Serialize};
 use std::path::PathBuf;
 

@@ -18,7 +18,7 @@ pub fn run_graph_for(file: &Path, sets: &[String], out: &Path, duration: Option<
         .iter()
         .map(|s| Override::parse(s).map_err(|e| err(format!("--set {e}"))))
         .collect::<Result<Vec<_>, _>>()?;
-    let checked = load_file(file, &crate::registry(), &overrides).map_err(|e| err(e.to_string()))?;
+    let checked = load_file(file, &evflow_nodes::registry(), &overrides).map_err(|e| err(e.to_string()))?;
     std::fs::create_dir_all(out).map_err(|e| StudyError::Io { path: out.to_path_buf(), message: e.to_string() })?;
     let opts = PlanOptions {
         max_block: 1024,

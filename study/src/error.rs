@@ -1,39 +1,4 @@
-//! The texture-rendering study (dissertation chapter 5, and beyond it): per
-//! lab profile, texture and condition, every synthesis method — the inverse
-//! NARX model on binary and on multilevel excitation, the optimized
-//! synthesis through a forward model, record-and-playback normalized per
-//! recording — played on the display and scored the same way: the same
-//! gain sweep and rules ([`gains`]), E_s in two readings, beside the repeat
-//! baseline, the display floor and the achievable floor ([`floor`]).
-//!
-//! One module computes every row; `evflow report textures`, `evflow report
-//! narx`, the interpolation cross-validation (`evflow report interp
-//! --cells …`: [`xval`], [`forces_first`]) and the tests call it. The
-//! cells of the live texture grids are cut from its runs ([`cells`]).
-
-pub mod cells;
-pub mod constant_speed;
-pub mod crossval;
-pub mod exact;
-pub mod floor;
-pub mod forces_first;
-pub mod gains;
-pub mod graphs;
-pub mod grid_plan;
-pub mod library;
-pub mod live;
-pub mod models;
-pub mod narx_settings;
-pub mod recordings;
-pub mod row;
-pub mod run;
-pub mod saved;
-pub mod setup;
-pub mod shard_file;
-pub mod spectrum;
-pub mod summary;
-pub mod twin;
-pub mod xval;
+//! Why a study could not run: one error type for every study step.
 
 use std::path::PathBuf;
 
@@ -67,10 +32,10 @@ pub enum StudyError {
     Config(String),
     /// A NARX model that cannot be read.
     #[error(transparent)]
-    Narx(#[from] crate::narx::error::NarxError),
+    Narx(#[from] evflow_nodes::narx::error::NarxError),
     /// A synthesis step failed.
     #[error(transparent)]
-    Synth(#[from] super::error::SynthError),
+    Synth(#[from] evflow_nodes::synth::error::SynthError),
     /// An error in one step, with the step named.
     #[error("{what}: {error}")]
     At {

@@ -8,9 +8,9 @@
 use super::row::LiveRow;
 use super::run::{LiveConfig, LiveStudy};
 use super::scope::LiveScope;
-use crate::synth::study::saved::SavedFailure;
-use crate::synth::study::shard_file;
-use crate::synth::study::StudyError;
+use crate::saved::SavedFailure;
+use crate::shard_file;
+use crate::StudyError;
 use evflow_engine::batch::Shard;
 use serde::{Deserialize, Serialize};
 use std::path::Path;
@@ -34,7 +34,7 @@ pub struct LiveRecord {
     /// Every step that failed, in order.
     pub failures: Vec<SavedFailure>,
     /// The shard's wall-clock time, s.
-    #[serde(with = "crate::synth::study::exact")]
+    #[serde(with = "crate::exact")]
     pub seconds: f64,
 }
 
@@ -103,8 +103,8 @@ impl LiveRecord {
 mod tests {
     use super::super::row::{Chain, ChainResult, StrokeFloor};
     use super::*;
-    use crate::synth::study::gains::{AtGain, Chosen};
-    use crate::synth::study::row::Reading;
+    use crate::gains::{AtGain, Chosen};
+    use crate::row::Reading;
     use std::path::PathBuf;
 
     fn row(k: usize) -> LiveRow {

@@ -33,8 +33,8 @@ use super::recordings::record_pair;
 use super::row::{self, Method, RowInputs};
 use super::setup::{Cond, Profile};
 use super::StudyError;
-use crate::narx::model::Model;
 use evflow_engine::batch::{for_each_ordered, Shard};
+use evflow_nodes::narx::model::Model;
 use std::ops::Range;
 use std::path::{Path, PathBuf};
 
@@ -188,7 +188,7 @@ impl NarxConfig {
             return bad("samples: at least one".into());
         }
         for (i, s) in self.samples.iter().enumerate() {
-            crate::lab::texture::samples::lookup(s).map_err(|e| StudyError::Config(format!("samples: {e}")))?;
+            evflow_nodes::lab::texture::samples::lookup(s).map_err(|e| StudyError::Config(format!("samples: {e}")))?;
             if self.samples[..i].contains(s) {
                 return bad(format!("samples: `{s}` is given twice"));
             }

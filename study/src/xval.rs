@@ -121,7 +121,7 @@ pub fn run(i: &XvalInputs<'_>) -> Result<Scores, StudyError> {
 /// `narx::nearest`, as `narx.grid` chooses live).
 pub fn nearest(c: &Cond, trained: &[Cond]) -> usize {
     let grid: Vec<(f64, f64)> = trained.iter().map(|t| (t.mass, t.speed)).collect();
-    crate::narx::nearest::nearest(&grid, c.mass, c.speed).unwrap_or(0)
+    evflow_nodes::narx::nearest::nearest(&grid, c.mass, c.speed).unwrap_or(0)
 }
 
 #[cfg(test)]

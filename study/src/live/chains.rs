@@ -5,11 +5,11 @@
 
 use super::play::Stage;
 use super::row::{Chain, ChainResult};
-use crate::recording::format::Recording;
-use crate::synth::study::gains::{choose, AtGain};
-use crate::synth::study::graphs::{path, run_graph_for, text, value};
-use crate::synth::study::row::Reading;
-use crate::synth::study::StudyError;
+use crate::gains::{choose, AtGain};
+use crate::graphs::{path, run_graph_for, text, value};
+use crate::row::Reading;
+use crate::StudyError;
+use evflow_nodes::recording::format::Recording;
 use std::path::Path;
 
 /// The quality graph's file name.

@@ -5,10 +5,10 @@
 //! the stroke's floor, which optimizes through the display knowing them.
 
 use super::scope::User;
-use crate::lab::texture::{samples, TextureScan};
-use crate::lab::user::finger::{Finger, FingerSettings};
-use crate::synth::output_filter::OutputFilter;
-use crate::synth::study::StudyError;
+use crate::StudyError;
+use evflow_nodes::lab::texture::{samples, TextureScan};
+use evflow_nodes::lab::user::finger::{Finger, FingerSettings};
+use evflow_nodes::synth::output_filter::OutputFilter;
 
 /// A user's strokes over a sample.
 #[derive(Debug, Clone, PartialEq)]
@@ -88,8 +88,8 @@ impl Stroke {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::recording::format::Recording;
-    use crate::synth::study::graphs::run_graph;
+    use crate::graphs::run_graph;
+    use evflow_nodes::recording::format::Recording;
 
     #[test]
     fn the_stroke_is_what_the_graphs_user_and_sample_give_sample_for_sample() {

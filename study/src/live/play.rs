@@ -5,12 +5,12 @@
 
 use super::scope::{LiveScope, User};
 use super::stroke::Stroke;
-use crate::recording::format::{Channel, RecordingMeta, RecordingWriter};
-use crate::synth::study::gains::AtGain;
-use crate::synth::study::graphs::{path, run_graph_for, text, value};
-use crate::synth::study::row::Reading;
-use crate::synth::study::setup::Profile;
-use crate::synth::study::StudyError;
+use crate::gains::AtGain;
+use crate::graphs::{path, run_graph_for, text, value};
+use crate::row::Reading;
+use crate::setup::Profile;
+use crate::StudyError;
+use evflow_nodes::recording::format::{Channel, RecordingMeta, RecordingWriter};
 use std::path::{Path, PathBuf};
 
 /// The play graph's file name.
@@ -21,7 +21,10 @@ pub const GRAPH: &str = "texture-live-play.toml";
 pub fn write(file: &Path, rate: f64, u: &[f64], add: &[f64], source: &str) -> Result<PathBuf, StudyError> {
     let mut meta = RecordingMeta::new(rate, vec![Channel::new("u", "1"), Channel::new("add", "N")]);
     meta.source = source.into();
-    let io = |e: crate::recording::format::RecordingError| StudyError::Io { path: file.into(), message: e.to_string() };
+    let io = |e: evflow_nodes::recording::format::RecordingError| StudyError::Io {
+        path: file.into(),
+        message: e.to_string(),
+    };
     let mut w = RecordingWriter::create(file, meta).map_err(io)?;
     let frames: Vec<f64> = u.iter().zip(add).flat_map(|(a, b)| [*a, *b]).collect();
     w.write_interleaved(&frames).map_err(io)?;

@@ -3,8 +3,8 @@
 //! (rectangular segments of one second, 1 Hz bins, magnitudes averaged).
 
 use super::StudyError;
-use crate::filters::segment::open_runs;
-use crate::metric::spectrum::{averaged_spectrum, SpectrumConfig, Window};
+use evflow_nodes::filters::segment::open_runs;
+use evflow_nodes::metric::spectrum::{averaged_spectrum, SpectrumConfig, Window};
 
 /// Magnitude spectrum of the samples of `x` where `gate` is open (> 0.5),
 /// at `rate` Hz: one bin per hertz.

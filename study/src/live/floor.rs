@@ -1,5 +1,5 @@
 //! The stroke's achievable floor: the actuation over a user's whole stroke
-//! optimized through the lab's twin of the display ([`crate::synth::study::twin`]:
+//! optimized through the lab's twin of the display ([`crate::twin`]:
 //! its equations with the noise off) knowing the finger's true path, load
 //! and the real force, within the range every method is played at
 //! (|u| ≤ 1, the `limit` of every chain). Each optimum is then played like
@@ -22,15 +22,15 @@
 //! seeded with, before the noise.
 
 use super::stroke::Stroke;
-use crate::lab::profile::LabProfile;
-use crate::metric::spectral_error::Band;
-use crate::metric::spectrum::{SpectrumConfig, Window};
-use crate::synth::lbfgsb::{minimize, Options};
-use crate::synth::output_filter::OutputFilter;
-use crate::synth::spectral::SpectralTarget;
-use crate::synth::start::carrier_scaled;
-use crate::synth::study::twin::{DisplayTwin, Tape};
-use crate::synth::study::StudyError;
+use crate::twin::{DisplayTwin, Tape};
+use crate::StudyError;
+use evflow_nodes::lab::profile::LabProfile;
+use evflow_nodes::metric::spectral_error::Band;
+use evflow_nodes::metric::spectrum::{SpectrumConfig, Window};
+use evflow_nodes::synth::lbfgsb::{minimize, Options};
+use evflow_nodes::synth::output_filter::OutputFilter;
+use evflow_nodes::synth::spectral::SpectralTarget;
+use evflow_nodes::synth::start::carrier_scaled;
 
 /// The carrier starts' offsets, relative to the least that keeps the
 /// envelope real.
@@ -173,7 +173,7 @@ pub fn optimize(
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::synth::study::live::scope::User;
+    use crate::live::scope::User;
 
     #[test]
     fn sliding_only_clears_the_reversals_and_keeps_the_strokes() {

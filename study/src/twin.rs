@@ -1,7 +1,7 @@
 //! Differentiable twins of the simulated display and force sensor: the same
 //! equations, the same exact maps and the same arithmetic as
-//! [`crate::lab::display_model::DisplayModel`] and
-//! [`crate::lab::sensor_model::SensorModel`] with their noise off, run
+//! [`evflow_nodes::lab::display_model::DisplayModel`] and
+//! [`evflow_nodes::lab::sensor_model::SensorModel`] with their noise off, run
 //! forward while recording a tape, then backward (reverse mode) to give the
 //! gradient of any function of the output force with respect to every
 //! actuation sample. The achievable floor ([`super::floor`]) optimizes
@@ -22,9 +22,9 @@
 //! rounding as the identity, off by at most half a converter step). The tests check the twin against the lab's models sample by
 //! sample and the gradient against central differences.
 
-use crate::lab::electrical::{self, Circuit};
-use crate::lab::expm::zoh;
-use crate::lab::profile::LabProfile;
+use evflow_nodes::lab::electrical::{self, Circuit};
+use evflow_nodes::lab::expm::zoh;
+use evflow_nodes::lab::profile::LabProfile;
 
 /// States of the circuit with its relaxation state.
 const NE: usize = electrical::NR;
@@ -346,9 +346,9 @@ impl SensorTwin {
         for n in 0..f.len() {
             let fi = if f[n].is_finite() { f[n] } else { 0.0 };
             let v = if velocity[n].is_finite() { velocity[n] } else { 0.0 };
-            if v > crate::lab::sensor_model::V_DIR {
+            if v > evflow_nodes::lab::sensor_model::V_DIR {
                 dir = 1;
-            } else if v < -crate::lab::sensor_model::V_DIR {
+            } else if v < -evflow_nodes::lab::sensor_model::V_DIR {
                 dir = -1;
             }
             let target = match dir {
@@ -392,10 +392,10 @@ impl SensorTwin {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::lab::display_model::DisplayModel;
-    use crate::lab::integrator::Method;
-    use crate::lab::sensor_model::SensorModel;
-    use crate::lab::tribometer_model::TribometerModel;
+    use evflow_nodes::lab::display_model::DisplayModel;
+    use evflow_nodes::lab::integrator::Method;
+    use evflow_nodes::lab::sensor_model::SensorModel;
+    use evflow_nodes::lab::tribometer_model::TribometerModel;
 
     /// Every profile shipped in graphs/lab (new ones included as they come).
     fn shipped() -> Vec<(String, LabProfile)> {
@@ -422,7 +422,7 @@ mod tests {
     }
 
     fn actuation(n: usize) -> Vec<f64> {
-        let mut r = crate::rng::Rng::new(4);
+        let mut r = evflow_nodes::rng::Rng::new(4);
         (0..n).map(|k| if k % 2 == 0 { 0.6 } else { -0.6 } * (1.0 + 0.4 * (2.0 * r.uniform() - 1.0))).collect()
     }
 
@@ -460,7 +460,7 @@ mod tests {
             let (load, vel) = (&load[..n], &vel[..n]);
             let u = actuation(n);
             let twin = DisplayTwin::new(&profile, 1000.0, 4).unwrap();
-            let mut r = crate::rng::Rng::new(8);
+            let mut r = evflow_nodes::rng::Rng::new(8);
             let fbar: Vec<f64> = (0..n).map(|_| r.gaussian()).collect();
             let mut tape = Tape::default();
             twin.forward(&u, load, vel, &mut tape);
@@ -485,7 +485,7 @@ mod tests {
     fn the_sensor_adjoint_satisfies_the_inner_product_identity() {
         let profile = LabProfile::default();
         let s = SensorTwin::new(&profile, 1000.0, 4).unwrap();
-        let mut r = crate::rng::Rng::new(2);
+        let mut r = evflow_nodes::rng::Rng::new(2);
         let n = 500;
         let f: Vec<f64> = (0..n).map(|_| 0.01 * r.gaussian()).collect();
         let ybar: Vec<f64> = (0..n).map(|_| r.gaussian()).collect();

@@ -6,8 +6,8 @@
 use super::recordings::{channel, gate};
 use super::setup::Cond;
 use super::StudyError;
-use crate::filters::segment::open_runs;
-use crate::recording::format::{Channel, RecordingMeta, RecordingWriter};
+use evflow_nodes::filters::segment::open_runs;
+use evflow_nodes::recording::format::{Channel, RecordingMeta, RecordingWriter};
 use std::path::{Path, PathBuf};
 
 /// The file name of the cell of `sample` at `c` in a grid folder.
@@ -83,8 +83,10 @@ fn write(
     }
     meta.source = source;
     let path = grid.join(name(sample, c));
-    let io =
-        |e: crate::recording::format::RecordingError| StudyError::Io { path: path.clone(), message: e.to_string() };
+    let io = |e: evflow_nodes::recording::format::RecordingError| StudyError::Io {
+        path: path.clone(),
+        message: e.to_string(),
+    };
     let mut w = RecordingWriter::create(&path, meta).map_err(io)?;
     w.write_interleaved(kept).map_err(io)?;
     w.finish().map_err(io)?;
@@ -94,7 +96,7 @@ fn write(
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::recording::format::Recording;
+    use evflow_nodes::recording::format::Recording;
 
     #[test]
     fn an_actuation_cell_keeps_the_steady_stretch_and_names_its_condition() {

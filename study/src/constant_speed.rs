@@ -5,7 +5,7 @@
 //! and out over 50 ms so that the joins add no steps, concatenated.
 
 use super::StudyError;
-use crate::recording::format::Recording;
+use evflow_nodes::recording::format::Recording;
 use std::path::Path;
 
 /// The constant-speed segments of `force` (the module's rule), `velocity` in m/s.

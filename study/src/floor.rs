@@ -21,16 +21,16 @@ use super::recordings::{self, channel};
 use super::row::{Achievable, Reading, RowInputs};
 use super::twin::{DisplayTwin, SensorTwin, Tape};
 use super::StudyError;
-use crate::lab::integrator::Method;
-use crate::lab::profile::LabProfile;
-use crate::lab::tribometer_model::TribometerModel;
-use crate::metric::spectral_error::Band;
-use crate::metric::spectrum::{SpectrumConfig, Window};
-use crate::recording::format::{Channel, RecordingMeta, RecordingWriter};
-use crate::synth::lbfgsb::{minimize, Options};
-use crate::synth::output_filter::OutputFilter;
-use crate::synth::spectral::SpectralTarget;
-use crate::synth::start::carrier_scaled;
+use evflow_nodes::lab::integrator::Method;
+use evflow_nodes::lab::profile::LabProfile;
+use evflow_nodes::lab::tribometer_model::TribometerModel;
+use evflow_nodes::metric::spectral_error::Band;
+use evflow_nodes::metric::spectrum::{SpectrumConfig, Window};
+use evflow_nodes::recording::format::{Channel, RecordingMeta, RecordingWriter};
+use evflow_nodes::synth::lbfgsb::{minimize, Options};
+use evflow_nodes::synth::output_filter::OutputFilter;
+use evflow_nodes::synth::spectral::SpectralTarget;
+use evflow_nodes::synth::start::carrier_scaled;
 use std::time::Instant;
 
 /// Iterations per start.

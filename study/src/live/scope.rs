@@ -3,7 +3,7 @@
 //! settings of the live synthesis — one serializable scope, used by the
 //! study's config, its shard record and its merge.
 
-use crate::synth::study::exact;
+use crate::exact;
 use serde::{Deserialize, Serialize};
 
 /// A virtual user: the strokes `sim.user` makes with this seed and these ranges.

@@ -6,8 +6,8 @@
 use super::graphs::{run_graph, text};
 use super::setup::{Cond, Profile};
 use super::StudyError;
-use crate::filters::segment::SpeedRule;
-use crate::recording::format::Recording;
+use evflow_nodes::filters::segment::SpeedRule;
+use evflow_nodes::recording::format::Recording;
 use std::path::{Path, PathBuf};
 
 /// The recording `graphs/record-textures.toml` writes for `sample` at `c`, repetition `rep`.

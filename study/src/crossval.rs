@@ -26,10 +26,10 @@ use super::row::{self, Method, Row, RowInputs};
 use super::setup::{Cond, Profile};
 use super::xval::{self, Grids, Scores, XvalInputs};
 use super::StudyError;
-use crate::metric::spectrum::{averaged_spectrum, SpectrumConfig, Window};
-use crate::recording::format::Recording;
-use crate::texture::freqvel::main_frequency;
-use crate::texture::kernel::INTERP_CUTOFF;
+use evflow_nodes::metric::spectrum::{averaged_spectrum, SpectrumConfig, Window};
+use evflow_nodes::recording::format::Recording;
+use evflow_nodes::texture::freqvel::main_frequency;
+use evflow_nodes::texture::kernel::INTERP_CUTOFF;
 use std::path::{Path, PathBuf};
 
 /// The channel of graphs/synthesize.toml's recording that holds a method's

@@ -20,6 +20,9 @@
 //! cells of the live texture grids are cut from its runs ([`cells`]).
 #![deny(missing_docs)]
 
+pub mod figure;
+pub mod tables;
+
 #[cfg(feature = "synth")]
 pub mod cells;
 #[cfg(feature = "synth")]

@@ -8,9 +8,9 @@
 
 use super::error::MergeError;
 use super::files::{copy_files, one_batch, write};
-use crate::report::live_table::{csv, figures, markdown};
 use evflow_engine::batch::{Failures, Shard};
 use evflow_study::live::saved::{LiveRecord, RECORD};
+use evflow_study::tables::live::{csv, figures, markdown};
 use evflow_study::StudyError;
 use std::path::{Path, PathBuf};
 

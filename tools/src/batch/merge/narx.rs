@@ -8,9 +8,9 @@ use super::error::MergeError;
 use super::files::{copy_files, k_order, write};
 use crate::batch::narx_shard::{NarxRecord, NARX_RECORD};
 use crate::plot::{write_png, PlotError, Written};
-use crate::report::narx_table::{figure, markdown, Table};
 use evflow_engine::batch::Failures;
 use evflow_study::narx_settings::{aggregate, item_label};
+use evflow_study::tables::narx::{figure, markdown, Table};
 use std::path::{Path, PathBuf};
 
 /// The name of the table in the output folder.

@@ -9,9 +9,9 @@
 
 use super::error::MergeError;
 use super::files::{copy_files, one_batch, write};
-use crate::report::textures_table::{csv, markdown, Timings};
 use evflow_engine::batch::{Failures, Shard};
 use evflow_study::saved::{SavedStudy, RECORD};
+use evflow_study::tables::textures::{csv, markdown, Timings};
 use evflow_study::StudyError;
 use std::path::{Path, PathBuf};
 

@@ -8,8 +8,8 @@ use evflow_nodes::lab::texture::samples;
 use evflow_study::live::run::{run, LiveConfig, Progress};
 use evflow_study::live::saved::{LiveRecord, RECORD};
 use evflow_study::live::scope::{LiveScope, LiveSettings, User};
+use evflow_study::tables::live::{csv, figures, markdown};
 use evflow_tools::batch::{progress_bar, BatchArgs};
-use evflow_tools::report::live_table::{csv, figures, markdown};
 use std::path::PathBuf;
 
 /// Arguments of `evflow report live`.

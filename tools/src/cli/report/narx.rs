@@ -1,7 +1,7 @@
 //! `evflow report narx`: error against run time of the inverse NARX model
 //! (issue 6, point 10). The study is library code
 //! (`evflow_study::narx_settings`, its table
-//! `evflow_tools::report::narx_table`); this parses, calls, prints and writes narx.md
+//! `evflow_study::tables::narx`); this parses, calls, prints and writes narx.md
 //! and the figure, or, with `--shard K/N`, the shard's record for `evflow
 //! merge` (`evflow_tools::batch::narx_shard`).
 
@@ -10,10 +10,10 @@ use evflow_engine::batch::Failures;
 use evflow_nodes::lab::texture::samples::NAMES;
 use evflow_study::narx_settings::{self, NarxConfig, Setting, DEFAULT_SETTINGS};
 use evflow_study::setup::Cond;
+use evflow_study::tables::narx::{figure, markdown, Table};
 use evflow_tools::batch::merge::narx::{NARX_FIGURE, NARX_TABLE};
 use evflow_tools::batch::narx_shard::{NarxArguments, NarxRecord, NARX_RECORD};
 use evflow_tools::batch::{progress_bar, BatchArgs};
-use evflow_tools::report::narx_table::{figure, markdown, Table};
 use std::path::PathBuf;
 
 /// Arguments of `evflow report narx`.

@@ -13,10 +13,10 @@ use evflow_study::run::{run_on, Progress, StudyConfig};
 use evflow_study::saved::{SavedStudy, RECORD};
 use evflow_study::setup::{Cond, Profile};
 use evflow_study::spectrum::gated;
+use evflow_study::tables::textures::Timings;
+use evflow_study::tables::textures::{csv, markdown};
 use evflow_tools::batch::{progress_bar, BatchArgs};
 use evflow_tools::plot::{Plot, Series};
-use evflow_tools::report::textures_table::Timings;
-use evflow_tools::report::textures_table::{csv, markdown};
 use std::path::PathBuf;
 
 /// Arguments of `evflow report textures`.

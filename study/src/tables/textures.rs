@@ -4,14 +4,14 @@
 //! [`Timings::Leave`] (`--no-times`) no time is written, so that both are
 //! byte for byte the same.
 
+use crate::row::{Method, Row};
+use crate::run::{Study, StudyConfig};
+use crate::summary::{es, standing, Basis};
 use evflow_nodes::lab::texture::samples::NAMES;
 use evflow_nodes::narx::model::Model;
 use evflow_nodes::synth::model_file::ForwardModel;
-use evflow_study::row::{Method, Row};
-use evflow_study::run::{Study, StudyConfig};
-use evflow_study::summary::{es, standing, Basis};
 
-pub use crate::batch::tables::Timings;
+pub use super::Timings;
 use std::fmt::Write as _;
 
 /// The basis of the headline figures.

@@ -4,9 +4,9 @@
 //! merge`, so both write the same bytes; and the report's figure
 //! ([`figure`]).
 
-use crate::plot::{Plot, Series};
-use evflow_study::narx_settings::{pareto, Scored};
-use evflow_study::setup::Cond;
+use crate::figure::{Plot, Series};
+use crate::narx_settings::{pareto, Scored};
+use crate::setup::Cond;
 use std::fmt::Write as _;
 
 /// What the table shows.
@@ -98,7 +98,7 @@ pub fn figure(condition: &Cond, scored: &[Scored]) -> Plot {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use evflow_study::narx_settings::{aggregate, Item, SeedScore, Setting};
+    use crate::narx_settings::{aggregate, Item, SeedScore, Setting};
 
     fn table(times: bool) -> String {
         let settings: Vec<Setting> = ["default=5/1/10/lm", "slow=3/1/5/adam", "broken=5/1/1000/lm"]

@@ -2,10 +2,10 @@
 //! everything else, from a live study or from the shards `evflow merge`
 //! joins (the same code, so a merge writes what one run writes).
 
-use evflow_study::gains::AtGain;
-use evflow_study::live::row::{Chain, LiveRow};
-use evflow_study::live::run::LiveStudy;
-use evflow_study::live::scope::LiveScope;
+use crate::gains::AtGain;
+use crate::live::row::{Chain, LiveRow};
+use crate::live::run::LiveStudy;
+use crate::live::scope::LiveScope;
 use std::fmt::Write as _;
 
 /// The factor of the stroke's floor the best chain is held to (issue 24, point 5).
@@ -246,8 +246,8 @@ pub fn csv(study: &LiveStudy) -> String {
 /// One figure per profile: E_s (Welch, mean over the users) of nothing,
 /// every chain at its best gain and the stroke's floor, sample by sample
 /// (x = the sample's number in the scope, 1 …).
-pub fn figures(study: &LiveStudy, scope: &LiveScope) -> Vec<(String, crate::plot::Plot)> {
-    use crate::plot::{Plot, Series};
+pub fn figures(study: &LiveStudy, scope: &LiveScope) -> Vec<(String, crate::figure::Plot)> {
+    use crate::figure::{Plot, Series};
     let mut out = Vec::new();
     for p in &scope.profiles {
         let cells: Vec<(f64, Cell)> = scope

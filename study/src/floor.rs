@@ -16,7 +16,7 @@
 //! the optimized synthesis' own actuation.
 
 use super::gains::{AtGain, Chosen};
-use super::graphs::{path, run_graph, text, value};
+use super::graphs::{run_graph, value, Sets};
 use super::recordings::{self, channel};
 use super::row::{Achievable, Reading, RowInputs};
 use super::twin::{DisplayTwin, SensorTwin, Tape};
@@ -158,16 +158,14 @@ pub fn achievable(i: &RowInputs<'_>) -> Result<Achievable, StudyError> {
         write_actuation(&file, rate, u, i.sample, &c)?;
         let mut sweep = Vec::new();
         for &gain in i.gains {
-            let sets = vec![
-                format!("recordings={}", path(i.recordings)),
-                format!("sample={}", text(i.sample)),
-                format!("mass={}", c.mass),
-                format!("speed={}", c.speed),
-                format!("actuation={}", path(&file)),
-                format!("gain={gain}"),
-                i.profile.set(),
-                format!("record.path={}", text(&format!("floor-played{k}"))),
-            ];
+            let sets = Sets::new()
+                .path("recordings", i.recordings)
+                .text("sample", i.sample)
+                .and(c.sets())
+                .path("actuation", &file)
+                .num("gain", gain)
+                .and(i.profile.sets())
+                .text("record.path", &format!("floor-played{k}"));
             let r = run_graph(&graph, &sets, &i.dir)?;
             sweep.push(AtGain {
                 gain,

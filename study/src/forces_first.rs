@@ -7,7 +7,7 @@
 //! display at the untrained condition (`graphs/play-actuation.toml`),
 //! scored against the real recording there.
 
-use super::graphs::{path, run_graph, text, value};
+use super::graphs::{run_graph, value, Sets};
 use super::setup::{Cond, Profile};
 use super::StudyError;
 use std::path::{Path, PathBuf};
@@ -61,33 +61,29 @@ pub struct FfScore {
 pub fn optimized(i: &FfInputs<'_>) -> Result<FfScore, StudyError> {
     let c = i.cond;
     let graph = i.graphs.join("synthesize-optimized.toml");
-    let sets = vec![
-        format!("sample={}", text(i.sample)),
-        format!("mass={}", c.mass),
-        format!("speed={}", c.speed),
-        format!("forward={}", path(i.forward)),
-        format!("narx_model={}", path(i.narx)),
-        format!("iterations={}", i.iterations),
-        format!("objective={}", text(i.objective)),
-        format!("opt.target={}", path(i.interpolated)),
-        "opt.channel=\"ff_in\"".to_string(),
-        "record_time=true".to_string(),
-    ];
+    let sets = Sets::new()
+        .text("sample", i.sample)
+        .and(c.sets())
+        .path("forward", i.forward)
+        .path("narx_model", i.narx)
+        .int("iterations", i.iterations as i64)
+        .text("objective", i.objective)
+        .path("opt.target", i.interpolated)
+        .text("opt.channel", "ff_in")
+        .flag("record_time", true);
     let r = run_graph(&graph, &sets, &i.dir)?;
     let seconds = value(&r, &graph, "opt", "seconds")?;
     let actuation = i.dir.join(format!("u-{}-{}", i.sample, c.tag()));
     let play = i.graphs.join("play-actuation.toml");
-    let mut sets = vec![
-        format!("recordings={}", path(i.recordings)),
-        format!("sample={}", text(i.sample)),
-        format!("mass={}", c.mass),
-        format!("speed={}", c.speed),
-        format!("actuation={}", path(&actuation)),
-        format!("gain={}", i.gain),
-        i.profile.set(),
-    ];
-    sets.push(format!("es.fmin={}", i.band[0]));
-    sets.push(format!("es.fmax={}", i.band[1]));
+    let sets = Sets::new()
+        .path("recordings", i.recordings)
+        .text("sample", i.sample)
+        .and(c.sets())
+        .path("actuation", &actuation)
+        .num("gain", i.gain)
+        .and(i.profile.sets())
+        .num("es.fmin", i.band[0])
+        .num("es.fmax", i.band[1]);
     let played = run_graph(&play, &sets, &i.dir.join("played"))?;
     Ok(FfScore {
         es: value(&played, &play, "es", "E_s")?,

@@ -4,7 +4,7 @@
 //! a 5-level MLS, §5.4/§7.2), and the forward model
 //! (`graphs/forward-build.toml`).
 
-use super::graphs::run_graph;
+use super::graphs::{run_graph, Sets};
 use super::setup::{Cond, Profile};
 use super::StudyError;
 use std::path::{Path, PathBuf};
@@ -36,32 +36,25 @@ pub fn build(
     record_time: bool,
     dir: &Path,
 ) -> Result<Models, StudyError> {
-    let common = vec![format!("mass={}", c.mass), format!("speed={}", c.speed), profile.set()];
-    let narx_sets = |extra: &[&str]| {
-        let mut s = common.clone();
-        s.push(format!("epochs={epochs}"));
-        s.push("train.progress=false".into());
-        s.push(format!("train.record_time={record_time}"));
-        s.extend(extra.iter().map(|e| e.to_string()));
-        s
-    };
+    let common = c.sets().and(profile.sets());
+    let narx_sets =
+        common.clone().int("epochs", epochs).flag("train.progress", false).flag("train.record_time", record_time);
     let t = std::time::Instant::now();
-    run_graph(&graphs.join("model-build.toml"), &narx_sets(&[]), dir)?;
+    run_graph(&graphs.join("model-build.toml"), &narx_sets, dir)?;
     let narx_s = t.elapsed().as_secs_f64();
     let narx = found(dir.join(format!("narx-{}.json", c.tag())))?;
     let mut ml_s = 0.0;
     let narx_multilevel = if multilevel {
         let ml_dir = dir.join("multilevel");
         let t = std::time::Instant::now();
-        run_graph(&graphs.join("model-build-multilevel.toml"), &narx_sets(&[]), &ml_dir)?;
+        run_graph(&graphs.join("model-build-multilevel.toml"), &narx_sets, &ml_dir)?;
         ml_s = t.elapsed().as_secs_f64();
         Some(found(ml_dir.join(format!("narx-{}.json", c.tag())))?)
     } else {
         None
     };
     let t = std::time::Instant::now();
-    let mut forward_sets = common.clone();
-    forward_sets.push(format!("record_time={record_time}"));
+    let forward_sets = common.flag("record_time", record_time);
     run_graph(&graphs.join("forward-build.toml"), &forward_sets, dir)?;
     let forward = found(dir.join(format!("forward-{}.json", c.tag())))?;
     Ok(Models { narx, narx_multilevel, forward, seconds: [narx_s, ml_s, t.elapsed().as_secs_f64()] })
@@ -69,25 +62,23 @@ pub fn build(
 
 /// Trains the inverse NARX model of `c` on `profile` alone
 /// (graphs/model-build.toml, binary excitation) into `dir`, with `extra`
-/// overrides (`--set` style, e.g. another network: `train.hidden=[5]`);
+/// values set after the study's own (e.g. another network: `train.hidden`);
 /// returns the model file.
 pub fn inverse(
     graphs: &Path,
     profile: &Profile,
     c: &Cond,
     epochs: u32,
-    extra: &[String],
+    extra: &Sets,
     dir: &Path,
 ) -> Result<PathBuf, StudyError> {
-    let mut sets = vec![
-        format!("mass={}", c.mass),
-        format!("speed={}", c.speed),
-        profile.set(),
-        format!("epochs={epochs}"),
-        "train.progress=false".to_string(),
-        "train.record_time=true".to_string(),
-    ];
-    sets.extend(extra.iter().cloned());
+    let sets = c
+        .sets()
+        .and(profile.sets())
+        .int("epochs", epochs)
+        .flag("train.progress", false)
+        .flag("train.record_time", true)
+        .and(extra.clone());
     run_graph(&graphs.join("model-build.toml"), &sets, dir)?;
     found(dir.join(format!("narx-{}.json", c.tag())))
 }

@@ -28,6 +28,7 @@
 //! left out of every setting's scores; every failure is listed with its
 //! reason ([`NarxStudy::failures`]).
 
+use super::graphs::Sets;
 use super::models::{self, Models};
 use super::recordings::record_pair;
 use super::row::{self, Method, RowInputs};
@@ -107,15 +108,14 @@ impl Setting {
         format!("{}={}/{}/{}/{}", self.name, h.join("-"), self.feedback, self.input, self.algorithm)
     }
 
-    /// The `--set` overrides of graphs/model-build.toml that select it.
-    pub fn overrides(&self) -> Vec<String> {
-        let hidden: Vec<String> = self.hidden.iter().map(|h| h.to_string()).collect();
-        vec![
-            format!("train.hidden=[{}]", hidden.join(", ")),
-            format!("train.feedback={}", self.feedback),
-            format!("train.input={}", self.input),
-            format!("train.algorithm=\"{}\"", self.algorithm),
-        ]
+    /// The values of graphs/model-build.toml that select it.
+    pub fn overrides(&self) -> Sets {
+        let hidden: Vec<f64> = self.hidden.iter().map(|&h| h as f64).collect();
+        Sets::new()
+            .nums("train.hidden", &hidden)
+            .int("train.feedback", self.feedback as i64)
+            .int("train.input", self.input as i64)
+            .text("train.algorithm", &self.algorithm)
     }
 
     /// "15-10-5, k_y 1, k_x 10, LM".
@@ -381,10 +381,9 @@ pub fn run(cfg: &NarxConfig, progress: &mut dyn FnMut(&Item)) -> Result<NarxStud
     let one = |_: usize, (i, seed): (usize, u32)| -> Result<SeedScore, StudyError> {
         let st = &cfg.settings[i];
         let dir = cfg.out.join("models").join(&st.name).join(format!("seed-{seed}"));
-        let mut sets = st.overrides();
-        sets.push(format!("train.seed={seed}"));
+        let mut sets = st.overrides().int("train.seed", seed);
         if !cfg.record_time {
-            sets.push("train.record_time=false".into());
+            sets = sets.flag("train.record_time", false);
         }
         let path = models::inverse(&cfg.graphs, &profile, &cond, cfg.epochs, &sets, &dir)?;
         let model = Model::load(&path)?;
@@ -454,15 +453,17 @@ fn row_inputs<'a>(
 #[cfg(test)]
 mod tests {
     use super::*;
+    use evflow_engine::Value;
 
     #[test]
     fn settings_parse_into_model_build_overrides() {
         let s = Setting::parse("wide=30-20-10/2/15/adam").unwrap();
         assert_eq!((s.hidden.clone(), s.feedback, s.input, s.algorithm.as_str()), (vec![30, 20, 10], 2, 15, "adam"));
-        assert_eq!(
-            s.overrides(),
-            ["train.hidden=[30, 20, 10]", "train.feedback=2", "train.input=15", "train.algorithm=\"adam\""]
-        );
+        let o = s.overrides();
+        assert_eq!(o.get("train.hidden"), Some(&Value::FloatList(vec![30.0, 20.0, 10.0])));
+        assert_eq!(o.get("train.feedback"), Some(&Value::Int(2)));
+        assert_eq!(o.get("train.input"), Some(&Value::Int(15)));
+        assert_eq!(o.get("train.algorithm"), Some(&Value::Text("adam".into())));
         assert_eq!(Setting::parse(&s.spec()).unwrap(), s);
         for bad in
             ["x", "x=15/1/10", "x=15-0/1/10/lm", "x=15/a/10/lm", "x=15/1/10/sgd", "a/b=5/1/10/lm", "base=5/1/1/lm"]

@@ -3,7 +3,8 @@
 //! (`graphs/record-textures.toml`), and what record-and-playback needs
 //! from them.
 
-use super::graphs::{run_graph, text};
+use super::constant_speed;
+use super::graphs::{run_graph, Sets};
 use super::setup::{Cond, Profile};
 use super::StudyError;
 use evflow_nodes::filters::segment::SpeedRule;
@@ -15,21 +16,68 @@ pub fn name(sample: &str, c: &Cond, rep: u32) -> String {
     format!("{sample}-{}-r{rep}", c.tag())
 }
 
+/// One condition of `graphs/record-textures.toml`: what it records.
+#[derive(Debug, Clone, Copy)]
+pub struct Condition<'a> {
+    /// Texture sample.
+    pub sample: &'a str,
+    /// Stylus mass, g.
+    pub mass: f64,
+    /// Speed, cm/s.
+    pub speed: f64,
+    /// Tribometer passes.
+    pub passes: u32,
+    /// Repetition (the force sensor's seed).
+    pub rep: u32,
+}
+
+impl Condition<'_> {
+    /// The name graphs/record-textures.toml gives its recording.
+    pub fn name(&self) -> String {
+        format!("{}-{}g-{}cms-r{}", self.sample, self.mass, self.speed, self.rep)
+    }
+
+    /// The values that make graphs/record-textures.toml record it.
+    pub fn sets(&self) -> Sets {
+        Sets::new()
+            .text("sample", self.sample)
+            .num("mass", self.mass)
+            .num("speed", self.speed)
+            .int("passes", self.passes)
+            .int("rep", self.rep)
+    }
+}
+
 /// Records repetitions 1 and 2 of `sample` at `c` on `profile` into `dir`
 /// (one pass each; the force sensor's seed is the repetition).
 pub fn record_pair(graphs: &Path, profile: &Profile, sample: &str, c: &Cond, dir: &Path) -> Result<(), StudyError> {
     for rep in [1, 2] {
-        let sets = vec![
-            format!("sample={}", text(sample)),
-            format!("mass={}", c.mass),
-            format!("speed={}", c.speed),
-            "passes=1".to_string(),
-            format!("rep={rep}"),
-            profile.set(),
-        ];
-        run_graph(&graphs.join("record-textures.toml"), &sets, dir)?;
+        let at = Condition { sample, mass: c.mass, speed: c.speed, passes: 1, rep };
+        run_graph(&graphs.join("record-textures.toml"), &at.sets().and(profile.sets()), dir)?;
     }
     Ok(())
+}
+
+/// Records `c` with `graph` (graphs/record-textures.toml or a graph like
+/// it) on the nominal lab into a folder under `dir` and returns the rate
+/// and the constant-speed force ([`constant_speed::of_recording`]): what
+/// `report freqvel` and `report interp` record on the spot.
+pub fn record(graph: &Path, c: &Condition<'_>, dir: &Path) -> Result<(f64, Vec<f64>), StudyError> {
+    let out = dir.join(c.name());
+    run_graph(graph, &c.sets(), &out)?;
+    let rec = recording_in(&out)?;
+    constant_speed::of_recording(&rec, c.speed, &out)
+}
+
+/// The only recording a graph run wrote into `dir`.
+pub fn recording_in(dir: &Path) -> Result<Recording, StudyError> {
+    let io = |e: std::io::Error| StudyError::Io { path: dir.to_path_buf(), message: e.to_string() };
+    let wav = std::fs::read_dir(dir)
+        .map_err(io)?
+        .filter_map(|e| e.ok().map(|e| e.path()))
+        .find(|p| p.extension().is_some_and(|x| x == "wav"))
+        .ok_or_else(|| StudyError::Recording(format!("{}: the graph wrote no recording", dir.display())))?;
+    Recording::open(&wav).map_err(|e| StudyError::Recording(e.to_string()))
 }
 
 /// A recording's channel.

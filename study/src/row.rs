@@ -2,7 +2,7 @@
 //! every method synthesized and scored the same way.
 
 use super::gains::{choose, AtGain, Chosen};
-use super::graphs::{path, run_graph, text, value};
+use super::graphs::{run_graph, value, Sets};
 use super::models::Models;
 use super::recordings::{self, playback_range};
 use super::setup::{Cond, Profile};
@@ -195,21 +195,19 @@ pub fn run(i: &RowInputs<'_>) -> Result<Row, StudyError> {
     let graph = i.graphs.join("synthesize.toml");
     let mut runs = Vec::new();
     for &gain in i.gains {
-        let mut sets = vec![
-            format!("recordings={}", path(i.recordings)),
-            format!("sample={}", text(i.sample)),
-            format!("mass={}", c.mass),
-            format!("speed={}", c.speed),
-            format!("model={}", path(&i.models.narx)),
-            format!("optimized={}", path(&optimized)),
-            format!("gain={gain}"),
-            format!("playback_min={lo}"),
-            format!("playback_max={hi}"),
-            i.profile.set(),
-        ];
         // Without a multilevel model its chain plays the binary one (and is not reported).
         let ml = i.models.narx_multilevel.as_ref().unwrap_or(&i.models.narx);
-        sets.push(format!("model_ml={}", path(ml)));
+        let sets = Sets::new()
+            .path("recordings", i.recordings)
+            .text("sample", i.sample)
+            .and(c.sets())
+            .path("model", &i.models.narx)
+            .path("optimized", &optimized)
+            .num("gain", gain)
+            .num("playback_min", lo)
+            .num("playback_max", hi)
+            .and(i.profile.sets())
+            .path("model_ml", ml);
         runs.push((gain, run_graph(&graph, &sets, &i.dir)?));
     }
     let first = &runs[0].1;
@@ -263,17 +261,15 @@ pub fn optimize(i: &RowInputs<'_>) -> Result<(PathBuf, f64), StudyError> {
     let c = i.cond;
     std::fs::create_dir_all(&i.dir).map_err(|e| StudyError::Io { path: i.dir.clone(), message: e.to_string() })?;
     let graph = i.graphs.join("synthesize-optimized.toml");
-    let sets = vec![
-        format!("recordings={}", path(i.recordings)),
-        format!("sample={}", text(i.sample)),
-        format!("mass={}", c.mass),
-        format!("speed={}", c.speed),
-        format!("forward={}", path(&i.models.forward)),
-        format!("narx_model={}", path(&i.models.narx)),
-        format!("iterations={}", i.iterations),
-        format!("objective={}", text(i.objective)),
-        "record_time=true".to_string(),
-    ];
+    let sets = Sets::new()
+        .path("recordings", i.recordings)
+        .text("sample", i.sample)
+        .and(c.sets())
+        .path("forward", &i.models.forward)
+        .path("narx_model", &i.models.narx)
+        .int("iterations", i.iterations as i64)
+        .text("objective", i.objective)
+        .flag("record_time", true);
     let r = run_graph(&graph, &sets, &i.dir)?;
     Ok((i.dir.join(format!("u-{}-{}", i.sample, c.tag())), value(&r, &graph, "opt", "seconds")?))
 }

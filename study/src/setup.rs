@@ -28,6 +28,11 @@ impl Cond {
         Ok(Self { mass, speed })
     }
 
+    /// The shipped graphs' `mass` (g) and `speed` (cm/s).
+    pub fn sets(&self) -> super::graphs::Sets {
+        super::graphs::Sets::new().num("mass", self.mass).num("speed", self.speed)
+    }
+
     /// "60 g, 3 cm/s".
     pub fn label(&self) -> String {
         format!("{} g, {} cm/s", self.mass, self.speed)
@@ -82,10 +87,8 @@ impl Profile {
     }
 
     /// The `profile` value the shipped graphs take (empty for nominal).
-    pub fn set(&self) -> String {
-        format!(
-            "profile={}",
-            super::graphs::text(&self.path.as_ref().map(|p| p.display().to_string()).unwrap_or_default())
-        )
+    pub fn sets(&self) -> super::graphs::Sets {
+        let file = self.path.as_ref().map(|p| p.display().to_string()).unwrap_or_default();
+        super::graphs::Sets::new().text("profile", &file)
     }
 }

@@ -6,7 +6,7 @@
 //! and "forces first" (the recorded forces interpolated, then the inverse
 //! NARX model of the nearest trained condition).
 
-use super::graphs::{path, run_graph, text, value};
+use super::graphs::{run_graph, value, Sets};
 use super::setup::{Cond, Profile};
 use super::StudyError;
 use std::path::{Path, PathBuf};
@@ -84,24 +84,21 @@ pub fn recording(i: &XvalInputs<'_>) -> PathBuf {
 pub fn run(i: &XvalInputs<'_>) -> Result<Scores, StudyError> {
     let c = i.cond;
     let graph = i.graphs.join(GRAPH);
-    let mut sets = vec![
-        format!("recordings={}", path(i.recordings)),
-        format!("sample={}", text(i.sample)),
-        format!("mass={}", c.mass),
-        format!("speed={}", c.speed),
-        format!("grid={}", path(&i.grids.cells)),
-        format!("playback_grid={}", path(&i.grids.playback)),
-        format!("forces={}", path(&i.grids.forces)),
-        "force_scale=1.0".to_string(),
-        format!("scheme={}", text(i.scheme)),
-        format!("period={}", i.period),
-        format!("model={}", path(i.model)),
-        format!("ff_gain={}", i.ff_gain),
-        i.profile.set(),
-    ];
+    let mut sets = Sets::new()
+        .path("recordings", i.recordings)
+        .text("sample", i.sample)
+        .and(c.sets())
+        .path("grid", &i.grids.cells)
+        .path("playback_grid", &i.grids.playback)
+        .path("forces", &i.grids.forces)
+        .num("force_scale", 1.0)
+        .text("scheme", i.scheme)
+        .num("period", i.period)
+        .path("model", i.model)
+        .num("ff_gain", i.ff_gain)
+        .and(i.profile.sets());
     for node in ["narx_es", "playback_es", "repeat_es", "ff_es"] {
-        sets.push(format!("{node}.fmin={}", i.band[0]));
-        sets.push(format!("{node}.fmax={}", i.band[1]));
+        sets = sets.num(&format!("{node}.fmin"), i.band[0]).num(&format!("{node}.fmax"), i.band[1]);
     }
     let r = run_graph(&graph, &sets, &i.dir)?;
     let v = |node: &str, name: &str| value(&r, &graph, node, name);

@@ -6,7 +6,7 @@
 use super::play::Stage;
 use super::row::{Chain, ChainResult};
 use crate::gains::{choose, AtGain};
-use crate::graphs::{path, run_graph_for, text, value};
+use crate::graphs::{run_graph_for, value, Sets};
 use crate::row::Reading;
 use crate::StudyError;
 use evflow_nodes::recording::format::Recording;
@@ -34,17 +34,16 @@ pub fn run(at: &Stage<'_>, library: &Path) -> Result<ChainsRun, StudyError> {
     let record_gain = if scope.gains.contains(&1.0) { 1.0 } else { scope.gains[0] };
     let mut runs = Vec::new();
     for &gain in &scope.gains {
-        let mut sets = vec![
-            format!("library={}", path(library)),
-            format!("sample={}", text(sample)),
-            profile.set(),
-            format!("gain={gain:?}"),
-            format!("lookahead={}", scope.live.lookahead),
-            format!("iterations={}", scope.live.iterations),
-            format!("offset={:?}", scope.live.offset),
-            format!("record={}", text(&format!("actuations-g{gain:?}"))),
-        ];
-        sets.extend(user.sets());
+        let sets = Sets::new()
+            .path("library", library)
+            .text("sample", sample)
+            .and(profile.sets())
+            .num("gain", gain)
+            .int("lookahead", scope.live.lookahead as i64)
+            .int("iterations", scope.live.iterations as i64)
+            .num("offset", scope.live.offset)
+            .text("record", &format!("actuations-g{gain:?}"))
+            .and(user.sets());
         runs.push((gain, run_graph_for(&graph, &sets, dir, Some(scope.seconds))?));
     }
     let first = &runs[0].1;

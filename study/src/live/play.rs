@@ -6,7 +6,7 @@
 use super::scope::{LiveScope, User};
 use super::stroke::Stroke;
 use crate::gains::AtGain;
-use crate::graphs::{path, run_graph_for, text, value};
+use crate::graphs::{run_graph_for, value, Sets};
 use crate::row::Reading;
 use crate::setup::Profile;
 use crate::StudyError;
@@ -56,13 +56,12 @@ pub fn sweep(at: &Stage<'_>, file: &Path, gains: &[f64]) -> Result<Vec<AtGain>, 
     let graph = at.graphs.join(GRAPH);
     let mut out = Vec::new();
     for &gain in gains {
-        let mut sets = vec![
-            format!("sample={}", text(sample)),
-            format!("actuation={}", path(file)),
-            profile.set(),
-            format!("gain={gain:?}"),
-        ];
-        sets.extend(user.sets());
+        let sets = Sets::new()
+            .text("sample", sample)
+            .path("actuation", file)
+            .and(profile.sets())
+            .num("gain", gain)
+            .and(user.sets());
         let r = run_graph_for(&graph, &sets, dir, Some(scope.seconds))?;
         out.push(AtGain {
             gain,

@@ -36,17 +36,17 @@ impl User {
         ]
     }
 
-    /// The `--set` values of graphs/texture-live-quality.toml and
-    /// graphs/texture-live-play.toml for this user.
-    pub fn sets(&self) -> Vec<String> {
-        vec![
-            format!("user_seed={}", self.seed),
-            format!("speed_min={:?}", self.speed[0]),
-            format!("speed_max={:?}", self.speed[1]),
-            format!("mass_min={:?}", self.mass[0]),
-            format!("mass_max={:?}", self.mass[1]),
-            format!("travel={:?}", self.travel_cm * 1e-2),
-        ]
+    /// The values of graphs/texture-live-quality.toml and
+    /// graphs/texture-live-play.toml for this user (a seed past `i64::MAX`
+    /// becomes −1, which `sim.user` refuses by name).
+    pub fn sets(&self) -> crate::graphs::Sets {
+        crate::graphs::Sets::new()
+            .int("user_seed", i64::try_from(self.seed).unwrap_or(-1))
+            .num("speed_min", self.speed[0])
+            .num("speed_max", self.speed[1])
+            .num("mass_min", self.mass[0])
+            .num("mass_max", self.mass[1])
+            .num("travel", self.travel_cm * 1e-2)
     }
 
     /// Checks the ranges (within `sim.user`'s limits, low ≤ high).

@@ -58,6 +58,8 @@ pub mod run;
 #[cfg(feature = "synth")]
 pub mod saved;
 #[cfg(feature = "synth")]
+pub mod scope;
+#[cfg(feature = "synth")]
 pub mod setup;
 #[cfg(feature = "synth")]
 pub mod shard_file;

@@ -7,52 +7,50 @@
 use super::models::{self, Models};
 use super::recordings;
 use super::row::{self, Row, RowInputs};
+use super::scope::Scope;
 use super::setup::{Cond, Profile};
 use super::StudyError;
 use evflow_engine::batch::{for_each_ordered, Shard};
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 use std::sync::atomic::AtomicBool;
 use std::time::Instant;
 
-/// What a study covers and how.
+/// A texture study to run: its [`Scope`], the profiles it names resolved,
+/// where the graphs are and the work goes, and its slice.
 #[derive(Debug, Clone)]
 pub struct StudyConfig {
+    /// What it covers and how.
+    pub scope: Scope,
+    /// The scope's lab profiles, resolved ([`StudyConfig::new`]).
+    pub profiles: Vec<Profile>,
     /// The folder of the shipped graphs.
     pub graphs: PathBuf,
     /// Where models, recordings and runs go.
     pub work: PathBuf,
-    /// Lab profiles.
-    pub profiles: Vec<Profile>,
-    /// Texture samples.
-    pub samples: Vec<String>,
-    /// Trained conditions.
-    pub conds: Vec<Cond>,
-    /// The gain sweep.
-    pub gains: Vec<f64>,
-    /// NARX training epochs at most.
-    pub epochs: u32,
-    /// The optimized synthesis' iteration budget.
-    pub iterations: usize,
-    /// Also the inverse model on multilevel excitation.
-    pub multilevel: bool,
-    /// Also the achievable floor (optimization through the display itself).
-    pub floor: bool,
-    /// The optimized synthesis' objective (`synth.optimize`'s `objective`,
-    /// which takes the waveform where a pass keeps less than one spectral
-    /// segment).
-    pub objective: String,
     /// The slice of the (profile, condition) cells to run ([`Shard::ALL`]:
     /// every one); each cell's models and rows run in the slice that holds it.
     pub shard: Shard,
-    /// Write each model's training time into its file (`--no-times` does
-    /// not, so that the files are the same on every run).
-    pub record_time: bool,
 }
 
 impl StudyConfig {
+    /// The config of `scope` run from the shipped graphs in `graphs`, its
+    /// work under `work`: the scope's profiles resolved (a name, or a
+    /// profile file), its slice `shard`.
+    pub fn new(scope: Scope, graphs: PathBuf, work: PathBuf, shard: Shard) -> Result<Self, StudyError> {
+        let profiles = scope.profiles.iter().map(|p| Profile::resolve(p, &graphs)).collect::<Result<Vec<_>, _>>()?;
+        Ok(Self { scope, profiles, graphs, work, shard })
+    }
+
+    /// The config of a merged study's tables: profiles by name only (no
+    /// graph is run from it), `base` as graphs and work.
+    pub fn merged(scope: Scope, base: &Path, shard: Shard) -> Self {
+        let profiles = scope.profiles.iter().map(|n| Profile { name: n.clone(), path: None }).collect();
+        Self { scope, profiles, graphs: base.to_path_buf(), work: base.join("work"), shard }
+    }
+
     /// Every (profile, condition) cell, profile by profile, in study order.
     pub fn all_cells(&self) -> Vec<(&Profile, Cond)> {
-        self.profiles.iter().flat_map(|p| self.conds.iter().map(move |c| (p, *c))).collect()
+        self.profiles.iter().flat_map(|p| self.scope.conds.iter().map(move |c| (p, *c))).collect()
     }
 
     /// The cells of this config's shard.
@@ -113,7 +111,7 @@ pub fn run_on(cfg: &StudyConfig, jobs: usize, progress: &mut dyn FnMut(Progress<
             return Err(StudyError::Missing(cfg.graphs.join(g)));
         }
     }
-    if cfg.gains.is_empty() || cfg.gains.iter().any(|g| !(g.is_finite() && *g > 0.0)) {
+    if cfg.scope.gains.is_empty() || cfg.scope.gains.iter().any(|g| !(g.is_finite() && *g > 0.0)) {
         return Err(StudyError::Config("the gains must be positive numbers, at least one".into()));
     }
     let never = AtomicBool::new(false);
@@ -124,7 +122,7 @@ pub fn run_on(cfg: &StudyConfig, jobs: usize, progress: &mut dyn FnMut(Progress<
     let mut built: Vec<Option<Models>> = Vec::with_capacity(cells.len());
     let build = |_: usize, (profile, c): (&Profile, Cond)| {
         let dir = cfg.work.join(&profile.name).join("models");
-        models::build(&cfg.graphs, profile, &c, cfg.epochs, cfg.multilevel, cfg.record_time, &dir)
+        models::build(&cfg.graphs, profile, &c, cfg.scope.epochs, cfg.scope.multilevel, cfg.scope.times, &dir)
     };
     for_each_ordered(cells.clone(), jobs, &never, build, |k, outcome| {
         let (profile, c) = cells[k];
@@ -132,7 +130,7 @@ pub fn run_on(cfg: &StudyConfig, jobs: usize, progress: &mut dyn FnMut(Progress<
         match outcome.map_err(StudyError::Config).and_then(|r| r) {
             Ok(m) => built.push(Some(m)),
             Err(e) => {
-                let why = format!("{e} (its {} rows were not run)", cfg.samples.len());
+                let why = format!("{e} (its {} rows were not run)", cfg.scope.samples.len());
                 failures.push((format!("{}: models at {}", profile.name, c.label()), why));
                 built.push(None);
             }
@@ -140,10 +138,10 @@ pub fn run_on(cfg: &StudyConfig, jobs: usize, progress: &mut dyn FnMut(Progress<
     });
 
     // Every row whose models were built.
-    let total = cells.len() * cfg.samples.len();
+    let total = cells.len() * cfg.scope.samples.len();
     let rows_to_run: Vec<(usize, &str)> = (0..cells.len())
         .filter(|k| built[*k].is_some())
-        .flat_map(|k| cfg.samples.iter().map(move |s| (k, s.as_str())))
+        .flat_map(|k| cfg.scope.samples.iter().map(move |s| (k, s.as_str())))
         .collect();
     let one_row = |_: usize, (k, sample): (usize, &str)| -> Result<Row, StudyError> {
         let (profile, c) = cells[k];
@@ -158,14 +156,14 @@ pub fn run_on(cfg: &StudyConfig, jobs: usize, progress: &mut dyn FnMut(Progress<
             cond: c,
             models: m,
             recordings: &rec_dir,
-            gains: &cfg.gains,
-            iterations: cfg.iterations,
-            objective: &cfg.objective,
+            gains: &cfg.scope.gains,
+            iterations: cfg.scope.iterations,
+            objective: &cfg.scope.objective,
             optimized: None,
             dir: pdir.join("rows").join(format!("{sample}-{}", c.tag())),
         };
         let mut r = row::run(&inputs)?;
-        if cfg.floor {
+        if cfg.scope.floor {
             r.achievable = Some(super::floor::achievable(&inputs)?);
         }
         Ok(r)

@@ -13,7 +13,8 @@
 use super::models::Models;
 use super::row::Row;
 use super::run::{Study, StudyConfig};
-use super::setup::{Cond, Profile};
+use super::scope::Scope;
+use super::setup::Cond;
 use super::StudyError;
 use evflow_engine::batch::Shard;
 use serde::{Deserialize, Serialize};
@@ -21,69 +22,6 @@ use std::path::{Path, PathBuf};
 
 /// The name of a study shard's record in its output folder.
 pub const RECORD: &str = "textures-shard.json";
-
-/// What must agree across the shards of one study.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-pub struct Scope {
-    /// Lab profiles, by name.
-    pub profiles: Vec<String>,
-    /// Texture samples.
-    pub samples: Vec<String>,
-    /// Trained conditions.
-    pub conds: Vec<Cond>,
-    /// The gain sweep (finite positive numbers, exact in JSON).
-    pub gains: Vec<f64>,
-    /// NARX training epochs at most.
-    pub epochs: u32,
-    /// The optimized synthesis' iteration budget.
-    pub iterations: usize,
-    /// Whether the multilevel inverse model was built.
-    pub multilevel: bool,
-    /// Whether the achievable floor was computed.
-    pub floor: bool,
-    /// The optimized synthesis' objective.
-    pub objective: String,
-    /// Whether the tables show times (`--no-times` leaves them out).
-    pub times: bool,
-}
-
-impl Scope {
-    /// The scope of `cfg`, with or without times.
-    pub fn of(cfg: &StudyConfig, times: bool) -> Self {
-        Self {
-            profiles: cfg.profiles.iter().map(|p| p.name.clone()).collect(),
-            samples: cfg.samples.clone(),
-            conds: cfg.conds.clone(),
-            gains: cfg.gains.clone(),
-            epochs: cfg.epochs,
-            iterations: cfg.iterations,
-            multilevel: cfg.multilevel,
-            floor: cfg.floor,
-            objective: cfg.objective.clone(),
-            times,
-        }
-    }
-
-    /// A config with this scope for the tables of a merged study: profiles
-    /// by name only (no graph is run from it), `base` as graphs and work.
-    pub fn config(&self, base: &Path, shard: Shard) -> StudyConfig {
-        StudyConfig {
-            graphs: base.to_path_buf(),
-            work: base.join("work"),
-            profiles: self.profiles.iter().map(|n| Profile { name: n.clone(), path: None }).collect(),
-            samples: self.samples.clone(),
-            conds: self.conds.clone(),
-            gains: self.gains.clone(),
-            epochs: self.epochs,
-            iterations: self.iterations,
-            multilevel: self.multilevel,
-            floor: self.floor,
-            objective: self.objective.clone(),
-            shard,
-            record_time: self.times,
-        }
-    }
-}
 
 /// The models of one profile and condition.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
@@ -143,7 +81,7 @@ fn rebase_models(m: &Models, f: &dyn Fn(&Path) -> PathBuf) -> Models {
 
 impl SavedStudy {
     /// What `study` (run with `cfg`, whose output folder is `base`) saves.
-    pub fn of(study: &Study, cfg: &StudyConfig, base: &Path, times: bool) -> Self {
+    pub fn of(study: &Study, cfg: &StudyConfig, base: &Path) -> Self {
         let rel = |p: &Path| relative(p, base);
         let all = cfg.all_cells().len();
         let range = cfg.shard.range(all);
@@ -151,7 +89,7 @@ impl SavedStudy {
             shard: cfg.shard.to_string(),
             cells: all,
             range: [range.start, range.end],
-            scope: Scope::of(cfg, times),
+            scope: cfg.scope.clone(),
             rows: study.rows.iter().map(|r| Row { dir: rel(&r.dir), ..r.clone() }).collect(),
             models: study
                 .models
@@ -210,26 +148,30 @@ impl SavedStudy {
 mod tests {
     use super::super::gains::{AtGain, Chosen};
     use super::super::row::{Achievable, Method, MethodResult, Reading};
+    use super::super::setup::Profile;
     use super::*;
 
     fn config(shard: Shard) -> StudyConfig {
         StudyConfig {
-            graphs: "/g".into(),
-            work: "/out/work".into(),
             profiles: vec![
                 Profile::nominal(),
                 Profile { name: "stiff".into(), path: Some("/g/lab/stiff.toml".into()) },
             ],
-            samples: vec!["felt-fabric".into()],
-            conds: vec![Cond { mass: 60.0, speed: 3.0 }, Cond { mass: 110.0, speed: 5.0 }],
-            gains: vec![0.6, 1.0],
-            epochs: 3,
-            iterations: 4,
-            multilevel: false,
-            floor: true,
-            objective: "expected".into(),
+            scope: Scope {
+                profiles: vec!["nominal".into(), "stiff".into()],
+                samples: vec!["felt-fabric".into()],
+                conds: vec![Cond { mass: 60.0, speed: 3.0 }, Cond { mass: 110.0, speed: 5.0 }],
+                gains: vec![0.6, 1.0],
+                epochs: 3,
+                iterations: 4,
+                multilevel: false,
+                floor: true,
+                objective: "expected".into(),
+                times: true,
+            },
+            graphs: "/g".into(),
+            work: "/out/work".into(),
             shard,
-            record_time: true,
         }
     }
 
@@ -283,10 +225,11 @@ mod tests {
         let dir = tempfile::tempdir().unwrap();
         let mut saved = Vec::new();
         for k in 1..=3 {
-            let cfg = config(Shard { k, n: 3 });
+            let mut cfg = config(Shard { k, n: 3 });
+            cfg.scope.times = false;
             let d = dir.path().join(format!("s{k}"));
             std::fs::create_dir_all(&d).unwrap();
-            SavedStudy::of(&shard_study(&cfg), &cfg, Path::new("/out"), false).write(&d).unwrap();
+            SavedStudy::of(&shard_study(&cfg), &cfg, Path::new("/out")).write(&d).unwrap();
             assert!(SavedStudy::is_in(&d));
             saved.push(SavedStudy::read(&d).unwrap());
         }
@@ -315,7 +258,7 @@ mod tests {
         assert_eq!(joined.failures.len(), 3);
         assert_eq!(joined.failures[1].0, "stiff: felt-fabric at 60 g, 3 cm/s (shard 2/3)");
         assert_eq!(joined.seconds, 30.0);
-        assert_eq!(saved[0].scope.config(Path::new("/m"), Shard::ALL).all_cells().len(), 4);
+        assert_eq!(StudyConfig::merged(saved[0].scope.clone(), Path::new("/m"), Shard::ALL).all_cells().len(), 4);
     }
 
     #[test]
@@ -328,7 +271,7 @@ mod tests {
         assert!(e.contains(RECORD) && e.contains("missing field") && e.contains("line"), "{e}");
         // A record whose range is not its K/N's.
         let cfg = config(Shard { k: 1, n: 2 });
-        let mut s = SavedStudy::of(&shard_study(&cfg), &cfg, Path::new("/out"), true);
+        let mut s = SavedStudy::of(&shard_study(&cfg), &cfg, Path::new("/out"));
         s.range = [0, 3];
         s.write(dir.path()).unwrap();
         let e = SavedStudy::read(dir.path()).unwrap_err().to_string();

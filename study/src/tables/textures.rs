@@ -57,7 +57,7 @@ pub fn markdown(study: &Study, cfg: &StudyConfig, timings: Timings) -> String {
          one-second segments) is used for the headline because with one or two rectangular segments per pass \
          E_s swings with the noise of a single spectrum (and leaks); the rect reading and the best-gain rule are \
          tabulated below. Definitions: docs/synthesis.md.\n",
-        cfg.gains.iter().map(|g| g.to_string()).collect::<Vec<_>>().join(", "),
+        cfg.scope.gains.iter().map(|g| g.to_string()).collect::<Vec<_>>().join(", "),
         HEADLINE.label()
     );
     let _ = writeln!(
@@ -201,10 +201,10 @@ fn table_51(md: &mut String, study: &Study, cfg: &StudyConfig) {
         md,
         "## Table 5.1: the gains chosen (nominal lab)\n\nEach cell: the dissertation's gain | inverse NARX (binary) | optimized synthesis | fair playback, chosen by Table 5.1's rule.\n"
     );
-    let samples = &cfg.samples;
+    let samples = &cfg.scope.samples;
     let _ = writeln!(md, "| condition | {} |", samples.join(" | "));
     let _ = writeln!(md, "|---|{}", "---|".repeat(samples.len()));
-    for c in &cfg.conds {
+    for c in &cfg.scope.conds {
         let mut line = format!("| {} |", c.label());
         for s in samples {
             let diss = TABLE_51

@@ -10,6 +10,7 @@
 use super::error::MergeError;
 use super::files::{copy_files, one_batch, write};
 use evflow_engine::batch::{Failures, Shard};
+use evflow_study::run::StudyConfig;
 use evflow_study::saved::{SavedStudy, RECORD};
 use evflow_study::tables::textures::{csv, markdown, Timings};
 use evflow_study::StudyError;
@@ -58,7 +59,7 @@ pub fn merge_textures(out: &Path, dirs: &[PathBuf]) -> Result<TexturesMerge, Mer
     let saved: Vec<SavedStudy> = shards.into_iter().map(|(_, _, s)| s).collect();
     let study = SavedStudy::join(&saved, &base);
     let scope = &saved[0].scope;
-    let cfg = scope.config(&base, Shard::ALL);
+    let cfg = StudyConfig::merged(scope.clone(), &base, Shard::ALL);
     let timings = if scope.times { Timings::Show } else { Timings::Leave };
     let md = markdown(&study, &cfg, timings);
     let (md_path, csv_path) = (out.join("textures.md"), out.join("rows.csv"));

@@ -48,7 +48,7 @@ pub mod live;
 #[cfg(feature = "synth")]
 pub mod models;
 #[cfg(feature = "synth")]
-pub mod narx_settings;
+pub mod narx;
 #[cfg(feature = "synth")]
 pub mod recordings;
 #[cfg(feature = "synth")]

@@ -1,11 +1,11 @@
 //! The Markdown table of the NARX settings study
-//! ([`evflow_study::narx_settings`]):
+//! ([`crate::narx`]):
 //! written by `evflow report narx` and, from the shards' items, by `evflow
 //! merge`, so both write the same bytes; and the report's figure
 //! ([`figure`]).
 
 use crate::figure::{Plot, Series};
-use crate::narx_settings::{pareto, Scored};
+use crate::narx::run::{pareto, Scored};
 use crate::setup::Cond;
 use std::fmt::Write as _;
 
@@ -98,7 +98,8 @@ pub fn figure(condition: &Cond, scored: &[Scored]) -> Plot {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::narx_settings::{aggregate, Item, SeedScore, Setting};
+    use crate::narx::run::{aggregate, Item, SeedScore};
+    use crate::narx::setting::Setting;
 
     fn table(times: bool) -> String {
         let settings: Vec<Setting> = ["default=5/1/10/lm", "slow=3/1/5/adam", "broken=5/1/1000/lm"]

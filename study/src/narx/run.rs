@@ -1,147 +1,23 @@
-//! Error against training time of the inverse NARX model over network
-//! settings (issue 6, point 10; `evflow report narx`).
-//!
-//! For each network setting — hidden layers, tap delays, trainer — models
-//! are trained for one condition with `graphs/model-build.toml` (one per
-//! seed); every texture's force at that condition is synthesized with each
-//! and played on the virtual display over the gain sweep
-//! (`graphs/synthesize.toml`, every method in one run, as the texture
-//! study does), the gain chosen by Table 5.1's rule (and, as a second
-//! reading, the best E_s). The optimized synthesis the graph also plays is
-//! computed once per texture (through the condition's forward model) and
-//! reused.
-//!
-//! **Items and shards.** The items are the (setting, seed) pairs, settings
-//! in the order given, seeds 1 … N within each; a shard (`K/N`) trains and
-//! scores its contiguous slice of them. The condition's default models
-//! (`models/base`) and the textures' recordings and optimized syntheses are
-//! shared by every item and are computed by every shard: they are
-//! deterministic, so each shard computes the same ones. Only shard 1 (or a
-//! run without shards) keeps the default models in the output folder; the
-//! others build them in the work folder, so that the shards' folders merge
-//! without two versions of one file.
-//!
-//! **Failures.** One failing item does not lose the others: a failed
-//! (setting, seed) is left out of its setting's means ([`Scored::seeds`]
-//! says over how many seeds a row is), a setting whose every seed failed has
-//! no scores, and a texture whose recording or optimized synthesis failed is
-//! left out of every setting's scores; every failure is listed with its
-//! reason ([`NarxStudy::failures`]).
+//! Running the study: the default models, the textures, every item.
 
-use super::graphs::Sets;
-use super::models::{self, Models};
-use super::recordings::record_pair;
-use super::row::{self, Method, RowInputs};
-use super::setup::{Cond, Profile};
-use super::StudyError;
+use super::scope::NarxScope;
+use super::setting::Setting;
+use crate::models::{self, Models};
+use crate::recordings::record_pair;
+use crate::row::{self, Method, RowInputs};
+use crate::setup::Profile;
+use crate::StudyError;
 use evflow_engine::batch::{for_each_ordered, Shard};
 use evflow_nodes::narx::model::Model;
 use std::ops::Range;
 use std::path::{Path, PathBuf};
 
-/// The settings compared by default; the first is evflow's default network.
-pub const DEFAULT_SETTINGS: &[&str] = &[
-    "default=15-10-5/1/10/lm",
-    "one-layer-5=5/1/10/lm",
-    "one-layer-15=15/1/10/lm",
-    "wide=30-20-10/1/10/lm",
-    "input-5=15-10-5/1/5/lm",
-    "input-20=15-10-5/1/20/lm",
-    "feedback-2=15-10-5/2/10/lm",
-    "adam=15-10-5/1/10/adam",
-    "adam-one-layer-5=5/1/10/adam",
-];
-
-/// One network setting: `NAME=HIDDEN/FEEDBACK/INPUT/TRAINER`.
-#[derive(Debug, Clone, PartialEq)]
-pub struct Setting {
-    /// Its name (the folder of its models, the table's first column).
-    pub name: String,
-    /// Hidden layer sizes.
-    pub hidden: Vec<usize>,
-    /// Feedback taps k_y.
-    pub feedback: usize,
-    /// Input taps k_x.
-    pub input: usize,
-    /// The trainer: `lm` or `adam`.
-    pub algorithm: String,
-}
-
-impl Setting {
-    /// Parses `NAME=HIDDEN/FEEDBACK/INPUT/TRAINER`, hidden layers joined by
-    /// `-` (e.g. `small=5/1/10/lm`).
-    pub fn parse(s: &str) -> Result<Self, StudyError> {
-        let bad = |m: &str| StudyError::Config(format!("setting `{s}`: {m}"));
-        let (name, rest) = s.split_once('=').ok_or_else(|| bad("not NAME=HIDDEN/FEEDBACK/INPUT/TRAINER"))?;
-        let parts: Vec<&str> = rest.split('/').collect();
-        if parts.len() != 4 {
-            return Err(bad("give HIDDEN/FEEDBACK/INPUT/TRAINER, e.g. 15-10-5/1/10/lm"));
-        }
-        let hidden = parts[0]
-            .split('-')
-            .map(|h| h.trim().parse::<usize>().ok().filter(|&h| h > 0))
-            .collect::<Option<Vec<_>>>()
-            .ok_or_else(|| bad("hidden layers are sizes ≥ 1 joined by `-`"))?;
-        let num = |x: &str, what: &str| {
-            x.trim().parse::<usize>().map_err(|_| bad(&format!("{what} `{x}` is not a whole number")))
-        };
-        let algorithm = parts[3].trim().to_string();
-        if algorithm != "lm" && algorithm != "adam" {
-            return Err(bad("the trainer is lm or adam"));
-        }
-        let name = name.trim();
-        if name.is_empty() || name.contains(['/', '\\']) || name == "." || name == ".." || name == "base" {
-            return Err(bad("the name is a folder name: not empty, no `/`, not `base`"));
-        }
-        Ok(Self {
-            name: name.into(),
-            hidden,
-            feedback: num(parts[1], "feedback")?,
-            input: num(parts[2], "input")?,
-            algorithm,
-        })
-    }
-
-    /// The setting as [`Setting::parse`] reads it.
-    pub fn spec(&self) -> String {
-        let h: Vec<String> = self.hidden.iter().map(|h| h.to_string()).collect();
-        format!("{}={}/{}/{}/{}", self.name, h.join("-"), self.feedback, self.input, self.algorithm)
-    }
-
-    /// The values of graphs/model-build.toml that select it.
-    pub fn overrides(&self) -> Sets {
-        let hidden: Vec<f64> = self.hidden.iter().map(|&h| h as f64).collect();
-        Sets::new()
-            .nums("train.hidden", &hidden)
-            .int("train.feedback", self.feedback as i64)
-            .int("train.input", self.input as i64)
-            .text("train.algorithm", &self.algorithm)
-    }
-
-    /// "15-10-5, k_y 1, k_x 10, LM".
-    pub fn describe(&self) -> String {
-        let h: Vec<String> = self.hidden.iter().map(|h| h.to_string()).collect();
-        format!("{}, k_y {}, k_x {}, {}", h.join("-"), self.feedback, self.input, self.algorithm.to_uppercase())
-    }
-}
-
-/// What one study computes, and where.
+/// One study to run: its [`NarxScope`], where the graphs are and the
+/// output and work go, and its slice.
 #[derive(Debug, Clone)]
 pub struct NarxConfig {
-    /// The condition the models are trained and scored at.
-    pub condition: Cond,
-    /// The network settings, in the table's order.
-    pub settings: Vec<Setting>,
-    /// The texture samples scored.
-    pub samples: Vec<String>,
-    /// The gain sweep (§5.3.2).
-    pub gains: Vec<f64>,
-    /// Models per setting, from seeds 1 … `seeds`.
-    pub seeds: u32,
-    /// Epochs at most per model.
-    pub epochs: u32,
-    /// Iterations at most of the optimized synthesis.
-    pub iterations: usize,
+    /// What it covers and how.
+    pub scope: NarxScope,
     /// The folder of the shipped graphs.
     pub graphs: PathBuf,
     /// The output folder: `models/base` and `models/SETTING/seed-N`.
@@ -153,66 +29,32 @@ pub struct NarxConfig {
     pub jobs: usize,
     /// The slice of the items to run.
     pub shard: Shard,
-    /// Whether the setting models record their training time (off: the
-    /// model files and every score are the same on every run).
-    pub record_time: bool,
 }
 
 impl NarxConfig {
-    /// Every item of the whole study, in order: (setting index, seed).
-    pub fn items(&self) -> Vec<(usize, u32)> {
-        let seeds = self.seeds;
-        (0..self.settings.len()).flat_map(|i| (1..=seeds).map(move |seed| (i, seed))).collect()
-    }
-
-    /// The items of this config's shard, as indices into [`NarxConfig::items`].
+    /// The items of this config's shard, as indices into [`NarxScope::items`].
     pub fn range(&self) -> Range<usize> {
-        self.shard.range(self.settings.len() * self.seeds as usize)
-    }
-
-    /// Checks what can be checked before anything runs.
-    pub fn check(&self) -> Result<(), StudyError> {
-        let bad = |m: String| Err(StudyError::Config(m));
-        if self.seeds == 0 {
-            return bad("seeds: at least 1".into());
-        }
-        if self.settings.is_empty() {
-            return bad("settings: at least one".into());
-        }
-        for (i, s) in self.settings.iter().enumerate() {
-            if self.settings[..i].iter().any(|t| t.name == s.name) {
-                return bad(format!("settings: the name `{}` is given twice", s.name));
-            }
-        }
-        if self.samples.is_empty() {
-            return bad("samples: at least one".into());
-        }
-        for (i, s) in self.samples.iter().enumerate() {
-            evflow_nodes::lab::texture::samples::lookup(s).map_err(|e| StudyError::Config(format!("samples: {e}")))?;
-            if self.samples[..i].contains(s) {
-                return bad(format!("samples: `{s}` is given twice"));
-            }
-        }
-        if self.gains.is_empty() || !self.gains.iter().all(|g| g.is_finite() && *g > 0.0) {
-            return bad("gains: positive numbers".into());
-        }
-        Ok(())
+        self.shard.range(self.scope.total())
     }
 }
 
 /// One model's scores: a (setting, seed) trained and every texture
-/// synthesized with it.
-#[derive(Debug, Clone, PartialEq)]
+/// synthesized with it (saved with its floats exact, NaN included).
+#[derive(Debug, Clone, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct SeedScore {
     /// E_s at the Table 5.1 gain, the mean over the textures scored.
+    #[serde(with = "crate::exact")]
     pub es: f64,
     /// E_s at the best gain of the sweep, the mean over the textures scored.
+    #[serde(with = "crate::exact")]
     pub best: f64,
     /// Training time, s (0 when not recorded).
+    #[serde(with = "crate::exact")]
     pub seconds: f64,
     /// Epochs run.
     pub epochs: usize,
     /// Closed-loop transition agreement on the validation block (NaN without one).
+    #[serde(with = "crate::exact")]
     pub transitions: f64,
     /// Weights of the network.
     pub weights: usize,
@@ -343,9 +185,9 @@ pub fn pareto(points: &[(f64, f64)]) -> Vec<bool> {
 /// is received, in order. Fails only when nothing can be scored: a
 /// config that cannot work, the default models, or every texture failed.
 pub fn run(cfg: &NarxConfig, progress: &mut dyn FnMut(&Item)) -> Result<NarxStudy, StudyError> {
-    cfg.check()?;
+    cfg.scope.check()?;
     let profile = Profile::nominal();
-    let cond = cfg.condition;
+    let cond = cfg.scope.condition;
     let io = |path: &Path| {
         let path = path.to_path_buf();
         move |e: std::io::Error| StudyError::Io { path, message: e.to_string() }
@@ -353,7 +195,7 @@ pub fn run(cfg: &NarxConfig, progress: &mut dyn FnMut(&Item)) -> Result<NarxStud
     std::fs::create_dir_all(&cfg.out).map_err(io(&cfg.out))?;
     std::fs::create_dir_all(&cfg.work).map_err(io(&cfg.work))?;
     let base_dir = if cfg.shard.k == 1 { cfg.out.join("models").join("base") } else { cfg.work.join("base") };
-    let base = models::build(&cfg.graphs, &profile, &cond, cfg.epochs, false, cfg.record_time, &base_dir)
+    let base = models::build(&cfg.graphs, &profile, &cond, cfg.scope.epochs, false, cfg.scope.times, &base_dir)
         .map_err(|e| e.at(format!("the default models at {}", cond.label())))?;
     let textures = cfg.work.join("textures");
     let never = Default::default();
@@ -365,8 +207,8 @@ pub fn run(cfg: &NarxConfig, progress: &mut dyn FnMut(&Item)) -> Result<NarxStud
     };
     let mut prepared = Vec::new();
     let mut left_out = Vec::new();
-    for_each_ordered(cfg.samples.iter().collect(), cfg.jobs, &never, prepare, |i, r| {
-        let s = cfg.samples[i].clone();
+    for_each_ordered(cfg.scope.samples.iter().collect(), cfg.jobs, &never, prepare, |i, r| {
+        let s = cfg.scope.samples[i].clone();
         match r.map_err(|p| format!("panicked: {p}")).and_then(|r| r.map_err(|e| e.to_string())) {
             Ok(o) => prepared.push((s, o)),
             Err(why) => left_out.push((s, why)),
@@ -376,16 +218,16 @@ pub fn run(cfg: &NarxConfig, progress: &mut dyn FnMut(&Item)) -> Result<NarxStud
         let why: Vec<String> = left_out.iter().map(|(s, why)| format!("{s}: {why}")).collect();
         return Err(StudyError::Config(format!("every texture failed:\n{}", why.join("\n"))));
     }
-    let all = cfg.items();
+    let all = cfg.scope.items();
     let range = cfg.range();
     let one = |_: usize, (i, seed): (usize, u32)| -> Result<SeedScore, StudyError> {
-        let st = &cfg.settings[i];
+        let st = &cfg.scope.settings[i];
         let dir = cfg.out.join("models").join(&st.name).join(format!("seed-{seed}"));
         let mut sets = st.overrides().int("train.seed", seed);
-        if !cfg.record_time {
+        if !cfg.scope.times {
             sets = sets.flag("train.record_time", false);
         }
-        let path = models::inverse(&cfg.graphs, &profile, &cond, cfg.epochs, &sets, &dir)?;
+        let path = models::inverse(&cfg.graphs, &profile, &cond, cfg.scope.epochs, &sets, &dir)?;
         let model = Model::load(&path)?;
         let m = Models { narx: path, narx_multilevel: None, forward: base.forward.clone(), seconds: [0.0; 3] };
         let (mut es, mut best) = (0.0, 0.0);
@@ -420,8 +262,8 @@ pub fn run(cfg: &NarxConfig, progress: &mut dyn FnMut(&Item)) -> Result<NarxStud
         progress(&item);
         items.push(item);
     });
-    let scored = aggregate(&cfg.settings, cfg.seeds, &items);
-    let failures = failures(&cfg.settings, &left_out, &items);
+    let scored = aggregate(&cfg.scope.settings, cfg.scope.seeds, &items);
+    let failures = failures(&cfg.scope.settings, &left_out, &items);
     Ok(NarxStudy { textures: prepared.into_iter().map(|(s, _)| s).collect(), left_out, items, scored, failures })
 }
 
@@ -439,11 +281,11 @@ fn row_inputs<'a>(
         graphs: &cfg.graphs,
         profile,
         sample,
-        cond: cfg.condition,
+        cond: cfg.scope.condition,
         models,
         recordings,
-        gains: &cfg.gains,
-        iterations: cfg.iterations,
+        gains: &cfg.scope.gains,
+        iterations: cfg.scope.iterations,
         objective: "expected",
         optimized: None,
         dir,
@@ -453,27 +295,7 @@ fn row_inputs<'a>(
 #[cfg(test)]
 mod tests {
     use super::*;
-    use evflow_engine::Value;
-
-    #[test]
-    fn settings_parse_into_model_build_overrides() {
-        let s = Setting::parse("wide=30-20-10/2/15/adam").unwrap();
-        assert_eq!((s.hidden.clone(), s.feedback, s.input, s.algorithm.as_str()), (vec![30, 20, 10], 2, 15, "adam"));
-        let o = s.overrides();
-        assert_eq!(o.get("train.hidden"), Some(&Value::FloatList(vec![30.0, 20.0, 10.0])));
-        assert_eq!(o.get("train.feedback"), Some(&Value::Int(2)));
-        assert_eq!(o.get("train.input"), Some(&Value::Int(15)));
-        assert_eq!(o.get("train.algorithm"), Some(&Value::Text("adam".into())));
-        assert_eq!(Setting::parse(&s.spec()).unwrap(), s);
-        for bad in
-            ["x", "x=15/1/10", "x=15-0/1/10/lm", "x=15/a/10/lm", "x=15/1/10/sgd", "a/b=5/1/10/lm", "base=5/1/1/lm"]
-        {
-            assert!(Setting::parse(bad).is_err(), "{bad}");
-        }
-        for d in DEFAULT_SETTINGS {
-            Setting::parse(d).unwrap();
-        }
-    }
+    use crate::setup::Cond;
 
     #[test]
     fn the_pareto_front_keeps_what_nothing_beats_in_both() {
@@ -527,30 +349,32 @@ mod tests {
     #[test]
     fn items_are_settings_by_seeds_and_shards_cut_them_in_order() {
         let mut cfg = NarxConfig {
-            condition: Cond { mass: 60.0, speed: 5.0 },
-            settings: ["a=5/1/10/lm", "b=3/1/5/adam"].iter().map(|s| Setting::parse(s).unwrap()).collect(),
-            samples: vec!["plastic-sheet".into()],
-            gains: vec![1.0],
-            seeds: 2,
-            epochs: 3,
-            iterations: 3,
+            scope: NarxScope {
+                condition: Cond { mass: 60.0, speed: 5.0 },
+                settings: ["a=5/1/10/lm", "b=3/1/5/adam"].iter().map(|s| Setting::parse(s).unwrap()).collect(),
+                samples: vec!["plastic-sheet".into()],
+                gains: vec![1.0],
+                seeds: 2,
+                epochs: 3,
+                iterations: 3,
+                times: true,
+            },
             graphs: "graphs".into(),
             out: "out".into(),
             work: "work".into(),
             jobs: 1,
             shard: Shard { k: 2, n: 3 },
-            record_time: true,
         };
-        assert_eq!(cfg.items(), [(0, 1), (0, 2), (1, 1), (1, 2)]);
+        assert_eq!(cfg.scope.items(), [(0, 1), (0, 2), (1, 1), (1, 2)]);
         assert_eq!(cfg.range(), 2..3);
-        cfg.check().unwrap();
-        cfg.settings.push(Setting::parse("a=1/1/1/lm").unwrap());
-        assert_eq!(cfg.check().unwrap_err().to_string(), "settings: the name `a` is given twice");
-        cfg.settings.pop();
-        cfg.samples.push("plastic-sheet".into());
-        assert_eq!(cfg.check().unwrap_err().to_string(), "samples: `plastic-sheet` is given twice");
-        cfg.samples.pop();
-        cfg.samples.push("no-such-sample".into());
-        assert!(cfg.check().unwrap_err().to_string().starts_with("samples: "));
+        cfg.scope.check().unwrap();
+        cfg.scope.settings.push(Setting::parse("a=1/1/1/lm").unwrap());
+        assert_eq!(cfg.scope.check().unwrap_err().to_string(), "settings: the name `a` is given twice");
+        cfg.scope.settings.pop();
+        cfg.scope.samples.push("plastic-sheet".into());
+        assert_eq!(cfg.scope.check().unwrap_err().to_string(), "samples: `plastic-sheet` is given twice");
+        cfg.scope.samples.pop();
+        cfg.scope.samples.push("no-such-sample".into());
+        assert!(cfg.scope.check().unwrap_err().to_string().starts_with("samples: "));
     }
 }

@@ -7,21 +7,19 @@
 //! found by optimizing through the display itself — is never above the
 //! best method (by its definition) nor below the repeat baseline.
 
-use evflow_nodes::synth::study::row::Method;
-use evflow_nodes::synth::study::run::{run, StudyConfig};
-use evflow_nodes::synth::study::setup::{Cond, Profile};
-use evflow_nodes::synth::study::summary::{es, Basis};
+use evflow_study::row::Method;
+use evflow_study::run::{run, StudyConfig};
+use evflow_study::scope::Scope;
+use evflow_study::setup::Cond;
+use evflow_study::summary::{es, Basis};
 
 #[test]
 fn the_best_method_beats_fair_playback_on_two_profiles() {
     let root = evflow_tests::root();
     let graphs = root.join("graphs");
     let work = tempfile::tempdir().unwrap();
-    let profiles = vec![Profile::nominal(), Profile::resolve("stiff", &graphs).unwrap()];
-    let cfg = StudyConfig {
-        graphs: graphs.clone(),
-        work: work.path().to_path_buf(),
-        profiles,
+    let scope = Scope {
+        profiles: vec!["nominal".into(), "stiff".into()],
         samples: vec!["plastic-sheet".into()],
         conds: vec![Cond { mass: 60.0, speed: 5.0 }],
         gains: vec![0.6, 1.0, 1.4],
@@ -30,9 +28,10 @@ fn the_best_method_beats_fair_playback_on_two_profiles() {
         multilevel: false,
         floor: true,
         objective: "expected".into(),
-        shard: evflow_engine::batch::Shard::ALL,
-        record_time: true,
+        times: true,
     };
+    let cfg =
+        StudyConfig::new(scope, graphs.clone(), work.path().to_path_buf(), evflow_engine::batch::Shard::ALL).unwrap();
     let study = run(&cfg, &mut |_| {}).unwrap_or_else(|e| panic!("{e}"));
     assert_eq!(study.rows.len(), 2);
     for row in &study.rows {

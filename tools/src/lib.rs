@@ -1,12 +1,11 @@
 //! The library half of the `evflow` program: what its commands share with
 //! tests and benchmarks: plots for reports, fits, and batch computations
-//! (a sweep's tables, shard records, the merge of shards), and the tables
-//! of reports.
+//! (a sweep's tables, shard records, the merge of shards). The studies
+//! and the tables of reports are in the study crate (`evflow_study`).
 #![deny(missing_docs)]
 
 pub mod batch;
 pub mod fit;
 pub mod plot;
-pub mod report;
 #[cfg(feature = "studio")]
 pub mod studio;

@@ -139,14 +139,12 @@ fn shards_merged_out_of_order_give_the_table_of_one_run() {
 
 /// The study as the library runs it: setting `a` (5 hidden, taps 1/10, LM)
 /// with 2 seeds at 60 g, 5 cm/s on `samples`, in `work`.
-fn study(
-    samples: &[&str],
-    out: &Path,
-    work: &Path,
-) -> Result<evflow_nodes::synth::study::narx_settings::NarxStudy, String> {
-    use evflow_nodes::synth::study::narx_settings::{run, NarxConfig, Setting};
-    use evflow_nodes::synth::study::setup::Cond;
-    let cfg = NarxConfig {
+fn study(samples: &[&str], out: &Path, work: &Path) -> Result<evflow_study::narx::run::NarxStudy, String> {
+    use evflow_study::narx::run::{run, NarxConfig};
+    use evflow_study::narx::scope::NarxScope;
+    use evflow_study::narx::setting::Setting;
+    use evflow_study::setup::Cond;
+    let scope = NarxScope {
         condition: Cond { mass: 60.0, speed: 5.0 },
         settings: vec![Setting::parse("a=5/1/10/lm").unwrap()],
         samples: samples.iter().map(|s| s.to_string()).collect(),
@@ -154,12 +152,15 @@ fn study(
         seeds: 2,
         epochs: 3,
         iterations: 3,
+        times: false,
+    };
+    let cfg = NarxConfig {
+        scope,
         graphs: root().join("graphs"),
         out: out.to_path_buf(),
         work: work.to_path_buf(),
         jobs: 2,
         shard: evflow_engine::batch::Shard::ALL,
-        record_time: false,
     };
     run(&cfg, &mut |_| {}).map_err(|e| e.to_string())
 }

@@ -19,7 +19,6 @@ pub mod optimize_node;
 pub mod output_filter;
 pub mod spectral;
 pub mod start;
-pub mod study;
 pub mod synthesize;
 pub mod train_node;
 pub mod volterra;

@@ -6,8 +6,6 @@
 //! (`evflow_engine::batch`).
 
 pub mod merge;
-#[cfg(feature = "synth")]
-pub mod narx_shard;
 pub mod record_json;
 pub mod shard_record;
 pub mod sweep_plots;

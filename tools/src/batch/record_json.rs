@@ -1,7 +1,6 @@
-//! What the shard records written by hand (a sweep's `shard.json`, `report
-//! narx`'s `narx-shard.json`) share: the document written through a
-//! temporary file, read back with every error naming the file, and its
-//! fields read with the fault named.
+//! A sweep's shard record (`shard.json`, [`super::shard_record`]) as a JSON
+//! document: written through a temporary file, read back with every error
+//! naming the file, and its fields read with the fault named.
 
 use serde_json::Value as Json;
 use std::path::{Path, PathBuf};

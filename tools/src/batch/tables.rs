@@ -18,16 +18,7 @@ pub fn number(v: f64) -> String {
     }
 }
 
-/// Whether run times appear in what is printed and written: they differ
-/// from run to run, so `--no-times` leaves them out for output that can be
-/// compared byte for byte.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub enum Timings {
-    /// Run times shown.
-    Show,
-    /// Run times left out.
-    Leave,
-}
+pub use evflow_study::tables::Timings;
 
 /// One run as JSON.
 fn run_json(r: &RunReport, timings: Timings) -> serde_json::Value {

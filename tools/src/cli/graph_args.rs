@@ -1,7 +1,7 @@
 //! Arguments shared by the commands that load a graph.
 
 use anyhow::{anyhow, Result};
-use evflow_engine::{load_file, run_offline, Checked, Override, Plan, PlanOptions, RunOptions, RunReport};
+use evflow_engine::{load_file, Checked, Override};
 use std::path::{Path, PathBuf};
 
 /// Loads and validates `file` with the node library and `sets` applied
@@ -12,25 +12,6 @@ pub fn load_with(file: &Path, sets: &[impl AsRef<str>]) -> Result<Checked> {
         .map(|s| Override::parse(s.as_ref()).map_err(|e| anyhow!("--set {e}")))
         .collect::<Result<Vec<_>>>()?;
     load_file(file, &evflow_nodes::registry(), &overrides).map_err(|e| anyhow!("{e}"))
-}
-
-/// Loads `file` with `sets` and runs it offline to its end, its outputs
-/// written under `out`: what the reports do with the shipped graphs.
-#[cfg_attr(not(feature = "synth"), allow(dead_code))]
-pub fn run_with(file: &Path, sets: &[impl AsRef<str>], out: &Path) -> Result<RunReport> {
-    let checked = load_with(file, sets)?;
-    let opts = PlanOptions {
-        max_block: 1024,
-        seed: None,
-        base_dir: None,
-        out_dir: Some(out.to_path_buf()),
-        timing: false,
-        mode: evflow_engine::RunMode::Offline,
-        check_only: false,
-    };
-    let mut plan = Plan::build(&checked, &opts).map_err(|e| anyhow!("{}: {e}", file.display()))?;
-    run_offline(&mut plan, RunOptions { duration: None, progress: None })
-        .map_err(|e| anyhow!("{}: {e}", file.display()))
 }
 
 /// A graph file and command-line overrides.

@@ -1,10 +1,10 @@
 //! `evflow library build --out DIR`: the model library (issue 17, point 3)
-//! — parse, call `evflow_nodes::synth::study::library`, print. docs/scale.md describes it.
+//! — parse, call `evflow_study::library`, print. docs/scale.md describes it.
 
 use anyhow::{ensure, Context, Result};
 use evflow_nodes::lab::texture::{generated, samples};
-use evflow_nodes::synth::study::library::{build, Plan};
-use evflow_nodes::synth::study::setup::{Cond, Profile};
+use evflow_study::library::{build, Plan};
+use evflow_study::setup::{Cond, Profile};
 use evflow_tools::batch::{progress_bar, BatchArgs};
 use std::path::PathBuf;
 

@@ -115,5 +115,5 @@ pub enum MergeError {
     /// read, or their indexes joined.
     #[cfg(feature = "synth")]
     #[error(transparent)]
-    Study(#[from] evflow_nodes::synth::study::StudyError),
+    Study(#[from] evflow_study::StudyError),
 }

@@ -21,7 +21,7 @@ pub struct LibraryMerge {
 /// Merges the shards of a model library (`evflow library build --shard`)
 /// in `dirs` into `out`: their files copied, their indexes joined.
 pub fn merge_library(out: &Path, dirs: &[PathBuf]) -> Result<LibraryMerge, MergeError> {
-    use evflow_nodes::synth::study::library::{merge_index, read_shard};
+    use evflow_study::library::{merge_index, read_shard};
     if dirs.is_empty() {
         return Err(MergeError::NoShards);
     }

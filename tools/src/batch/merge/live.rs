@@ -1,6 +1,6 @@
 //! The merge of a live report's shards (`evflow report live --shard K/N`):
 //! each shard saved the rows of its slice of the (profile, sample, user)
-//! items ([`evflow_nodes::synth::study::live::saved`]); the merge checks
+//! items ([`evflow_study::live::saved`]); the merge checks
 //! that the shards are the N slices of one report, copies their files
 //! (libraries, runs, floors), joins the rows in item order and writes
 //! live.md, rows.csv and the figures with the code `evflow report live`
@@ -8,10 +8,10 @@
 
 use super::error::MergeError;
 use super::files::{copy_files, one_batch, write};
-use crate::report::live_table::{csv, figures, markdown};
 use evflow_engine::batch::{Failures, Shard};
-use evflow_nodes::synth::study::live::saved::{LiveRecord, RECORD};
-use evflow_nodes::synth::study::StudyError;
+use evflow_study::live::saved::{LiveRecord, RECORD};
+use evflow_study::tables::live::{csv, figures, markdown};
+use evflow_study::StudyError;
 use std::path::{Path, PathBuf};
 
 /// What a merge of a live report's shards did.

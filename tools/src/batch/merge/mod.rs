@@ -66,7 +66,7 @@ pub fn merge(out: &Path, dirs: &[PathBuf]) -> Result<Merged, MergeError> {
         return Err(MergeError::NoShards);
     }
     #[cfg(feature = "synth")]
-    if dirs.iter().any(|d| evflow_nodes::synth::study::saved::SavedStudy::is_in(d)) {
+    if dirs.iter().any(|d| evflow_study::saved::SavedStudy::is_in(d)) {
         return textures::merge_textures(out, dirs).map(Merged::Textures);
     }
     #[cfg(feature = "synth")]
@@ -78,10 +78,7 @@ pub fn merge(out: &Path, dirs: &[PathBuf]) -> Result<Merged, MergeError> {
         return narx::merge_narx(out, dirs).map(Merged::Narx);
     }
     #[cfg(feature = "synth")]
-    if dirs
-        .iter()
-        .all(|d| !d.join(super::shard_record::RECORD).exists() && evflow_nodes::synth::study::library::is_library(d))
-    {
+    if dirs.iter().all(|d| !d.join(super::shard_record::RECORD).exists() && evflow_study::library::is_library(d)) {
         return merge_library(out, dirs).map(Merged::Library);
     }
     merge_sweep(out, dirs).map(Merged::Sweep)

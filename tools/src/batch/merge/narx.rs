@@ -6,11 +6,11 @@
 
 use super::error::MergeError;
 use super::files::{copy_files, k_order, write};
-use crate::batch::narx_shard::{NarxRecord, NARX_RECORD};
 use crate::plot::{write_png, PlotError, Written};
-use crate::report::narx_table::{figure, markdown, Table};
 use evflow_engine::batch::Failures;
-use evflow_nodes::synth::study::narx_settings::{aggregate, item_label};
+use evflow_study::narx::run::{aggregate, item_label, Item};
+use evflow_study::narx::saved::{NarxRecord, NARX_RECORD};
+use evflow_study::tables::narx::{figure, markdown, Table};
 use std::path::{Path, PathBuf};
 
 /// The name of the table in the output folder.
@@ -55,35 +55,38 @@ pub fn merge_narx(out: &Path, dirs: &[PathBuf]) -> Result<NarxMerge, MergeError>
     {
         return Err(MergeError::NotNarx { dir: other.clone(), narx: narx.clone() });
     }
-    let mut shards =
-        dirs.iter().map(|d| Ok((d.clone(), NarxRecord::read(d)?))).collect::<Result<Vec<_>, MergeError>>()?;
-    shards.sort_by_key(|(_, r)| r.shard.k);
-    let (first_dir, first) = &shards[0];
-    for (dir, r) in &shards {
+    // Each record is read checked: its items are its K/N's slice, of its scope's settings.
+    let mut shards = dirs
+        .iter()
+        .map(|d| {
+            let r = NarxRecord::read(d)?;
+            let shard = r.slice().map_err(|e| evflow_study::StudyError::Config(e.to_string()))?;
+            let items = r.items()?;
+            Ok((d.clone(), shard, r, items))
+        })
+        .collect::<Result<Vec<_>, MergeError>>()?;
+    shards.sort_by_key(|(_, s, _, _)| s.k);
+    let (first_dir, first_shard, first, _) = &shards[0];
+    for (dir, shard, r, _) in &shards {
         let differs =
             |what: &'static str| MergeError::NotOneBatch { first: first_dir.clone(), other: dir.clone(), what };
-        if r.shard.n != first.shard.n {
+        if shard.n != first_shard.n {
             return Err(differs("the shard counts N"));
         }
-        if r.arguments != first.arguments {
-            return Err(differs("the arguments of `report narx`"));
+        if r.scope != first.scope {
+            return Err(differs("the scopes of `report narx`"));
         }
         if r.textures != first.textures || r.left_out.iter().map(|t| &t.0).ne(first.left_out.iter().map(|t| &t.0)) {
             return Err(differs("the textures scored"));
         }
-        let total = r.arguments.total();
-        let expected = r.shard.range(total);
-        if !r.items.iter().map(|i| i.index).eq(expected.clone()) {
-            return Err(MergeError::WrongRange { dir: dir.clone(), shard: r.shard, expected, total });
-        }
     }
-    let shards = k_order(shards.into_iter().map(|(d, r)| (d, r.shard, r)).collect())?;
+    let shards = k_order(shards.into_iter().map(|(d, s, r, items)| (d, s, (r, items))).collect())?;
     let folders: Vec<&Path> = shards.iter().map(|(d, _, _)| d.as_path()).collect();
     let skip = [NARX_RECORD, NARX_TABLE, NARX_FIGURE].map(PathBuf::from);
     let files = copy_files(out, &folders, &skip)?;
-    let first = &shards[0].2;
-    let a = &first.arguments;
-    let items: Vec<_> = shards.iter().flat_map(|(_, _, r)| r.items.iter().cloned()).collect();
+    let first = &shards[0].2 .0;
+    let a = &first.scope;
+    let items: Vec<Item> = shards.iter().flat_map(|(_, _, (_, items))| items.iter().cloned()).collect();
     let scored = aggregate(&a.settings, a.seeds, &items);
     let left_out: Vec<String> = first.left_out.iter().map(|(s, _)| s.clone()).collect();
     let md = markdown(&Table {
@@ -102,8 +105,8 @@ pub fn merge_narx(out: &Path, dirs: &[PathBuf]) -> Result<NarxMerge, MergeError>
     for (s, why) in &first.left_out {
         failures.push(format!("texture {s}"), why);
     }
-    for (_, shard, r) in &shards {
-        for i in &r.items {
+    for (_, shard, (_, items)) in &shards {
+        for i in items {
             if let Err(why) = &i.score {
                 failures.push(format!("{} (shard {shard})", item_label(&a.settings, i)), why);
             }
@@ -124,19 +127,61 @@ pub fn merge_narx(out: &Path, dirs: &[PathBuf]) -> Result<NarxMerge, MergeError>
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::batch::narx_shard::tests::record;
     use evflow_engine::batch::Shard;
+    use evflow_study::narx::run::{NarxConfig, NarxStudy, SeedScore};
+    use evflow_study::narx::scope::NarxScope;
+    use evflow_study::narx::setting::Setting;
+    use evflow_study::setup::Cond;
+
+    /// Shard `shard` of 2 settings × 2 seeds, item 1 failed, felt-fabric left out.
+    fn record(shard: Shard) -> (NarxRecord, Vec<Item>) {
+        let scope = NarxScope {
+            condition: Cond { mass: 60.0, speed: 0.1 + 0.2 },
+            settings: ["a=5/1/10/lm", "b=3/1/5/adam"].iter().map(|s| Setting::parse(s).unwrap()).collect(),
+            samples: vec!["plastic-sheet".into(), "felt-fabric".into()],
+            gains: vec![1.0 / 3.0, 1.4],
+            seeds: 2,
+            epochs: 3,
+            iterations: 3,
+            times: false,
+        };
+        let cfg = NarxConfig { scope, graphs: "g".into(), out: "o".into(), work: "w".into(), jobs: 1, shard };
+        let score = |index: usize| SeedScore {
+            es: 1.0 / (index + 3) as f64,
+            best: 5e-324,
+            seconds: 0.0,
+            epochs: 3,
+            transitions: f64::NAN,
+            weights: 86,
+        };
+        let items: Vec<Item> = cfg
+            .range()
+            .map(|index| Item {
+                index,
+                setting: index / 2,
+                seed: (index % 2 + 1) as u32,
+                score: if index == 1 { Err("it broke".into()) } else { Ok(score(index)) },
+            })
+            .collect();
+        let study = NarxStudy {
+            textures: vec!["plastic-sheet".into()],
+            left_out: vec![("felt-fabric".into(), "no recording".into())],
+            items: items.clone(),
+            scored: Vec::new(),
+            failures: Vec::new(),
+        };
+        (NarxRecord::of(&study, &cfg), items)
+    }
 
     /// The three shards of the test record, written into `base/s1..s3`,
     /// each with the models it trained.
     fn three_shards(base: &Path) -> Vec<PathBuf> {
         (1..=3)
             .map(|k| {
-                let shard = Shard { k, n: 3 };
                 let dir = base.join(format!("s{k}"));
-                let r = record(shard);
+                let (r, _) = record(Shard { k, n: 3 });
                 for i in &r.items {
-                    let d = dir.join(format!("models/{}/seed-{}", r.arguments.settings[i.setting].name, i.seed));
+                    let d = dir.join(format!("models/{}/seed-{}", i.setting, i.seed));
                     std::fs::create_dir_all(&d).unwrap();
                     std::fs::write(d.join("model.json"), format!("{}", i.index)).unwrap();
                 }
@@ -153,9 +198,9 @@ mod tests {
         dirs.swap(0, 2);
         let out = base.path().join("out");
         let m = merge_narx(&out, &dirs).unwrap();
-        let all = record(Shard::ALL);
-        let a = &all.arguments;
-        let scored = aggregate(&a.settings, a.seeds, &all.items);
+        let (all, items) = record(Shard::ALL);
+        let a = &all.scope;
+        let scored = aggregate(&a.settings, a.seeds, &items);
         let one = markdown(&Table {
             condition: a.condition,
             textures: &all.textures,
@@ -181,19 +226,20 @@ mod tests {
         let e = merge_narx(&out, &dirs[..2]).unwrap_err();
         assert_eq!(e.to_string(), "shards missing: 3/3 (given 2 of 3)");
         let mut other = NarxRecord::read(&dirs[2]).unwrap();
-        other.arguments.epochs = 4;
+        other.scope.epochs = 4;
         other.write(&dirs[2]).unwrap();
         let e = merge_narx(&out, &dirs).unwrap_err();
         let (d0, d2) = (dirs[0].display(), dirs[2].display());
         assert_eq!(
             e.to_string(),
-            format!("{d0} and {d2}: not shards of one batch (the arguments of `report narx` differ)")
+            format!("{d0} and {d2}: not shards of one batch (the scopes of `report narx` differ)")
         );
-        other.arguments.epochs = 3;
+        other.scope.epochs = 3;
         other.items.clear();
         other.write(&dirs[2]).unwrap();
         let e = merge_narx(&out, &dirs).unwrap_err();
-        assert_eq!(e.to_string(), format!("{d2}: shard 3/3 should hold runs 3..4 of 4"));
+        let record = dirs[2].join(NARX_RECORD);
+        assert_eq!(e.to_string(), format!("{}: the items are not items 3..4 in order", record.display()));
         assert!(!out.exists(), "a refused merge wrote {}", out.display());
         let sweep = base.path().join("sweep");
         std::fs::create_dir_all(&sweep).unwrap();

@@ -1,6 +1,6 @@
 //! The merge of a texture report's shards (`evflow report textures --shard
 //! K/N`): each shard saved its (profile, condition) cells' rows and models
-//! ([`evflow_nodes::synth::study::saved`]); the merge checks that the
+//! ([`evflow_study::saved`]); the merge checks that the
 //! shards are the N slices of one report, copies their files (models,
 //! recordings, runs, spectra), joins the saved studies in study order with
 //! every path put under the output folder, and writes textures.md and
@@ -9,10 +9,11 @@
 
 use super::error::MergeError;
 use super::files::{copy_files, one_batch, write};
-use crate::report::textures_table::{csv, markdown, Timings};
 use evflow_engine::batch::{Failures, Shard};
-use evflow_nodes::synth::study::saved::{SavedStudy, RECORD};
-use evflow_nodes::synth::study::StudyError;
+use evflow_study::run::StudyConfig;
+use evflow_study::saved::{SavedStudy, RECORD};
+use evflow_study::tables::textures::{csv, markdown, Timings};
+use evflow_study::StudyError;
 use std::path::{Path, PathBuf};
 
 /// What a merge of a texture report's shards did. Steps that failed in the
@@ -58,7 +59,7 @@ pub fn merge_textures(out: &Path, dirs: &[PathBuf]) -> Result<TexturesMerge, Mer
     let saved: Vec<SavedStudy> = shards.into_iter().map(|(_, _, s)| s).collect();
     let study = SavedStudy::join(&saved, &base);
     let scope = &saved[0].scope;
-    let cfg = scope.config(&base, Shard::ALL);
+    let cfg = StudyConfig::merged(scope.clone(), &base, Shard::ALL);
     let timings = if scope.times { Timings::Show } else { Timings::Leave };
     let md = markdown(&study, &cfg, timings);
     let (md_path, csv_path) = (out.join("textures.md"), out.join("rows.csv"));

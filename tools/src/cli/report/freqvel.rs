@@ -5,11 +5,11 @@
 //! main spectral component is fitted against the speed (slope, intercept,
 //! R²). A table and a PNG.
 
-use super::lab_recording::{record, Condition};
 use anyhow::{anyhow, Context, Result};
 use evflow_engine::batch::{for_each_ordered, Failures};
 use evflow_nodes::lab::texture::samples::{self, NAMES};
 use evflow_nodes::texture::freqvel::relation;
+use evflow_study::recordings::{record, Condition};
 use evflow_tools::batch::{progress_bar, JobsArg};
 use evflow_tools::plot::{Plot, Series};
 use std::path::PathBuf;
@@ -73,7 +73,7 @@ pub fn main(a: Args) -> Result<()> {
             .iter()
             .map(|&v| {
                 let c = Condition { sample: s, mass: a.mass, speed: v, passes: a.passes, rep: 1 };
-                record(&a.graph, &c, tmp.path()).map(|r| (v, r))
+                record(&a.graph, &c, tmp.path()).map(|r| (v, r)).map_err(anyhow::Error::from)
             })
             .collect::<Result<Vec<_>>>();
         bar.inc(1);

@@ -1,15 +1,15 @@
 //! `evflow report live`: every live texture chain under virtual users on
 //! every lab profile, held to the stroke's achievable floor (docs/texture.md
-//! §9). The study is library code (`evflow_nodes::synth::study::live`);
+//! §9). The study is library code (`evflow_study::live`);
 //! this command parses, calls, prints and draws.
 
 use anyhow::{Context, Result};
 use evflow_nodes::lab::texture::samples;
-use evflow_nodes::synth::study::live::run::{run, LiveConfig, Progress};
-use evflow_nodes::synth::study::live::saved::{LiveRecord, RECORD};
-use evflow_nodes::synth::study::live::scope::{LiveScope, LiveSettings, User};
+use evflow_study::live::run::{run, LiveConfig, Progress};
+use evflow_study::live::saved::{LiveRecord, RECORD};
+use evflow_study::live::scope::{LiveScope, LiveSettings, User};
+use evflow_study::tables::live::{csv, figures, markdown};
 use evflow_tools::batch::{progress_bar, BatchArgs};
-use evflow_tools::report::live_table::{csv, figures, markdown};
 use std::path::PathBuf;
 
 /// Arguments of `evflow report live`.

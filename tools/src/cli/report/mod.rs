@@ -7,8 +7,6 @@ pub mod freqvel;
 #[cfg(feature = "synth")]
 pub mod interp;
 #[cfg(feature = "synth")]
-pub mod lab_recording;
-#[cfg(feature = "synth")]
 pub mod live;
 #[cfg(feature = "mesh")]
 pub mod mesh;

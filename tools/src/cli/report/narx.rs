@@ -1,19 +1,21 @@
 //! `evflow report narx`: error against run time of the inverse NARX model
 //! (issue 6, point 10). The study is library code
-//! (`evflow_nodes::synth::study::narx_settings`, its table
-//! `evflow_tools::report::narx_table`); this parses, calls, prints and writes narx.md
-//! and the figure, or, with `--shard K/N`, the shard's record for `evflow
-//! merge` (`evflow_tools::batch::narx_shard`).
+//! (`evflow_study::narx`, its table `evflow_study::tables::narx`); this
+//! parses, calls, prints and writes narx.md and the figure, or, with
+//! `--shard K/N`, the shard's record for `evflow merge`
+//! (`evflow_study::narx::saved`).
 
 use anyhow::{anyhow, bail, Context, Result};
 use evflow_engine::batch::Failures;
 use evflow_nodes::lab::texture::samples::NAMES;
-use evflow_nodes::synth::study::narx_settings::{self, NarxConfig, Setting, DEFAULT_SETTINGS};
-use evflow_nodes::synth::study::setup::Cond;
+use evflow_study::narx::run::{self as narx_study, NarxConfig};
+use evflow_study::narx::saved::{NarxRecord, NARX_RECORD};
+use evflow_study::narx::scope::NarxScope;
+use evflow_study::narx::setting::{Setting, DEFAULT_SETTINGS};
+use evflow_study::setup::Cond;
+use evflow_study::tables::narx::{figure, markdown, Table};
 use evflow_tools::batch::merge::narx::{NARX_FIGURE, NARX_TABLE};
-use evflow_tools::batch::narx_shard::{NarxArguments, NarxRecord, NARX_RECORD};
 use evflow_tools::batch::{progress_bar, BatchArgs};
-use evflow_tools::report::narx_table::{figure, markdown, Table};
 use std::path::PathBuf;
 
 /// Arguments of `evflow report narx`.
@@ -87,7 +89,7 @@ pub fn main(a: Args) -> Result<()> {
     let graphs = std::fs::canonicalize(&a.graphs).with_context(|| format!("--graphs {}", a.graphs.display()))?;
     let tmp = tempfile::tempdir().context("cannot create a temporary folder")?;
     let shard = a.batch.shard();
-    let cfg = NarxConfig {
+    let scope = NarxScope {
         condition,
         settings,
         samples,
@@ -95,40 +97,30 @@ pub fn main(a: Args) -> Result<()> {
         seeds: a.seeds,
         epochs: a.epochs,
         iterations: a.iterations,
-        graphs,
-        out: out.clone(),
-        work: tmp.path().to_path_buf(),
-        jobs: a.batch.jobs(),
-        shard,
-        record_time: !a.no_times,
+        times: !a.no_times,
     };
-    cfg.check().map_err(|e| anyhow!("--{e}"))?;
+    scope.check().map_err(|e| anyhow!("--{e}"))?;
+    let cfg =
+        NarxConfig { scope, graphs, out: out.clone(), work: tmp.path().to_path_buf(), jobs: a.batch.jobs(), shard };
     let range = cfg.range();
     eprintln!(
         "building the default inverse model and the forward model at {}, recording {} textures …",
         condition.label(),
-        cfg.samples.len()
+        cfg.scope.samples.len()
     );
     let bar = progress_bar(range.len(), "models", false);
-    let study = narx_settings::run(&cfg, &mut |item| {
+    let study = narx_study::run(&cfg, &mut |item| {
         bar.inc(1);
-        bar.set_message(narx_settings::item_label(&cfg.settings, item));
+        bar.set_message(narx_study::item_label(&cfg.scope.settings, item));
     })?;
     bar.finish_and_clear();
     if a.batch.shard.is_some() {
-        let record = NarxRecord {
-            shard,
-            arguments: NarxArguments::of(&cfg),
-            textures: study.textures.clone(),
-            left_out: study.left_out.clone(),
-            items: study.items.clone(),
-        };
-        record.write(&out)?;
+        NarxRecord::of(&study, &cfg).write(&out)?;
         println!(
             "shard {shard}: (setting, seed) items {}–{} of {}; wrote {}",
             range.start + 1,
             range.end,
-            cfg.items().len(),
+            cfg.scope.total(),
             out.join(NARX_RECORD).display()
         );
         println!("join the {} shards' folders with: evflow merge OUT DIR1 … DIR{}", shard.n, shard.n);
@@ -138,8 +130,8 @@ pub fn main(a: Args) -> Result<()> {
             condition,
             textures: &study.textures,
             left_out: &left_out,
-            gains: &cfg.gains,
-            seeds: cfg.seeds,
+            gains: &cfg.scope.gains,
+            seeds: cfg.scope.seeds,
             times: !a.no_times,
             scored: &study.scored,
         });
@@ -151,7 +143,7 @@ pub fn main(a: Args) -> Result<()> {
     }
     if !study.failures.is_empty() {
         let f = Failures { list: study.failures };
-        bail!("{}", f.summary(cfg.samples.len() + range.len(), "steps").trim_end());
+        bail!("{}", f.summary(cfg.scope.samples.len() + range.len(), "steps").trim_end());
     }
     Ok(())
 }

@@ -1,22 +1,23 @@
 //! `evflow report textures`: dissertation Fig. 5.7/5.8 and Table 5.1, and
 //! beyond them — every synthesis method on every lab profile, scored the
 //! same way (docs/synthesis.md). The study itself is library code
-//! (`evflow_nodes::synth::study`); this command parses, calls, prints and
+//! (`evflow_study`); this command parses, calls, prints and
 //! draws.
 
 use anyhow::{anyhow, Context, Result};
 use evflow_nodes::lab::texture::samples::{self, NAMES};
 use evflow_nodes::recording::format::Recording;
-use evflow_nodes::synth::study::cells::write_actuation;
-use evflow_nodes::synth::study::row::{Method, Row};
-use evflow_nodes::synth::study::run::{run_on, Progress, StudyConfig};
-use evflow_nodes::synth::study::saved::{SavedStudy, RECORD};
-use evflow_nodes::synth::study::setup::{Cond, Profile};
-use evflow_nodes::synth::study::spectrum::gated;
+use evflow_study::cells::write_actuation;
+use evflow_study::row::{Method, Row};
+use evflow_study::run::{run_on, Progress, StudyConfig};
+use evflow_study::saved::{SavedStudy, RECORD};
+use evflow_study::scope::Scope;
+use evflow_study::setup::Cond;
+use evflow_study::spectrum::gated;
+use evflow_study::tables::textures::Timings;
+use evflow_study::tables::textures::{csv, markdown};
 use evflow_tools::batch::{progress_bar, BatchArgs};
 use evflow_tools::plot::{Plot, Series};
-use evflow_tools::report::textures_table::Timings;
-use evflow_tools::report::textures_table::{csv, markdown};
 use std::path::PathBuf;
 
 /// Arguments of `evflow report textures`.
@@ -93,7 +94,6 @@ pub fn main(a: Args) -> Result<()> {
         samples::lookup(s).map_err(|e| anyhow::anyhow!("--samples: {e}"))?;
     }
     let conds = a.conditions.iter().map(|s| Cond::parse(s)).collect::<Result<Vec<_>, _>>()?;
-    let profiles = a.profiles.iter().map(|p| Profile::resolve(p, &a.graphs)).collect::<Result<Vec<_>, _>>()?;
     let shard = a.batch.shard();
     if a.grid.is_some() && a.batch.shard.is_some() {
         anyhow::bail!(
@@ -106,10 +106,8 @@ pub fn main(a: Args) -> Result<()> {
     let graphs = std::fs::canonicalize(&a.graphs).with_context(|| format!("--graphs {}", a.graphs.display()))?;
     let base = std::fs::canonicalize(&a.out)?;
     let work = base.join("work");
-    let cfg = StudyConfig {
-        graphs,
-        work,
-        profiles,
+    let scope = Scope {
+        profiles: a.profiles.clone(),
         samples,
         conds,
         gains: a.gains.clone(),
@@ -118,11 +116,11 @@ pub fn main(a: Args) -> Result<()> {
         multilevel: !a.no_multilevel,
         floor: !a.no_floor,
         objective: a.objective.clone(),
-        shard,
-        record_time: !a.no_times,
+        times: !a.no_times,
     };
+    let cfg = StudyConfig::new(scope, graphs, work, shard)?;
     let cells = cfg.cells().len();
-    let bar = progress_bar(cells + cells * cfg.samples.len(), "steps", false);
+    let bar = progress_bar(cells + cells * cfg.scope.samples.len(), "steps", false);
     let study = run_on(&cfg, a.batch.jobs(), &mut |p| {
         bar.inc(1);
         match p {
@@ -132,7 +130,7 @@ pub fn main(a: Args) -> Result<()> {
     })?;
     bar.finish_and_clear();
     if a.batch.shard.is_some() {
-        SavedStudy::of(&study, &cfg, &base, timings == Timings::Show).write(&base)?;
+        SavedStudy::of(&study, &cfg, &base).write(&base)?;
         println!(
             "shard {shard}: {} of {} (profile, condition) cells, {} rows; saved {}. \
              Join the shards with `evflow merge OUT SHARD_FOLDERS…`.",
@@ -183,7 +181,7 @@ pub fn main(a: Args) -> Result<()> {
     }
     if !study.failures.is_empty() {
         let f = evflow_engine::batch::Failures { list: study.failures };
-        anyhow::bail!("{}", f.summary(cells + cells * cfg.samples.len(), "steps").trim_end());
+        anyhow::bail!("{}", f.summary(cells + cells * cfg.scope.samples.len(), "steps").trim_end());
     }
     Ok(())
 }

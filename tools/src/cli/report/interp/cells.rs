@@ -2,18 +2,18 @@
 //! cross-validation of Fig. 5.6, 5.9 and 6.8 through the whole chain, in
 //! both orders (the actuations interpolated; the forces interpolated, then
 //! synthesized). The study module runs it
-//! (`evflow_nodes::synth::study::crossval`); this file parses, calls,
+//! (`evflow_study::crossval`); this file parses, calls,
 //! prints the table ([`super::cells_table`]) and draws the spectra.
 
 use super::cells_table::table;
 use super::{Args, Cells};
 use anyhow::{anyhow, bail, Context, Result};
 use evflow_nodes::recording::format::Recording;
-use evflow_nodes::synth::study::crossval::{self, CrossvalConfig, Run};
-use evflow_nodes::synth::study::row::Method;
-use evflow_nodes::synth::study::setup::Profile;
-use evflow_nodes::synth::study::spectrum::gated;
-use evflow_nodes::synth::study::xval::GRAPH;
+use evflow_study::crossval::{self, CrossvalConfig, Run};
+use evflow_study::row::Method;
+use evflow_study::setup::Profile;
+use evflow_study::spectrum::gated;
+use evflow_study::xval::GRAPH;
 use evflow_tools::plot::{Plot, Series};
 use std::path::Path;
 use std::time::Instant;

@@ -3,10 +3,10 @@
 //! the cross-validation in both orders.
 
 use super::Args;
-use evflow_nodes::synth::study::crossval::{Cell, Run, SchemeRun};
-use evflow_nodes::synth::study::row::Method;
-use evflow_nodes::synth::study::xval::GRAPH;
 use evflow_nodes::texture::kernel::INTERP_CUTOFF;
+use evflow_study::crossval::{Cell, Run, SchemeRun};
+use evflow_study::row::Method;
+use evflow_study::xval::GRAPH;
 use std::fmt::Write as _;
 
 fn num(x: f64) -> String {

@@ -1,17 +1,17 @@
 //! `evflow report interp` with the recorded forces as cells (the
 //! default), and the command's entry: other cells go to [`super::cells`].
 
-use super::super::lab_recording::{record, Condition};
 use super::{Args, Cells};
 use anyhow::{anyhow, Context, Result};
 use evflow_engine::batch::{for_each_ordered, Failures};
 use evflow_nodes::lab::texture::samples::{self, NAMES};
 use evflow_nodes::metric::spectral_error::{spectral_rms_error, Band};
 use evflow_nodes::metric::spectrum::{averaged_spectrum, SpectrumConfig, Window};
-use evflow_nodes::synth::study::grid_plan::GridPlan;
 use evflow_nodes::texture::grid::Grid;
 use evflow_nodes::texture::kernel::SincKernel;
 use evflow_nodes::texture::scheme::{Geometry, Mix, Scheme};
+use evflow_study::grid_plan::GridPlan;
+use evflow_study::recordings::{record, Condition};
 use evflow_tools::batch::progress_bar;
 use evflow_tools::plot::{Plot, Series};
 use std::path::Path;

@@ -1,0 +1,226 @@
+//! The stroke's achievable floor: the actuation over a user's whole stroke
+//! optimized through the lab's twin of the display ([`crate::twin`]:
+//! its equations with the noise off) knowing the finger's true path, load
+//! and the real force, within the range every method is played at
+//! (|u| ≤ 1, the `limit` of every chain). Each optimum is then played like
+//! every method — noise on, the gain sweep, the same metric — by
+//! [`super::play`]. The evaluation knows the display and the future; a
+//! live chain, which knows neither, can approach this figure, not pass it.
+//! Where a method does pass it, the optimization was not optimal there and
+//! the floor takes the method's value ([`super::row::LiveRow::floor`]).
+//!
+//! Objective: E_s² in the Welch reading (Hann, half-overlapping one-second
+//! segments, 2–200 Hz) of the twin's force, high-passed at 10 Hz, against
+//! the real force high-passed alike, over the whole stroke — reversals
+//! included, as every live method is scored.
+//!
+//! Starts: the square-law envelope on a Nyquist-rate carrier for the real
+//! force (its sign taken off with the direction of motion) at half and
+//! once the least offset, with the display's true carrier gain on this
+//! stroke; and every method's own actuation (the chains' output after
+//! `limit`, at gain 1), so the floor is never above a method it was
+//! seeded with, before the noise.
+
+use super::stroke::Stroke;
+use crate::twin::{DisplayTwin, Tape};
+use crate::StudyError;
+use evflow_nodes::lab::profile::LabProfile;
+use evflow_nodes::metric::spectral_error::Band;
+use evflow_nodes::metric::spectrum::{SpectrumConfig, Window};
+use evflow_nodes::synth::lbfgsb::{minimize, Options};
+use evflow_nodes::synth::output_filter::OutputFilter;
+use evflow_nodes::synth::spectral::SpectralTarget;
+use evflow_nodes::synth::start::carrier_scaled;
+
+/// The carrier starts' offsets, relative to the least that keeps the
+/// envelope real.
+pub const START_OFFSETS: [f64; 2] = [0.5, 1.0];
+
+/// Half-width of the window around a reversal that [`sliding_only`] clears, ms.
+pub const REVERSAL_MS: f64 = 150.0;
+
+/// `u` with every sample within [`REVERSAL_MS`] of a reversal of the
+/// finger (a change of the sign of its velocity, rests included) set to 0.
+pub fn sliding_only(u: &[f64], stroke: &Stroke) -> Vec<f64> {
+    let w = (REVERSAL_MS * 1e-3 * stroke.rate).round() as usize;
+    let v = &stroke.velocity;
+    let n = u.len().min(v.len());
+    let mut clear = vec![false; n];
+    let mut last: Option<usize> = None;
+    for k in 0..n {
+        if v[k] != 0.0 {
+            if let Some(j) = last {
+                if v[j].signum() != v[k].signum() || k > j + 1 {
+                    let (lo, hi) = (j.saturating_sub(w), (k + w).min(n - 1));
+                    clear[lo..=hi].iter_mut().for_each(|c| *c = true);
+                }
+            }
+            last = Some(k);
+        }
+    }
+    u.iter().take(n).zip(&clear).map(|(x, c)| if *c { 0.0 } else { *x }).collect()
+}
+
+/// One start's optimum.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Candidate {
+    /// Where it started: `carrier ×0.5`, `carrier ×1`, or a method's name.
+    pub start: String,
+    /// E_s² against the real force through the twin at the start (noise off).
+    pub start_objective: f64,
+    /// The same at the optimum.
+    pub objective: f64,
+    /// The actuation, |u| ≤ 1.
+    pub u: Vec<f64>,
+}
+
+/// The display's twin, the high-pass and the target of one stroke.
+struct Chain<'a> {
+    twin: DisplayTwin,
+    filter: OutputFilter,
+    stroke: &'a Stroke,
+    target: SpectralTarget,
+    tape: Tape,
+    y: Vec<f64>,
+}
+
+impl Chain<'_> {
+    fn force(&mut self, u: &[f64]) -> Vec<f64> {
+        self.twin.forward(u, &self.stroke.load, &self.stroke.velocity, &mut self.tape)
+    }
+
+    /// J = E_s² and ∂J/∂u.
+    fn value_grad(&mut self, u: &[f64], g: &mut [f64]) -> f64 {
+        let mut y = self.force(u);
+        self.filter.apply_in_place(&mut y);
+        self.y.resize(y.len(), 0.0);
+        let j = self.target.value_grad(&y, &mut self.y);
+        self.filter.adjoint_in_place(&mut self.y);
+        g.iter_mut().for_each(|v| *v = 0.0);
+        self.twin.backward(&self.tape, &self.y, g);
+        j
+    }
+
+    fn value(&mut self, u: &[f64]) -> f64 {
+        let mut y = self.force(u);
+        self.filter.apply_in_place(&mut y);
+        self.target.es(&y).powi(2)
+    }
+
+    /// The steady friction a unit Nyquist-rate carrier adds on this stroke
+    /// in the direction of motion (N): the display's true carrier gain.
+    fn carrier_gain(&mut self) -> f64 {
+        let n = self.stroke.len();
+        let unit: Vec<f64> = (0..n).map(|k| if k % 2 == 0 { 1.0 } else { -1.0 }).collect();
+        let on = self.force(&unit);
+        let off = self.force(&vec![0.0; n]);
+        let v = &self.stroke.velocity;
+        let moving: Vec<usize> = (0..n).filter(|&k| v[k] != 0.0).collect();
+        let s: f64 = moving.iter().map(|&k| (on[k] - off[k]) * v[k].signum()).sum();
+        s / moving.len().max(1) as f64
+    }
+}
+
+/// Optimizes the stroke's actuation through the display of `profile` from
+/// the carrier starts and every seed (`(name, actuation)`, each clipped to
+/// |u| ≤ 1 and cut or padded with 0 to the stroke), `iterations` each.
+pub fn optimize(
+    stroke: &Stroke,
+    profile: &LabProfile,
+    seeds: &[(String, Vec<f64>)],
+    iterations: usize,
+) -> Result<Vec<Candidate>, StudyError> {
+    let rate = stroke.rate;
+    let nfft = rate.round() as usize;
+    let real = stroke.real_highpassed()?;
+    let cfg = SpectrumConfig { rate, nfft, window: Window::Hann, overlap: 0.5 };
+    let band = Band::new(rate, nfft, 2.0, 200.0, false).map_err(|e| StudyError::Config(e.message))?;
+    let mut chain = Chain {
+        twin: DisplayTwin::new(profile, rate, 4).map_err(StudyError::Config)?,
+        filter: OutputFilter::highpass(4, 10.0, rate)?,
+        stroke,
+        target: SpectralTarget::new(&real, cfg, band)?,
+        tape: Tape::default(),
+        y: Vec::new(),
+    };
+    let n = stroke.len();
+    let kappa = chain.carrier_gain();
+    // The real force's magnitude variation: its sign taken off with the motion's.
+    let magnitude: Vec<f64> = real.iter().zip(&stroke.velocity).map(|(f, v)| if *v < 0.0 { -f } else { *f }).collect();
+    let keep = vec![true; n];
+    let mut starts: Vec<(String, Vec<f64>)> = Vec::new();
+    if kappa.is_finite() && kappa > 0.0 {
+        for scale in START_OFFSETS {
+            starts.push((format!("carrier ×{scale}"), carrier_scaled(&magnitude, &keep, kappa, 1.0, scale)?));
+        }
+    }
+    for (name, u) in seeds {
+        let mut u: Vec<f64> = u.iter().take(n).map(|v| if v.is_finite() { v.clamp(-1.0, 1.0) } else { 0.0 }).collect();
+        u.resize(n, 0.0);
+        starts.push((name.clone(), u));
+    }
+    let opts = Options { max_iter: iterations, ..Options::default() };
+    let mut out = Vec::with_capacity(starts.len());
+    for (start, u0) in starts {
+        let start_objective = chain.value(&u0);
+        let mut f = |u: &[f64], g: &mut [f64]| chain.value_grad(u, g);
+        let r = minimize(&mut f, &u0, -1.0, 1.0, &opts);
+        out.push(Candidate { start, start_objective, objective: r.f, u: r.x });
+    }
+    Ok(out)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::live::scope::User;
+
+    #[test]
+    fn sliding_only_clears_the_reversals_and_keeps_the_strokes() {
+        let user = User { name: "t".into(), seed: 5, speed: [3.0, 7.0], mass: [60.0, 110.0], travel_cm: 3.0 };
+        let stroke = Stroke::of(&user, "plastic-sheet", 4.0, 1000.0).unwrap();
+        let u = vec![1.0; stroke.len()];
+        let s = sliding_only(&u, &stroke);
+        let reversals =
+            stroke.velocity.windows(2).filter(|w| w[0] != 0.0 && w[1] != 0.0 && w[0].signum() != w[1].signum()).count()
+                + stroke.velocity.windows(2).filter(|w| w[0] != 0.0 && w[1] == 0.0).count();
+        assert!(reversals >= 2, "{reversals}");
+        let cleared = s.iter().filter(|x| **x == 0.0).count();
+        assert!(cleared >= 300 && cleared < stroke.len() / 2, "{cleared} of {}", stroke.len());
+        // Around every sign change the actuation is cleared; at full speed it is kept.
+        for (k, sk) in s.iter().enumerate().skip(1) {
+            let (a, b) = (stroke.velocity[k - 1], stroke.velocity[k]);
+            if a != 0.0 && b != 0.0 && a.signum() != b.signum() {
+                assert_eq!(*sk, 0.0);
+            }
+            if stroke.velocity[k].abs() > 0.06 && *sk == 0.0 {
+                // Full speed is reached within 50 ms of a reversal at most: only those samples are cleared.
+                let near =
+                    (k.saturating_sub(200)..(k + 200).min(stroke.len())).any(|j| stroke.velocity[j].abs() < 0.005);
+                assert!(near, "sample {k} cleared at full speed far from a reversal");
+            }
+        }
+    }
+
+    #[test]
+    fn the_floor_never_rises_above_its_starts_and_stays_in_range() {
+        let user = User { name: "t".into(), seed: 5, speed: [3.0, 7.0], mass: [60.0, 110.0], travel_cm: 8.0 };
+        let stroke = Stroke::of(&user, "plastic-sheet", 3.0, 1000.0).unwrap();
+        let seed: Vec<f64> = (0..stroke.len()).map(|k| if k % 2 == 0 { 0.6 } else { -0.6 }).collect();
+        let c = optimize(&stroke, &LabProfile::default(), &[("held carrier".into(), seed)], 8).unwrap();
+        assert_eq!(c.len(), 3);
+        for cand in &c {
+            assert!(
+                cand.objective <= cand.start_objective,
+                "{}: {} > {}",
+                cand.start,
+                cand.objective,
+                cand.start_objective
+            );
+            assert!(cand.u.iter().all(|u| u.abs() <= 1.0));
+            assert_eq!(cand.u.len(), stroke.len());
+        }
+        // Optimizing does something on a stroke where the display can render texture.
+        assert!(c.iter().any(|cand| cand.objective < 0.95 * cand.start_objective));
+    }
+}

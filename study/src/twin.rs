@@ -1,0 +1,503 @@
+//! Differentiable twins of the simulated display and force sensor: the same
+//! equations, the same exact maps and the same arithmetic as
+//! [`evflow_nodes::lab::display_model::DisplayModel`] and
+//! [`evflow_nodes::lab::sensor_model::SensorModel`] with their noise off, run
+//! forward while recording a tape, then backward (reverse mode) to give the
+//! gradient of any function of the output force with respect to every
+//! actuation sample. The achievable floor ([`super::floor`]) optimizes
+//! through them — through the display itself, not a model of it.
+//!
+//! Forward, per substep (exact integrator): circuit with its charge
+//! relaxation state q (electrical.rs) x_e ← Φ_e x_e + Γ_e V_cmd;
+//! F_e = k_e v_r², v_r = v_g − q (q ≡ 0 without relaxation); lag F_l ← a F_l + (1 − a) F_e; N = max(0, F_n + F_l); the
+//! tip's augmented exact map gives the free motion and the slip s; the
+//! contact sticks if the force that keeps s = 0 is within the static limit,
+//! else it slides with the Stribeck friction (or with that force, if
+//! smaller). Backward: the same steps transposed; the stick/slide branch and
+//! the clamps (amplifier limit, N ≥ 0, sensor full scale) are held as the
+//! forward pass took them (their derivative where they switch is taken as
+//! that of the branch taken), the sensor's quantization is exact forward and
+//! passed straight through backward (its derivative is 0 almost everywhere,
+//! which would stop every gradient; the straight-through estimate treats the
+//! rounding as the identity, off by at most half a converter step). The tests check the twin against the lab's models sample by
+//! sample and the gradient against central differences.
+
+use evflow_nodes::lab::electrical::{self, Circuit};
+use evflow_nodes::lab::expm::zoh;
+use evflow_nodes::lab::profile::LabProfile;
+
+/// States of the circuit with its relaxation state.
+const NE: usize = electrical::NR;
+
+/// How a substep's contact step went.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+enum Branch {
+    /// Held: the slip is 0.
+    Stuck,
+    /// Sliding with the Stribeck friction.
+    Slide,
+    /// Sliding with the smaller force that keeps the slip 0 (the friction
+    /// can stop the tip within the step, but the contact was not stuck).
+    Clipped,
+}
+
+#[derive(Debug, Clone, Copy)]
+struct Step {
+    xe0: [f64; NE],
+    xm0: [f64; 2],
+    /// The square-law voltage v_r = v_g − q after the circuit step.
+    vr: f64,
+    npre: f64,
+    branch: Branch,
+    req_sign: f64,
+}
+
+/// What the forward pass of the display keeps for the backward pass.
+#[derive(Debug, Clone, Default)]
+pub struct Tape {
+    steps: Vec<Step>,
+    /// Per sample: the lag factor a and whether V_cmd was clamped.
+    samples: Vec<(f64, bool)>,
+    velocity: Vec<f64>,
+}
+
+/// The display's twin.
+#[derive(Debug, Clone)]
+pub struct DisplayTwin {
+    sub: usize,
+    hs: f64,
+    phi_e: Vec<f64>,
+    gam_e: Vec<f64>,
+    ke: f64,
+    gain: f64,
+    vmax: f64,
+    offset: f64,
+    mu_s: f64,
+    mu_k: f64,
+    v_s: f64,
+    viscous: f64,
+    lag0: f64,
+    lag_slope: f64,
+    k: f64,
+    c: f64,
+    /// Augmented tip map: states (δ, v_tip, s), inputs (v_holder, f).
+    phi_m: Vec<f64>,
+    gam_m: Vec<f64>,
+    x0: [f64; NE],
+}
+
+#[inline]
+fn matvec(m: &[f64], x: &[f64], rows: usize, cols: usize, y: &mut [f64]) {
+    for (i, yi) in y.iter_mut().enumerate().take(rows) {
+        let row = &m[i * cols..(i + 1) * cols];
+        *yi = row.iter().zip(x).map(|(a, b)| a * b).sum();
+    }
+}
+
+impl DisplayTwin {
+    /// The twin of `sim.display` on `profile` at `rate` Hz with `substeps`.
+    pub fn new(profile: &LabProfile, rate: f64, substeps: usize) -> Result<Self, String> {
+        profile.validate()?;
+        let sub = substeps.max(1);
+        let hs = 1.0 / rate / sub as f64;
+        let circuit = Circuit::of(profile);
+        let (ae, be) = circuit.relaxed_matrices();
+        let (phi_e, gam_e) = zoh(&ae, &be, NE, 1, hs).ok_or("the circuit's matrix exponential is not finite")?;
+        let ct = &profile.display.contact;
+        let (k, c, m) = (ct.stiffness_n_per_m, ct.damping_ns_per_m, ct.tip_mass_g * 1e-3);
+        // As CoulombLti::new: the plant (δ, v_tip) with input v_holder, the
+        // friction column, and the slip integrator ṡ = v_tip.
+        let a = [0.0, -1.0, k / m, -c / m];
+        let b = [1.0, c / m];
+        let bf = [0.0, -1.0 / m];
+        let (na, ma) = (3, 2);
+        let mut aa = vec![0.0; na * na];
+        let mut ba = vec![0.0; na * ma];
+        for i in 0..2 {
+            aa[i * na..i * na + 2].copy_from_slice(&a[i * 2..(i + 1) * 2]);
+            ba[i * ma] = b[i];
+            ba[i * ma + 1] = bf[i];
+        }
+        aa[2 * na + 1] = 1.0;
+        let (phi_m, gam_m) = zoh(&aa, &ba, na, ma, hs).ok_or("the contact's matrix exponential is not finite")?;
+        let amp = &profile.display.amplifier;
+        let f = &profile.display.friction;
+        let x0 = circuit.dc_state(amp.offset_v).ok_or("the display circuit has no DC steady state")?;
+        Ok(Self {
+            sub,
+            hs,
+            phi_e,
+            gam_e,
+            ke: profile.electrostatic_coefficient(),
+            gain: amp.gain_v,
+            vmax: amp.max_v,
+            offset: amp.offset_v,
+            mu_s: f.mu_static,
+            mu_k: f.mu_kinetic,
+            v_s: f.stribeck_velocity,
+            viscous: f.viscous,
+            lag0: 2.0 * std::f64::consts::PI * f.lag_cutoff_hz,
+            lag_slope: 2.0 * std::f64::consts::PI * f.lag_slope_hz_per_mm_s * 1e3,
+            k,
+            c,
+            phi_m,
+            gam_m,
+            x0,
+        })
+    }
+
+    fn slide(&self, speed: f64, n: f64) -> f64 {
+        let r = speed / self.v_s;
+        (self.mu_k + (self.mu_s - self.mu_k) * (-r * r).exp()) * n + self.viscous * speed
+    }
+
+    /// ∂slide/∂speed and ∂slide/∂n.
+    fn slide_grad(&self, speed: f64, n: f64) -> (f64, f64) {
+        let r = speed / self.v_s;
+        let e = (-r * r).exp();
+        (
+            (self.mu_s - self.mu_k) * e * (-2.0 * r / self.v_s) * n + self.viscous,
+            self.mu_k + (self.mu_s - self.mu_k) * e,
+        )
+    }
+
+    /// The display force for actuation `u`, normal load `load` (N) and
+    /// holder velocity `velocity` (m/s), sample by sample from the model's
+    /// initial state, keeping the tape.
+    pub fn forward(&self, u: &[f64], load: &[f64], velocity: &[f64], tape: &mut Tape) -> Vec<f64> {
+        tape.steps.clear();
+        tape.samples.clear();
+        tape.velocity.clear();
+        let mut xe = self.x0;
+        let vr0 = electrical::force_voltage(&self.x0);
+        let mut fl = self.ke * vr0 * vr0;
+        let mut xm = [0.0f64; 2];
+        let mut stuck = true;
+        let mut out = Vec::with_capacity(u.len());
+        let ds_df = self.gam_m[2 * 2 + 1];
+        for n in 0..u.len() {
+            let uu = if u[n].is_finite() { u[n] } else { 0.0 };
+            let ld = if load[n].is_finite() { load[n].max(0.0) } else { 0.0 };
+            let v = if velocity[n].is_finite() { velocity[n] } else { 0.0 };
+            let raw = self.gain * uu + self.offset;
+            let vcmd = raw.clamp(-self.vmax, self.vmax);
+            let wc = self.lag0 + self.lag_slope * v.abs();
+            let a = (-wc * self.hs).exp();
+            tape.samples.push((a, vcmd != raw));
+            tape.velocity.push(v);
+            for _ in 0..self.sub {
+                let xe0 = xe;
+                let mut y = [0.0; NE];
+                matvec(&self.phi_e, &xe, NE, NE, &mut y);
+                for i in 0..NE {
+                    xe[i] = y[i] + self.gam_e[i] * vcmd;
+                }
+                let vr = electrical::force_voltage(&xe);
+                let fe = self.ke * vr * vr;
+                fl = a * fl + (1.0 - a) * fe;
+                let npre = ld + fl;
+                let nf = npre.max(0.0);
+                let limit = if stuck { self.mu_s * nf } else { self.slide(xm[1].abs(), nf) };
+                let xa = [xm[0], xm[1], 0.0];
+                let mut free = [0.0; 3];
+                matvec(&self.phi_m, &xa, 3, 3, &mut free);
+                let mut g = [0.0; 3];
+                matvec(&self.gam_m, &[v, 0.0], 3, 2, &mut g);
+                for i in 0..3 {
+                    free[i] += g[i];
+                }
+                let required = if ds_df != 0.0 { -free[2] / ds_df } else { 0.0 };
+                let xm0 = xm;
+                let branch;
+                if required.abs() <= limit.max(0.0) {
+                    branch = Branch::Stuck;
+                    xm[0] += v * self.hs;
+                    xm[1] = 0.0;
+                    stuck = true;
+                } else {
+                    let fs = self.slide(xm[1].abs(), nf).max(0.0);
+                    let force = fs.min(required.abs()) * required.signum();
+                    branch = if fs < required.abs() { Branch::Slide } else { Branch::Clipped };
+                    for i in 0..2 {
+                        xm[i] = free[i] + self.gam_m[i * 2 + 1] * force;
+                    }
+                    stuck = false;
+                }
+                tape.steps.push(Step { xe0, xm0, vr, npre, branch, req_sign: required.signum() });
+            }
+            out.push(self.k * xm[0] + self.c * (v - xm[1]));
+        }
+        out
+    }
+
+    /// Adds to `ubar` the gradient of Σ_n f̄[n]·F[n] with respect to the
+    /// actuation, for the forward pass recorded in `tape`.
+    pub fn backward(&self, tape: &Tape, fbar: &[f64], ubar: &mut [f64]) {
+        let (mut bxe, mut bfl, mut bxm) = ([0.0; NE], 0.0, [0.0; 2]);
+        let ds_df = self.gam_m[2 * 2 + 1];
+        for n in (0..tape.samples.len()).rev() {
+            let (a, clamped) = tape.samples[n];
+            let v = tape.velocity[n];
+            let _ = v;
+            bxm[0] += self.k * fbar[n];
+            bxm[1] -= self.c * fbar[n];
+            let mut bvcmd = 0.0;
+            for j in (0..self.sub).rev() {
+                let s = &tape.steps[n * self.sub + j];
+                // (5) contact step.
+                let mut bn = 0.0;
+                let mut bxm0 = [0.0; 2];
+                match s.branch {
+                    Branch::Stuck => {
+                        bxm0[0] = bxm[0];
+                    }
+                    Branch::Slide | Branch::Clipped => {
+                        let bforce = bxm[0] * self.gam_m[1] + bxm[1] * self.gam_m[3];
+                        let mut bfree = [bxm[0], bxm[1], 0.0];
+                        if s.branch == Branch::Clipped {
+                            bfree[2] += -bforce / ds_df;
+                        } else {
+                            let w = s.xm0[1].abs();
+                            let nf = s.npre.max(0.0);
+                            if self.slide(w, nf) > 0.0 {
+                                let (dw, dn) = self.slide_grad(w, nf);
+                                bn += bforce * s.req_sign * dn;
+                                bxm0[1] += bforce * s.req_sign * dw * s.xm0[1].signum();
+                            }
+                        }
+                        for (jj, b) in bxm0.iter_mut().enumerate() {
+                            for (i, bf) in bfree.iter().enumerate() {
+                                *b += bf * self.phi_m[i * 3 + jj];
+                            }
+                        }
+                    }
+                }
+                bxm = bxm0;
+                // (3) N = max(0, F_n + F_l).
+                if s.npre > 0.0 {
+                    bfl += bn;
+                }
+                // (2) lag and square law.
+                let bfe = (1.0 - a) * bfl;
+                bfl *= a;
+                let mut bxe1 = bxe;
+                bxe1[electrical::GAP] += bfe * 2.0 * self.ke * s.vr;
+                bxe1[electrical::RELAX] -= bfe * 2.0 * self.ke * s.vr;
+                // (1) circuit.
+                let mut b0 = [0.0; NE];
+                for (i, bi) in bxe1.iter().enumerate() {
+                    for (jj, b) in b0.iter_mut().enumerate() {
+                        *b += bi * self.phi_e[i * NE + jj];
+                    }
+                    bvcmd += bi * self.gam_e[i];
+                }
+                bxe = b0;
+                let _ = s.xe0;
+            }
+            if !clamped {
+                ubar[n] += bvcmd * self.gain;
+            }
+        }
+    }
+}
+
+/// The force sensor's twin: resonance (exact map, substeps), direction
+/// bias, full-scale clip and quantization, noise off.
+#[derive(Debug, Clone)]
+pub struct SensorTwin {
+    sub: usize,
+    phi: Vec<f64>,
+    gam: Vec<f64>,
+    bias_right: f64,
+    bias_left: f64,
+    a_bias: f64,
+    lsb: f64,
+    full_scale: f64,
+}
+
+impl SensorTwin {
+    /// The twin of `sim.forcesensor` on `profile` at `rate` Hz with `substeps`.
+    pub fn new(profile: &LabProfile, rate: f64, substeps: usize) -> Result<Self, String> {
+        profile.validate()?;
+        let s = &profile.sensor;
+        let h = 1.0 / rate;
+        let sub = substeps.max(1);
+        let w = 2.0 * std::f64::consts::PI * s.resonance_hz;
+        let (phi, gam) = zoh(&[0.0, 1.0, -w * w, -2.0 * s.damping_ratio * w], &[0.0, w * w], 2, 1, h / sub as f64)
+            .ok_or("the sensor's matrix exponential is not finite")?;
+        Ok(Self {
+            sub,
+            phi,
+            gam,
+            bias_right: s.bias_right_n,
+            bias_left: s.bias_left_n,
+            a_bias: (-h / s.bias_time_s).exp(),
+            lsb: 2.0 * s.full_scale_n / 2f64.powi(s.bits as i32),
+            full_scale: s.full_scale_n,
+        })
+    }
+
+    /// The acquired force for surface force `f` and velocity `v`; `pass`
+    /// marks the samples whose derivative passes (not clipped).
+    pub fn forward(&self, f: &[f64], velocity: &[f64], pass: &mut Vec<bool>) -> Vec<f64> {
+        pass.clear();
+        let (mut x, mut bias, mut dir) = ([0.0; 2], 0.0, 0i8);
+        let mut out = Vec::with_capacity(f.len());
+        for n in 0..f.len() {
+            let fi = if f[n].is_finite() { f[n] } else { 0.0 };
+            let v = if velocity[n].is_finite() { velocity[n] } else { 0.0 };
+            if v > evflow_nodes::lab::sensor_model::V_DIR {
+                dir = 1;
+            } else if v < -evflow_nodes::lab::sensor_model::V_DIR {
+                dir = -1;
+            }
+            let target = match dir {
+                1 => self.bias_right,
+                -1 => self.bias_left,
+                _ => 0.0,
+            };
+            bias = target + (bias - target) * self.a_bias;
+            for _ in 0..self.sub {
+                let mut y = [0.0; 2];
+                matvec(&self.phi, &x, 2, 2, &mut y);
+                x = [y[0] + self.gam[0] * fi, y[1] + self.gam[1] * fi];
+            }
+            let raw = x[0] + bias;
+            let y = raw.clamp(-self.full_scale, self.full_scale - self.lsb);
+            pass.push(y == raw);
+            out.push((y / self.lsb).round() * self.lsb);
+        }
+        out
+    }
+
+    /// The gradient with respect to the surface force of Σ ȳ[n]·y[n]
+    /// (quantization passed straight through, clipped samples 0).
+    pub fn backward(&self, pass: &[bool], ybar: &[f64]) -> Vec<f64> {
+        let mut fbar = vec![0.0; ybar.len()];
+        let mut bx = [0.0; 2];
+        for n in (0..ybar.len()).rev() {
+            if pass[n] {
+                bx[0] += ybar[n];
+            }
+            for _ in 0..self.sub {
+                // x' = Φx + Γf: x̄ ← Φᵀx̄', f̄ += Γ·x̄'.
+                fbar[n] += self.gam[0] * bx[0] + self.gam[1] * bx[1];
+                bx = [self.phi[0] * bx[0] + self.phi[2] * bx[1], self.phi[1] * bx[0] + self.phi[3] * bx[1]];
+            }
+        }
+        fbar
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use evflow_nodes::lab::display_model::DisplayModel;
+    use evflow_nodes::lab::integrator::Method;
+    use evflow_nodes::lab::sensor_model::SensorModel;
+    use evflow_nodes::lab::tribometer_model::TribometerModel;
+
+    /// Every profile shipped in graphs/lab (new ones included as they come).
+    fn shipped() -> Vec<(String, LabProfile)> {
+        let dir = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../graphs/lab");
+        let mut files: Vec<_> = std::fs::read_dir(&dir).unwrap().filter_map(|e| e.ok().map(|e| e.path())).collect();
+        files.sort();
+        files
+            .into_iter()
+            .filter(|p| p.extension().is_some_and(|e| e == "toml"))
+            .map(|p| (p.file_stem().unwrap().to_string_lossy().into_owned(), LabProfile::load(&p).unwrap()))
+            .collect()
+    }
+
+    fn pass(profile: &LabProfile, mass_g: f64, speed: f64) -> (Vec<f64>, Vec<f64>) {
+        let mut t = TribometerModel::new(profile, 1000.0, speed * 1e-2, mass_g * 1e-3, 1, Method::Exact, 4).unwrap();
+        let n = t.total_samples().unwrap() as usize;
+        let (mut load, mut vel) = (Vec::with_capacity(n), Vec::with_capacity(n));
+        for _ in 0..n {
+            let (_, v, l) = t.step();
+            vel.push(v);
+            load.push(l);
+        }
+        (load, vel)
+    }
+
+    fn actuation(n: usize) -> Vec<f64> {
+        let mut r = evflow_nodes::rng::Rng::new(4);
+        (0..n).map(|k| if k % 2 == 0 { 0.6 } else { -0.6 } * (1.0 + 0.4 * (2.0 * r.uniform() - 1.0))).collect()
+    }
+
+    #[test]
+    fn the_twins_are_the_lab_models_with_their_noise_off() {
+        for (name, profile) in shipped() {
+            let (load, vel) = pass(&profile, 85.0, 5.0);
+            let u = actuation(load.len());
+            let twin = DisplayTwin::new(&profile, 1000.0, 4).unwrap();
+            let mut tape = Tape::default();
+            let f = twin.forward(&u, &load, &vel, &mut tape);
+            let mut model = DisplayModel::new(&profile, 1000.0, Method::Exact, 4, 0.0, 1).unwrap();
+            let sensor = SensorTwin::new(&profile, 1000.0, 4).unwrap();
+            let mut sm = SensorModel::new(&profile, 1000.0, Method::Exact, 4, 0.0, 1).unwrap();
+            let mut passed = Vec::new();
+            let y = sensor.forward(&f, &vel, &mut passed);
+            for n in 0..u.len() {
+                let want = model.step(u[n], load[n], vel[n]);
+                assert!(
+                    (f[n] - want).abs() <= 1e-12 * want.abs().max(1e-3),
+                    "{name} display n {n}: {} vs {want}",
+                    f[n]
+                );
+                let ys = sm.step(want, vel[n]);
+                assert!((y[n] - ys).abs() <= sensor.lsb * 1.001, "{name} sensor n {n}: {} vs {ys}", y[n]);
+            }
+        }
+    }
+
+    #[test]
+    fn the_gradient_matches_central_differences() {
+        for (name, profile) in shipped() {
+            let (load, vel) = pass(&profile, 60.0, 3.0);
+            let n = 900; // dwell, start and the first part of the constant speed
+            let (load, vel) = (&load[..n], &vel[..n]);
+            let u = actuation(n);
+            let twin = DisplayTwin::new(&profile, 1000.0, 4).unwrap();
+            let mut r = evflow_nodes::rng::Rng::new(8);
+            let fbar: Vec<f64> = (0..n).map(|_| r.gaussian()).collect();
+            let mut tape = Tape::default();
+            twin.forward(&u, load, vel, &mut tape);
+            let mut g = vec![0.0; n];
+            twin.backward(&tape, &fbar, &mut g);
+            let obj = |u: &[f64]| {
+                let mut t = Tape::default();
+                twin.forward(u, load, vel, &mut t).iter().zip(&fbar).map(|(a, b)| a * b).sum::<f64>()
+            };
+            let h = 1e-6;
+            for k in [700, 750, 800, 850, 890] {
+                let (mut a, mut b) = (u.clone(), u.clone());
+                a[k] += h;
+                b[k] -= h;
+                let fd = (obj(&a) - obj(&b)) / (2.0 * h);
+                assert!((fd - g[k]).abs() < 1e-4 * (fd.abs() + 1e-3), "{name} u[{k}]: {} vs {fd}", g[k]);
+            }
+        }
+    }
+
+    #[test]
+    fn the_sensor_adjoint_satisfies_the_inner_product_identity() {
+        let profile = LabProfile::default();
+        let s = SensorTwin::new(&profile, 1000.0, 4).unwrap();
+        let mut r = evflow_nodes::rng::Rng::new(2);
+        let n = 500;
+        let f: Vec<f64> = (0..n).map(|_| 0.01 * r.gaussian()).collect();
+        let ybar: Vec<f64> = (0..n).map(|_| r.gaussian()).collect();
+        let vel = vec![0.05; n];
+        let mut pass = Vec::new();
+        // Linear part only: the response to f minus the response to 0 (bias).
+        let y1 = s.forward(&f, &vel, &mut pass);
+        let y0 = s.forward(&vec![0.0; n], &vel, &mut pass);
+        let lhs: f64 = y1.iter().zip(&y0).zip(&ybar).map(|((a, b), c)| (a - b) * c).sum();
+        let fbar = s.backward(&pass, &ybar);
+        let rhs: f64 = f.iter().zip(&fbar).map(|(a, b)| a * b).sum();
+        // Quantization (0.37 mN steps) bounds the agreement.
+        assert!((lhs - rhs).abs() < 0.02 * lhs.abs().max(rhs.abs()), "{lhs} vs {rhs}");
+    }
+}

@@ -6,13 +6,8 @@ use std::path::PathBuf;
 #[derive(Debug, thiserror::Error)]
 pub enum StudyError {
     /// A graph that could not be loaded or run.
-    #[error("{file}: {message}")]
-    Graph {
-        /// The graph file.
-        file: PathBuf,
-        /// What went wrong.
-        message: String,
-    },
+    #[error(transparent)]
+    Graph(#[from] crate::graphs::GraphError),
     /// A file or folder that cannot be read or written.
     #[error("{path}: {message}")]
     Io {

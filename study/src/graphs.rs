@@ -1,10 +1,32 @@
 //! Running the shipped graphs from a study: load with the node library and
 //! typed overrides ([`Sets`], what `--set` gives the engine), plan, run
-//! offline, keep the report.
+//! offline, keep the report — the one way every study runs a graph.
+//!
+//! [`run_graph`] and [`run_graph_for`] run a graph file into an output
+//! folder; [`read`] and [`run`] let a study add probes to a graph (e.g. a
+//! reference node and an `error` sink) before running it, and run it with no
+//! output folder at all when it writes nothing.
 
-use super::StudyError;
-use evflow_engine::{load_file, run_offline, Override, Plan, PlanOptions, RunMode, RunOptions, RunReport, Value};
-use std::path::Path;
+use evflow_engine::{
+    check, read_graph, run_offline, Graph, Override, Plan, PlanOptions, RunMode, RunOptions, RunReport, Value,
+};
+use std::path::{Path, PathBuf};
+
+/// Why a graph could not be loaded or run, or did not report what a study reads.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+#[error("{file}: {message}")]
+pub struct GraphError {
+    /// The graph file.
+    pub file: PathBuf,
+    /// What went wrong.
+    pub message: String,
+}
+
+impl GraphError {
+    fn new(file: &Path, message: String) -> Self {
+        Self { file: file.to_path_buf(), message }
+    }
+}
 
 /// The values a study sets on a graph (`name` for a `[vars]` variable,
 /// `node.param` for a parameter), typed: what `--set name=value` gives
@@ -53,6 +75,11 @@ impl Sets {
         self.with(key, Value::FloatList(v.to_vec()))
     }
 
+    /// A list of words (e.g. the scenes of a mesh node).
+    pub fn words(self, key: &str, v: &[&str]) -> Self {
+        self.with(key, Value::TextList(v.iter().map(|w| w.to_string()).collect()))
+    }
+
     /// These values, then `more`'s (a later value for the same key wins).
     pub fn and(mut self, more: Sets) -> Self {
         self.0.extend(more.0);
@@ -71,20 +98,44 @@ impl Sets {
 }
 
 /// Runs the graph `file` with `sets` to its end, its outputs written under `out`.
-pub fn run_graph(file: &Path, sets: &Sets, out: &Path) -> Result<RunReport, StudyError> {
+pub fn run_graph(file: &Path, sets: &Sets, out: &Path) -> Result<RunReport, GraphError> {
     run_graph_for(file, sets, out, None)
 }
 
 /// [`run_graph`] for `duration` seconds instead of the graph's own.
-pub fn run_graph_for(file: &Path, sets: &Sets, out: &Path, duration: Option<f64>) -> Result<RunReport, StudyError> {
-    let err = |m: String| StudyError::Graph { file: file.to_path_buf(), message: m };
-    let checked = load_file(file, &evflow_nodes::registry(), sets.overrides()).map_err(|e| err(e.to_string()))?;
-    std::fs::create_dir_all(out).map_err(|e| StudyError::Io { path: out.to_path_buf(), message: e.to_string() })?;
+pub fn run_graph_for(file: &Path, sets: &Sets, out: &Path, duration: Option<f64>) -> Result<RunReport, GraphError> {
+    run(&read(file)?, sets, Some(out), duration)
+}
+
+/// Reads and parses the graph file `file` (to add probes to it before [`run`]).
+pub fn read(file: &Path) -> Result<Graph, GraphError> {
+    read_graph(file).map_err(|e| GraphError::new(file, e.to_string()))
+}
+
+/// `graph` without its node `node` and every connection to or from it
+/// (e.g. a sink that writes a file a study does not need).
+pub fn without(mut graph: Graph, node: &str) -> Graph {
+    graph.nodes.retain(|n| n.name != node);
+    graph.connections.retain(|c| c.from.node != node && c.to.node != node);
+    graph
+}
+
+/// Checks `graph` with the node library and `sets`, plans it with node
+/// timing on and runs it offline for `duration` s (its own length if
+/// `None`). Its outputs go under `out` (created); with `None` the run has no
+/// output folder, for a graph that writes nothing.
+pub fn run(graph: &Graph, sets: &Sets, out: Option<&Path>, duration: Option<f64>) -> Result<RunReport, GraphError> {
+    let file = graph.file.as_path();
+    let err = |e: String| GraphError::new(file, e);
+    let checked = check(graph, &evflow_nodes::registry(), sets.overrides()).map_err(|e| err(e.to_string()))?;
+    if let Some(out) = out {
+        std::fs::create_dir_all(out).map_err(|e| err(format!("{}: {e}", out.display())))?;
+    }
     let opts = PlanOptions {
         max_block: 1024,
         seed: None,
         base_dir: None,
-        out_dir: Some(out.to_path_buf()),
+        out_dir: out.map(Path::to_path_buf),
         timing: true,
         mode: RunMode::Offline,
         check_only: false,
@@ -93,12 +144,23 @@ pub fn run_graph_for(file: &Path, sets: &Sets, out: &Path, duration: Option<f64>
     run_offline(&mut plan, RunOptions { duration, ..RunOptions::default() }).map_err(|e| err(e.to_string()))
 }
 
-/// The value `name` that node `node` reported in run `r`.
-pub fn value(r: &RunReport, file: &Path, node: &str, name: &str) -> Result<f64, StudyError> {
-    r.value(node, name).ok_or_else(|| StudyError::Graph {
-        file: file.to_path_buf(),
-        message: format!("the run reported no `{node}.{name}`"),
-    })
+/// The value `name` that node `node` reported in run `r` of the graph `file`.
+pub fn value(r: &RunReport, file: &Path, node: &str, name: &str) -> Result<f64, GraphError> {
+    r.value(node, name).ok_or_else(|| GraphError::new(file, format!("the run reported no `{node}.{name}`")))
+}
+
+/// The processing time of `nodes` together per base tick of run `r`, s.
+pub fn seconds_per_tick(r: &RunReport, file: &Path, nodes: &[&str]) -> Result<f64, GraphError> {
+    let mut total = 0.0;
+    for node in nodes {
+        let t = r
+            .times
+            .iter()
+            .find(|t| t.node == *node)
+            .ok_or_else(|| GraphError::new(file, format!("no time for node `{node}` (timing off?)")))?;
+        total += t.process.as_secs_f64();
+    }
+    Ok(total / r.ticks.max(1) as f64)
 }
 
 #[cfg(test)]

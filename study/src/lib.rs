@@ -21,6 +21,7 @@
 #![deny(missing_docs)]
 
 pub mod figure;
+pub mod graphs;
 pub mod precision;
 pub mod tables;
 
@@ -38,8 +39,6 @@ pub mod floor;
 pub mod forces_first;
 #[cfg(feature = "synth")]
 pub mod gains;
-#[cfg(feature = "synth")]
-pub mod graphs;
 #[cfg(feature = "synth")]
 pub mod grid_plan;
 #[cfg(feature = "synth")]

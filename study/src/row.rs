@@ -7,6 +7,7 @@ use super::models::Models;
 use super::recordings::{self, playback_range};
 use super::setup::{Cond, Profile};
 use super::StudyError;
+use evflow_engine::RunReport;
 use std::path::{Path, PathBuf};
 
 /// A synthesis method.
@@ -258,9 +259,21 @@ pub fn run(i: &RowInputs<'_>) -> Result<Row, StudyError> {
 /// Runs graphs/synthesize-optimized.toml for the row; returns the actuation
 /// recording and the synthesis time.
 pub fn optimize(i: &RowInputs<'_>) -> Result<(PathBuf, f64), StudyError> {
+    let (u, r) = optimize_run(i)?;
+    Ok((u, value(&r, &optimize_graph(i.graphs), "opt", "seconds")?))
+}
+
+/// The graph [`optimize`] runs, in the shipped graphs' folder `graphs`.
+pub fn optimize_graph(graphs: &Path) -> PathBuf {
+    graphs.join("synthesize-optimized.toml")
+}
+
+/// [`optimize`] with the whole run's report (node `opt` reports the
+/// optimizer's objective, iterations, evaluations and seconds).
+pub fn optimize_run(i: &RowInputs<'_>) -> Result<(PathBuf, RunReport), StudyError> {
     let c = i.cond;
     std::fs::create_dir_all(&i.dir).map_err(|e| StudyError::Io { path: i.dir.clone(), message: e.to_string() })?;
-    let graph = i.graphs.join("synthesize-optimized.toml");
+    let graph = optimize_graph(i.graphs);
     let sets = Sets::new()
         .path("recordings", i.recordings)
         .text("sample", i.sample)
@@ -271,5 +284,5 @@ pub fn optimize(i: &RowInputs<'_>) -> Result<(PathBuf, f64), StudyError> {
         .text("objective", i.objective)
         .flag("record_time", true);
     let r = run_graph(&graph, &sets, &i.dir)?;
-    Ok((i.dir.join(format!("u-{}-{}", i.sample, c.tag())), value(&r, &graph, "opt", "seconds")?))
+    Ok((i.dir.join(format!("u-{}-{}", i.sample, c.tag())), r))
 }

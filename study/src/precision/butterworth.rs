@@ -100,6 +100,7 @@ pub fn curve(size: Size) -> Result<Curve, PrecisionError> {
         cost_unit: "second of signal".into(),
         reference: "analog Butterworth H(jω) per tone (exact)".into(),
         reference_error: 0.0,
+        baseline: None,
         default: format!("f_s = {DEFAULT_RATIO} f_c"),
         points,
     })

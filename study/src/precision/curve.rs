@@ -37,6 +37,9 @@ pub struct Curve {
     /// The reference's own error (0 for an exact one; else measured
     /// against a still finer reference).
     pub reference_error: f64,
+    /// The error with the computation left out, where that means something
+    /// (e.g. the display with no actuation); every setting should beat it.
+    pub baseline: Option<f64>,
     /// The setting of the shipped default (one point's `setting`).
     pub default: String,
     /// Every setting measured, in the order measured.
@@ -219,6 +222,7 @@ mod tests {
             cost_unit: "sample".into(),
             reference: "exact".into(),
             reference_error: 0.0,
+            baseline: None,
             default: "d".into(),
             points: sample(),
         };

@@ -85,6 +85,7 @@ pub fn curve(size: Size) -> Result<Curve, PrecisionError> {
         cost_unit: "output sample".into(),
         reference: "the in-band tones at the output instants (exact)".into(),
         reference_error: 0.0,
+        baseline: None,
         default,
         points,
     })

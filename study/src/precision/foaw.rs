@@ -99,6 +99,7 @@ pub fn curve(size: Size) -> Result<Curve, PrecisionError> {
         cost_unit: "position sample".into(),
         reference: "the trajectories' analytic velocity (exact)".into(),
         reference_error: 0.0,
+        baseline: None,
         default: Estimator::Foaw(Fit::Best, NOISE, DEFAULT_WINDOW).label(),
         points,
     })

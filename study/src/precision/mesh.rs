@@ -45,6 +45,7 @@ pub fn curve(size: Size) -> Result<Curve, PrecisionError> {
         cost_unit: "tick".into(),
         reference: "the analytic Gaussian surface (exact)".into(),
         reference_error: 0.0,
+        baseline: None,
         default: format!("{}, {} cells", DEFAULT.1, DEFAULT.0),
         points,
     })

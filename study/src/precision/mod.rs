@@ -5,18 +5,27 @@
 //! and one summary [`table::Row`] — the default's error and cost, and the
 //! cheapest setting within 10 % of the best error.
 //!
-//! The computations reuse the code of the reports that drew them first
-//! (`report resample`, `foaw`, `mesh`, the graph `lab-work-precision.toml`).
+//! The computations reuse the code of the reports and studies that drew
+//! them first (`report resample`, `foaw`, `mesh`, `narx`, the texture and
+//! live studies, the graph `lab-work-precision.toml`); graphs run through
+//! [`crate::graphs`] with typed values.
 
 pub mod butterworth;
 pub mod curve;
 pub mod decimate;
 pub mod foaw;
-pub mod graph;
 #[cfg(feature = "lab")]
 pub mod integrators;
 #[cfg(feature = "mesh")]
+pub mod live_mesh;
+#[cfg(feature = "synth")]
+pub mod live_texture;
+#[cfg(feature = "mesh")]
 pub mod mesh;
+#[cfg(feature = "synth")]
+pub mod narx;
+#[cfg(feature = "synth")]
+pub mod optimize;
 #[cfg(feature = "texture")]
 pub mod resample;
 pub mod table;
@@ -24,7 +33,8 @@ pub mod table;
 pub mod volterra;
 
 pub use curve::{Curve, WorkPoint};
-use std::path::Path;
+use std::path::{Path, PathBuf};
+use std::sync::atomic::{AtomicUsize, Ordering};
 use std::time::Instant;
 
 /// How much each curve measures.
@@ -62,20 +72,18 @@ pub enum PrecisionError {
     #[error("{0}")]
     Method(String),
     /// A graph could not be loaded or run.
-    #[error("{file}: {message}")]
-    Graph {
-        /// The graph file.
-        file: String,
-        /// What went wrong.
-        message: String,
-    },
+    #[error(transparent)]
+    Graph(#[from] crate::graphs::GraphError),
+    /// A study the curve runs failed.
+    #[error("{0}")]
+    Study(String),
     /// `--only` named no computation.
     #[error("no computation `{0}`; the computations are: {list}", list = names().join(", "))]
     Unknown(String),
 }
 
 /// The computations, in the report's order. Each gives one curve, except
-/// `lab`, which gives one per lab node.
+/// `lab`, which gives one per lab node, and `optimize`, one per lab profile.
 pub fn names() -> Vec<&'static str> {
     let mut v = Vec::new();
     #[cfg(feature = "lab")]
@@ -87,7 +95,9 @@ pub fn names() -> Vec<&'static str> {
     #[cfg(feature = "mesh")]
     v.push("mesh-gradient");
     #[cfg(feature = "synth")]
-    v.push("volterra-memory");
+    v.extend(["volterra-memory", "optimize", "narx", "live-texture"]);
+    #[cfg(feature = "mesh")]
+    v.push("live-mesh");
     v
 }
 
@@ -109,6 +119,14 @@ pub fn run(name: &str, graphs: &Path, size: Size) -> Result<Vec<Curve>, Precisio
         "mesh-gradient" => Ok(vec![mesh::curve(size)?]),
         #[cfg(feature = "synth")]
         "volterra-memory" => Ok(vec![volterra::curve(size)?]),
+        #[cfg(feature = "synth")]
+        "optimize" => optimize::curves(graphs, size),
+        #[cfg(feature = "synth")]
+        "narx" => Ok(vec![narx::curve(graphs, size)?]),
+        #[cfg(feature = "synth")]
+        "live-texture" => Ok(vec![live_texture::curve(graphs, size)?]),
+        #[cfg(feature = "mesh")]
+        "live-mesh" => Ok(vec![live_mesh::curve(graphs, size)?]),
         other => Err(PrecisionError::Unknown(other.to_string())),
     }
 }
@@ -122,4 +140,32 @@ pub fn time_best(repeats: usize, mut f: impl FnMut()) -> f64 {
         best = best.min(t.elapsed().as_secs_f64());
     }
     best
+}
+
+/// A folder for a curve's work files under the system's temporary folder,
+/// removed with everything in it when dropped.
+#[derive(Debug)]
+pub struct Scratch(PathBuf);
+
+impl Scratch {
+    /// A new empty folder, its name starting with `what`.
+    pub fn new(what: &str) -> Result<Self, PrecisionError> {
+        static COUNT: AtomicUsize = AtomicUsize::new(0);
+        let n = COUNT.fetch_add(1, Ordering::Relaxed);
+        let nanos = std::time::SystemTime::now().duration_since(std::time::UNIX_EPOCH).map_or(0, |d| d.subsec_nanos());
+        let dir = std::env::temp_dir().join(format!("evflow-precision-{what}-{}-{n}-{nanos}", std::process::id()));
+        std::fs::create_dir_all(&dir).map_err(|e| PrecisionError::Study(format!("{}: {e}", dir.display())))?;
+        Ok(Self(dir))
+    }
+
+    /// The folder.
+    pub fn path(&self) -> &Path {
+        &self.0
+    }
+}
+
+impl Drop for Scratch {
+    fn drop(&mut self) {
+        let _ = std::fs::remove_dir_all(&self.0);
+    }
 }

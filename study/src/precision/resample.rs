@@ -121,6 +121,7 @@ pub fn curve(size: Size) -> Result<Curve, PrecisionError> {
         cost_unit: "output sample".into(),
         reference: "the tones at the new instants (exact)".into(),
         reference_error: 0.0,
+        baseline: None,
         default: RsMethod::Node(Quality::Balanced).label(),
         points,
     })
@@ -146,6 +147,7 @@ pub fn interp_curve(size: Size) -> Result<Curve, PrecisionError> {
         cost_unit: "output sample".into(),
         reference: "the tones at the new instants (exact)".into(),
         reference_error: 0.0,
+        baseline: None,
         default: RsMethod::Kernel(INTERP_DEFAULT_WIDTH).label(),
         points,
     })

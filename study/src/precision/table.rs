@@ -159,6 +159,7 @@ mod tests {
             cost_unit: "sample".into(),
             reference: "exact".into(),
             reference_error: 0.0,
+            baseline: None,
             default: "b".into(),
             points: vec![pt("a", 1e-2, 1e-8), pt("b", 1e-4, 1e-7), pt("c, fine", 0.95e-4, 1e-6)],
         };

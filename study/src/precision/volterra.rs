@@ -49,6 +49,7 @@ pub fn curve(size: Size) -> Result<Curve, PrecisionError> {
         cost_unit: "sample evaluated".into(),
         reference: "the noiseless simulated lab it models".into(),
         reference_error: 0.0,
+        baseline: None,
         default: format!("memory {DEFAULT_MEMORY}"),
         points,
     })

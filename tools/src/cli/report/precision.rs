@@ -19,10 +19,11 @@ pub struct Args {
     #[arg(long, default_value = "full")]
     size: String,
     /// Run one computation only (lab, butterworth, decimate, resample, interp-kernel, foaw, mesh-gradient,
-    /// volterra-memory).
+    /// volterra-memory, optimize, narx, live-texture, live-mesh).
     #[arg(long)]
     only: Option<String>,
-    /// The folder of the shipped graphs (the lab's curves run lab-work-precision.toml).
+    /// The folder of the shipped graphs (lab-work-precision.toml, synthesize-optimized.toml, model-build.toml,
+    /// texture-live-quality.toml, mesh-live.toml … and the model library data/).
     #[arg(long, default_value = "graphs")]
     graphs: PathBuf,
 }
@@ -33,6 +34,13 @@ fn plot(c: &Curve) -> Plot {
         .into_iter()
         .map(|(name, pts)| Series::line_points(name, pts.iter().map(|p| (p.cost, p.error)).collect()))
         .collect();
+    if let Some(b) = c.baseline {
+        let costs = c.points.iter().map(|p| p.cost).filter(|x| x.is_finite() && *x > 0.0);
+        let (lo, hi) = costs.fold((f64::INFINITY, 0.0_f64), |(lo, hi), x| (lo.min(x), hi.max(x)));
+        if lo <= hi {
+            series.push(Series::line_points("left out (baseline)", vec![(lo, b), (hi, b)]));
+        }
+    }
     if let Some(d) = c.default_point() {
         series.push(Series::points(format!("shipped default: {}", d.setting), vec![(d.cost, d.error)]));
     }

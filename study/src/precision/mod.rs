@@ -104,7 +104,9 @@ pub fn names() -> Vec<&'static str> {
 /// Measures computation `name` (one of [`names`]); `graphs` is the folder
 /// of the shipped graphs.
 pub fn run(name: &str, graphs: &Path, size: Size) -> Result<Vec<Curve>, PrecisionError> {
-    let _ = graphs;
+    // Absolute: the graphs' own paths (recordings, models) are relative to their files.
+    let graphs = &std::fs::canonicalize(graphs)
+        .map_err(|e| PrecisionError::Study(format!("the graphs folder {}: {e}", graphs.display())))?;
     match name {
         #[cfg(feature = "lab")]
         "lab" => integrators::curves(graphs, size),

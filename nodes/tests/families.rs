@@ -44,3 +44,25 @@ fn a_full_build_marks_nothing_absent() {
         }
     }
 }
+
+#[test]
+fn every_family_is_a_folder_and_every_node_names_its_folder() {
+    let src = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("src");
+    let families = evflow_nodes::families();
+    for (folder, specs) in &families {
+        assert!(src.join(folder).join("mod.rs").is_file(), "family `{folder}` is not a folder of nodes/src");
+        for s in *specs {
+            assert_eq!(s.family, *folder, "`{}` names family `{}` but lives in nodes/src/{folder}", s.name, s.family);
+        }
+    }
+    // Every folder that declares nodes is a family.
+    for entry in std::fs::read_dir(&src).unwrap() {
+        let dir = entry.unwrap().path();
+        let declares = std::fs::read_to_string(dir.join("mod.rs")).is_ok_and(|t| t.contains("pub static SPECS"));
+        let name = dir.file_name().unwrap().to_string_lossy().into_owned();
+        assert!(
+            !declares || families.iter().any(|(f, _)| *f == name),
+            "nodes/src/{name} declares nodes but is no family"
+        );
+    }
+}

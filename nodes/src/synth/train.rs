@@ -16,7 +16,7 @@ use std::time::Instant;
 /// Declaration of `forward.train`.
 pub static SPEC: NodeSpec = NodeSpec::new(
     "forward.train",
-    "models",
+    "synth",
     Role::Sink,
     "Identifies a forward model of the display (actuation → force, a second-order Volterra NFIR) and writes the model file at the end.",
     build,

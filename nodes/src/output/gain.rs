@@ -2,7 +2,8 @@
 
 use evflow_engine::node::Constant;
 use evflow_engine::spec::FoldArgs;
-use evflow_engine::{BuildContext, Io, Node, NodeError, NodeSpec, ParamSpec, Params, PortSpec, Refused, Role};
+use evflow_engine::typed_params::Float;
+use evflow_engine::{BuildContext, Io, Node, NodeError, NodeSpec, Params, PortSpec, Refused, Role};
 
 /// Declaration of `gain`.
 pub static SPEC: NodeSpec =
@@ -21,16 +22,18 @@ pub static SPEC: NodeSpec =
          only this node. A live plan never folds on `gain`, which may change while it runs.",
         )
         .ports(&[PortSpec::input("in", "1", "signal"), PortSpec::output("out", "1", "signal × gain")])
-        .params(&[
-            ParamSpec::float("gain", -1e6, 1e6, 1.0, "1", "multiplier").live(),
-            ParamSpec::float("ramp", 0.0, 10.0, 0.01, "s", "time a live change of `gain` takes"),
-        ])
+        .params(&[GAIN.spec(), RAMP.spec()])
         .example("gain = 1.2")
         .fold(fold);
 
+/// `gain`: the multiplier, changeable live.
+const GAIN: Float = Float::new("gain", -1e6, 1e6, 1.0, "1", "multiplier").live();
+/// `ramp`: how long a live change takes.
+const RAMP: Float = Float::new("ramp", 0.0, 10.0, 0.01, "s", "time a live change of `gain` takes");
+
 /// Constant when the gain is 0 (inputs are finite), or of a constant input.
 fn fold(f: &FoldArgs<'_>) -> Option<Constant> {
-    let g = f.f64("gain")?;
+    let g = f.f64(GAIN.name())?;
     if g == 0.0 {
         return Some(Constant::all(1, 0.0, "gain = 0"));
     }
@@ -49,8 +52,8 @@ struct Gain {
 }
 
 fn build(p: &Params, ctx: &BuildContext) -> Result<Box<dyn Node>, NodeError> {
-    let g = p.f64("gain");
-    let ramp_samples = (p.f64("ramp") * ctx.rate).round().max(1.0) as u64;
+    let g = GAIN.get(p);
+    let ramp_samples = (RAMP.get(p) * ctx.rate).round().max(1.0) as u64;
     Ok(Box::new(Gain { initial: g, gain: g, target: g, delta: 0.0, left: 0, ramp_samples }))
 }
 
@@ -80,7 +83,7 @@ impl Node for Gain {
     }
 
     fn set(&mut self, param: &'static str, value: f64) -> Result<(), Refused> {
-        if param != "gain" {
+        if param != GAIN.name() {
             return Err(Refused(param));
         }
         self.target = value;

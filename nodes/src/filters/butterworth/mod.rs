@@ -4,7 +4,8 @@ pub mod design;
 pub mod sos;
 
 use design::{butterworth, DesignError, Kind, MIN_RELATIVE_CUTOFF};
-use evflow_engine::{BuildContext, Io, Node, NodeError, NodeSpec, ParamSpec, Params, PortSpec, Role};
+use evflow_engine::typed_params::{Choice, Float, Int};
+use evflow_engine::{BuildContext, Io, Node, NodeError, NodeSpec, Params, PortSpec, Role};
 use sos::Cascade;
 
 /// Declaration of `butterworth`.
@@ -41,23 +42,25 @@ pub static SPEC: NodeSpec = NodeSpec::new(
      cut-offs of 0.01 Hz and 499 Hz at 1 kHz.",
 )
 .ports(&[PortSpec::input("in", "1", "signal"), PortSpec::output("out", "1", "filtered signal")])
-.params(&[
-    ParamSpec::choice("kind", &["lowpass", "highpass"], "lowpass", "which band passes"),
-    ParamSpec::int("order", 1, design::MAX_ORDER as i64, 4, "1", "filter order (roll-off 6·order dB per octave)"),
-    ParamSpec::float("cutoff", 0.001, f64::INFINITY, 10.0, "Hz", "−3 dB frequency; below half the input's rate")
-        .required(),
-])
+.params(&[KIND.spec(), ORDER.spec(), CUTOFF.spec()])
 .example("kind = \"highpass\"\norder = 4\ncutoff = 10.0");
+
+/// `kind`: which band passes.
+const KIND: Choice<Kind> =
+    Choice::new("kind", &["lowpass", "highpass"], &[Kind::Lowpass, Kind::Highpass], "lowpass", "which band passes");
+/// `order`: the roll-off.
+const ORDER: Int =
+    Int::new("order", 1, design::MAX_ORDER as i64, 4, "1", "filter order (roll-off 6·order dB per octave)");
+/// `cutoff`: the −3 dB frequency.
+const CUTOFF: Float =
+    Float::new("cutoff", 0.001, f64::INFINITY, 10.0, "Hz", "−3 dB frequency; below half the input's rate").required();
 
 struct Butterworth {
     cascade: Cascade,
 }
 
 fn build(p: &Params, ctx: &BuildContext) -> Result<Box<dyn Node>, NodeError> {
-    let kind = Kind::from_name(p.str("kind"))
-        .ok_or_else(|| NodeError::param("kind", format!("`{}` is neither `lowpass` nor `highpass`", p.str("kind"))))?;
-    let order = p.usize("order");
-    let cutoff = p.f64("cutoff");
+    let (kind, order, cutoff) = (KIND.get(p), ORDER.count(p), CUTOFF.get(p));
     let sections = butterworth(kind, order, cutoff, ctx.rate).map_err(|e| match e {
         DesignError::Order(_) => NodeError::param("order", e.to_string()),
         DesignError::Rate(_) => NodeError::Other(e.to_string()),

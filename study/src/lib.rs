@@ -6,3 +6,6 @@
 //! prints); the CLI, the tests and the benchmarks share it
 //! (docs/architecture.md).
 #![deny(missing_docs)]
+
+/// `evflow report stability`: extreme and stiff cases over every node type.
+pub mod stability;

@@ -467,7 +467,12 @@ fn mesh_cases(v: &mut Vec<Case>, env: &Env) {
 /// jump over one sample).
 fn foaw_cases(v: &mut Vec<Case>, env: &Env) {
     let foaw = spec("foaw");
-    let n = env.size.long_run() as usize / 2;
+    // A resting finger keeps every window at its longest: the estimator's
+    // cost per sample grows with max_window² (see docs/numerics.md).
+    let n = match env.size {
+        super::Size::Ci => 2000,
+        super::Size::Full => 10_000,
+    };
     for fit in ["best", "end"] {
         v.push(case(
             &format!("foaw · resting finger ({fit} fit)"),

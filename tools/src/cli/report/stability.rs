@@ -36,6 +36,8 @@ pub fn main(a: Args) -> Result<()> {
     let rows = stability::run(&env, &a.only, &mut |r| {
         if !r.verdict.passed() {
             eprintln!("FAIL {}: {}", r.case, r.verdict.text());
+        } else if r.seconds > 10.0 {
+            eprintln!("slow {}: {:.0} s", r.case, r.seconds);
         }
     });
     anyhow::ensure!(!rows.is_empty(), "no case matches `{}`", a.only);

@@ -21,6 +21,7 @@
 #![deny(missing_docs)]
 
 pub mod figure;
+pub mod stability;
 pub mod tables;
 
 #[cfg(feature = "synth")]

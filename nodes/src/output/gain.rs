@@ -11,7 +11,8 @@ pub static SPEC: NodeSpec =
         .doc(
             "y[n] = g · x[n]. Used to scale synthesized actuation signals before the display \
          (the gain sweep 0.6–1.4 of dissertation §5.3.1, Table 5.1; 1.0 corresponds to 100 Vpp \
-         through the amplifier). Runs at the rate of its input.\n\n\
+         through the amplifier). Runs at the rate of its input. A product beyond the range of \
+         f64 saturates at ±f64::MAX instead of becoming infinite.\n\n\
          `gain` changes live (a session's parameter queue): the multiplier then moves linearly \
          from its current value to the new one over `ramp` seconds (round(ramp·rate) samples, at \
          least one), so a change never clicks; a change during a ramp starts a new ramp from where \
@@ -37,7 +38,7 @@ fn fold(f: &FoldArgs<'_>) -> Option<Constant> {
     if g == 0.0 {
         return Some(Constant::all(1, 0.0, "gain = 0"));
     }
-    f.input(0).map(|x| Constant::all(1, g * x, format!("gain {g} × constant input {x}")))
+    f.input(0).map(|x| Constant::all(1, (g * x).clamp(-f64::MAX, f64::MAX), format!("gain {g} × constant input {x}")))
 }
 
 struct Gain {
@@ -62,7 +63,7 @@ impl Node for Gain {
         let (x, y) = io.io(0, 0);
         if self.left == 0 {
             for (y, x) in y.iter_mut().zip(x) {
-                *y = self.gain * x;
+                *y = (self.gain * x).clamp(-f64::MAX, f64::MAX);
             }
             return Ok(());
         }
@@ -71,7 +72,7 @@ impl Node for Gain {
                 self.left -= 1;
                 self.gain = if self.left == 0 { self.target } else { self.gain + self.delta };
             }
-            *y = self.gain * x;
+            *y = (self.gain * x).clamp(-f64::MAX, f64::MAX);
         }
         Ok(())
     }
@@ -135,6 +136,23 @@ mod tests {
         assert!(fold(&FoldArgs::new(&SPEC, &two, &[None], 1, true)).is_none());
         // A plan that takes live changes may not rely on `gain`.
         assert!(fold(&FoldArgs::new(&SPEC, &zero, &[Some(1.0)], 1, false)).is_none());
+    }
+
+    #[test]
+    fn a_product_beyond_f64_saturates() {
+        let y = evflow_engine::harness::Single {
+            spec: &SPEC,
+            params: "gain = -2.0",
+            inputs: vec![("in", vec![f64::MAX, 1e300, -f64::MAX], 1000.0)],
+            outputs: vec!["out"],
+            base_rate: 1000.0,
+            ticks: 3,
+            block: 2,
+            base_dir: std::path::Path::new("."),
+        }
+        .run()
+        .unwrap();
+        assert_eq!(y[0], [-f64::MAX, -2e300, f64::MAX]);
     }
 
     #[test]

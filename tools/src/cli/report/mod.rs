@@ -14,6 +14,7 @@ pub mod mesh;
 pub mod narx;
 #[cfg(feature = "texture")]
 pub mod resample;
+pub mod stability;
 #[cfg(feature = "synth")]
 pub mod textures;
 
@@ -104,6 +105,16 @@ enum Which {
     /// Example: cargo run --release -p evflow -- report live --out report-live
     #[cfg(feature = "synth")]
     Live(live::Args),
+    /// Numerical stability (issue 26, docs/numerics.md): every node type
+    /// with each numeric parameter at its declared limits and every input
+    /// at ±1e300, ±f64::MAX, subnormals, full-scale steps and impulses and
+    /// a long constant run; the named stiff cases; every shipped graph
+    /// family. Per case the largest |output|, the NaN/Inf count, the
+    /// invariant checked and the verdict; table.md and rows.csv; exit 1
+    /// when a case fails. `--size ci` is the suite CI runs.
+    ///
+    /// Example: cargo run --release -p evflow -- report stability --out report
+    Stability(stability::Args),
 }
 
 /// Writes `plot` to `path` and says so (unlabelled without a font); a plot
@@ -146,5 +157,6 @@ pub fn main(a: ReportArgs) -> anyhow::Result<()> {
         Which::Narx(n) => narx::main(n),
         #[cfg(feature = "synth")]
         Which::Live(l) => live::main(l),
+        Which::Stability(s) => stability::main(s),
     }
 }

@@ -62,7 +62,8 @@ pub(super) fn connect(graph: &Graph, nodes: &[Option<CheckedNode>], sink: &mut S
 impl Wiring {
     /// Reports inputs without a producer and hardware inputs not fed by a
     /// safety guard's first output.
-    pub(super) fn check_inputs(&self, nodes: &[Option<CheckedNode>], sink: &mut Sink) {
+    /// `guards` names the registry's safety guards ([`crate::Registry::guard_words`]).
+    pub(super) fn check_inputs(&self, nodes: &[Option<CheckedNode>], guards: &str, sink: &mut Sink) {
         let producer = &self.producer;
         for (i, n) in nodes.iter().enumerate() {
             let Some(n) = n else { continue };
@@ -87,7 +88,18 @@ impl Wiring {
                             s.spec.safety_guard && s.outputs().next().is_some_and(|o| s.ports[o].name == from.port)
                         });
                         if !guarded {
-                            sink.err(n.loc, Some(&n.name), format!("hardware output `{}.{}` is not fed by a `limit` node", n.name, n.ports[p].name), Some("every signal that reaches hardware must pass a `limit` node (amplitude clamp, slew limit, ramp to zero on faults)".into()));
+                            sink.err(
+                                n.loc,
+                                Some(&n.name),
+                                format!(
+                                    "hardware output `{}.{}` is not fed by a {guards} node",
+                                    n.name, n.ports[p].name
+                                ),
+                                Some(format!(
+                                    "every signal that reaches hardware must pass a {guards} node (amplitude clamp, \
+                                     slew limit, ramp to zero on faults)"
+                                )),
+                            );
                         }
                     }
                 }

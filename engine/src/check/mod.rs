@@ -160,7 +160,7 @@ pub fn check(graph: &Graph, registry: &Registry, overrides: &[Override]) -> Resu
     names::nodes(&graph, &mut sink);
     let nodes = check_nodes(&graph, registry, &mut sink);
     let wiring = connections::connect(&graph, &nodes, &mut sink);
-    wiring.check_inputs(&nodes, &mut sink);
+    wiring.check_inputs(&nodes, &registry.guard_words(), &mut sink);
     let edges = wiring.edges;
 
     if !sink.diags.is_empty() {

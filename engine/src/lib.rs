@@ -28,6 +28,7 @@ pub mod spec;
 pub mod suggest;
 pub mod sweep;
 pub mod sweep_files;
+pub mod typed_params;
 
 pub use check::{check, Checked, Override};
 pub use diag::{Diagnostic, Diagnostics};

@@ -2,11 +2,13 @@
 //! nodes and preallocated buffer slots. Both drivers (offline and live) call
 //! the same [`Plan::step`].
 
-use crate::check::prune::{Folded, Pruning};
+mod build;
+
+use crate::check::prune::Folded;
 use crate::check::{Checked, Pruned};
 use crate::diag::Loc;
-use crate::node::{BuildContext, Io, Node, NodeError, PrepareContext, Refused, RunMode, Summary};
-use crate::rate::{lcm, Ratio};
+use crate::node::{Io, Node, NodeError, Refused, RunMode, Summary};
+use crate::rate::Ratio;
 use crate::spec::NodeSpec;
 use std::path::PathBuf;
 use std::time::{Duration, Instant};
@@ -52,7 +54,7 @@ pub struct PlanOptions {
     pub mode: RunMode,
     /// Built only to be checked (`evflow check`), never run: nodes validate
     /// their files as a run would but may leave out what only running needs
-    /// ([`BuildContext::check_only`]).
+    /// ([`BuildContext::check_only`](crate::node::BuildContext::check_only)).
     pub check_only: bool,
 }
 
@@ -184,217 +186,7 @@ impl Plan {
 
     /// [`Plan::build`] with a choice of [`Folding`].
     pub fn build_with(checked: &Checked, opts: &PlanOptions, folding: Folding) -> Result<Plan, Box<NodeFailure>> {
-        let g = &checked.graph;
-        let base_dir =
-            opts.base_dir.clone().unwrap_or_else(|| g.file.parent().map(|p| p.to_path_buf()).unwrap_or_default());
-        let seed = opts.seed.unwrap_or(g.seed);
-        let fail = |i: usize, error: NodeError| {
-            let n = &checked.nodes[i];
-            Box::new(NodeFailure { file: g.file.clone(), loc: n.loc, node: n.name.clone(), kind: n.spec.name, error })
-        };
-        let takes_changes = folding == Folding::Changes || opts.mode == RunMode::Live;
-        let mut pruning =
-            Pruning::new(checked, !takes_changes, folding != Folding::Off).map_err(|(i, e)| fail(i, e))?;
-
-        // Build, downstream first: a node that turns out constant leaves
-        // out its upstream before that is built.
-        let n_nodes = checked.nodes.len();
-        let mut built: Vec<Option<Box<dyn Node>>> = (0..n_nodes).map(|_| None).collect();
-        let mut setup_of = vec![Duration::ZERO; n_nodes];
-        let mut notes = Vec::new();
-        for &i in checked.order.iter().rev() {
-            if !pruning.needed(i) || pruning.constant(i).is_some() {
-                continue;
-            }
-            let n = &checked.nodes[i];
-            let ctx = BuildContext {
-                node: n.name.clone(),
-                base_rate: g.rate,
-                rate: n.ratio.hz(g.rate),
-                port_rates: n.ports.iter().map(|p| p.ratio.hz(g.rate)).collect(),
-                base_dir: base_dir.clone(),
-                out_dir: opts.out_dir.clone().unwrap_or_default(),
-                seed,
-                check_only: opts.check_only,
-            };
-            let started = Instant::now();
-            let node = (n.spec.build)(&n.params, &ctx).map_err(|e| fail(i, e))?;
-            let constant = if folding == Folding::Off { None } else { node.constant_output() };
-            if opts.timing {
-                setup_of[i] = started.elapsed();
-            }
-            let lines = node.notes();
-            if !lines.is_empty() {
-                notes.push((i, lines));
-            }
-            if let Some(k) = constant {
-                pruning.declare(i, k).map_err(|(j, e)| fail(j, e))?;
-            }
-            if pruning.constant(i).is_none() {
-                built[i] = Some(node);
-            }
-        }
-        let order = pruning.order();
-        notes.retain(|(i, _)| pruning.needed(*i));
-        notes.sort_by_key(|(i, _)| order.iter().position(|j| j == i));
-
-        // Block size: a multiple of every divided rate, within feedback delays.
-        let mut unit = 1u64;
-        for &i in &order {
-            for p in &checked.nodes[i].ports {
-                unit = lcm(unit, p.ratio.div);
-            }
-        }
-        // …and no larger than memory allows: every buffer holds one block of
-        // its port's rate, so a port at many samples per base tick (a fast node
-        // in a graph of a slow base rate) or a huge `--block` would ask for
-        // gigabytes. The block shrinks to fit (down to `unit`); a graph whose
-        // smallest block does not fit is refused, naming the fastest node.
-        let requested = (opts.max_block.max(1) as u64).div_ceil(unit).saturating_mul(unit);
-        let per_tick = |r: &Ratio| if r.div == 1 { r.mul as f64 } else { 1.0 / r.div as f64 };
-        let (mut widest, mut total) = (None::<(usize, f64)>, 0.0);
-        for &i in &order {
-            for p in checked.nodes[i].outputs() {
-                let w = per_tick(&checked.nodes[i].ports[p].ratio);
-                total += w;
-                if widest.is_none_or(|(_, x)| w > x) {
-                    widest = Some((i, w));
-                }
-            }
-        }
-        let fits = |samples_per_tick: f64, limit: usize| {
-            if samples_per_tick > 0.0 {
-                (limit as f64 / samples_per_tick).floor()
-            } else {
-                f64::INFINITY
-            }
-        };
-        let by_memory = fits(widest.map_or(0.0, |w| w.1), MAX_BUFFER_SAMPLES).min(fits(total, MAX_POOL_SAMPLES));
-        let by_memory = (by_memory.min(u64::MAX as f64) as u64) / unit * unit;
-        if by_memory < unit {
-            let (i, w) = widest.unwrap_or((order.first().copied().unwrap_or(0), 0.0));
-            return Err(fail(
-                i,
-                NodeError::Other(format!(
-                    "this node makes {w} samples per base tick of the graph's {} Hz, and the smallest block the \
-                     graph's rates allow is {unit} base ticks: its buffers would need {:.3e} samples, more than the \
-                     {MAX_BUFFER_SAMPLES} (128 MiB) a buffer may hold ({MAX_POOL_SAMPLES} for all); raise [graph] rate",
-                    g.rate,
-                    w * unit as f64
-                )),
-            ));
-        }
-        let mut max_block = requested.min(by_memory);
-
-        // Slots: one per output of each node in the plan.
-        let mut slot_of = vec![Vec::new(); n_nodes];
-        let mut n_slots = 0;
-        for &i in &order {
-            slot_of[i] = checked.nodes[i]
-                .outputs()
-                .map(|_| {
-                    n_slots += 1;
-                    n_slots - 1
-                })
-                .collect();
-        }
-
-        let mut entries = Vec::with_capacity(order.len());
-        let mut late = Vec::new();
-        for &i in &order {
-            let n = &checked.nodes[i];
-            let held = pruning.constant(i).map(|k| k.outputs.clone());
-            let node: Box<dyn Node> = match (&held, built[i].take()) {
-                (None, Some(node)) => node,
-                (None, None) => return Err(fail(i, NodeError::Other("the planner lost this node".into()))),
-                (Some(_), _) => Box::new(Held { takes_changes }),
-            };
-            let mut in_slots = Vec::new();
-            let mut in_ratios = Vec::new();
-            if held.is_none() {
-                for p in n.inputs() {
-                    let e =
-                        checked.edges.iter().find(|e| e.to == (i, p)).expect("validated: every input has a producer");
-                    let out_index = checked.nodes[e.from.0]
-                        .outputs()
-                        .position(|q| q == e.from.1)
-                        .expect("producer port is an output");
-                    in_slots.push(slot_of[e.from.0][out_index]);
-                    in_ratios.push(n.ports[p].ratio);
-                }
-            }
-            let out_ratios: Vec<Ratio> = n.outputs().map(|p| n.ports[p].ratio).collect();
-            let split = held.is_none() && checked.in_cycle.contains(&i);
-            if split {
-                let d = node.cycle_delay() as u64;
-                let limit = if n.ratio.div == 1 { d / n.ratio.mul } else { d * n.ratio.div };
-                if limit < unit {
-                    return Err(fail(i, NodeError::Other(format!("this feedback delay of {d} samples is shorter than the smallest block the graph's rates allow ({unit} base ticks)"))));
-                }
-                max_block = max_block.min(limit / unit * unit);
-                late.push(entries.len());
-            }
-            entries.push(Entry {
-                name: n.name.clone(),
-                kind: n.spec.name,
-                spec: n.spec,
-                out_names: n.outputs().map(|p| n.ports[p].name.clone()).collect(),
-                loc: n.loc,
-                node,
-                ratio: n.ratio,
-                in_lens: vec![0; in_slots.len()],
-                in_slots,
-                in_ratios,
-                out_lens: vec![0; out_ratios.len()],
-                scratch: (0..out_ratios.len()).map(|_| Vec::new()).collect(),
-                out_slots: slot_of[i].clone(),
-                out_ratios,
-                split,
-                held,
-                setup: setup_of[i],
-                elapsed: Duration::ZERO,
-                finishing: Duration::ZERO,
-            });
-        }
-        let cap = |r: &Ratio| if r.div == 1 { max_block * r.mul } else { max_block.div_ceil(r.div) } as usize;
-        let mut pool = vec![Vec::new(); n_slots];
-        for e in &entries {
-            for (s, r) in e.out_slots.iter().zip(&e.out_ratios) {
-                pool[*s] = vec![0.0; cap(r)];
-            }
-        }
-        for (k, e) in entries.iter_mut().enumerate() {
-            if e.held.is_some() {
-                continue;
-            }
-            let largest = e.in_ratios.iter().chain(&e.out_ratios).map(cap).max().unwrap_or(cap(&e.ratio));
-            let started = Instant::now();
-            e.node.prepare(&PrepareContext { max_block: largest, mode: opts.mode }).map_err(|err| {
-                let i = order[k];
-                fail(i, err)
-            })?;
-            if opts.timing {
-                e.setup += started.elapsed();
-            }
-        }
-        let mut plan = Plan {
-            name: g.name.clone(),
-            file: g.file.clone(),
-            base_rate: g.rate,
-            entries,
-            late,
-            pool,
-            tick: 0,
-            max_block: max_block as usize,
-            timing: opts.timing,
-            pruned: pruning.pruned(),
-            folded: pruning.folded(),
-            notes: notes.into_iter().map(|(i, l)| (checked.nodes[i].name.clone(), l)).collect(),
-            duration: g.duration,
-            mode: opts.mode,
-        };
-        plan.hold_constants();
-        Ok(plan)
+        build::build(checked, opts, folding)
     }
 
     /// Fills the output buffers of the nodes replaced by constants.

@@ -6,7 +6,7 @@ use crate::spec::{Direction, NodeSpec, ParamDefault, RateSpec};
 use std::fmt::Write;
 
 /// One node type as Markdown: summary, doc, ports, parameters, example.
-pub fn node_markdown(spec: &NodeSpec) -> String {
+pub fn node_markdown(spec: &NodeSpec, guards: &str) -> String {
     let mut s = String::new();
     let _ = writeln!(s, "## `{}`\n\n{}\n", spec.name, spec.summary);
     if !spec.doc.is_empty() {
@@ -15,7 +15,7 @@ pub fn node_markdown(spec: &NodeSpec) -> String {
     let role = format!("{:?}", spec.role).to_lowercase();
     let mut flags = vec![format!("family `{}`", spec.family), role];
     if spec.hardware {
-        flags.push("drives hardware (must be fed by `limit`)".into());
+        flags.push(format!("drives hardware (must be fed by {guards})"));
     }
     if spec.safety_guard {
         flags.push("safety guard (may feed hardware)".into());
@@ -94,7 +94,7 @@ pub fn reference_markdown(reg: &Registry) -> String {
     for f in &families {
         let _ = writeln!(s, "# {f}\n");
         for spec in reg.specs().filter(|s| s.family == *f) {
-            s.push_str(&node_markdown(spec));
+            s.push_str(&node_markdown(spec, &reg.guard_words()));
         }
     }
     s

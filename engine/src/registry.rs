@@ -42,6 +42,17 @@ impl Registry {
     pub fn absent(&self, name: &str) -> Option<&'static str> {
         self.absent.iter().find(|(n, _)| *n == name).map(|(_, f)| *f)
     }
+    /// The safety guards (specs with `safety_guard`, the only nodes that may
+    /// feed hardware) as messages name them: "`limit`", "`a` or `b`", or
+    /// "safety-guard" when the registry has none.
+    pub fn guard_words(&self) -> String {
+        let names: Vec<String> = self.specs().filter(|s| s.safety_guard).map(|s| format!("`{}`", s.name)).collect();
+        if names.is_empty() {
+            "safety-guard".to_string()
+        } else {
+            names.join(" or ")
+        }
+    }
     /// All type names.
     pub fn names(&self) -> impl Iterator<Item = &'static str> + Clone + '_ {
         self.specs.iter().map(|s| s.name)

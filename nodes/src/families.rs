@@ -2,7 +2,7 @@
 //! types each one holds — so that a graph naming a type of a family this
 //! build left out is told which feature brings it back, instead of
 //! "unknown node type". The lists are checked against the families' own
-//! declarations by this module's test (in a build with every feature).
+//! declarations by `nodes/tests/families.rs` (in a build with every feature).
 
 /// `(cargo feature, node types)` for each optional family.
 pub const OPTIONAL: &[(&str, &[&str])] = &[
@@ -26,51 +26,5 @@ pub fn enabled(name: &str) -> bool {
         "synth" => cfg!(feature = "synth"),
         "serial" => cfg!(feature = "serial"),
         _ => false,
-    }
-}
-
-#[cfg(all(
-    test,
-    feature = "lab",
-    feature = "mesh",
-    feature = "narx",
-    feature = "texture",
-    feature = "synth",
-    feature = "serial"
-))]
-mod tests {
-    use super::*;
-
-    fn names(specs: &[&evflow_engine::NodeSpec]) -> Vec<&'static str> {
-        specs.iter().map(|s| s.name).collect()
-    }
-
-    #[test]
-    fn the_lists_match_the_families_declarations() {
-        let families = [
-            ("lab", names(crate::lab::SPECS)),
-            ("mesh", names(crate::mesh::SPECS)),
-            ("narx", names(crate::narx::SPECS)),
-            ("texture", names(crate::texture::SPECS)),
-            ("synth", names(crate::synth::SPECS)),
-            ("serial", names(crate::serial::SPECS)),
-        ];
-        assert_eq!(families.len(), OPTIONAL.len());
-        for ((feature, declared), (listed_feature, listed)) in families.iter().zip(OPTIONAL) {
-            assert_eq!(feature, listed_feature);
-            assert_eq!(declared, &listed.to_vec(), "family `{feature}`");
-            assert!(enabled(feature));
-        }
-        assert!(!enabled("studio"));
-    }
-
-    #[test]
-    fn a_full_build_marks_nothing_absent() {
-        let reg = crate::registry();
-        for (_, types) in OPTIONAL {
-            for t in *types {
-                assert!(reg.get(t).is_some() && reg.absent(t).is_none(), "{t}");
-            }
-        }
     }
 }

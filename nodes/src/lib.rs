@@ -52,28 +52,43 @@ pub fn registry() -> Registry {
     reg
 }
 
+/// `(folder, declarations)` of the family module `$m`: its name is its folder.
+macro_rules! family {
+    ($m:ident) => {
+        (stringify!($m), $m::SPECS)
+    };
+}
+
+/// Every family of this build, as `(its folder under nodes/src, its node
+/// declarations)`: each declaration names that folder as its family
+/// (`nodes/tests/families.rs` checks it).
+pub fn families() -> Vec<(&'static str, &'static [&'static NodeSpec])> {
+    let mut v = vec![
+        family!(sources),
+        family!(filters),
+        family!(output),
+        family!(safety),
+        family!(recording),
+        family!(metric),
+        family!(math),
+    ];
+    #[cfg(feature = "mesh")]
+    v.push(family!(mesh));
+    v.push(family!(analysis));
+    #[cfg(feature = "lab")]
+    v.push(family!(lab));
+    v.push(family!(rate));
+    #[cfg(feature = "texture")]
+    v.push(family!(texture));
+    v.push(family!(serial));
+    #[cfg(feature = "narx")]
+    v.push(family!(narx));
+    #[cfg(feature = "synth")]
+    v.push(family!(synth));
+    v
+}
+
 /// Every node declaration, family by family.
 pub fn all_specs() -> Vec<&'static NodeSpec> {
-    let mut v = Vec::new();
-    v.extend_from_slice(sources::SPECS);
-    v.extend_from_slice(filters::SPECS);
-    v.extend_from_slice(output::SPECS);
-    v.extend_from_slice(safety::SPECS);
-    v.extend_from_slice(recording::SPECS);
-    v.extend_from_slice(metric::SPECS);
-    v.extend_from_slice(math::SPECS);
-    #[cfg(feature = "mesh")]
-    v.extend_from_slice(mesh::SPECS);
-    v.extend_from_slice(analysis::SPECS);
-    #[cfg(feature = "lab")]
-    v.extend_from_slice(lab::SPECS);
-    v.extend_from_slice(rate::SPECS);
-    #[cfg(feature = "texture")]
-    v.extend_from_slice(texture::SPECS);
-    v.extend_from_slice(serial::SPECS);
-    #[cfg(feature = "narx")]
-    v.extend_from_slice(narx::SPECS);
-    #[cfg(feature = "synth")]
-    v.extend_from_slice(synth::SPECS);
-    v
+    families().into_iter().flat_map(|(_, specs)| specs.iter().copied()).collect()
 }

@@ -4,7 +4,7 @@
 
 use evflow_engine::harness::Single;
 use evflow_nodes::narx::fit::{fit, FitConfig};
-use evflow_nodes::narx::{grid_node, node};
+use evflow_nodes::narx::{grid, node};
 use std::path::Path;
 
 /// Two small models that read the same force oppositely (u = sign x and
@@ -37,7 +37,7 @@ fn force(n: usize) -> Vec<f64> {
 fn grid(dir: &Path, f: Vec<f64>, load: Vec<f64>, vel: Vec<f64>, block: usize) -> Result<Vec<Vec<f64>>, String> {
     let n = f.len() as u64;
     Single {
-        spec: &grid_node::SPEC,
+        spec: &grid::SPEC,
         params: "models = [\"m0.json\", \"m1.json\"]\nupdate_rate = 10.0\ncrossfade = 10.0",
         inputs: vec![("force", f, 1000.0), ("load", load, 1000.0), ("velocity", vel, 1000.0)],
         outputs: vec!["u", "model"],
@@ -100,7 +100,7 @@ fn models_without_a_place_in_the_grid_are_refused_naming_the_file() {
     let params = |models: &str| format!("models = [{models}]");
     let run = |p: &str| {
         Single {
-            spec: &grid_node::SPEC,
+            spec: &grid::SPEC,
             params: p,
             inputs: vec![
                 ("force", vec![0.0; 10], 1000.0),

@@ -23,6 +23,7 @@
 pub mod figure;
 pub mod graphs;
 pub mod precision;
+pub mod stability;
 pub mod tables;
 
 #[cfg(feature = "synth")]

@@ -2,14 +2,16 @@
 //! constructed — names, parameters, ports, connections, safety, cycles,
 //! rates — and every problem is reported with its file, line and node.
 
+mod connections;
 pub mod interpolate;
+mod names;
 mod params;
 pub mod prune;
 mod rate_hint;
 mod topology;
 
 use crate::diag::{Diagnostic, Diagnostics, Loc};
-use crate::graph::{Endpoint, Graph};
+use crate::graph::Graph;
 use crate::params::{Params, Value};
 use crate::rate::Ratio;
 use crate::registry::Registry;
@@ -153,149 +155,13 @@ impl Sink {
 pub fn check(graph: &Graph, registry: &Registry, overrides: &[Override]) -> Result<Checked, Diagnostics> {
     let mut sink = Sink { file: graph.file.clone(), diags: Vec::new() };
     let graph = apply_overrides(graph, overrides, &mut sink);
-
-    // Sweep axes name declared variables, once each.
-    for (i, a) in graph.sweep.iter().enumerate() {
-        if graph.sweep[..i].iter().any(|b| b.name == a.name) {
-            sink.err(a.loc, None, format!("sweep `{}` is given twice", a.name), None);
-        } else if !graph.vars.iter().any(|v| v.name == a.name) {
-            let help = if graph.vars.is_empty() {
-                format!("declare it in [vars] (e.g. `{} = …`), then sweep it", a.name)
-            } else {
-                suggest::help(&a.name, graph.vars.iter().map(|v| v.name.as_str()))
-            };
-            sink.err(a.loc, None, format!("sweep `{}`: no graph variable `{}`", a.name, a.name), Some(help));
-        }
-    }
-
-    // Plots name variables, nodes' reported values or run times.
-    for p in &graph.plots {
-        let known = |q: &str| -> bool {
-            q == "seconds"
-                || graph.vars.iter().any(|v| v.name == q)
-                || q.split_once('.').is_some_and(|(n, v)| !v.is_empty() && graph.nodes.iter().any(|d| d.name == n))
-        };
-        for q in std::iter::once(&p.x).chain(&p.y) {
-            if !known(q) {
-                let names =
-                    graph.vars.iter().map(|v| v.name.as_str()).chain(graph.nodes.iter().map(|n| n.name.as_str()));
-                let help = format!(
-                    "a quantity is a graph variable, `NODE.VALUE` (a value the node reports), `NODE.time` or `seconds`; {}",
-                    suggest::help(q.split('.').next().unwrap_or(q), names)
-                );
-                sink.err(p.loc, None, format!("plot `{}`: unknown quantity `{q}`", p.file), Some(help));
-            }
-        }
-        if !p.series.is_empty() && !graph.vars.iter().any(|v| v.name == p.series) {
-            let help = suggest::help(&p.series, graph.vars.iter().map(|v| v.name.as_str()));
-            sink.err(
-                p.loc,
-                None,
-                format!("plot `{}`: `series` names no graph variable `{}`", p.file, p.series),
-                Some(help),
-            );
-        }
-    }
-
-    // Names.
-    for (i, n) in graph.nodes.iter().enumerate() {
-        if graph.nodes[..i].iter().any(|m| m.name == n.name) {
-            sink.err(n.loc, Some(&n.name), "a node of this name is declared twice", None);
-        }
-    }
-
-    // Types, parameters, ports.
-    let mut nodes: Vec<Option<CheckedNode>> = Vec::with_capacity(graph.nodes.len());
-    for decl in &graph.nodes {
-        let Some(spec) = registry.get(&decl.kind) else {
-            if let Some(feature) = registry.absent(&decl.kind) {
-                let help = format!(
-                    "rebuild evflow with its cargo feature `{feature}` (on by default; e.g. `cargo build --release -p evflow --features {feature}`)"
-                );
-                sink.err(
-                    decl.kind_loc,
-                    Some(&decl.name),
-                    format!("node type `{}` is not in this build of evflow", decl.kind),
-                    Some(help),
-                );
-            } else if !decl.kind.is_empty() {
-                let help = suggest::help(&decl.kind, registry.names());
-                sink.err(decl.kind_loc, Some(&decl.name), format!("unknown node type `{}`", decl.kind), Some(help));
-            }
-            nodes.push(None);
-            continue;
-        };
-        let params = params::check_params(decl, spec, &graph.vars, &mut sink);
-        let ports = params.as_ref().map(|p| params::resolve_ports(decl, spec, p, &mut sink)).unwrap_or_default();
-        nodes.push(params.map(|params| CheckedNode {
-            name: decl.name.clone(),
-            spec,
-            params,
-            ports,
-            ratio: Ratio::ONE,
-            loc: decl.loc,
-        }));
-    }
-
-    // Connections.
-    let mut edges = Vec::new();
-    let mut producer: Vec<Vec<Option<(usize, crate::diag::Loc, Endpoint)>>> =
-        nodes.iter().map(|n| n.as_ref().map(|n| vec![None; n.ports.len()]).unwrap_or_default()).collect();
-    // Inputs fed by a connection that could not be resolved (already
-    // reported) must not also be reported as having no producer.
-    let mut covered: Vec<(String, String)> = Vec::new();
-    for c in &graph.connections {
-        covered.push((c.to.node.clone(), c.to.port.clone()));
-        let from = endpoint(&graph, &nodes, &c.from, Direction::Out, c.loc, &mut sink);
-        let to = endpoint(&graph, &nodes, &c.to, Direction::In, c.loc, &mut sink);
-        if let (Some(f), Some(t)) = (from, to) {
-            match &producer[t.0][t.1] {
-                Some((_, first_loc, first)) => {
-                    let msg = format!(
-                        "input `{}` has two producers: `{}` (line {}) and `{}`",
-                        c.to, first, first_loc.line, c.from
-                    );
-                    sink.err(
-                        c.loc,
-                        Some(&c.to.node),
-                        msg,
-                        Some("an input takes exactly one producer; add a node that combines them".into()),
-                    );
-                }
-                None => {
-                    producer[t.0][t.1] = Some((f.0, c.loc, c.from.clone()));
-                    edges.push(Edge { from: f, to: t });
-                }
-            }
-        }
-    }
-    for (i, n) in nodes.iter().enumerate() {
-        let Some(n) = n else { continue };
-        for p in n.inputs() {
-            if producer[i][p].is_none() && !covered.iter().any(|(nn, pp)| *nn == n.name && *pp == n.ports[p].name) {
-                sink.err(
-                    n.loc,
-                    Some(&n.name),
-                    format!("input `{}.{}` has no producer", n.name, n.ports[p].name),
-                    Some(format!("connect an output to it: \"SOURCE.out -> {}.{}\"", n.name, n.ports[p].name)),
-                );
-            }
-        }
-        if n.spec.hardware {
-            for p in n.inputs() {
-                if let Some((src, _, from)) = &producer[i][p] {
-                    // Only a guard's first output is the guarded signal (the
-                    // others, like `limit.state`, are for monitoring).
-                    let guarded = nodes[*src].as_ref().is_some_and(|s| {
-                        s.spec.safety_guard && s.outputs().next().is_some_and(|o| s.ports[o].name == from.port)
-                    });
-                    if !guarded {
-                        sink.err(n.loc, Some(&n.name), format!("hardware output `{}.{}` is not fed by a `limit` node", n.name, n.ports[p].name), Some("every signal that reaches hardware must pass a `limit` node (amplitude clamp, slew limit, ramp to zero on faults)".into()));
-                    }
-                }
-            }
-        }
-    }
+    names::sweeps(&graph, &mut sink);
+    names::plots(&graph, &mut sink);
+    names::nodes(&graph, &mut sink);
+    let nodes = check_nodes(&graph, registry, &mut sink);
+    let wiring = connections::connect(&graph, &nodes, &mut sink);
+    wiring.check_inputs(&nodes, &registry.guard_words(), &mut sink);
+    let edges = wiring.edges;
 
     if !sink.diags.is_empty() {
         return Err(Diagnostics(sink.diags));
@@ -316,40 +182,41 @@ pub fn check(graph: &Graph, registry: &Registry, overrides: &[Override]) -> Resu
     Ok(Checked { graph, nodes, edges, order, pruned, in_cycle })
 }
 
-fn endpoint(
-    graph: &Graph,
-    nodes: &[Option<CheckedNode>],
-    e: &Endpoint,
-    dir: Direction,
-    loc: Loc,
-    sink: &mut Sink,
-) -> Option<(usize, usize)> {
-    let Some(i) = graph.nodes.iter().position(|n| n.name == e.node) else {
-        let help = suggest::help(&e.node, graph.nodes.iter().map(|n| n.name.as_str()));
-        sink.err(loc, None, format!("connection names unknown node `{}`", e.node), Some(help));
-        return None;
-    };
-    let n = nodes[i].as_ref()?;
-    if let Some(p) = n.port(&e.port, dir) {
-        return Some((i, p));
+/// Types, parameters, ports: each node checked against its type's spec
+/// (`None` where it could not be).
+fn check_nodes(graph: &Graph, registry: &Registry, sink: &mut Sink) -> Vec<Option<CheckedNode>> {
+    let mut nodes: Vec<Option<CheckedNode>> = Vec::with_capacity(graph.nodes.len());
+    for decl in &graph.nodes {
+        let Some(spec) = registry.get(&decl.kind) else {
+            if let Some(feature) = registry.absent(&decl.kind) {
+                let help = format!(
+                    "rebuild evflow with its cargo feature `{feature}` (on by default; e.g. `cargo build --release -p evflow --features {feature}`)"
+                );
+                sink.err(
+                    decl.kind_loc,
+                    Some(&decl.name),
+                    format!("node type `{}` is not in this build of evflow", decl.kind),
+                    Some(help),
+                );
+            } else if !decl.kind.is_empty() {
+                let help = suggest::help(&decl.kind, registry.names());
+                sink.err(decl.kind_loc, Some(&decl.name), format!("unknown node type `{}`", decl.kind), Some(help));
+            }
+            nodes.push(None);
+            continue;
+        };
+        let params = params::check_params(decl, spec, &graph.vars, sink);
+        let ports = params.as_ref().map(|p| params::resolve_ports(decl, spec, p, sink)).unwrap_or_default();
+        nodes.push(params.map(|params| CheckedNode {
+            name: decl.name.clone(),
+            spec,
+            params,
+            ports,
+            ratio: Ratio::ONE,
+            loc: decl.loc,
+        }));
     }
-    let (what, other) = match dir {
-        Direction::Out => ("output", "an input"),
-        Direction::In => ("input", "an output"),
-    };
-    if n.ports.iter().any(|p| p.name == e.port) {
-        sink.err(
-            loc,
-            Some(&e.node),
-            format!("`{e}` is {other}, not {}", if dir == Direction::Out { "an output" } else { "an input" }),
-            Some("connections go \"producer.output -> consumer.input\"".into()),
-        );
-        return None;
-    }
-    let names: Vec<&str> = n.ports.iter().filter(|p| p.dir == dir).map(|p| p.name.as_str()).collect();
-    let help = suggest::help(&e.port, names.iter().copied());
-    sink.err(loc, Some(&e.node), format!("node type `{}` has no {what} port `{}`", n.spec.name, e.port), Some(help));
-    None
+    nodes
 }
 
 fn apply_overrides(graph: &Graph, overrides: &[Override], sink: &mut Sink) -> Graph {

@@ -463,3 +463,32 @@ fn plots_parse_check_and_round_trip() {
     let d = one_error(&text.replace("log_y = true", "logy = true"));
     assert!(d.message.contains("unknown plot key `logy`"), "{}", d.message);
 }
+
+/// A device sink and a guard of names the engine has never heard of: the
+/// rule and its message come from the specs' roles, not from a node name.
+static DEVICE: NodeSpec = NodeSpec::new("device", "test", Role::Sink, "drives hardware", build_pass)
+    .ports(&[PortSpec::input("in", "1", "x")])
+    .hardware();
+static CLAMP: NodeSpec = NodeSpec::new("clamp", "test", Role::Filter, "a guard", build_pass)
+    .ports(&[PortSpec::input("in", "1", "x"), PortSpec::output("out", "1", "x")])
+    .safety_guard();
+
+#[test]
+fn hardware_must_be_fed_by_a_guard_named_by_its_spec() {
+    let mut reg = registry();
+    reg.add(&DEVICE).add(&CLAMP);
+    assert_eq!(reg.guard_words(), "`clamp`");
+    let graph = |via: &str| {
+        format!(
+            "[graph]\nformat = 1\nname = \"t\"\nrate = 1000\nconnections = [\"src.out -> {via}.in\", \"{via}.out -> dev.in\"]\n\n\
+             [nodes.src]\ntype = \"harness.feed\"\nvalues = [1.0]\n\n[nodes.{via}]\n{}\n\n[nodes.dev]\ntype = \"device\"\n",
+            if via == "g" { "type = \"clamp\"" } else { "type = \"filt\"\nneed = 0.5" }
+        )
+    };
+    let run = |text: &str| parse_graph(Path::new("g.toml"), text).map(|g| check(&g, &reg, &[]).map(|_| ()));
+    assert!(matches!(run(&graph("g")), Ok(Ok(()))), "fed by the guard: accepted");
+    let Ok(Err(d)) = run(&graph("f")) else { panic!("fed by a filter: refused") };
+    let msg: Vec<String> = d.0.iter().map(|e| e.message.clone()).collect();
+    assert!(msg.iter().any(|m| m == "hardware output `dev.in` is not fed by a `clamp` node"), "{msg:?}");
+    assert_eq!(Registry::new().guard_words(), "safety-guard");
+}

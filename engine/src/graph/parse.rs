@@ -1,12 +1,22 @@
 //! Reading a graph file: TOML with spans, so every error names its line.
 
-use super::{Axis, Connection, Endpoint, Graph, NodeDecl, ParamDecl, Var, FORMAT_VERSION};
+use super::model::{Axis, Connection, Endpoint, Graph, NodeDecl, ParamDecl, Var, FORMAT_VERSION};
 use crate::diag::{Diagnostic, Diagnostics, LineIndex, Loc};
 use crate::params::Value;
 use crate::suggest;
 use std::path::Path;
 use toml::de::{DeTable, DeValue};
 use toml::Spanned;
+
+impl Graph {
+    /// Adds a connection written `"a.out -> b.in"`; returns an error message
+    /// when the text is not of that form.
+    pub fn connect(&mut self, text: &str) -> Result<&mut Self, String> {
+        let (from, to) = parse_connection(text)?;
+        self.connections.push(Connection { from, to, loc: Loc::default() });
+        Ok(self)
+    }
+}
 
 const TOP_KEYS: [&str; 5] = ["graph", "vars", "sweep", "plot", "nodes"];
 

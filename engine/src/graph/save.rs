@@ -1,6 +1,6 @@
 //! Writing a graph back to TOML (load → save → load round-trips).
 
-use super::{Graph, FORMAT_VERSION};
+use super::model::{Graph, FORMAT_VERSION};
 use crate::params::{toml_float, toml_string};
 use std::fmt::Write;
 

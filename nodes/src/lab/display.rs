@@ -74,17 +74,12 @@ impl Node for SimDisplay {
     }
 
     fn finish(&mut self) -> Result<Summary, NodeError> {
-        let mut s = Summary::default();
-        if self.model.diverged > 0 {
-            s = s.line(format!(
-                "sim.display: the integrator diverged {} times (state reset each time); use integrator = \"exact\" or more substeps",
-                self.model.diverged
-            ));
-        }
-        if self.model.bad_inputs > 0 {
-            s = s.line(format!("sim.display: {} NaN or infinite input samples were read as 0", self.model.bad_inputs));
-        }
-        Ok(s)
+        Ok(super::health(
+            "sim.display",
+            self.model.diverged,
+            "; use integrator = \"exact\" or more substeps",
+            self.model.bad_inputs,
+        ))
     }
 }
 

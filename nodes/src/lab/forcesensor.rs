@@ -60,20 +60,7 @@ impl Node for SimForceSensor {
     }
 
     fn finish(&mut self) -> Result<Summary, NodeError> {
-        let mut s = Summary::default();
-        if self.model.diverged > 0 {
-            s = s.line(format!(
-                "sim.forcesensor: the integrator diverged {} times (state reset each time)",
-                self.model.diverged
-            ));
-        }
-        if self.model.bad_inputs > 0 {
-            s = s.line(format!(
-                "sim.forcesensor: {} NaN or infinite input samples were read as 0",
-                self.model.bad_inputs
-            ));
-        }
-        Ok(s)
+        Ok(super::health("sim.forcesensor", self.model.diverged, "", self.model.bad_inputs))
     }
 }
 

@@ -35,7 +35,7 @@ mod tribometer_tests;
 pub use profile::LabProfile;
 pub use profile_load::ProfileError;
 
-use evflow_engine::{BuildContext, NodeError, NodeSpec, ParamSpec, Params};
+use evflow_engine::{BuildContext, NodeError, NodeSpec, ParamSpec, Params, Summary};
 use integrator::Method;
 
 /// The node types of this family.
@@ -88,6 +88,20 @@ pub fn profile_of(p: &Params, ctx: &BuildContext) -> Result<LabProfile, NodeErro
     }
     let path = ctx.path(name);
     LabProfile::load(&path).map_err(|e| NodeError::file(&path, e.issues_text()))
+}
+
+/// What a simulated device's run reports when it ends: how often its
+/// integrator diverged (and `hint`, what to change) and how many input
+/// samples were NaN or infinite and read as 0; nothing when neither.
+pub(crate) fn health(node: &str, diverged: u64, hint: &str, bad_inputs: u64) -> Summary {
+    let mut s = Summary::default();
+    if diverged > 0 {
+        s = s.line(format!("{node}: the integrator diverged {diverged} times (state reset each time){hint}"));
+    }
+    if bad_inputs > 0 {
+        s = s.line(format!("{node}: {bad_inputs} NaN or infinite input samples were read as 0"));
+    }
+    s
 }
 
 /// The method named by the `integrator` parameter.

@@ -91,13 +91,6 @@ impl Node for SimTribometer {
     }
 
     fn finish(&mut self) -> Result<Summary, NodeError> {
-        let mut s = Summary::default();
-        if self.model.diverged > 0 {
-            s = s.line(format!(
-                "sim.tribometer: the integrator diverged {} times (state reset each time); use integrator = \"exact\" or more substeps",
-                self.model.diverged
-            ));
-        }
-        Ok(s)
+        Ok(super::health("sim.tribometer", self.model.diverged, "; use integrator = \"exact\" or more substeps", 0))
     }
 }

@@ -12,7 +12,8 @@ pub static SPEC: NodeSpec =
             "Adds two streams sample by sample: e.g. a force and the display's own friction noise, \
 to score what a perfect rendering would still carry (the display floor of `graphs/synthesize.toml`, \
 docs/narx.md §11). Both inputs and the output run at the node's rate, the rate of its producers. \
-Exact to one IEEE addition per sample. Two constant inputs make a constant output, which the planner \
+Exact to one IEEE addition per sample; a sum beyond the range of f64 saturates at ±f64::MAX \
+instead of becoming infinite. Two constant inputs make a constant output, which the planner \
 holds (docs/pruning.md).",
         )
         .ports(&[
@@ -30,5 +31,5 @@ fn build(_: &Params, _: &BuildContext) -> Result<Box<dyn Node>, NodeError> {
 /// Constant when both terms are.
 fn fold(f: &FoldArgs<'_>) -> Option<Constant> {
     let (a, b) = (f.input(0)?, f.input(1)?);
-    Some(Constant::all(1, a + b, format!("{a} + {b}, both constant")))
+    Some(Constant::all(1, super::binary::saturate(a + b), format!("{a} + {b}, both constant")))
 }

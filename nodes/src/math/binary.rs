@@ -3,7 +3,15 @@
 
 use evflow_engine::{Io, Node, NodeError};
 
-/// y[n] = op(a[n], b[n]); generic over the operation, so it is inlined.
+/// `v` held within ±f64::MAX: a sum or product of finite samples that
+/// overflows saturates instead of leaving the node as ±∞ (every finite
+/// value passes unchanged, bit for bit; found by `evflow report stability`).
+#[inline]
+pub fn saturate(v: f64) -> f64 {
+    v.clamp(-f64::MAX, f64::MAX)
+}
+
+/// y[n] = op(a[n], b[n]), saturated ([`saturate`]); generic over the operation, so it is inlined.
 pub struct Binary<F>(pub F);
 
 impl<F: Fn(f64, f64) -> f64 + Send> Node for Binary<F> {
@@ -11,7 +19,7 @@ impl<F: Fn(f64, f64) -> f64 + Send> Node for Binary<F> {
         let n = io.len();
         for k in 0..n {
             let v = (self.0)(io.input(0)[k], io.input(1)[k]);
-            io.output(0)[k] = v;
+            io.output(0)[k] = saturate(v);
         }
         Ok(())
     }
@@ -39,6 +47,15 @@ mod tests {
         .run()
         .unwrap()
         .remove(0)
+    }
+
+    #[test]
+    fn sums_and_products_beyond_f64_saturate() {
+        let m = f64::MAX;
+        let a = [m, -m, 1e300, 2.0, -m];
+        let b = [m, -m, -1e300, 3.0, m];
+        assert_eq!(run(&crate::math::add::SPEC, &a, &b), [m, -m, 0.0, 5.0, 0.0]);
+        assert_eq!(run(&crate::math::mul::SPEC, &a, &b), [m, m, -m, 6.0, -m]);
     }
 
     #[test]

@@ -12,7 +12,8 @@ pub static SPEC: NodeSpec =
             "Multiplies two streams sample by sample: an actuation waveform by an intensity or a \
 gate (dissertation §3.1.2: a haptic effect switched on in one segment of eight; §4.1: a grain scaled \
 by the rendered intensity). Both inputs and the output run at the node's rate, the rate of its \
-producers. Exact: one IEEE multiplication per sample. A constant 0 on either input (the other is finite, as \
+producers. Exact: one IEEE multiplication per sample; a product beyond the range of f64 saturates at \
+±f64::MAX instead of becoming infinite. A constant 0 on either input (the other is finite, as \
 every node's output is) or two constant inputs make a constant output, which the planner holds and \
 leaves out what fed only the other input (docs/pruning.md).",
         )
@@ -31,7 +32,9 @@ fn build(_: &Params, _: &BuildContext) -> Result<Box<dyn Node>, NodeError> {
 /// Constant when either factor is a constant 0, or both are constant.
 fn fold(f: &FoldArgs<'_>) -> Option<Constant> {
     match (f.input(0), f.input(1)) {
-        (Some(a), Some(b)) => Some(Constant::all(1, a * b, format!("{a} · {b}, both constant"))),
+        (Some(a), Some(b)) => {
+            Some(Constant::all(1, super::binary::saturate(a * b), format!("{a} · {b}, both constant")))
+        }
         (Some(z), _) | (_, Some(z)) if z == 0.0 => Some(Constant::all(1, 0.0, "a factor is a constant 0")),
         _ => None,
     }

@@ -53,20 +53,7 @@ boundary and non-manifold cases (unit tests); fandisk's dihedral angles in the f
     PortSpec::output("sharpness", "1", "sharpness S (Eq. 4.8) on the crossing tick, else 0"),
     PortSpec::output("angle", "deg", "dihedral angle θ crossed this tick (180: none)"),
 ])
-.params(&[
-    source::FILE,
-    source::SHAPE,
-    source::CONFIG,
-    source::RESOLUTION,
-    source::UNIT,
-    source::OFFSET_X,
-    source::OFFSET_Y,
-    source::UP,
-    source::FIT,
-    source::FIT_SIZE,
-    source::WELD,
-    source::SCENES,
-    source::SCENE,
+.params(source::with_scene_params![
     ParamSpec::float("max_angle", 1.0, 180.0, 160.0, "deg", "convex bends flatter than this are not edges"),
     ParamSpec::float("max_step", 1e-6, 1e3, 0.01, "m", "largest move per tick taken as motion (longer: a jump)"),
 ])

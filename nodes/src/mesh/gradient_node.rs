@@ -69,20 +69,7 @@ gradient of the Gaussian scene (fidelity report), and the robustness cases of `d
     PortSpec::output("z", "m", "height of the surface under the finger"),
     PortSpec::output("tri", "1", "index of the triangle hit, −1 off the mesh"),
 ])
-.params(&[
-    source::FILE,
-    source::SHAPE,
-    source::CONFIG,
-    source::RESOLUTION,
-    source::UNIT,
-    source::OFFSET_X,
-    source::OFFSET_Y,
-    source::UP,
-    source::FIT,
-    source::FIT_SIZE,
-    source::WELD,
-    source::SCENES,
-    source::SCENE,
+.params(source::with_scene_params![
     ParamSpec::float("switch_fade", 0.0, 1000.0, 10.0, "ms", "intensity crossfade when `scene` changes"),
     ParamSpec::choice("slope", &["secant", "normal"], "secant", "slope estimate: Eq. 4.1 secant or triangle normal"),
     ParamSpec::float("min_step", 0.0, 1.0, 0.0005, "m", "smallest move that updates the previous hit point"),

@@ -14,7 +14,7 @@
 use super::error::MeshError;
 use super::trimesh::Mesh;
 use ply_rs_bw::parser::{Parser, Reader};
-use ply_rs_bw::ply::{ElementDef, Encoding, Property, PropertyAccess, PropertyAccessResult, PropertyType};
+use ply_rs_bw::ply::{ElementDef, Encoding, Header, Property, PropertyAccess, PropertyAccessResult, PropertyType};
 use std::io::Cursor;
 use std::path::Path;
 
@@ -84,7 +84,6 @@ enum At {
 
 /// Parses PLY bytes; `path` only names the source in errors.
 pub fn parse_ply(path: &Path, bytes: &[u8], weld: f64) -> Result<Mesh, MeshError> {
-    let header_err = |line: usize, message: String| MeshError::PlyHeader { path: path.into(), line, message };
     if !bytes.starts_with(b"ply") {
         let found = String::from_utf8_lossy(&bytes[..bytes.len().min(4)]).into_owned();
         return Err(MeshError::Magic { path: path.into(), format: "PLY", expected: "ply".into(), found });
@@ -93,10 +92,51 @@ pub fn parse_ply(path: &Path, bytes: &[u8], weld: f64) -> Result<Mesh, MeshError
     let mut reader = Reader::new(Cursor::new(bytes));
     let header = parser.read_header(&mut reader).map_err(|e| {
         let line = e.line().unwrap_or(reader.line().max(1));
-        header_err(line, one_line(&e.to_string()))
+        header_err(path, line, one_line(&e.to_string()))
     })?;
     let body_start = reader.get_ref().position() as usize;
     let header_text = String::from_utf8_lossy(&bytes[..body_start]);
+    let (vertex, face) = mesh_elements(path, &header, &header_text)?;
+    let mut body = Body {
+        path,
+        parser: &parser,
+        header: &header,
+        bytes,
+        body_start,
+        header_lines: header_text.lines().count(),
+        n_vertices: vertex.count,
+        vertices: Vec::with_capacity(vertex.count.min(1 << 24)),
+        triangles: Vec::with_capacity(face.count.min(1 << 24)),
+    };
+    match header.encoding {
+        Encoding::Ascii => body.read_ascii()?,
+        Encoding::BinaryLittleEndian | Encoding::BinaryBigEndian => {
+            body.read_binary(header.encoding == Encoding::BinaryBigEndian)?
+        }
+    }
+    Mesh::from_faces(&path.display().to_string(), body.vertices, body.triangles, weld)
+}
+
+/// An error in the header at `line`.
+fn header_err(path: &Path, line: usize, message: String) -> MeshError {
+    MeshError::PlyHeader { path: path.into(), line, message }
+}
+
+/// An error in the element read at `at`.
+fn bad(path: &Path, at: At, message: String) -> MeshError {
+    match at {
+        At::Line(line) => MeshError::Syntax { path: path.into(), line, message },
+        At::Byte(offset) => MeshError::Binary { path: path.into(), offset, message },
+    }
+}
+
+/// The header's vertex and face elements, checked to hold what a mesh
+/// needs: numeric `x`, `y`, `z` and an integer `vertex_indices` list.
+fn mesh_elements<'h>(
+    path: &Path,
+    header: &'h Header,
+    header_text: &str,
+) -> Result<(&'h ElementDef, &'h ElementDef), MeshError> {
     let header_lines = header_text.lines().count();
     // The header line that declares an element (or `end_header`), for errors.
     let line_of = |element: &str| {
@@ -111,18 +151,25 @@ pub fn parse_ply(path: &Path, bytes: &[u8], weld: f64) -> Result<Mesh, MeshError
     let vertex = header
         .elements
         .get("vertex")
-        .ok_or_else(|| header_err(header_lines, "no `element vertex`: not a mesh this loader can read".into()))?;
+        .ok_or_else(|| header_err(path, header_lines, "no `element vertex`: not a mesh this loader can read".into()))?;
     for axis in ["x", "y", "z"] {
         match vertex.properties.get(axis).map(|p| &p.data_type) {
             Some(PropertyType::Scalar(_)) => {}
             Some(PropertyType::List(..)) => {
-                return Err(header_err(line_of("vertex"), format!("vertex property `{axis}` is a list, not a number")))
+                return Err(header_err(
+                    path,
+                    line_of("vertex"),
+                    format!("vertex property `{axis}` is a list, not a number"),
+                ))
             }
-            None => return Err(header_err(line_of("vertex"), format!("the vertex element has no `{axis}` property"))),
+            None => {
+                return Err(header_err(path, line_of("vertex"), format!("the vertex element has no `{axis}` property")))
+            }
         }
     }
     let Some(face) = header.elements.get("face") else {
         return Err(header_err(
+            path,
             header_lines,
             "no `element face`: a point cloud, with no surface to touch (mesh it first, e.g. by Poisson reconstruction)"
                 .into(),
@@ -133,111 +180,142 @@ pub fn parse_ply(path: &Path, bytes: &[u8], weld: f64) -> Result<Mesh, MeshError
         Some(PropertyType::List(_, item))
             if !matches!(item, ply_rs_bw::ply::ScalarType::Float | ply_rs_bw::ply::ScalarType::Double) => {}
         Some(_) => {
-            return Err(header_err(line_of("face"), "the face's `vertex_indices` must be a list of integers".into()))
+            return Err(header_err(
+                path,
+                line_of("face"),
+                "the face's `vertex_indices` must be a list of integers".into(),
+            ))
         }
-        None => return Err(header_err(line_of("face"), "the face element has no `vertex_indices` list".into())),
+        None => return Err(header_err(path, line_of("face"), "the face element has no `vertex_indices` list".into())),
     }
-    let n_vertices = vertex.count;
-    let mut vertices: Vec<[f64; 3]> = Vec::with_capacity(n_vertices.min(1 << 24));
-    let mut triangles: Vec<[u32; 3]> = Vec::with_capacity(face.count.min(1 << 24));
-    // Elements after both the vertices and the faces are not read.
-    let (mut faces_seen, mut vertices_seen) = (false, false);
-    let bad = |at: At, message: String| match at {
-        At::Line(line) => MeshError::Syntax { path: path.into(), line, message },
-        At::Byte(offset) => MeshError::Binary { path: path.into(), offset, message },
-    };
-    // Takes one element of `def` read at `at`.
-    let mut take = |def: &ElementDef, k: usize, e: Element, at: At| -> Result<(), MeshError> {
+    Ok((vertex, face))
+}
+
+/// The file's body as it is read: the elements in header order, until both
+/// the vertices and the faces are read (elements after them are not read).
+struct Body<'a> {
+    path: &'a Path,
+    parser: &'a Parser<Element>,
+    header: &'a Header,
+    bytes: &'a [u8],
+    body_start: usize,
+    header_lines: usize,
+    n_vertices: usize,
+    vertices: Vec<[f64; 3]>,
+    triangles: Vec<[u32; 3]>,
+}
+
+impl Body<'_> {
+    /// Reads an ASCII body, one element a (non-blank) line.
+    fn read_ascii(&mut self) -> Result<(), MeshError> {
+        let (path, bytes, body_start, header_lines) = (self.path, self.bytes, self.body_start, self.header_lines);
+        let body = std::str::from_utf8(&bytes[body_start..]).map_err(|e| {
+            let line = header_lines
+                + bytes[body_start..body_start + e.valid_up_to()].iter().filter(|&&b| b == b'\n').count()
+                + 1;
+            bad(path, At::Line(line), format!("not text (byte {}) in an ASCII PLY", body_start + e.valid_up_to()))
+        })?;
+        let mut lines =
+            body.lines().enumerate().map(|(k, l)| (header_lines + k + 1, l)).filter(|(_, l)| !l.trim().is_empty());
+        let (mut faces_seen, mut vertices_seen) = (false, false);
+        for def in self.header.elements.values() {
+            if faces_seen && vertices_seen {
+                break;
+            }
+            for k in 0..def.count {
+                let Some((no, line)) = lines.next() else {
+                    let last = header_lines + body.lines().count() + 1;
+                    return Err(bad(
+                        path,
+                        At::Line(last),
+                        format!(
+                            "the file ends before {} `{}` {k} of {}: truncated?",
+                            article(&def.name),
+                            def.name,
+                            def.count
+                        ),
+                    ));
+                };
+                let e = self
+                    .parser
+                    .read_ascii_element(line, def)
+                    .map_err(|e| bad(path, At::Line(no), format!("{} {k}: {}", def.name, one_line(&e.to_string()))))?;
+                self.take(def, k, e, At::Line(no))?;
+            }
+            faces_seen |= def.name == "face";
+            vertices_seen |= def.name == "vertex";
+        }
+        Ok(())
+    }
+
+    /// Reads a binary body, little- or big-endian.
+    fn read_binary(&mut self, big: bool) -> Result<(), MeshError> {
+        let (path, bytes) = (self.path, self.bytes);
+        let mut cursor = Cursor::new(bytes);
+        cursor.set_position(self.body_start as u64);
+        let (mut faces_seen, mut vertices_seen) = (false, false);
+        for def in self.header.elements.values() {
+            if faces_seen && vertices_seen {
+                break;
+            }
+            for k in 0..def.count {
+                let at = cursor.position();
+                let read = if big {
+                    self.parser.read_big_endian_element(&mut cursor, def)
+                } else {
+                    self.parser.read_little_endian_element(&mut cursor, def)
+                };
+                let e = read.map_err(|e| {
+                    if e.kind() == std::io::ErrorKind::UnexpectedEof {
+                        MeshError::Truncated {
+                            path: path.into(),
+                            offset: at,
+                            what: format!("`{}` {k} of {}", def.name, def.count),
+                            available: bytes.len() as u64 - at,
+                        }
+                    } else {
+                        bad(path, At::Byte(at), format!("{} {k}: {}", def.name, one_line(&e.to_string())))
+                    }
+                })?;
+                self.take(def, k, e, At::Byte(at))?;
+            }
+            faces_seen |= def.name == "face";
+            vertices_seen |= def.name == "vertex";
+        }
+        Ok(())
+    }
+
+    /// Takes element `k` of `def`, read at `at`: a vertex (finite
+    /// coordinates) or a face (in-range indices, triangulated as a fan).
+    fn take(&mut self, def: &ElementDef, k: usize, e: Element, at: At) -> Result<(), MeshError> {
+        let n_vertices = self.n_vertices;
         if def.name == "vertex" {
             if let Some(i) = e.xyz.iter().position(|x| !x.is_finite()) {
-                return Err(bad(at, format!("vertex {k}: {} is {}", ["x", "y", "z"][i], e.xyz[i])));
+                return Err(bad(self.path, at, format!("vertex {k}: {} is {}", ["x", "y", "z"][i], e.xyz[i])));
             }
-            vertices.push(e.xyz);
+            self.vertices.push(e.xyz);
         } else if def.name == "face" {
             if e.indices.len() < 3 {
-                return Err(bad(at, format!("face {k}: a face needs at least 3 vertices, found {}", e.indices.len())));
+                return Err(bad(
+                    self.path,
+                    at,
+                    format!("face {k}: a face needs at least 3 vertices, found {}", e.indices.len()),
+                ));
             }
             if let Some(i) = e.indices.iter().find(|&&i| i < 0 || i as usize >= n_vertices) {
-                return Err(bad(at, format!("face {k}: vertex index {i} is out of range (0..{n_vertices})")));
+                return Err(bad(
+                    self.path,
+                    at,
+                    format!("face {k}: vertex index {i} is out of range (0..{n_vertices})"),
+                ));
             }
             let ix: Vec<u32> = e.indices.iter().map(|&i| i as u32).collect();
             for j in 1..ix.len() - 1 {
-                triangles.push([ix[0], ix[j], ix[j + 1]]);
+                self.triangles.push([ix[0], ix[j], ix[j + 1]]);
             }
         }
         Ok(())
-    };
-    match header.encoding {
-        Encoding::Ascii => {
-            let body = std::str::from_utf8(&bytes[body_start..]).map_err(|e| {
-                let line = header_lines
-                    + bytes[body_start..body_start + e.valid_up_to()].iter().filter(|&&b| b == b'\n').count()
-                    + 1;
-                bad(At::Line(line), format!("not text (byte {}) in an ASCII PLY", body_start + e.valid_up_to()))
-            })?;
-            let mut lines =
-                body.lines().enumerate().map(|(k, l)| (header_lines + k + 1, l)).filter(|(_, l)| !l.trim().is_empty());
-            for def in header.elements.values() {
-                if faces_seen && vertices_seen {
-                    break;
-                }
-                for k in 0..def.count {
-                    let Some((no, line)) = lines.next() else {
-                        let last = header_lines + body.lines().count() + 1;
-                        return Err(bad(
-                            At::Line(last),
-                            format!(
-                                "the file ends before {} `{}` {k} of {}: truncated?",
-                                article(&def.name),
-                                def.name,
-                                def.count
-                            ),
-                        ));
-                    };
-                    let e = parser
-                        .read_ascii_element(line, def)
-                        .map_err(|e| bad(At::Line(no), format!("{} {k}: {}", def.name, one_line(&e.to_string()))))?;
-                    take(def, k, e, At::Line(no))?;
-                }
-                faces_seen |= def.name == "face";
-                vertices_seen |= def.name == "vertex";
-            }
-        }
-        Encoding::BinaryLittleEndian | Encoding::BinaryBigEndian => {
-            let big = header.encoding == Encoding::BinaryBigEndian;
-            let mut cursor = Cursor::new(bytes);
-            cursor.set_position(body_start as u64);
-            for def in header.elements.values() {
-                if faces_seen && vertices_seen {
-                    break;
-                }
-                for k in 0..def.count {
-                    let at = cursor.position();
-                    let read = if big {
-                        parser.read_big_endian_element(&mut cursor, def)
-                    } else {
-                        parser.read_little_endian_element(&mut cursor, def)
-                    };
-                    let e = read.map_err(|e| {
-                        if e.kind() == std::io::ErrorKind::UnexpectedEof {
-                            MeshError::Truncated {
-                                path: path.into(),
-                                offset: at,
-                                what: format!("`{}` {k} of {}", def.name, def.count),
-                                available: bytes.len() as u64 - at,
-                            }
-                        } else {
-                            bad(At::Byte(at), format!("{} {k}: {}", def.name, one_line(&e.to_string())))
-                        }
-                    })?;
-                    take(def, k, e, At::Byte(at))?;
-                }
-                faces_seen |= def.name == "face";
-                vertices_seen |= def.name == "vertex";
-            }
-        }
     }
-    Mesh::from_faces(&path.display().to_string(), vertices, triangles, weld)
 }
 
 /// "a" or "an" before an element name.

@@ -11,6 +11,32 @@ use super::scenes::{scene, Shape, CONFIGS};
 use super::trimesh::Mesh;
 use evflow_engine::{BuildContext, NodeError, ParamSpec, Params};
 
+/// The parameters of a node that loads its scenes here (`file`, `shape`,
+/// `config`, `resolution`, `unit`, `offset_x`, `offset_y`, `up`, `fit`,
+/// `fit_size`, `weld`, `scenes`, `scene`), then the node's own: the one
+/// list `mesh.gradient` and `mesh.edges` both declare.
+macro_rules! with_scene_params {
+    ($($own:expr),* $(,)?) => {
+        &[
+            $crate::mesh::source::FILE,
+            $crate::mesh::source::SHAPE,
+            $crate::mesh::source::CONFIG,
+            $crate::mesh::source::RESOLUTION,
+            $crate::mesh::source::UNIT,
+            $crate::mesh::source::OFFSET_X,
+            $crate::mesh::source::OFFSET_Y,
+            $crate::mesh::source::UP,
+            $crate::mesh::source::FIT,
+            $crate::mesh::source::FIT_SIZE,
+            $crate::mesh::source::WELD,
+            $crate::mesh::source::SCENES,
+            $crate::mesh::source::SCENE,
+            $($own),*
+        ]
+    };
+}
+pub(crate) use with_scene_params;
+
 /// `file`: a mesh file; empty for a generated scene.
 pub const FILE: ParamSpec = ParamSpec::text(
     "file",

@@ -11,7 +11,7 @@ const MAX_NFFT: i64 = 1 << 20;
 /// Declaration of `metric`.
 pub static SPEC: NodeSpec = NodeSpec::new(
     "metric",
-    "output",
+    "metric",
     Role::Sink,
     "Relative spectral RMS error E_s (Eq. 5.2), RMS, peak-to-peak and spectral peak of a virtual force against a real one.",
     build,

@@ -8,7 +8,7 @@ pub mod eval;
 pub mod fast_tanh;
 pub mod fast_tanh_avx2;
 pub mod fit;
-pub mod grid_node;
+pub mod grid;
 #[cfg(feature = "lab")]
 pub mod labdata;
 pub mod mapminmax;
@@ -18,7 +18,7 @@ pub mod net;
 pub mod node;
 pub mod packed;
 pub mod pairs;
-pub mod score_node;
+pub mod score;
 pub mod taps;
 pub mod train;
 pub mod train_node;
@@ -26,4 +26,4 @@ pub mod train_node;
 use evflow_engine::NodeSpec;
 
 /// The node types of this family.
-pub static SPECS: &[&NodeSpec] = &[&train_node::SPEC, &score_node::SPEC, &node::SPEC, &grid_node::SPEC];
+pub static SPECS: &[&NodeSpec] = &[&train_node::SPEC, &score::SPEC, &node::SPEC, &grid::SPEC];

@@ -9,7 +9,7 @@ use evflow_engine::{BuildContext, Io, Node, NodeError, NodeSpec, ParamSpec, Para
 /// Declaration of `narx`.
 pub static SPEC: NodeSpec = NodeSpec::new(
     "narx",
-    "models",
+    "narx",
     Role::Filter,
     "Inverse NARX model run closed loop: a desired lateral force in, the actuation that produces it out.",
     build,

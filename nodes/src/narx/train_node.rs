@@ -14,7 +14,7 @@ use std::path::PathBuf;
 /// Declaration of `narx.train`.
 pub static SPEC: NodeSpec = NodeSpec::new(
     "narx.train",
-    "models",
+    "narx",
     Role::Sink,
     "Trains an inverse NARX model (force → actuation) on the stream and writes the model file at the end.",
     build,

@@ -2,7 +2,8 @@
 
 use evflow_engine::node::Constant;
 use evflow_engine::spec::FoldArgs;
-use evflow_engine::{BuildContext, Io, Node, NodeError, NodeSpec, ParamSpec, Params, PortSpec, Refused, Role};
+use evflow_engine::typed_params::Float;
+use evflow_engine::{BuildContext, Io, Node, NodeError, NodeSpec, Params, PortSpec, Refused, Role};
 
 /// Declaration of `gain`.
 pub static SPEC: NodeSpec =
@@ -10,7 +11,8 @@ pub static SPEC: NodeSpec =
         .doc(
             "y[n] = g · x[n]. Used to scale synthesized actuation signals before the display \
          (the gain sweep 0.6–1.4 of dissertation §5.3.1, Table 5.1; 1.0 corresponds to 100 Vpp \
-         through the amplifier). Runs at the rate of its input.\n\n\
+         through the amplifier). Runs at the rate of its input. A product beyond the range of \
+         f64 saturates at ±f64::MAX instead of becoming infinite.\n\n\
          `gain` changes live (a session's parameter queue): the multiplier then moves linearly \
          from its current value to the new one over `ramp` seconds (round(ramp·rate) samples, at \
          least one), so a change never clicks; a change during a ramp starts a new ramp from where \
@@ -21,20 +23,22 @@ pub static SPEC: NodeSpec =
          only this node. A live plan never folds on `gain`, which may change while it runs.",
         )
         .ports(&[PortSpec::input("in", "1", "signal"), PortSpec::output("out", "1", "signal × gain")])
-        .params(&[
-            ParamSpec::float("gain", -1e6, 1e6, 1.0, "1", "multiplier").live(),
-            ParamSpec::float("ramp", 0.0, 10.0, 0.01, "s", "time a live change of `gain` takes"),
-        ])
+        .params(&[GAIN.spec(), RAMP.spec()])
         .example("gain = 1.2")
         .fold(fold);
 
+/// `gain`: the multiplier, changeable live.
+const GAIN: Float = Float::new("gain", -1e6, 1e6, 1.0, "1", "multiplier").live();
+/// `ramp`: how long a live change takes.
+const RAMP: Float = Float::new("ramp", 0.0, 10.0, 0.01, "s", "time a live change of `gain` takes");
+
 /// Constant when the gain is 0 (inputs are finite), or of a constant input.
 fn fold(f: &FoldArgs<'_>) -> Option<Constant> {
-    let g = f.f64("gain")?;
+    let g = f.f64(GAIN.name())?;
     if g == 0.0 {
         return Some(Constant::all(1, 0.0, "gain = 0"));
     }
-    f.input(0).map(|x| Constant::all(1, g * x, format!("gain {g} × constant input {x}")))
+    f.input(0).map(|x| Constant::all(1, (g * x).clamp(-f64::MAX, f64::MAX), format!("gain {g} × constant input {x}")))
 }
 
 struct Gain {
@@ -49,8 +53,8 @@ struct Gain {
 }
 
 fn build(p: &Params, ctx: &BuildContext) -> Result<Box<dyn Node>, NodeError> {
-    let g = p.f64("gain");
-    let ramp_samples = (p.f64("ramp") * ctx.rate).round().max(1.0) as u64;
+    let g = GAIN.get(p);
+    let ramp_samples = (RAMP.get(p) * ctx.rate).round().max(1.0) as u64;
     Ok(Box::new(Gain { initial: g, gain: g, target: g, delta: 0.0, left: 0, ramp_samples }))
 }
 
@@ -59,7 +63,7 @@ impl Node for Gain {
         let (x, y) = io.io(0, 0);
         if self.left == 0 {
             for (y, x) in y.iter_mut().zip(x) {
-                *y = self.gain * x;
+                *y = (self.gain * x).clamp(-f64::MAX, f64::MAX);
             }
             return Ok(());
         }
@@ -68,7 +72,7 @@ impl Node for Gain {
                 self.left -= 1;
                 self.gain = if self.left == 0 { self.target } else { self.gain + self.delta };
             }
-            *y = self.gain * x;
+            *y = (self.gain * x).clamp(-f64::MAX, f64::MAX);
         }
         Ok(())
     }
@@ -80,7 +84,7 @@ impl Node for Gain {
     }
 
     fn set(&mut self, param: &'static str, value: f64) -> Result<(), Refused> {
-        if param != "gain" {
+        if param != GAIN.name() {
             return Err(Refused(param));
         }
         self.target = value;
@@ -132,6 +136,23 @@ mod tests {
         assert!(fold(&FoldArgs::new(&SPEC, &two, &[None], 1, true)).is_none());
         // A plan that takes live changes may not rely on `gain`.
         assert!(fold(&FoldArgs::new(&SPEC, &zero, &[Some(1.0)], 1, false)).is_none());
+    }
+
+    #[test]
+    fn a_product_beyond_f64_saturates() {
+        let y = evflow_engine::harness::Single {
+            spec: &SPEC,
+            params: "gain = -2.0",
+            inputs: vec![("in", vec![f64::MAX, 1e300, -f64::MAX], 1000.0)],
+            outputs: vec!["out"],
+            base_rate: 1000.0,
+            ticks: 3,
+            block: 2,
+            base_dir: std::path::Path::new("."),
+        }
+        .run()
+        .unwrap();
+        assert_eq!(y[0], [-f64::MAX, -2e300, f64::MAX]);
     }
 
     #[test]

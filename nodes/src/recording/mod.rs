@@ -1,23 +1,23 @@
 //! Recordings: the on-disk format ([`format`](mod@format): 64-bit float WAV + JSON
 //! sidecar, described in `docs/recording-format.md`) and the nodes that read
-//! and write it, `recording.in` ([`source`]) and `recording.out` ([`sink`]);
+//! and write it, `recording.in` ([`input`]) and `recording.out` ([`output`]);
 //! [`import`](mod@import) turns a lab's `.npy` and CSV files into recordings.
 
 pub mod atomic;
 pub mod format;
 pub mod import;
-pub mod sink;
-pub mod source;
+pub mod input;
+pub mod output;
 pub mod sweep_fields;
 
 use evflow_engine::NodeSpec;
 
 /// The node types of this family.
-pub static SPECS: &[&NodeSpec] = &[&source::SPEC, &sink::SPEC];
+pub static SPECS: &[&NodeSpec] = &[&input::SPEC, &output::SPEC];
 
 #[cfg(test)]
 mod tests {
-    use super::{sink, source};
+    use super::{input, output};
     use evflow_engine::harness::TAP;
     use evflow_engine::{check, graph::parse_graph, run_offline, Plan, PlanOptions, Registry, RunOptions};
 
@@ -63,7 +63,7 @@ source = "copy"
 type = "harness.tap"
 "#;
         let mut reg = Registry::new();
-        reg.add(&source::SPEC).add(&sink::SPEC).add(&TAP);
+        reg.add(&input::SPEC).add(&output::SPEC).add(&TAP);
         let g = parse_graph(&dir.path().join("copy.toml"), doc).unwrap();
         let checked = check(&g, &reg, &[]).unwrap();
         let mut plan = Plan::build(

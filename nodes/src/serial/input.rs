@@ -131,15 +131,7 @@ impl Node for SerialIn {
             self.idle = Some(params::OFFLINE.to_string());
             return Ok(());
         }
-        let l = link::attach(config, &self.name).map_err(NodeError::Other)?;
-        let rings = l.take_in().ok_or_else(|| {
-            NodeError::Other(format!(
-                "port {} already has a `serial.in` node, in this plan or in a running one; one per port (a \
-                 replacement plan cannot take a port the running plan holds: stop the session and start anew)",
-                config.port
-            ))
-        })?;
-        l.wait_connected().map_err(NodeError::Other)?;
+        let (l, rings) = link::claim(config, &self.name, "serial.in", |l| l.take_in()).map_err(NodeError::Other)?;
         self.idle = None;
         self.live = Some(Live { link: l, rings });
         Ok(())

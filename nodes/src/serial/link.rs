@@ -47,6 +47,28 @@ pub struct Link {
 
 static LINKS: Mutex<Vec<(String, Weak<Link>)>> = Mutex::new(Vec::new());
 
+/// The link on `config.port` for the node `node` of type `kind`
+/// (`serial.in`, `serial.out`) and its end of it, `take`n — refused when
+/// another node of that type holds it — once the link is connected (or
+/// its `wait` is over): what each serial node's `prepare` does.
+pub fn claim<T>(
+    config: &LinkConfig,
+    node: &str,
+    kind: &str,
+    take: impl FnOnce(&Link) -> Option<T>,
+) -> Result<(Arc<Link>, T), String> {
+    let link = attach(config, node)?;
+    let end = take(&link).ok_or_else(|| {
+        format!(
+            "port {} already has a `{kind}` node, in this plan or in a running one; one per port (a \
+             replacement plan cannot take a port the running plan holds: stop the session and start anew)",
+            config.port
+        )
+    })?;
+    link.wait_connected()?;
+    Ok((link, end))
+}
+
 /// The link on `config.port`: the running one, or a new one (its I/O
 /// thread starts opening the port at once). `node` names the caller for
 /// errors.

@@ -88,15 +88,7 @@ impl Node for SerialOut {
             return Ok(());
         }
         let hz = params::rate_hz(&self.name, self.rate)?;
-        let l = link::attach(config, &self.name).map_err(NodeError::Other)?;
-        let ring = l.take_out(hz).ok_or_else(|| {
-            NodeError::Other(format!(
-                "port {} already has a `serial.out` node, in this plan or in a running one; one per port (a \
-                 replacement plan cannot take a port the running plan holds: stop the session and start anew)",
-                config.port
-            ))
-        })?;
-        l.wait_connected().map_err(NodeError::Other)?;
+        let (l, ring) = link::claim(config, &self.name, "serial.out", |l| l.take_out(hz)).map_err(NodeError::Other)?;
         self.idle = None;
         self.live = Some(Live { link: l, ring });
         Ok(())

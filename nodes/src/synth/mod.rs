@@ -15,16 +15,16 @@ pub mod lbfgsb;
 pub mod live;
 pub mod model_file;
 pub mod objective;
-pub mod optimize_node;
+pub mod optimize;
 pub mod output_filter;
 pub mod spectral;
 pub mod start;
 pub mod synthesize;
-pub mod train_node;
+pub mod train;
 pub mod volterra;
 pub mod volterra_fit;
 
 use evflow_engine::NodeSpec;
 
 /// The node types of this family.
-pub static SPECS: &[&NodeSpec] = &[&train_node::SPEC, &optimize_node::SPEC, &live::node::SPEC];
+pub static SPECS: &[&NodeSpec] = &[&train::SPEC, &optimize::SPEC, &live::node::SPEC];

@@ -1,22 +1,24 @@
 //! `evflow live FILE`: run a graph in real time, recording the session.
 
+mod ending;
 pub mod integrity;
 mod recorder;
 pub mod session;
+mod setup;
 mod steal;
+mod threads;
 
 use super::graph_args::GraphArgs;
 use anyhow::{anyhow, Context, Result};
-use evflow_engine::live::{self, LiveConfig, LivePlan, Metrics, RealtimeRequest, StopReason, Tap};
-use evflow_engine::{Plan, PlanOptions};
+use evflow_engine::live;
 use recorder::Recorder;
-use serde_json::json;
-use session::Manifest;
-use std::io::{BufRead, IsTerminal};
-use std::path::{Path, PathBuf};
-use std::sync::atomic::{AtomicBool, AtomicU32, Ordering};
+#[cfg(feature = "studio")]
+use std::path::Path;
+use std::path::PathBuf;
+use std::sync::atomic::AtomicBool;
 use std::sync::Arc;
-use std::time::{Duration, Instant};
+#[cfg(feature = "studio")]
+use std::time::Duration;
 
 /// Deadline misses in a row that stop a session driving hardware.
 const DEFAULT_MISS_STREAK: u64 = 10;
@@ -113,77 +115,16 @@ pub fn main(a: Args) -> Result<()> {
     // Bound before the session (and its folder) starts: a taken port stops
     // nothing that runs.
     #[cfg(feature = "studio")]
-    let bound = match &a.studio {
-        Some(addr) => {
-            let cfg =
-                evflow_tools::studio::StudioConfig { addr: super::studio::studio_addr(addr)?, public: a.studio_public };
-            Some(evflow_tools::studio::Bound::bind(&cfg)?)
-        }
-        None => None,
-    };
+    let bound = bind_studio(&a)?;
     let graph_text =
         std::fs::read_to_string(&a.graph.file).with_context(|| format!("{}: cannot read", a.graph.file.display()))?;
     std::fs::create_dir_all(&a.out).map_err(|e| anyhow!("{}: cannot create output folder: {e}", a.out.display()))?;
     let seed = a.seed.unwrap_or(checked.graph.seed);
-    let opts = PlanOptions {
-        max_block: 1,
-        seed: Some(seed),
-        base_dir: None,
-        out_dir: Some(a.out.clone()),
-        timing: false,
-        mode: evflow_engine::RunMode::Live,
-        check_only: false,
-    };
-    let plan = Plan::build(&checked, &opts).map_err(|e| anyhow!("{e}"))?;
-    #[allow(unused_mut)]
-    let mut extra = a.taps.clone();
-    #[cfg(feature = "studio")]
-    if a.studio.is_some() {
-        // What the page shows by default is recorded too.
-        extra.extend(
-            evflow_tools::studio::default_taps(&checked, &plan).into_iter().map(|t| format!("{}.{}", t.node, t.port)),
-        );
-    }
-    let (taps, n_inputs) = taps_of(&plan, &extra)?;
-    let lp = LivePlan::new(plan, &taps).map_err(|e| anyhow!("{}: {e}", a.graph.file.display()))?;
+    let (lp, n_inputs) = setup::live_plan(&a, &checked, seed)?;
     let (inputs, outputs) = session::files(lp.taps(), n_inputs)?;
-
-    // The session folder and its manifest, before anything runs.
-    let dir = a.session.clone().unwrap_or_else(|| a.out.join("sessions").join(session_name(&checked.graph.name)));
-    if dir.join("session.json").exists() {
-        return Err(anyhow!("{}: a session is already recorded there; choose another --session", dir.display()));
-    }
-    std::fs::create_dir_all(&dir).map_err(|e| anyhow!("{}: cannot create the session folder: {e}", dir.display()))?;
-    std::fs::write(dir.join("graph.toml"), &graph_text)?;
-    let graph_hash = integrity::file_hash(&dir.join("graph.toml"))
-        .map_err(|e| anyhow!("{}: cannot read back: {e}", dir.join("graph.toml").display()))?;
-    let graph_path = std::fs::canonicalize(&a.graph.file).unwrap_or_else(|_| a.graph.file.clone());
-    let manifest = Manifest {
-        identity: Some(integrity::identity(&graph_hash, seed, &a.graph.set, lp.plan().base_rate(), &inputs, &outputs)),
-        graph_hash: Some(graph_hash),
-        name: checked.graph.name.clone(),
-        base_dir: graph_path.parent().map(Path::to_path_buf).unwrap_or_default(),
-        graph_source: graph_path,
-        overrides: a.graph.set.clone(),
-        seed,
-        base_rate: lp.plan().base_rate(),
-        inputs: inputs.clone(),
-        outputs: outputs.clone(),
-        started: std::time::SystemTime::now().duration_since(std::time::UNIX_EPOCH).map(|d| d.as_secs()).unwrap_or(0),
-    };
-    manifest.write(&dir, "running", None)?;
-
-    let duration = if a.endless { None } else { a.duration.or(checked.graph.duration) };
-    let last_cpu = std::thread::available_parallelism().map(|n| n.get() - 1).unwrap_or(0);
-    let realtime = if a.no_realtime {
-        RealtimeRequest::default()
-    } else {
-        RealtimeRequest { priority: Some(a.priority), lock_memory: true, cpu: Some(a.cpu.unwrap_or(last_cpu)) }
-    };
-    let hardware = checked.nodes.iter().any(|n| n.spec.hardware);
-    let miss_streak = a.miss_streak.unwrap_or(if hardware { DEFAULT_MISS_STREAK } else { 0 });
-    let cfg =
-        LiveConfig { duration, realtime, spin: Duration::from_micros(a.spin_us), miss_streak, ..LiveConfig::default() };
+    let folder = setup::Folder { graph_text: &graph_text, seed, inputs: &inputs, outputs: &outputs };
+    let (dir, manifest) = folder.open(&a, &checked, &lp)?;
+    let pacing = setup::Pacing::of(&a, &checked);
     let vars = live::live_vars(&checked);
     #[cfg(feature = "studio")]
     let description = a.studio.is_some().then(|| {
@@ -191,24 +132,10 @@ pub fn main(a: Args) -> Result<()> {
         evflow_tools::studio::Description::live(&checked, &lp, &vars)
             .with_scene(evflow_tools::studio::scene_json(&checked, graph_dir))
     });
-    let mut session = live::start(lp, &cfg).map_err(|e| anyhow!("{e}"))?;
-    let vars_line = vars
-        .iter()
-        .map(|v| {
-            let uses: Vec<String> = v.uses.iter().map(|(n, p)| format!("{n}.{p}")).collect();
-            format!("{} ({})", v.name, uses.join(", "))
-        })
-        .collect::<Vec<_>>()
-        .join("; ");
+    let mut session = live::start(lp, &pacing.config).map_err(|e| anyhow!("{e}"))?;
+    let vars_line = setup::vars_line(&vars);
     session.control.bind_vars(vars);
-    for c in &a.changes {
-        let (t, change) = c
-            .split_once(':')
-            .ok_or_else(|| anyhow!("--change {c}: expected SECONDS:node.param=value or SECONDS:variable=value"))?;
-        let t: f64 = t.trim().parse().map_err(|_| anyhow!("--change {c}: `{t}` is not a number of seconds"))?;
-        let at = session.control.tick_at(t);
-        session.control.set_text(change, Some(at)).map_err(|e| anyhow!("--change {c}: {e}"))?;
-    }
+    setup::schedule_changes(&mut session.control, &a.changes)?;
     let base_rate = session.base_rate;
     let names = session.node_names.clone();
     let parts = session.into_parts();
@@ -216,32 +143,8 @@ pub fn main(a: Args) -> Result<()> {
     // The console and the studio queue changes through the same control.
     let control = Arc::new(std::sync::Mutex::new(parts.control));
     #[cfg(feature = "studio")]
-    let studio = match (bound, description) {
-        (Some(bound), Some(d)) => {
-            let (studio, ingest) = bound.start_live(&d, control.clone(), shared.clone())?;
-            eprintln!("studio: {}", studio.url());
-            if studio.token().is_some() {
-                eprintln!("studio: serving beyond this machine; the address above holds its one-time token");
-            }
-            Some((studio, ingest))
-        }
-        _ => None,
-    };
-
-    // Ctrl-C: the first stops (the limiters fade out), a second quits at once.
-    let presses = Arc::new(AtomicU32::new(0));
-    {
-        let shared = shared.clone();
-        let presses = presses.clone();
-        let _ = ctrlc::set_handler(move || {
-            if presses.fetch_add(1, Ordering::SeqCst) == 0 {
-                shared.request_stop(StopReason::Requested);
-            } else {
-                eprintln!("\nsecond Ctrl-C: quitting without waiting");
-                std::process::exit(130);
-            }
-        });
-    }
+    let studio = start_studio(bound, description, &control, &shared)?;
+    threads::on_ctrl_c(&shared);
 
     // Recorder, metrics display and console: ordinary threads.
     let done = Arc::new(AtomicBool::new(false));
@@ -251,212 +154,75 @@ pub fn main(a: Args) -> Result<()> {
         Some((_, ingest)) => recorder.tee(Box::new(ingest.clone())),
         None => recorder,
     };
-    let rec_thread = {
-        let done = done.clone();
-        std::thread::Builder::new()
-            .name("evflow-recorder".into())
-            .spawn(move || recorder.run(done, Duration::from_millis(20), Duration::from_millis(200)))?
-    };
+    let rec_thread = threads::spawn_recorder(recorder, &done)?;
     let show = !a.quiet;
-    let metrics_thread = {
-        let done = done.clone();
-        let shared = shared.clone();
-        let mut stats = parts.stats;
-        #[cfg(feature = "studio")]
-        let ingest = studio.as_ref().map(|(_, i)| i.clone());
-        #[cfg(not(feature = "studio"))]
-        let ingest: Option<()> = None;
-        std::thread::Builder::new().name("evflow-metrics".into()).spawn(move || {
-            let mut m = Metrics::new();
-            let mut shown = Instant::now();
-            let tty = std::io::stderr().is_terminal();
-            let steal0 = steal::steal_seconds();
-            while !done.load(Ordering::Acquire) {
-                std::thread::sleep(Duration::from_millis(50));
-                #[cfg(feature = "studio")]
-                if let Some(i) = &ingest {
-                    drain_to_studio(&mut m, &mut stats, i);
-                    i.steal(steal::steal_seconds().zip(steal0).map(|(b, a)| (b - a).max(0.0)));
-                }
-                #[cfg(not(feature = "studio"))]
-                let _ = &ingest;
-                m.drain(&mut stats);
-                if show && shown.elapsed() >= Duration::from_secs(1) {
-                    let mut line = m.summary(&shared, base_rate).line();
-                    // The host's steal so far: misses that coincide with it are the VM's, not the graph's.
-                    if let Some(st) = steal::steal_seconds().zip(steal0).map(|(b, a)| b - a).filter(|&st| st > 0.0) {
-                        line += &format!(" | host steal {:.0} ms", st * 1e3);
-                    }
-                    if tty {
-                        eprint!("\r{line}\x1b[K");
-                    } else {
-                        eprintln!("{line}");
-                    }
-                    shown = Instant::now();
-                }
-            }
-            m.drain(&mut stats);
-            if show && tty {
-                eprintln!();
-            }
-            m
-        })?
-    };
+    #[cfg(feature = "studio")]
+    let ingest = studio.as_ref().map(|(_, i)| i.clone());
+    #[cfg(not(feature = "studio"))]
+    let ingest: Option<()> = None;
+    let display = threads::Display { done: done.clone(), shared: shared.clone(), base_rate, show };
+    let metrics_thread = display.spawn(parts.stats, ingest)?;
     if show {
-        eprintln!(
-            "live: `{}` at {base_rate} Hz{}; recording to {}",
-            checked.graph.name,
-            duration.map(|d| format!(" for {d} s")).unwrap_or_default(),
-            dir.display()
-        );
-        eprintln!(
-            "{}",
-            match (miss_streak, hardware) {
-                (0, false) => "deadline misses are counted; without hardware they never stop the session \
-                               (--miss-streak N stops it after N in a row)"
-                    .to_string(),
-                (0, true) => "deadline misses are counted and never stop the session (--miss-streak 0)".to_string(),
-                (n, _) => format!("{n} deadline misses in a row stop the session (--miss-streak)"),
-            }
-        );
-        eprintln!("type node.param=value and Enter to change a live parameter, `stop` or Ctrl-C to stop");
-        if !vars_line.is_empty() {
-            eprintln!("or variable=value for a graph variable, which changes its parameters at one tick: {vars_line}");
-        }
+        pacing.print_intro(&checked.graph.name, base_rate, &dir, &vars_line);
     }
-    std::thread::Builder::new().name("evflow-console".into()).spawn(move || {
-        let stdin = std::io::stdin();
-        for line in stdin.lock().lines() {
-            let Ok(line) = line else { break };
-            let line = line.trim();
-            match line {
-                "" => {}
-                "stop" | "q" | "quit" => control.lock().unwrap_or_else(|e| e.into_inner()).stop(),
-                _ => match control.lock().unwrap_or_else(|e| e.into_inner()).set_text(line, None) {
-                    Ok(()) => eprintln!("queued {line}"),
-                    Err(e) => eprintln!("{e}"),
-                },
-            }
-            control.lock().unwrap_or_else(|e| e.into_inner()).collect_retired();
-        }
-    })?;
+    threads::spawn_console(control)?;
 
-    let started = Instant::now();
-    let steal_before = steal::steal_seconds();
-    let exit = parts.thread.join();
-    let wall = started.elapsed();
-    let stolen = steal::steal_seconds().zip(steal_before).map(|(b, a)| (b - a).max(0.0));
-    done.store(true, Ordering::Release);
-    let rec = rec_thread.join().map_err(|_| anyhow!("the recorder thread panicked"))?;
-    let metrics = metrics_thread.join().map_err(|_| anyhow!("the metrics thread panicked"))?;
+    let ran = ending::Ran::wait(parts.thread, &done, rec_thread, metrics_thread)?;
     #[cfg(feature = "studio")]
     if let Some((studio, _)) = studio {
-        // The last frames reach the page before it is told the session ended.
-        std::thread::sleep(Duration::from_millis(150));
-        if studio.frames_dropped() > 0 {
-            eprintln!(
-                "studio: browsers lost {} frames (slow to read; the session was not delayed)",
-                studio.frames_dropped()
-            );
-        }
-        studio.close();
+        close_studio(studio);
     }
-    let summary = metrics.summary(&shared, base_rate);
-    let mut exit = exit;
-    let sums = exit.plan.plan_mut().finish().map_err(|e| anyhow!("{e}"))?;
-
-    let reason = match (&exit.failure, exit.reason) {
-        (Some(f), _) => format!("node failure: {f}"),
-        (None, Some(r)) => r.as_str().to_string(),
-        (None, None) => "unknown".into(),
-    };
-    let files: Vec<_> = rec
-        .files
-        .iter()
-        .map(|(f, n, gap, err)| {
-            // The fingerprint of the samples as written: `evflow replay --check` holds the file to it.
-            let hash = integrity::file_hash(&dir.join(format!("{f}.wav"))).ok();
-            json!({ "file": f, "frames": n, "gap_frames": gap, "error": err, "hash": hash })
-        })
-        .collect();
-    let end = json!({
-        "ticks": exit.ticks,
-        "seconds": exit.ticks as f64 / base_rate,
-        "wall_seconds": wall.as_secs_f64(),
-        "stopped": reason,
-        "realtime": exit.realtime.to_string(),
-        "metrics": metrics_json(&summary),
-        "host_steal_seconds": stolen,
-        "files": files,
-        "events": rec.events,
-    });
-    manifest.write(&dir, if exit.failure.is_some() { "failed" } else { "ended" }, Some(end.clone()))?;
-    if let Some(path) = &a.json {
-        std::fs::write(path, serde_json::to_string_pretty(&end)?)
-            .map_err(|e| anyhow!("{}: cannot write results: {e}", path.display()))?;
-    }
-
-    println!(
-        "session {}: {} ticks ({:.3} s), stopped: {reason}",
-        dir.display(),
-        exit.ticks,
-        exit.ticks as f64 / base_rate
-    );
-    println!("real-time thread: {}", exit.realtime);
-    if let Some(st) = stolen.filter(|&st| st > 0.0) {
-        println!(
-            "host steal: {:.0} ms of CPU time taken from this virtual machine by its host during the session \
-             (stalls no setting inside the machine prevents; see docs/live.md)",
-            st * 1e3
-        );
-    }
-    println!("{summary}");
-    for (f, n, gap, err) in &rec.files {
-        let gap = if *gap > 0 {
-            format!(", {gap} lost to a slow disk (zero-filled, see events.jsonl)")
-        } else {
-            String::new()
-        };
-        match err {
-            None => println!("recorded {f} ({n} frames{gap})"),
-            Some(e) => println!("recorded {f}: FAILED: {e}"),
-        }
-    }
-    if let Some(e) = &rec.event_error {
-        println!("event log: FAILED: {e}");
-    }
-    for (node, s) in &sums {
-        for l in &s.lines {
-            println!("{node}: {l}");
-        }
-        for (k, v, unit) in &s.values {
-            println!("{node}: {k} = {v}{}", unit_suffix(unit));
-        }
-    }
-    match exit.failure {
-        Some(f) => Err(anyhow!("{f}")),
-        None if exit.reason.is_some_and(|r| r.is_fault()) => Err(anyhow!("session stopped by a fault: {reason}")),
-        None => Ok(()),
-    }
+    ran.finish(&a, &dir, &manifest, &shared, base_rate)
 }
 
-/// Hands the tick timings to the studio as well, then counts them.
+/// Binds the studio's address when `--studio` asks for it.
 #[cfg(feature = "studio")]
-fn drain_to_studio(
-    m: &mut Metrics,
-    ring: &mut evflow_engine::live::rtrb::Consumer<evflow_engine::live::TickStat>,
-    studio: &evflow_tools::studio::Ingest,
-) {
-    let n = ring.slots();
-    if let Ok(chunk) = ring.read_chunk(n) {
-        let (a, b) = chunk.as_slices();
-        studio.stats(a);
-        studio.stats(b);
-        for s in a.iter().chain(b) {
-            m.absorb(s);
+fn bind_studio(a: &Args) -> Result<Option<evflow_tools::studio::Bound>> {
+    Ok(match &a.studio {
+        Some(addr) => {
+            let cfg =
+                evflow_tools::studio::StudioConfig { addr: super::studio::studio_addr(addr)?, public: a.studio_public };
+            Some(evflow_tools::studio::Bound::bind(&cfg)?)
         }
-        chunk.commit_all();
+        None => None,
+    })
+}
+
+/// Starts serving the studio on the bound address, sharing the session's
+/// control; prints its address.
+#[cfg(feature = "studio")]
+fn start_studio(
+    bound: Option<evflow_tools::studio::Bound>,
+    description: Option<evflow_tools::studio::Description>,
+    control: &Arc<std::sync::Mutex<live::Control>>,
+    shared: &Arc<live::Shared>,
+) -> Result<Option<(evflow_tools::studio::Studio, evflow_tools::studio::Ingest)>> {
+    Ok(match (bound, description) {
+        (Some(bound), Some(d)) => {
+            let (studio, ingest) = bound.start_live(&d, control.clone(), shared.clone())?;
+            eprintln!("studio: {}", studio.url());
+            if studio.token().is_some() {
+                eprintln!("studio: serving beyond this machine; the address above holds its one-time token");
+            }
+            Some((studio, ingest))
+        }
+        _ => None,
+    })
+}
+
+/// Lets the last frames reach the page, reports frames browsers lost, and
+/// closes the studio.
+#[cfg(feature = "studio")]
+fn close_studio(studio: evflow_tools::studio::Studio) {
+    // The last frames reach the page before it is told the session ended.
+    std::thread::sleep(Duration::from_millis(150));
+    if studio.frames_dropped() > 0 {
+        eprintln!(
+            "studio: browsers lost {} frames (slow to read; the session was not delayed)",
+            studio.frames_dropped()
+        );
     }
+    studio.close();
 }
 
 /// ` unit`, or nothing for dimensionless values.
@@ -465,66 +231,5 @@ pub(crate) fn unit_suffix(unit: &str) -> String {
         String::new()
     } else {
         format!(" {unit}")
-    }
-}
-
-fn metrics_json(s: &evflow_engine::live::MetricsSummary) -> serde_json::Value {
-    let p = |p: &evflow_engine::live::Percentiles| json!({ "p50": p.p50, "p99": p.p99, "p99_9": p.p999, "max": p.max, "mean": p.mean });
-    json!({
-        "jitter_us": p(&s.jitter),
-        "compute_us": p(&s.compute),
-        "deadline_misses": s.misses,
-        "longest_miss_streak": s.longest_streak,
-        "tap_overruns": s.tap_overruns,
-        "event_overruns": s.event_overruns,
-        "stat_overruns": s.stat_overruns,
-        "command_overruns": s.command_overruns,
-    })
-}
-
-/// Sources first (the session's inputs), then guards and `--tap`s.
-fn taps_of(plan: &Plan, extra: &[String]) -> Result<(Vec<Tap>, usize)> {
-    let mut taps = LivePlan::source_taps(plan);
-    let n_inputs = taps.len();
-    for t in LivePlan::guard_taps(plan) {
-        if !taps.contains(&t) {
-            taps.push(t);
-        }
-    }
-    for e in extra {
-        let (node, port) = e.split_once('.').ok_or_else(|| anyhow!("--tap {e}: expected node.port"))?;
-        let t = Tap::new(node, port);
-        if !taps[n_inputs..].contains(&t) {
-            taps.push(t);
-        }
-    }
-    Ok((taps, n_inputs))
-}
-
-/// `NAME-YYYYMMDD-HHMMSS` in UTC.
-fn session_name(graph: &str) -> String {
-    let secs = std::time::SystemTime::now().duration_since(std::time::UNIX_EPOCH).map(|d| d.as_secs()).unwrap_or(0);
-    let days = (secs / 86_400) as i64;
-    let rem = secs % 86_400;
-    // Civil date from days since 1970-01-01 (H. Hinnant's algorithm).
-    let z = days + 719_468;
-    let era = z.div_euclid(146_097);
-    let doe = z - era * 146_097;
-    let yoe = (doe - doe / 1460 + doe / 36_524 - doe / 146_096) / 365;
-    let doy = doe - (365 * yoe + yoe / 4 - yoe / 100);
-    let mp = (5 * doy + 2) / 153;
-    let d = doy - (153 * mp + 2) / 5 + 1;
-    let m = if mp < 10 { mp + 3 } else { mp - 9 };
-    let y = yoe + era * 400 + i64::from(m <= 2);
-    format!("{graph}-{y:04}{m:02}{d:02}-{:02}{:02}{:02}", rem / 3600, rem % 3600 / 60, rem % 60)
-}
-
-#[cfg(test)]
-mod tests {
-    #[test]
-    fn session_names_sort_by_time() {
-        let n = super::session_name("g");
-        assert!(n.starts_with("g-20"), "{n}");
-        assert_eq!(n.len(), "g-20250101-120000".len());
     }
 }

@@ -142,12 +142,81 @@ fn replay_one(session: &Path, graph: Option<&Path>, out: &Path, a: &Args) -> Res
         .with_context(|| format!("{}: cannot read", graph_file.display()))?;
     let mut graph = parse_graph(&graph_file, &text).map_err(|e| anyhow!("{e}"))?;
 
-    // Recorded inputs replace the sources of the same names.
     let session_dir = std::fs::canonicalize(session).unwrap_or_else(|_| session.to_path_buf());
+    let (mut ticks, replaced) = replace_sources(&mut graph, &m, &session_dir)?;
+    let recorded = recorded_outputs(&m, &session_dir)?;
+    for (f, s) in &recorded {
+        ticks = ticks.min(f.ratio.ticks_for(s.len() as u64));
+    }
+    if ticks == u64::MAX {
+        return Err(anyhow!("{}: the session recorded nothing to replay", session.display()));
+    }
+
+    let overrides = overrides(own, &m, a, &replaced)?;
+    let checked = check(&graph, &evflow_nodes::registry(), &overrides).map_err(|e| anyhow!("{e}"))?;
+    std::fs::create_dir_all(out).map_err(|e| anyhow!("{}: cannot create output folder: {e}", out.display()))?;
+    let opts = PlanOptions {
+        max_block: a.block.max(1),
+        seed: Some(m.seed),
+        base_dir: Some(base_dir),
+        out_dir: Some(out.to_path_buf()),
+        timing: true,
+        mode: evflow_engine::RunMode::Offline,
+        check_only: false,
+    };
+    // The session's parameter changes apply: no constant may rest on a live parameter.
+    let mut plan =
+        Plan::build_with(&checked, &opts, evflow_engine::plan::Folding::Changes).map_err(|e| anyhow!("{e}"))?;
+    if (plan.base_rate() - m.base_rate).abs() > 1e-9 * m.base_rate {
+        return Err(anyhow!("the graph runs at {} Hz but the session at {} Hz", plan.base_rate(), m.base_rate));
+    }
+
+    let (sets, exact_until) = session_changes(session, &plan, &replaced, ticks)?;
+    let (replayed, report_ticks) = run(&mut plan, &recorded, &sets, ticks)?;
+    let summaries = plan.finish().map_err(|e| anyhow!("{e}"))?;
+
+    if !a.quiet {
+        let _ = writeln!(
+            shown,
+            "replayed {} ticks ({:.3} s) of session `{}`{}",
+            report_ticks,
+            report_ticks as f64 / m.base_rate,
+            m.name,
+            if replaced.is_empty() { String::new() } else { format!("; recorded inputs: {}", replaced.join(", ")) }
+        );
+        for (node, s) in &summaries {
+            for l in &s.lines {
+                let _ = writeln!(shown, "{node}: {l}");
+            }
+            for (k, v, unit) in &s.values {
+                let _ = writeln!(shown, "{node}: {k} = {v}{}", super::live::unit_suffix(unit));
+            }
+        }
+    }
+    let mut all_same = compare_outputs(&mut shown, &recorded, &replayed, exact_until);
+    if exact_until < ticks {
+        let _ =
+            writeln!(shown, "compared up to tick {exact_until} (the session lost samples or replaced its plan there)");
+    }
+    // The folder held to what the session recorded of itself: its graph,
+    // seed and files, every file as long and as written as it ended.
+    if own {
+        for f in super::live::integrity::check(&session_dir, &m, &raw) {
+            let _ = writeln!(shown, "{}{}", if f.ok { "" } else { "not the session's: " }, f.what);
+            all_same &= f.ok;
+        }
+    }
+    Ok((shown, all_same))
+}
+
+/// Recorded inputs replace the sources of the same names in `graph`;
+/// returns the ticks the shortest input lasts (`u64::MAX` without inputs)
+/// and the sources replaced.
+fn replace_sources(graph: &mut evflow_engine::Graph, m: &Manifest, session_dir: &Path) -> Result<(u64, Vec<String>)> {
     let mut ticks = u64::MAX;
     let mut replaced = Vec::new();
     for f in &m.inputs {
-        let rec = open(&session_dir, f)?;
+        let rec = open(session_dir, f)?;
         ticks = ticks.min(f.ratio.ticks_for(rec.frames() as u64));
         let path = session_dir.join(&f.file).to_string_lossy().into_owned();
         let params = vec![
@@ -176,24 +245,24 @@ fn replay_one(session: &Path, graph: Option<&Path>, out: &Path, a: &Args) -> Res
             replaced.push(f.node.clone());
         }
     }
-    let recorded: Vec<(FileSpec, Vec<f64>)> = m
-        .outputs
+    Ok((ticks, replaced))
+}
+
+/// The session's recorded outputs, each file's first channel.
+fn recorded_outputs(m: &Manifest, session_dir: &Path) -> Result<Vec<(FileSpec, Vec<f64>)>> {
+    m.outputs
         .iter()
         .map(|f| {
-            let rec = open(&session_dir, f)?;
+            let rec = open(session_dir, f)?;
             let samples = rec.channel(&f.ports[0]).map(<[f64]>::to_vec).unwrap_or_default();
             Ok((f.clone(), samples))
         })
-        .collect::<Result<_>>()?;
-    for (f, s) in &recorded {
-        ticks = ticks.min(f.ratio.ticks_for(s.len() as u64));
-    }
-    if ticks == u64::MAX {
-        return Err(anyhow!("{}: the session recorded nothing to replay", session.display()));
-    }
+        .collect()
+}
 
-    // Overrides: the session's (for its own graph) and the command line's;
-    // none may address a replaced source.
+/// Overrides: the session's (for its own graph) and the command line's;
+/// none may address a replaced source.
+fn overrides(own: bool, m: &Manifest, a: &Args, replaced: &[String]) -> Result<Vec<Override>> {
     let mut overrides = Vec::new();
     for s in if own { m.overrides.iter().chain(&a.set).collect::<Vec<_>>() } else { a.set.iter().collect() } {
         let o = Override::parse(s).map_err(|e| anyhow!("--set {e}"))?;
@@ -202,25 +271,17 @@ fn replay_one(session: &Path, graph: Option<&Path>, out: &Path, a: &Args) -> Res
         }
         overrides.push(o);
     }
-    let checked = check(&graph, &evflow_nodes::registry(), &overrides).map_err(|e| anyhow!("{e}"))?;
-    std::fs::create_dir_all(out).map_err(|e| anyhow!("{}: cannot create output folder: {e}", out.display()))?;
-    let opts = PlanOptions {
-        max_block: a.block.max(1),
-        seed: Some(m.seed),
-        base_dir: Some(base_dir),
-        out_dir: Some(out.to_path_buf()),
-        timing: true,
-        mode: evflow_engine::RunMode::Offline,
-        check_only: false,
-    };
-    // The session's parameter changes apply: no constant may rest on a live parameter.
-    let mut plan =
-        Plan::build_with(&checked, &opts, evflow_engine::plan::Folding::Changes).map_err(|e| anyhow!("{e}"))?;
-    if (plan.base_rate() - m.base_rate).abs() > 1e-9 * m.base_rate {
-        return Err(anyhow!("the graph runs at {} Hz but the session at {} Hz", plan.base_rate(), m.base_rate));
-    }
+    Ok(overrides)
+}
 
-    // Events: changes to apply; gaps and plan replacements end the exact part.
+/// A parameter change the session made: at which tick, to which node (its
+/// index in the plan), which parameter, what value.
+type Change = (u64, usize, &'static str, f64);
+
+/// Events: changes to apply (before `ticks`, to nodes not replaced); gaps
+/// and plan replacements end the exact part. Returns the changes and the
+/// tick the exact part ends at.
+fn session_changes(session: &Path, plan: &Plan, replaced: &[String], ticks: u64) -> Result<(Vec<Change>, u64)> {
     let mut exact_until = ticks;
     let mut sets = Vec::new();
     for e in read_events(&session.join("events.jsonl"))? {
@@ -243,29 +304,19 @@ fn replay_one(session: &Path, graph: Option<&Path>, out: &Path, a: &Args) -> Res
             _ => {}
         }
     }
-    let (replayed, report_ticks) = run(&mut plan, &recorded, &sets, ticks)?;
-    let summaries = plan.finish().map_err(|e| anyhow!("{e}"))?;
+    Ok((sets, exact_until))
+}
 
-    if !a.quiet {
-        let _ = writeln!(
-            shown,
-            "replayed {} ticks ({:.3} s) of session `{}`{}",
-            report_ticks,
-            report_ticks as f64 / m.base_rate,
-            m.name,
-            if replaced.is_empty() { String::new() } else { format!("; recorded inputs: {}", replaced.join(", ")) }
-        );
-        for (node, s) in &summaries {
-            for l in &s.lines {
-                let _ = writeln!(shown, "{node}: {l}");
-            }
-            for (k, v, unit) in &s.values {
-                let _ = writeln!(shown, "{node}: {k} = {v}{}", super::live::unit_suffix(unit));
-            }
-        }
-    }
+/// Compares each recorded output with its replay up to `exact_until`,
+/// writing a line for each to `shown`; true when all are identical.
+fn compare_outputs(
+    shown: &mut String,
+    recorded: &[(FileSpec, Vec<f64>)],
+    replayed: &[Option<Vec<f64>>],
+    exact_until: u64,
+) -> bool {
     let mut all_same = true;
-    for ((f, rec), replay) in recorded.iter().zip(&replayed) {
+    for ((f, rec), replay) in recorded.iter().zip(replayed) {
         let name = format!("{}.{}", f.node, f.ports[0]);
         let Some(out) = replay else {
             let _ = writeln!(shown, "{name}: not in the replayed graph");
@@ -288,19 +339,7 @@ fn replay_one(session: &Path, graph: Option<&Path>, out: &Path, a: &Args) -> Res
             }
         }
     }
-    if exact_until < ticks {
-        let _ =
-            writeln!(shown, "compared up to tick {exact_until} (the session lost samples or replaced its plan there)");
-    }
-    // The folder held to what the session recorded of itself: its graph,
-    // seed and files, every file as long and as written as it ended.
-    if own {
-        for f in super::live::integrity::check(&session_dir, &m, &raw) {
-            let _ = writeln!(shown, "{}{}", if f.ok { "" } else { "not the session's: " }, f.what);
-            all_same &= f.ok;
-        }
-    }
-    Ok((shown, all_same))
+    all_same
 }
 
 fn param(name: &str, value: Value) -> ParamDecl {
@@ -316,7 +355,7 @@ fn open(dir: &Path, f: &FileSpec) -> Result<Recording> {
 fn run(
     plan: &mut Plan,
     recorded: &[(FileSpec, Vec<f64>)],
-    sets: &[(u64, usize, &'static str, f64)],
+    sets: &[Change],
     ticks: u64,
 ) -> Result<(Vec<Option<Vec<f64>>>, u64)> {
     let taps: Vec<Option<(usize, usize)>> = recorded

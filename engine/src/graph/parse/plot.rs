@@ -1,8 +1,8 @@
 //! Reading `[[plot]]` tables.
 
 use super::Ctx;
+use crate::graph::model::Graph;
 use crate::graph::plot::{Fit, PlotDecl};
-use crate::graph::Graph;
 use crate::suggest;
 use toml::de::DeValue;
 use toml::Spanned;

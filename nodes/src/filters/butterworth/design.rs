@@ -62,17 +62,6 @@ pub enum Kind {
     Highpass,
 }
 
-impl Kind {
-    /// The kind named `lowpass` or `highpass`.
-    pub fn from_name(name: &str) -> Option<Kind> {
-        match name {
-            "lowpass" => Some(Kind::Lowpass),
-            "highpass" => Some(Kind::Highpass),
-            _ => None,
-        }
-    }
-}
-
 /// Why a design was refused.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
 pub enum DesignError {

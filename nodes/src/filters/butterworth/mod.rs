@@ -4,7 +4,8 @@ pub mod design;
 pub mod sos;
 
 use design::{butterworth, DesignError, Kind, MIN_RELATIVE_CUTOFF};
-use evflow_engine::{BuildContext, Io, Node, NodeError, NodeSpec, ParamSpec, Params, PortSpec, Role};
+use evflow_engine::typed_params::{Choice, Float, Int};
+use evflow_engine::{BuildContext, Io, Node, NodeError, NodeSpec, Params, PortSpec, Role};
 use sos::Cascade;
 
 /// Declaration of `butterworth`.
@@ -31,7 +32,7 @@ pub static SPEC: NodeSpec = NodeSpec::new(
      the Nyquist frequency (half the input's rate) and at or above 1e-6 × the rate (below that the \
      rounding of f64 coefficients changes the low-frequency gain by more than about 1e-5; decimate \
      first). A non-finite input sample stops the run with an error rather than leaving the filter's \
-     state NaN forever.\n\n\
+     state NaN forever; so does a finite input so large (near ±f64::MAX) that the state overflows.\n\n\
      Dissertation: §5.1.1 removes the force sensor's DC biases with a 10 Hz high-pass on the 1 kHz \
      tribometer forces; §3.1.2 low-passes the 10 kHz force data at 500 Hz before measuring \
      peak-to-peak amplitudes.\n\n\
@@ -41,23 +42,25 @@ pub static SPEC: NodeSpec = NodeSpec::new(
      cut-offs of 0.01 Hz and 499 Hz at 1 kHz.",
 )
 .ports(&[PortSpec::input("in", "1", "signal"), PortSpec::output("out", "1", "filtered signal")])
-.params(&[
-    ParamSpec::choice("kind", &["lowpass", "highpass"], "lowpass", "which band passes"),
-    ParamSpec::int("order", 1, design::MAX_ORDER as i64, 4, "1", "filter order (roll-off 6·order dB per octave)"),
-    ParamSpec::float("cutoff", 0.001, f64::INFINITY, 10.0, "Hz", "−3 dB frequency; below half the input's rate")
-        .required(),
-])
+.params(&[KIND.spec(), ORDER.spec(), CUTOFF.spec()])
 .example("kind = \"highpass\"\norder = 4\ncutoff = 10.0");
+
+/// `kind`: which band passes.
+const KIND: Choice<Kind> =
+    Choice::new("kind", &["lowpass", "highpass"], &[Kind::Lowpass, Kind::Highpass], "lowpass", "which band passes");
+/// `order`: the roll-off.
+const ORDER: Int =
+    Int::new("order", 1, design::MAX_ORDER as i64, 4, "1", "filter order (roll-off 6·order dB per octave)");
+/// `cutoff`: the −3 dB frequency.
+const CUTOFF: Float =
+    Float::new("cutoff", 0.001, f64::INFINITY, 10.0, "Hz", "−3 dB frequency; below half the input's rate").required();
 
 struct Butterworth {
     cascade: Cascade,
 }
 
 fn build(p: &Params, ctx: &BuildContext) -> Result<Box<dyn Node>, NodeError> {
-    let kind = Kind::from_name(p.str("kind"))
-        .ok_or_else(|| NodeError::param("kind", format!("`{}` is neither `lowpass` nor `highpass`", p.str("kind"))))?;
-    let order = p.usize("order");
-    let cutoff = p.f64("cutoff");
+    let (kind, order, cutoff) = (KIND.get(p), ORDER.count(p), CUTOFF.get(p));
     let sections = butterworth(kind, order, cutoff, ctx.rate).map_err(|e| match e {
         DesignError::Order(_) => NodeError::param("order", e.to_string()),
         DesignError::Rate(_) => NodeError::Other(e.to_string()),
@@ -92,6 +95,17 @@ impl Node for Butterworth {
             )));
         }
         self.cascade.process(x, y);
+        // Finite inputs near ±f64::MAX overflow the sections' state (found
+        // by `evflow report stability`): stop, naming the sample, rather
+        // than let ±∞ or NaN out.
+        if let Some(i) = y.iter().position(|v| !v.is_finite()) {
+            let peak = x[..=i].iter().fold(0.0f64, |m, v| m.max(v.abs()));
+            return Err(NodeError::Data(format!(
+                "output sample {} overflows (the input reaches {peak:e}, beyond what the filter's state \
+                 can hold); scale the input down upstream",
+                start + i as u64
+            )));
+        }
         Ok(())
     }
 
@@ -261,6 +275,18 @@ mod tests {
             let err = node.process(&mut io).unwrap_err().to_string();
             assert!(err.contains(&format!("input sample 113 is {bad}")), "{err}");
         }
+    }
+
+    #[test]
+    fn an_input_that_overflows_the_state_is_an_error_naming_the_sample() {
+        // Steps 0 → +f64::MAX → −f64::MAX: the state overflows.
+        let mut x: Vec<f64> = (0..40).map(|i| [0.0, f64::MAX, -f64::MAX][i / 14]).collect();
+        let err = run("kind = \"lowpass\"\norder = 4\ncutoff = 100.0", &x, 1000.0, 16).unwrap_err();
+        assert!(err.contains("output sample ") && err.contains("overflows"), "{err}");
+        // 1e300 does not overflow: the output stays finite.
+        x.iter_mut().for_each(|v| *v = v.signum() * 1e300 * f64::from(u8::from(*v != 0.0)));
+        let y = run("kind = \"lowpass\"\norder = 4\ncutoff = 100.0", &x, 1000.0, 16).unwrap();
+        assert!(y.iter().all(|v| v.is_finite()));
     }
 
     #[test]

@@ -17,7 +17,7 @@
 //!   semicolon, tab or space delimiter also the decimal comma `1,5`). Cells
 //!   may be quoted (`"1.5"`, RFC 4180 quoting).
 
-use super::ImportError;
+use super::error::{non_finite_word, ImportError};
 use std::path::Path;
 
 /// How the cells of a row are separated.
@@ -170,7 +170,7 @@ pub(super) fn parse(text: &str, path: &Path, delimiter: Option<Delimiter>) -> Re
             };
             match number(c, delimiter) {
                 Some(x) if x.is_finite() => samples.push(x),
-                Some(x) => return Err(cell_err(format!("`{c}` is {}", super::non_finite_word(x)))),
+                Some(x) => return Err(cell_err(format!("`{c}` is {}", non_finite_word(x)))),
                 None if c.is_empty() => return Err(cell_err("is empty".into())),
                 None if header.is_none() && lines.is_empty() => {
                     return Err(cell_err(format!(

@@ -29,185 +29,17 @@
 //! MATLAB lines that write CSV (or the WAV + JSON pair) instead.
 
 mod csv;
+mod error;
 mod npy;
 #[cfg(test)]
 mod tests;
 
 pub use super::format::Written;
 pub use csv::Delimiter;
+pub use error::ImportError;
 
-use super::format::{
-    Channel, Condition, RecordingError, RecordingMeta, RecordingPaths, RecordingWriter, MAX_RATE_HZ, MIN_RATE_HZ,
-};
+use super::format::{Channel, Condition, RecordingMeta, RecordingPaths, RecordingWriter, MAX_RATE_HZ, MIN_RATE_HZ};
 use std::path::{Path, PathBuf};
-
-/// Why an import failed. Every message starts with the file it concerns
-/// (the source, or for writing the destination), and for delimited text
-/// with the line (`force.csv:12: …`).
-#[derive(Debug, thiserror::Error)]
-pub enum ImportError {
-    /// The source could not be read, or a destination folder not created.
-    #[error("{}: {source}", path.display())]
-    Io {
-        /// The file or folder.
-        path: PathBuf,
-        /// The system's error.
-        source: std::io::Error,
-    },
-    /// The source's extension is not one evflow imports.
-    #[error("{}: cannot import {what}; evflow import reads .npy (NumPy) and .csv, .tsv or .txt (delimited text)", path.display())]
-    UnsupportedKind {
-        /// The source.
-        path: PathBuf,
-        /// The kind found, in words (`a .xlsx file`, `a file without an extension`).
-        what: String,
-    },
-    /// A MATLAB `.mat` file.
-    #[error(
-        "{}: MATLAB .mat files are not read (docs/rig.md says why); in MATLAB write the columns as CSV, e.g. \
-         writematrix([t force u], 'NAME.csv') with a header via writetable, then `evflow import NAME.csv`",
-        path.display()
-    )]
-    Mat {
-        /// The source.
-        path: PathBuf,
-    },
-    /// A NumPy `.npz` archive.
-    #[error("{}: .npz archives are not read; save the array with np.save('NAME.npy', arr) and import that", path.display())]
-    Npz {
-        /// The source.
-        path: PathBuf,
-    },
-    /// The `.npy` file is malformed or holds an array evflow cannot take.
-    #[error("{}: not an importable .npy file: {message}", path.display())]
-    Npy {
-        /// The source.
-        path: PathBuf,
-        /// What is wrong.
-        message: String,
-    },
-    /// A line of delimited text is malformed.
-    #[error("{}:{line}: {message}", path.display())]
-    Text {
-        /// The source.
-        path: PathBuf,
-        /// Line number, from 1.
-        line: usize,
-        /// What is wrong.
-        message: String,
-    },
-    /// A cell of delimited text is not a finite number.
-    #[error("{}:{line}: column {column}{}: {message}", path.display(), name.as_ref().map(|n| format!(" (`{n}`)")).unwrap_or_default())]
-    Cell {
-        /// The source.
-        path: PathBuf,
-        /// Line number, from 1.
-        line: usize,
-        /// Column number, from 1.
-        column: usize,
-        /// The column's name in the header, if any.
-        name: Option<String>,
-        /// What is wrong.
-        message: String,
-    },
-    /// A sample of an `.npy` array is NaN or infinite.
-    #[error("{}: column {channel} (from 0) frame {frame} is {what}; a recording holds finite samples", path.display())]
-    NonFinite {
-        /// The source.
-        path: PathBuf,
-        /// The column, from 0.
-        channel: usize,
-        /// The frame (row), from 0.
-        frame: u64,
-        /// `NaN`, `+Inf` or `-Inf`.
-        what: &'static str,
-    },
-    /// The source holds no samples.
-    #[error("{}: holds no samples: {what}", path.display())]
-    Empty {
-        /// The source.
-        path: PathBuf,
-        /// What it holds instead.
-        what: String,
-    },
-    /// No rate was given and none could be inferred.
-    #[error("{}: no sample rate: {hint}", path.display())]
-    NoRate {
-        /// The source.
-        path: PathBuf,
-        /// Where a rate could come from, for this kind of file.
-        hint: String,
-    },
-    /// The time column's steps are not uniform.
-    #[error(
-        "{}:{line}: time column `{name}` steps by {step} s here (from line {previous}), where a uniform rate \
-         needs {expected} s (the median step) ± {tolerance_pct} %; a recording has one fixed rate: resample the data first, or \
-         widen the tolerance (--time-tolerance) if the time stamps only jitter",
-        path.display()
-    )]
-    IrregularTime {
-        /// The source.
-        path: PathBuf,
-        /// Line (or, for `.npy`, frame from 1) of the first irregular step.
-        line: usize,
-        /// Line of the row before it.
-        previous: usize,
-        /// The time column's name.
-        name: String,
-        /// The step found, in seconds.
-        step: f64,
-        /// The median step, in seconds.
-        expected: f64,
-        /// The tolerance, in percent of the mean step.
-        tolerance_pct: f64,
-    },
-    /// The given rate and the time column disagree.
-    #[error(
-        "{}: --rate {given} Hz disagrees with the {inferred} Hz of time column `{name}` (more than {tolerance_pct} % apart)",
-        path.display()
-    )]
-    RateDisagrees {
-        /// The source.
-        path: PathBuf,
-        /// The rate given.
-        given: f64,
-        /// The rate from the time column.
-        inferred: f64,
-        /// The time column's name.
-        name: String,
-        /// The tolerance, in percent.
-        tolerance_pct: f64,
-    },
-    /// The options do not fit the source (channel or unit count, a name, a
-    /// condition value, the rate).
-    #[error("{}: {message}", path.display())]
-    Options {
-        /// The source.
-        path: PathBuf,
-        /// What does not fit.
-        message: String,
-    },
-    /// A `--condition key=value` (or another option) is malformed.
-    #[error("{0}")]
-    Usage(String),
-    /// The destination holds a recording already.
-    #[error("{}: already exists; give --force to replace it, or another --out", path.display())]
-    Exists {
-        /// The existing file.
-        path: PathBuf,
-    },
-    /// Writing the recording failed (the message names the destination);
-    /// nothing was left there.
-    #[error(transparent)]
-    Write(#[from] RecordingError),
-    /// The import was stopped (Ctrl-C, SIGTERM) while writing; nothing was
-    /// left at the destination.
-    #[error("{}: import interrupted; nothing was written", path.display())]
-    Interrupted {
-        /// The destination's `NAME.wav`.
-        path: PathBuf,
-    },
-}
 
 /// How to import: everything the source does not say.
 #[derive(Debug, Clone, PartialEq)]
@@ -548,72 +380,119 @@ fn read_regular(src: &Path) -> Result<Vec<u8>, ImportError> {
 
 /// Names, units, time column and rate: the recording's metadata.
 fn assemble(src: &Path, t: Columns, opts: &ImportOptions, mut notes: Vec<String>) -> Result<Imported, ImportError> {
-    let options = |message: String| ImportError::Options { path: src.to_path_buf(), message };
     let n = t.columns;
     let frames = t.samples.len() / n.max(1);
+    let mut labels = Labels::of(src, &t, opts, &mut notes)?;
+    let time = time_column(src, &labels.names, n, opts)?;
+    let inferred = match time {
+        Some(k) => inferred_rate(src, &t, k, &labels, frames, opts, &mut notes)?,
+        None => None,
+    };
+    let rate = settle_rate(src, opts, inferred, t.lines.is_some(), time.is_some())?;
+    let samples = drop_time(src, t.samples, n, time, opts, &mut labels, &mut notes)?;
 
-    // Names and units, one per column of the source.
-    let mut names: Vec<String> = match &opts.channels {
-        Some(list) => {
-            if list.len() != n {
-                return Err(options(format!("--channels lists {} name(s) but the file has {n} column(s)", list.len())));
-            }
-            for name in list {
-                if !valid_name(name) {
-                    return Err(ImportError::Usage(format!(
-                        "--channels: `{name}` is not a valid channel name (letters, digits, `_`, `-`)"
+    let condition = opts.condition.clone();
+    check_condition(&condition).map_err(ImportError::Usage)?;
+    let channels = labels.names.into_iter().zip(labels.units).map(|(n, u)| Channel::new(n, u)).collect();
+    let meta = RecordingMeta {
+        rate,
+        channels,
+        condition,
+        source: format!("evflow import of {} ({})", src.display(), t.description),
+    };
+    Ok(Imported { meta, frames, notes, samples })
+}
+
+/// A mistake in the options for this source.
+fn options_err(src: &Path, message: String) -> ImportError {
+    ImportError::Options { path: src.to_path_buf(), message }
+}
+
+/// The channels' names and units, one per column of the source.
+struct Labels {
+    names: Vec<String>,
+    units: Vec<String>,
+}
+
+impl Labels {
+    /// Names from `--channels`, else the header (made into port names),
+    /// else `ch0`, `ch1`, …, all different; units from `--units`, else the
+    /// header, else none.
+    fn of(src: &Path, t: &Columns, opts: &ImportOptions, notes: &mut Vec<String>) -> Result<Labels, ImportError> {
+        let options = |message: String| options_err(src, message);
+        let n = t.columns;
+        let names: Vec<String> = match &opts.channels {
+            Some(list) => {
+                if list.len() != n {
+                    return Err(options(format!(
+                        "--channels lists {} name(s) but the file has {n} column(s)",
+                        list.len()
                     )));
                 }
-            }
-            list.clone()
-        }
-        None => match &t.heads {
-            Some(h) => h
-                .iter()
-                .enumerate()
-                .map(|(k, (raw, _))| {
-                    let name = port_name(raw);
-                    if name.is_empty() {
-                        notes.push(format!("column {} has no usable name in the header: named ch{k}", k + 1));
-                        format!("ch{k}")
-                    } else {
-                        if &name != raw {
-                            notes.push(format!("header name `{raw}` written as channel `{name}`"));
-                        }
-                        name
+                for name in list {
+                    if !valid_name(name) {
+                        return Err(ImportError::Usage(format!(
+                            "--channels: `{name}` is not a valid channel name (letters, digits, `_`, `-`)"
+                        )));
                     }
-                })
-                .collect(),
-            None => (0..n).map(|k| format!("ch{k}")).collect(),
-        },
-    };
-    for (i, a) in names.iter().enumerate() {
-        if let Some(j) = names[..i].iter().position(|b| b == a) {
-            return Err(options(format!(
-                "columns {} and {} are both named `{a}`; name them with --channels",
-                j + 1,
-                i + 1
-            )));
+                }
+                list.clone()
+            }
+            None => match &t.heads {
+                Some(h) => h
+                    .iter()
+                    .enumerate()
+                    .map(|(k, (raw, _))| {
+                        let name = port_name(raw);
+                        if name.is_empty() {
+                            notes.push(format!("column {} has no usable name in the header: named ch{k}", k + 1));
+                            format!("ch{k}")
+                        } else {
+                            if &name != raw {
+                                notes.push(format!("header name `{raw}` written as channel `{name}`"));
+                            }
+                            name
+                        }
+                    })
+                    .collect(),
+                None => (0..n).map(|k| format!("ch{k}")).collect(),
+            },
+        };
+        for (i, a) in names.iter().enumerate() {
+            if let Some(j) = names[..i].iter().position(|b| b == a) {
+                return Err(options(format!(
+                    "columns {} and {} are both named `{a}`; name them with --channels",
+                    j + 1,
+                    i + 1
+                )));
+            }
         }
+        let units: Vec<String> = match &opts.units {
+            Some(list) if list.len() != n => {
+                return Err(options(format!("--units lists {} unit(s) but the file has {n} column(s)", list.len())))
+            }
+            Some(list) => list.iter().map(|u| u.trim().to_string()).collect(),
+            None => match &t.heads {
+                Some(h) => h.iter().map(|(_, u)| u.clone()).collect(),
+                None => vec![String::new(); n],
+            },
+        };
+        Ok(Labels { names, units })
     }
-    let mut units: Vec<String> = match &opts.units {
-        Some(list) if list.len() != n => {
-            return Err(options(format!("--units lists {} unit(s) but the file has {n} column(s)", list.len())))
-        }
-        Some(list) => list.iter().map(|u| u.trim().to_string()).collect(),
-        None => match &t.heads {
-            Some(h) => h.iter().map(|(_, u)| u.clone()).collect(),
-            None => vec![String::new(); n],
-        },
-    };
+}
 
-    // The time column, and the rate.
+/// The time column among the `n` (named `time` or `t`; at most one),
+/// after checking the time tolerance.
+fn time_column(src: &Path, names: &[String], n: usize, opts: &ImportOptions) -> Result<Option<usize>, ImportError> {
     let time: Vec<usize> = (0..n).filter(|&k| is_time_name(&names[k])).collect();
     if time.len() > 1 {
-        return Err(options(format!(
-            "columns {} are all time columns (named time or t); keep one, or rename the others with --channels",
-            time.iter().map(|k| (k + 1).to_string()).collect::<Vec<_>>().join(", ")
-        )));
+        return Err(options_err(
+            src,
+            format!(
+                "columns {} are all time columns (named time or t); keep one, or rename the others with --channels",
+                time.iter().map(|k| (k + 1).to_string()).collect::<Vec<_>>().join(", ")
+            ),
+        ));
     }
     let tol = opts.time_tolerance;
     if !(tol.is_finite() && (0.0..1.0).contains(&tol)) {
@@ -621,18 +500,46 @@ fn assemble(src: &Path, t: Columns, opts: &ImportOptions, mut notes: Vec<String>
             "--time-tolerance {tol}: a fraction of the time step, at least 0 and below 1 (e.g. 0.01)"
         )));
     }
-    let mut inferred = None;
-    if let Some(&k) = time.first() {
-        let scale = seconds_per(&units[k]).ok_or_else(|| {
-            options(format!("time column `{}` has unit `{}`; give its times in s, ms, us or ns", names[k], units[k]))
-        })?;
-        if frames >= 2 {
-            let rate = infer_rate(src, &t, k, &names[k], scale, opts.time_tolerance)?;
-            notes.push(format!("rate {rate} Hz from time column `{}`", names[k]));
-            inferred = Some((rate, names[k].clone()));
-        }
+    Ok(time.first().copied())
+}
+
+/// The rate the time column `k` gives (with its name), when it has at
+/// least two rows; its unit must be a unit of time.
+fn inferred_rate(
+    src: &Path,
+    t: &Columns,
+    k: usize,
+    labels: &Labels,
+    frames: usize,
+    opts: &ImportOptions,
+    notes: &mut Vec<String>,
+) -> Result<Option<(f64, String)>, ImportError> {
+    let (names, units) = (&labels.names, &labels.units);
+    let scale = seconds_per(&units[k]).ok_or_else(|| {
+        options_err(
+            src,
+            format!("time column `{}` has unit `{}`; give its times in s, ms, us or ns", names[k], units[k]),
+        )
+    })?;
+    if frames < 2 {
+        return Ok(None);
     }
-    let rate = match (opts.rate, &inferred) {
+    let rate = infer_rate(src, t, k, &names[k], scale, opts.time_tolerance)?;
+    notes.push(format!("rate {rate} Hz from time column `{}`", names[k]));
+    Ok(Some((rate, names[k].clone())))
+}
+
+/// The recording's rate: `--rate` (within the rates a recording may have,
+/// and agreeing with a time column's), else the time column's; `text` and
+/// `has_time` choose the hint when there is neither.
+fn settle_rate(
+    src: &Path,
+    opts: &ImportOptions,
+    inferred: Option<(f64, String)>,
+    text: bool,
+    has_time: bool,
+) -> Result<f64, ImportError> {
+    Ok(match (opts.rate, &inferred) {
         (Some(r), _) if !(r.is_finite() && r > 0.0) => {
             return Err(ImportError::Usage(format!("--rate {r}: not a positive number of Hz")))
         }
@@ -659,47 +566,46 @@ fn assemble(src: &Path, t: Columns, opts: &ImportOptions, mut notes: Vec<String>
         (Some(r), None) => r,
         (None, Some((i, _))) => *i,
         (None, None) => {
-            let hint = match (t.lines.is_some(), time.first()) {
-                (_, Some(_)) => "the time column has a single row; give --rate HZ".to_string(),
-                (true, None) => {
+            let hint = match (text, has_time) {
+                (_, true) => "the time column has a single row; give --rate HZ".to_string(),
+                (true, false) => {
                     "give --rate HZ, or a time column in the header (`time [s]`, `t`, or named with --channels)".into()
                 }
-                (false, None) => {
+                (false, false) => {
                     "an .npy array holds none; give --rate HZ (or name a time column with --channels time,…)".into()
                 }
             };
             return Err(ImportError::NoRate { path: src.to_path_buf(), hint });
         }
-    };
+    })
+}
 
-    // Drop the time column unless asked to keep it.
-    let mut samples = t.samples;
-    if let (Some(&k), false) = (time.first(), opts.keep_time) {
-        if n == 1 {
-            return Err(options(format!(
-                "the only column is the time column `{}`; there is nothing else to record",
-                names[k]
-            )));
-        }
-        samples = samples
-            .chunks_exact(n)
-            .flat_map(|row| row.iter().enumerate().filter(|(j, _)| *j != k).map(|(_, x)| *x))
-            .collect();
-        notes.push(format!("time column `{}` dropped (--keep-time keeps it)", names[k]));
-        names.remove(k);
-        units.remove(k);
+/// Drops the time column `time` from the `n`-column rows unless
+/// `--keep-time`, with its name and unit.
+fn drop_time(
+    src: &Path,
+    samples: Vec<f64>,
+    n: usize,
+    time: Option<usize>,
+    opts: &ImportOptions,
+    labels: &mut Labels,
+    notes: &mut Vec<String>,
+) -> Result<Vec<f64>, ImportError> {
+    let (Some(k), false) = (time, opts.keep_time) else { return Ok(samples) };
+    if n == 1 {
+        return Err(options_err(
+            src,
+            format!("the only column is the time column `{}`; there is nothing else to record", labels.names[k]),
+        ));
     }
-
-    let condition = opts.condition.clone();
-    check_condition(&condition).map_err(ImportError::Usage)?;
-    let channels = names.into_iter().zip(units).map(|(n, u)| Channel::new(n, u)).collect();
-    let meta = RecordingMeta {
-        rate,
-        channels,
-        condition,
-        source: format!("evflow import of {} ({})", src.display(), t.description),
-    };
-    Ok(Imported { meta, frames, notes, samples })
+    let samples = samples
+        .chunks_exact(n)
+        .flat_map(|row| row.iter().enumerate().filter(|(j, _)| *j != k).map(|(_, x)| *x))
+        .collect();
+    notes.push(format!("time column `{}` dropped (--keep-time keeps it)", labels.names[k]));
+    labels.names.remove(k);
+    labels.units.remove(k);
+    Ok(samples)
 }
 
 /// The rate of a time column `k` (in units of `scale` seconds). Every step
@@ -829,15 +735,4 @@ fn check_condition(c: &Condition) -> Result<(), String> {
         return Err(format!("--material `{m}`: empty"));
     }
     Ok(())
-}
-
-/// `NaN`, `+Inf` or `-Inf`.
-fn non_finite_word(x: f64) -> &'static str {
-    if x.is_nan() {
-        "NaN"
-    } else if x > 0.0 {
-        "+Inf"
-    } else {
-        "-Inf"
-    }
 }

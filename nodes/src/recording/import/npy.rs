@@ -17,7 +17,7 @@
 //! longer than the header claims) is refused with a message saying what was
 //! found.
 
-use super::ImportError;
+use super::error::{non_finite_word, ImportError};
 use std::path::Path;
 
 /// The magic string every `.npy` file starts with.
@@ -152,7 +152,7 @@ pub(super) fn parse(bytes: &[u8], path: &Path) -> Result<NpyArray, ImportError> 
             path: path.to_path_buf(),
             channel: k % channels,
             frame: (k / channels) as u64,
-            what: super::non_finite_word(samples[k]),
+            what: non_finite_word(samples[k]),
         });
     }
     let order = if header.shape.len() == 1 {

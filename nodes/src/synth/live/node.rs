@@ -12,7 +12,7 @@ use std::time::{Duration, Instant};
 /// Declaration of `synth.live`.
 pub static SPEC: NodeSpec = NodeSpec::new(
     "synth.live",
-    "models",
+    "synth",
     Role::Filter,
     "Live synthesis on a receding horizon: the carrier envelope whose force, through the forward models blended at the finger's load and speed, follows the texture force ahead.",
     build,

@@ -15,6 +15,7 @@ pub mod narx;
 pub mod precision;
 #[cfg(feature = "texture")]
 pub mod resample;
+pub mod stability;
 #[cfg(feature = "synth")]
 pub mod textures;
 
@@ -106,15 +107,28 @@ enum Which {
     #[cfg(feature = "synth")]
     Live(live::Args),
     /// Error against run time of every computation with a tolerance or a
-    /// discretization (issue 26, point 2): the lab's integrators,
-    /// `butterworth`, `decimate`, `resample`, `interp`'s kernel, FOAW and the
-    /// mesh gradient, each against an exact reference (or one ≥ 10× more
-    /// precise): a log-log PNG each with the shipped default marked,
-    /// table.md (default, its error and cost, the cheapest setting within
-    /// 10 % of the best error) and rows.csv. `--size ci` runs in seconds.
+    /// discretization (docs/numerics.md): the lab's integrators,
+    /// `butterworth`, `decimate`, `resample`, `interp`'s kernel, FOAW, the
+    /// mesh gradient, the forward model's memory, `synth.optimize`'s
+    /// iterations on every lab profile, NARX sizes and trainers, and the
+    /// live texture and mesh chains end to end, each against an exact
+    /// reference (or one ≥ 10× more precise, or says why there is none):
+    /// a log-log PNG each with the shipped default marked, table.md
+    /// (default, its error and cost, the cheapest setting within 10 % of the
+    /// best error) and rows.csv. `--size ci` runs in seconds.
     ///
     /// Example: cargo run --release -p evflow -- report precision --out report-precision
     Precision(precision::Args),
+    /// Numerical stability (docs/numerics.md): every node type
+    /// with each numeric parameter at its declared limits and every input
+    /// at ±1e300, ±f64::MAX, subnormals, full-scale steps and impulses and
+    /// a long constant run; the named stiff cases; every shipped graph
+    /// family. Per case the largest |output|, the NaN/Inf count, the
+    /// invariant checked and the verdict; table.md and rows.csv; exit 1
+    /// when a case fails. `--size ci` is the suite CI runs.
+    ///
+    /// Example: cargo run --release -p evflow -- report stability --out report
+    Stability(stability::Args),
 }
 
 /// Writes `plot` to `path` and says so (unlabelled without a font); a plot
@@ -158,5 +172,6 @@ pub fn main(a: ReportArgs) -> anyhow::Result<()> {
         #[cfg(feature = "synth")]
         Which::Live(l) => live::main(l),
         Which::Precision(p) => precision::main(p),
+        Which::Stability(s) => stability::main(s),
     }
 }

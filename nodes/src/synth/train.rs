@@ -16,7 +16,7 @@ use std::time::Instant;
 /// Declaration of `forward.train`.
 pub static SPEC: NodeSpec = NodeSpec::new(
     "forward.train",
-    "models",
+    "synth",
     Role::Sink,
     "Identifies a forward model of the display (actuation → force, a second-order Volterra NFIR) and writes the model file at the end.",
     build,
@@ -60,8 +60,15 @@ pub static SPEC: NodeSpec = NodeSpec::new(
 .params(&[
     ParamSpec::text("path", "", "model file to write (JSON), relative to the run's output folder").required(),
     ParamSpec::int("memory", 1, 128, 20, "samples", "memory M of the kernels (20 ms at 1 kHz)"),
-    ParamSpec::int("highpass_order", 0, 16, 4, "1", "order of the Butterworth high-pass the force went through (0 = none)"),
-    ParamSpec::float("highpass_hz", 0.0, 1e6, 10.0, "Hz", "its cut-off"),
+    ParamSpec::int(
+        "highpass_order",
+        0,
+        crate::filters::butterworth::design::MAX_ORDER as i64,
+        4,
+        "1",
+        "order of the Butterworth high-pass the force went through (0 = none)",
+    ),
+    ParamSpec::float("highpass_hz", 0.001, 1e6, 10.0, "Hz", "its cut-off (as `butterworth`'s `cutoff`)"),
     ParamSpec::float("validation", 0.0, 0.89, 0.15, "1", "fraction of the kept samples, at their end, held out"),
     ParamSpec::float("ridge", 0.0, 1.0, 1e-9, "1", "ridge δ relative to the mean diagonal of ΦᵀΦ"),
     ParamSpec::float("noise_window", 0.001, 10.0, 0.25, "s", "window of the local actuation power in the noise model"),

@@ -12,7 +12,7 @@ use evflow_engine::{BuildContext, Io, Node, NodeError, NodeSpec, ParamSpec, Para
 /// Declaration of `narx.grid`.
 pub static SPEC: NodeSpec = NodeSpec::new(
     "narx.grid",
-    "models",
+    "narx",
     Role::Filter,
     "Inverse NARX models over the (load, velocity) grid, run closed loop; the nearest condition's actuation out, switched with a crossfade.",
     build,

@@ -14,7 +14,7 @@ use std::path::PathBuf;
 /// Declaration of `narx.score`.
 pub static SPEC: NodeSpec = NodeSpec::new(
     "narx.score",
-    "models",
+    "narx",
     Role::Sink,
     "Scores an inverse NARX model on a recording of force and actuation it was not trained on (closed loop).",
     build,
@@ -33,7 +33,7 @@ pub static SPEC: NodeSpec = NodeSpec::new(
      Use: a second excitation recording per condition, kept in a folder of its own \
      (graphs/model-validate-recordings.toml, docs/rig.md).\n\n\
      Checked against: a model trained on one simulated recording scores a second recording of the same \
-     condition well above chance and the noise-force run near it (nodes/src/narx/score_node.rs tests; \
+     condition well above chance and the noise-force run near it (nodes/src/narx/score.rs tests; \
      tests/rig_recordings.rs end to end).",
 )
 .ports(&[

@@ -6,7 +6,7 @@ use evflow_engine::{BuildContext, Io, Node, NodeError, NodeSpec, ParamSpec, Para
 /// Declaration of `recording.in`.
 pub static SPEC: NodeSpec = NodeSpec::new(
     "recording.in",
-    "sources",
+    "recording",
     Role::Source,
     "Plays chosen channels of a recording (NAME.wav + NAME.json), once.",
     build,

@@ -16,7 +16,7 @@ use evflow_engine::{BuildContext, Io, Node, NodeError, NodeSpec, ParamSpec, Para
 /// Declaration of `synth.optimize`.
 pub static SPEC: NodeSpec = NodeSpec::new(
     "synth.optimize",
-    "models",
+    "synth",
     Role::Source,
     "Synthesizes the actuation for a recorded texture force by bounded optimization through a forward model, and plays it.",
     build,

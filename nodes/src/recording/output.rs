@@ -9,7 +9,7 @@ use std::path::Path;
 /// Declaration of `recording.out`.
 pub static SPEC: NodeSpec = NodeSpec::new(
     "recording.out",
-    "output",
+    "recording",
     Role::Sink,
     "Writes its inputs to a recording (NAME.wav + NAME.json), committed when the run ends.",
     build,

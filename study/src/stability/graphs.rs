@@ -1,0 +1,226 @@
+//! Whole graphs with every output of every node watched: one case per
+//! shipped graph family (the graphs of `graphs/` grouped by the first word
+//! of their file name), and the runner the stiff cases share.
+
+use super::bounds::{bound, from_params};
+use super::invariant::{Invariant, Observed};
+use super::{Case, Env, Group};
+use evflow_engine::graph::parse_graph;
+use evflow_engine::{check, Checked, Plan, PlanOptions, Registry};
+use std::path::{Path, PathBuf};
+
+/// The node library's registry plus the harness' `harness.feed` source
+/// (a list of values) and `harness.tap` sink.
+pub fn registry() -> Registry {
+    let mut reg = evflow_nodes::registry();
+    reg.add(&evflow_engine::harness::FEED);
+    reg.add(&evflow_engine::harness::TAP);
+    reg
+}
+
+/// Checks graph `text` (as if read from `file`) against [`registry`].
+pub fn check_text(file: &Path, text: &str) -> Result<Checked, String> {
+    let g = parse_graph(file, text).map_err(|e| e.to_string())?;
+    check(&g, &registry(), &[]).map_err(|e| e.to_string())
+}
+
+/// How to run a graph for a case.
+#[derive(Debug, Clone)]
+pub struct Running {
+    /// Folder relative input paths are read from.
+    pub base_dir: PathBuf,
+    /// Folder relative output paths are written to.
+    pub out_dir: PathBuf,
+    /// Seconds to run at most (the graph's own end comes first).
+    pub seconds: f64,
+    /// Base ticks per step.
+    pub block: usize,
+}
+
+/// Builds and runs a checked graph, watching every output of every node
+/// after every step (and each node with a bound in [`super::bounds`]
+/// that holds whatever its inputs against that bound: a breach is a
+/// violation), then every value the nodes report.
+pub fn run_checked(checked: &Checked, r: &Running) -> Observed {
+    let mut o = Observed::default();
+    let opts = PlanOptions {
+        max_block: r.block,
+        base_dir: Some(r.base_dir.clone()),
+        out_dir: Some(r.out_dir.clone()),
+        timing: false,
+        ..PlanOptions::default()
+    };
+    let mut plan = match Plan::build(checked, &opts) {
+        Ok(p) => p,
+        Err(e) => {
+            o.error = Some(e.to_string());
+            return o;
+        }
+    };
+    let by_time = (r.seconds * plan.base_rate()).round() as u64;
+    let total = plan.remaining_ticks().map_or(by_time, |t| t.min(by_time));
+    // (node index, output index, name, bound)
+    let mut watched = Vec::new();
+    for k in 0..plan.len() {
+        let name = plan.node_name(k).to_string();
+        let spec = plan.spec(k);
+        let b =
+            checked.index(&name).and_then(|i| bound(spec.name, &from_params(&checked.nodes[i].params), f64::INFINITY));
+        for (j, port) in plan.output_names(k).iter().enumerate() {
+            let limit = b.as_ref().filter(|(p, _, _)| p == port).map(|(_, v, _)| *v);
+            watched.push((k, j, format!("{name}.{port}"), limit));
+        }
+    }
+    let mut done = 0;
+    while done < total {
+        let n = (plan.max_block() as u64).min(total - done) as usize;
+        if let Err(e) = plan.step(n) {
+            o.error = Some(e.to_string());
+            return o;
+        }
+        for (k, j, name, limit) in &watched {
+            if plan.output_dropped(*k, *j) {
+                continue;
+            }
+            let values = plan.output_at(*k, *j);
+            o.watch(name, values);
+            if let Some(b) = limit {
+                let m = values.iter().fold(0.0f64, |m, x| m.max(x.abs()));
+                if m > *b {
+                    o.violations.push(format!("{name}: |{m:e}| above its bound {b}"));
+                }
+            }
+        }
+        done += n as u64;
+    }
+    match plan.finish() {
+        Ok(summaries) => {
+            for (node, s) in summaries {
+                for (name, v, _) in &s.values {
+                    o.watch(&format!("{node} {name}"), &[*v]);
+                }
+            }
+        }
+        Err(e) => o.error = Some(e.to_string()),
+    }
+    o.notes.insert(0, format!("{done} ticks"));
+    o
+}
+
+/// The shipped graphs, by family: `(family, files)`, sorted.
+pub fn families(graphs: &Path) -> Vec<(String, Vec<PathBuf>)> {
+    let mut files: Vec<PathBuf> =
+        std::fs::read_dir(graphs).map(|d| d.filter_map(|e| e.ok().map(|e| e.path())).collect()).unwrap_or_default();
+    files.retain(|p| p.extension().is_some_and(|e| e == "toml"));
+    files.sort();
+    let mut out: Vec<(String, Vec<PathBuf>)> = Vec::new();
+    for f in files {
+        let stem = f.file_stem().map(|s| s.to_string_lossy().into_owned()).unwrap_or_default();
+        let family = stem.split('-').next().unwrap_or(&stem).to_string();
+        match out.iter_mut().find(|(n, _)| *n == family) {
+            Some((_, v)) => v.push(f),
+            None => out.push((family, vec![f])),
+        }
+    }
+    out
+}
+
+/// The family of a shipped graph file name (`texture-live.toml` → `texture`).
+pub fn family_of(file: &str) -> &str {
+    file.split(['-', '.']).next().unwrap_or(file)
+}
+
+/// One case per shipped graph family: each of its graphs run as shipped
+/// (its variables' defaults, no sweep) for at most the size's seconds,
+/// every output of every node watched.
+pub fn cases(env: &Env) -> Vec<Case> {
+    families(&env.graphs)
+        .into_iter()
+        .map(|(family, files)| {
+            let names: Vec<String> =
+                files.iter().filter_map(|f| f.file_name().map(|n| n.to_string_lossy().into_owned())).collect();
+            let mut covers: Vec<&'static str> = Vec::new();
+            for f in &files {
+                if let Ok(c) = evflow_engine::load_file(f, &registry(), &[]) {
+                    for n in &c.nodes {
+                        if !covers.contains(&n.spec.name) {
+                            covers.push(n.spec.name);
+                        }
+                    }
+                }
+            }
+            let seconds = env.size.graph_seconds();
+            let body = move |env: &Env| {
+                let mut o = Observed::default();
+                let out = env.dir.join("graph-out");
+                for f in &files {
+                    let name = f.display().to_string();
+                    let checked = match evflow_engine::load_file(f, &registry(), &[]) {
+                        Ok(c) => c,
+                        Err(e) => {
+                            o.error = Some(format!("{name}: {e}"));
+                            return o;
+                        }
+                    };
+                    let base = f.parent().map(Path::to_path_buf).unwrap_or_default();
+                    let run = Running { base_dir: base, out_dir: out.clone(), seconds, block: 4096 };
+                    let mut g = run_checked(&checked, &run);
+                    if let Some(e) = g.error.take() {
+                        o.error = Some(format!("{name}: {e}"));
+                    }
+                    g.notes = vec![format!("{}: {}", f.file_name().unwrap_or_default().to_string_lossy(), g.notes[0])];
+                    o.merge(g);
+                }
+                o
+            };
+            Case {
+                name: format!("graphs · {family}"),
+                group: Group::Graph,
+                covers,
+                family: Some(family.clone()),
+                extreme: format!(
+                    "{} as shipped, every node's every output watched, ≤ {seconds} s each",
+                    names.join(", ")
+                ),
+                invariant: Invariant::Finite { refusal_ok: false },
+                body: Box::new(body),
+            }
+        })
+        .collect()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn families_are_the_first_word() {
+        assert_eq!(family_of("texture-live-play.toml"), "texture");
+        assert_eq!(family_of("characterize.toml"), "characterize");
+        let root = Path::new(env!("CARGO_MANIFEST_DIR")).join("../graphs");
+        let f = families(&root);
+        assert!(f.iter().any(|(n, v)| n == "texture" && v.len() > 3), "{f:?}");
+    }
+
+    #[test]
+    fn a_limit_above_its_bound_is_caught_in_a_graph() {
+        // A sine of amplitude 2 through a limit of amplitude 1: the limit's
+        // output stays within 1; a bound of 0.5 would not hold (checked via
+        // the bound table's rule for `limit`).
+        let text =
+            "[graph]\nformat = 1\nname = \"t\"\nrate = 1000\nconnections = [\"s.out -> l.in\", \"l.out -> t.in\"]\n\
+                    [nodes.s]\ntype = \"sine\"\namplitude = 2.0\nfrequency = 5.0\n\
+                    [nodes.l]\ntype = \"limit\"\namplitude = 1.0\nslew = 1e12\nramp = 0.0\n\
+                    [nodes.t]\ntype = \"harness.tap\"\n";
+        let checked = check_text(Path::new("t.toml"), text).unwrap();
+        let dir = tempfile::tempdir().unwrap();
+        let r = Running { base_dir: dir.path().into(), out_dir: dir.path().into(), seconds: 1.0, block: 64 };
+        let o = run_checked(&checked, &r);
+        assert_eq!(o.error, None);
+        assert_eq!(o.non_finite, 0, "{o:?}");
+        let lim = o.ports.iter().find(|(n, _)| n == "l.out").unwrap().1;
+        assert!(lim <= 1.0 && lim > 0.99, "{lim}");
+        let s = o.ports.iter().find(|(n, _)| n == "s.out").unwrap().1;
+        assert!(s > 1.9, "{s}");
+    }
+}

@@ -1,0 +1,180 @@
+//! The session's end: waiting for its threads, the record of how it ended
+//! (in the manifest and `--json`) and the printed report.
+
+use super::recorder::RecorderReport;
+use super::session::Manifest;
+use super::{integrity, unit_suffix, Args};
+use anyhow::{anyhow, Result};
+use evflow_engine::live::{Metrics, MetricsSummary, Percentiles, RtExit, RtThread, Shared};
+use evflow_engine::Summary;
+use serde_json::json;
+use std::path::Path;
+use std::sync::atomic::{AtomicBool, Ordering};
+use std::sync::Arc;
+use std::thread::JoinHandle;
+use std::time::{Duration, Instant};
+
+/// A session that has run: what its threads returned.
+pub(super) struct Ran {
+    /// The real-time thread's exit.
+    exit: RtExit,
+    /// Wall-clock time from the wait's start to the real-time thread's end.
+    wall: Duration,
+    /// Host steal during the session (seconds), where the system tells it.
+    stolen: Option<f64>,
+    /// What the recorder wrote.
+    rec: RecorderReport,
+    /// The tick timings of the whole session.
+    metrics: Metrics,
+}
+
+impl Ran {
+    /// Waits for the real-time thread to end, then tells the recorder and
+    /// the metrics display (`done`) and waits for them.
+    pub(super) fn wait(
+        thread: RtThread,
+        done: &AtomicBool,
+        rec_thread: JoinHandle<RecorderReport>,
+        metrics_thread: JoinHandle<Metrics>,
+    ) -> Result<Self> {
+        let started = Instant::now();
+        let steal_before = super::steal::steal_seconds();
+        let exit = thread.join();
+        let wall = started.elapsed();
+        let stolen = super::steal::steal_seconds().zip(steal_before).map(|(b, a)| (b - a).max(0.0));
+        done.store(true, Ordering::Release);
+        let rec = rec_thread.join().map_err(|_| anyhow!("the recorder thread panicked"))?;
+        let metrics = metrics_thread.join().map_err(|_| anyhow!("the metrics thread panicked"))?;
+        Ok(Ran { exit, wall, stolen, rec, metrics })
+    }
+
+    /// Finishes the plan's nodes, writes how the session ended to the
+    /// manifest (and `--json`), prints the report, and fails when a node
+    /// or a fault stopped the session.
+    pub(super) fn finish(
+        self,
+        a: &Args,
+        dir: &Path,
+        manifest: &Manifest,
+        shared: &Arc<Shared>,
+        base_rate: f64,
+    ) -> Result<()> {
+        let summary = self.metrics.summary(shared, base_rate);
+        let mut exit = self.exit;
+        let sums = exit.plan.plan_mut().finish().map_err(|e| anyhow!("{e}"))?;
+
+        let reason = match (&exit.failure, exit.reason) {
+            (Some(f), _) => format!("node failure: {f}"),
+            (None, Some(r)) => r.as_str().to_string(),
+            (None, None) => "unknown".into(),
+        };
+        let end = End { exit: &exit, wall: self.wall, stolen: self.stolen, rec: &self.rec, summary: &summary };
+        let record = end.record(dir, base_rate, &reason);
+        manifest.write(dir, if exit.failure.is_some() { "failed" } else { "ended" }, Some(record.clone()))?;
+        if let Some(path) = &a.json {
+            std::fs::write(path, serde_json::to_string_pretty(&record)?)
+                .map_err(|e| anyhow!("{}: cannot write results: {e}", path.display()))?;
+        }
+        end.print(dir, base_rate, &reason, &sums);
+        match exit.failure {
+            Some(f) => Err(anyhow!("{f}")),
+            None if exit.reason.is_some_and(|r| r.is_fault()) => Err(anyhow!("session stopped by a fault: {reason}")),
+            None => Ok(()),
+        }
+    }
+}
+
+/// What a session's end is told from.
+struct End<'a> {
+    exit: &'a RtExit,
+    wall: Duration,
+    stolen: Option<f64>,
+    rec: &'a RecorderReport,
+    summary: &'a MetricsSummary,
+}
+
+impl End<'_> {
+    /// The record of the session's end: ticks, times, why it stopped, the
+    /// metrics and each recorded file with its fingerprint.
+    fn record(&self, dir: &Path, base_rate: f64, reason: &str) -> serde_json::Value {
+        let files: Vec<_> = self
+            .rec
+            .files
+            .iter()
+            .map(|(f, n, gap, err)| {
+                // The fingerprint of the samples as written: `evflow replay --check` holds the file to it.
+                let hash = integrity::file_hash(&dir.join(format!("{f}.wav"))).ok();
+                json!({ "file": f, "frames": n, "gap_frames": gap, "error": err, "hash": hash })
+            })
+            .collect();
+        json!({
+            "ticks": self.exit.ticks,
+            "seconds": self.exit.ticks as f64 / base_rate,
+            "wall_seconds": self.wall.as_secs_f64(),
+            "stopped": reason,
+            "realtime": self.exit.realtime.to_string(),
+            "metrics": metrics_json(self.summary),
+            "host_steal_seconds": self.stolen,
+            "files": files,
+            "events": self.rec.events,
+        })
+    }
+
+    /// Prints the report: ticks and why it stopped, the real-time grant,
+    /// host steal, the metrics, the recorded files and the nodes' summaries.
+    fn print(&self, dir: &Path, base_rate: f64, reason: &str, sums: &[(String, Summary)]) {
+        let exit = self.exit;
+        println!(
+            "session {}: {} ticks ({:.3} s), stopped: {reason}",
+            dir.display(),
+            exit.ticks,
+            exit.ticks as f64 / base_rate
+        );
+        println!("real-time thread: {}", exit.realtime);
+        if let Some(st) = self.stolen.filter(|&st| st > 0.0) {
+            println!(
+                "host steal: {:.0} ms of CPU time taken from this virtual machine by its host during the session \
+                 (stalls no setting inside the machine prevents; see docs/live.md)",
+                st * 1e3
+            );
+        }
+        println!("{}", self.summary);
+        for (f, n, gap, err) in &self.rec.files {
+            let gap = if *gap > 0 {
+                format!(", {gap} lost to a slow disk (zero-filled, see events.jsonl)")
+            } else {
+                String::new()
+            };
+            match err {
+                None => println!("recorded {f} ({n} frames{gap})"),
+                Some(e) => println!("recorded {f}: FAILED: {e}"),
+            }
+        }
+        if let Some(e) = &self.rec.event_error {
+            println!("event log: FAILED: {e}");
+        }
+        for (node, s) in sums {
+            for l in &s.lines {
+                println!("{node}: {l}");
+            }
+            for (k, v, unit) in &s.values {
+                println!("{node}: {k} = {v}{}", unit_suffix(unit));
+            }
+        }
+    }
+}
+
+/// The session's metrics as JSON (microseconds).
+fn metrics_json(s: &MetricsSummary) -> serde_json::Value {
+    let p = |p: &Percentiles| json!({ "p50": p.p50, "p99": p.p99, "p99_9": p.p999, "max": p.max, "mean": p.mean });
+    json!({
+        "jitter_us": p(&s.jitter),
+        "compute_us": p(&s.compute),
+        "deadline_misses": s.misses,
+        "longest_miss_streak": s.longest_streak,
+        "tap_overruns": s.tap_overruns,
+        "event_overruns": s.event_overruns,
+        "stat_overruns": s.stat_overruns,
+        "command_overruns": s.command_overruns,
+    })
+}

@@ -3,6 +3,7 @@
 use super::spectral_error::{spectral_rms_error, Band, SpectralError};
 use super::spectrum::{Spectrum, SpectrumAccumulator, SpectrumConfig, Window};
 use crate::filters::segment::Gates;
+use evflow_engine::typed_params::Choice;
 use evflow_engine::{BuildContext, Io, Node, NodeError, NodeSpec, ParamSpec, Params, PortSpec, Role, Summary};
 
 /// Largest FFT length (2²⁰ samples: 17 min at 1 kHz, 105 s at 10 kHz).
@@ -83,7 +84,7 @@ E_s(x, 2x) = 0.5, E_s = √2 for equal sines on different bins.",
 ])
 .params(&[
     ParamSpec::int("nfft", 0, MAX_NFFT, 0, "samples", "FFT (segment) length; 0 = the sampling rate (1 Hz bins)"),
-    ParamSpec::choice("window", &["rect", "hann"], "rect", "window applied to each segment"),
+    WINDOW.spec(),
     ParamSpec::float("overlap", 0.0, 0.9, 0.0, "1", "fraction of a segment shared with the next"),
     ParamSpec::float("fmin", 0.0, 1e7, 0.0, "Hz", "lowest frequency counted in E_s"),
     ParamSpec::float("fmax", 0.0, 1e7, 0.0, "Hz", "highest frequency counted in E_s; 0 = Nyquist"),
@@ -162,6 +163,10 @@ struct Metric {
     gated_out: u64,
 }
 
+/// `window`: applied to each segment, arriving as a [`Window`].
+const WINDOW: Choice<Window> =
+    Choice::new("window", &["rect", "hann"], &[Window::Rect, Window::Hann], "rect", "window applied to each segment");
+
 fn build(p: &Params, ctx: &BuildContext) -> Result<Box<dyn Node>, NodeError> {
     let rate = ctx.rate;
     let gates = Gates::from_params(p, 2)?;
@@ -179,8 +184,7 @@ fn build(p: &Params, ctx: &BuildContext) -> Result<Box<dyn Node>, NodeError> {
         1 => return Err(NodeError::param("nfft", "must be 0 (= the sampling rate) or at least 2 samples")),
         n => n,
     };
-    let window = Window::from_name(p.str("window"))
-        .ok_or_else(|| NodeError::param("window", format!("`{}` is not rect or hann", p.str("window"))))?;
+    let window = WINDOW.get(p);
     let include_dc = p.bool("include_dc");
     let band = Band::new(rate, nfft, p.f64("fmin"), p.f64("fmax"), include_dc)
         .map_err(|e| NodeError::param(e.param, e.message))?;

@@ -2,6 +2,7 @@
 //! asynchronous resampler, streaming, with a fixed latency.
 
 use super::resampler::{Quality, ResampleError, Stream, QUALITY_NAMES};
+use evflow_engine::typed_params::Choice;
 use evflow_engine::{
     BuildContext, Io, Node, NodeError, NodeSpec, ParamSpec, Params, PortSpec, PrepareContext, RateSpec, Role,
 };
@@ -56,17 +57,18 @@ with `fast`, 1.1e-6 with `balanced`; every 1 ms step moves on), linearity, block
     PortSpec::input("in", "1", "the stream").at(RateSpec::Any),
     PortSpec::output("out", "1", "the stream resampled to `rate`, late by the stated latency"),
 ])
-.params(&[
-    ParamSpec::float("rate", 1e-3, 1e7, 1000.0, "Hz", "output rate"),
-    ParamSpec::choice(
-        "quality",
-        QUALITY_NAMES,
-        "balanced",
-        "interpolator: fast (cubic), balanced (sinc of 128 taps) or best (256 taps)",
-    ),
-])
+.params(&[ParamSpec::float("rate", 1e-3, 1e7, 1000.0, "Hz", "output rate"), QUALITY.spec()])
 .rate_param("rate")
 .example("rate = 2000.0\nquality = \"balanced\"");
+
+/// `quality`: the interpolator, arriving as a [`Quality`].
+const QUALITY: Choice<Quality> = Choice::new(
+    "quality",
+    QUALITY_NAMES,
+    &Quality::ALL,
+    "balanced",
+    "interpolator: fast (cubic), balanced (sinc of 128 taps) or best (256 taps)",
+);
 
 struct Resample {
     stream: Stream,
@@ -74,9 +76,7 @@ struct Resample {
 }
 
 fn build(p: &Params, ctx: &BuildContext) -> Result<Box<dyn Node>, NodeError> {
-    let quality = Quality::from_name(p.str("quality")).ok_or_else(|| {
-        NodeError::param("quality", format!("`{}` is not one of {}", p.str("quality"), QUALITY_NAMES.join(", ")))
-    })?;
+    let quality = QUALITY.get(p);
     let ratio = ctx.rate / ctx.port_rates[0];
     let stream = Stream::new(ratio, quality).map_err(|e| match e {
         ResampleError::StepTooLarge { .. } | ResampleError::Ratio(_) => NodeError::param("rate", e.to_string()),

@@ -11,6 +11,7 @@ use crate::metric::spectral_error::Band;
 use crate::metric::spectrum::{SpectrumConfig, Window};
 use crate::narx::model::Model;
 use crate::recording::format::Recording;
+use evflow_engine::typed_params::Choice;
 use evflow_engine::{BuildContext, Io, Node, NodeError, NodeSpec, ParamSpec, Params, PortSpec, Role, Summary};
 
 /// Declaration of `synth.optimize`.
@@ -68,7 +69,7 @@ pub static SPEC: NodeSpec = NodeSpec::new(
     ParamSpec::text("narx_model", "", "inverse NARX model for start = \"narx\""),
     ParamSpec::choice("objective", &["time", "spectral", "expected"], "time", "what to match"),
     ParamSpec::int("nfft", 0, 1 << 20, 0, "samples", "spectral objective: segment length (0 = the rate)"),
-    ParamSpec::choice("window", &["rect", "hann"], "rect", "spectral objective: window"),
+    WINDOW.spec(),
     ParamSpec::float("overlap", 0.0, 0.9, 0.0, "1", "spectral objective: overlap of segments"),
     ParamSpec::float("fmin", 0.0, 1e7, 2.0, "Hz", "spectral objective: lowest frequency"),
     ParamSpec::float("fmax", 0.0, 1e7, 200.0, "Hz", "spectral objective: highest frequency (0 = Nyquist)"),
@@ -98,6 +99,10 @@ struct Optimize {
     /// Report `seconds`.
     record_time: bool,
 }
+
+/// `window`: the spectral objective's window, arriving as a [`Window`].
+const WINDOW: Choice<Window> =
+    Choice::new("window", &["rect", "hann"], &[Window::Rect, Window::Hann], "rect", "spectral objective: window");
 
 fn build(p: &Params, ctx: &BuildContext) -> Result<Box<dyn Node>, NodeError> {
     let shown = p.str("target");
@@ -190,7 +195,7 @@ fn build(p: &Params, ctx: &BuildContext) -> Result<Box<dyn Node>, NodeError> {
             (ObjectiveKind::Expected { cfg, band }, "expected")
         }
         "spectral" => {
-            let window = Window::from_name(p.str("window")).unwrap_or(Window::Rect);
+            let window = WINDOW.get(p);
             let band = Band::new(ctx.rate, nfft, p.f64("fmin"), p.f64("fmax"), false)
                 .map_err(|e| NodeError::param(e.param, e.message))?;
             let cfg = SpectrumConfig { rate: ctx.rate, nfft, window, overlap: p.f64("overlap") };

@@ -39,3 +39,24 @@ fn report_precision_names_its_computations_on_a_wrong_only() {
     assert!(!ok);
     assert!(err.contains("nope") && err.contains("butterworth") && err.contains("decimate"), "{err}");
 }
+
+#[test]
+fn a_failing_computation_is_named_and_exits_1() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().to_str().unwrap();
+    let (ok, stdout, err) = evflow(&[
+        "report",
+        "precision",
+        "--size",
+        "ci",
+        "--only",
+        "decimate",
+        "--graphs",
+        "/nonexistent",
+        "--out",
+        out,
+    ]);
+    assert!(!ok, "{stdout}");
+    assert!(err.contains("decimate: failed") && err.contains("/nonexistent"), "{err}");
+    assert!(err.contains("1 of 1 computations"), "the summary counts it: {err}");
+}

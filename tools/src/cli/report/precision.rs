@@ -66,11 +66,22 @@ pub fn main(a: Args) -> Result<()> {
     std::fs::create_dir_all(&a.out).with_context(|| format!("{}: cannot create", a.out.display()))?;
     let started = Instant::now();
     let mut curves = Vec::new();
+    // One computation that fails does not lose the others: it is named at
+    // the end and the exit code is 1.
+    let mut failures = evflow_engine::batch::Failures::new();
+    let total = names.len();
     for name in names {
         let t = Instant::now();
-        let cs = precision::run(name, &a.graphs, size)?;
-        println!("{name}: {} curve(s) in {:.1} s", cs.len(), t.elapsed().as_secs_f64());
-        curves.extend(cs);
+        match precision::run(name, &a.graphs, size) {
+            Ok(cs) => {
+                println!("{name}: {} curve(s) in {:.1} s", cs.len(), t.elapsed().as_secs_f64());
+                curves.extend(cs);
+            }
+            Err(e) => {
+                eprintln!("{name}: failed: {e}");
+                failures.push(name.to_string(), e.to_string());
+            }
+        }
     }
     let rows: Vec<table::Row> = curves.iter().map(table::Row::of).collect();
     let md = table::markdown(&rows);
@@ -84,5 +95,8 @@ pub fn main(a: Args) -> Result<()> {
         super::save_png(&plot(c), &a.out.join(format!("precision-{}.png", c.name)));
     }
     println!("report precision ({}) in {:.1} s", a.size, started.elapsed().as_secs_f64());
+    if !failures.is_empty() {
+        anyhow::bail!("{}", failures.summary(total, "computations").trim_end());
+    }
     Ok(())
 }

@@ -29,7 +29,10 @@ fn report_precision_writes_its_table_rows_and_figure() {
     assert!(stdout.contains(&table), "the table is printed as written: {stdout}");
     let csv = std::fs::read_to_string(dir.path().join("rows.csv")).unwrap();
     assert_eq!(csv.lines().count(), 1 + 5, "{csv}");
-    assert_eq!(csv.lines().filter(|l| l.contains(",true,")).count(), 5, "every attenuation is on the front: {csv}");
+    // The error falls as the attenuation (and the taps) rise. Which points
+    // are on the front depends on measured times, so it is not tested here.
+    let errors: Vec<f64> = csv.lines().skip(1).map(|l| l.rsplitn(9, ',').nth(7).unwrap().parse().unwrap()).collect();
+    assert!(errors.windows(2).all(|w| w[1] < w[0]), "the error falls with the taps: {errors:?}\n{csv}");
     assert!(dir.path().join("precision-decimate.png").exists() || stdout.contains("warning"), "{stdout}");
 }
 

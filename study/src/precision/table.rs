@@ -3,6 +3,7 @@
 //! the best error, the reference — as Markdown and CSV.
 
 use super::curve::Curve;
+use crate::figure::{Plot, Series};
 
 /// One computation's summary.
 #[derive(Debug, Clone)]
@@ -140,6 +141,35 @@ pub fn csv(curves: &[Curve]) -> String {
         }
     }
     s
+}
+
+/// The curve's work-precision figure (log-log): a line per series, the
+/// baseline when there is one, the shipped default marked.
+pub fn figure(c: &Curve) -> Plot {
+    let mut series: Vec<Series> = c
+        .series()
+        .into_iter()
+        .map(|(name, pts)| Series::line_points(name, pts.iter().map(|p| (p.cost, p.error)).collect()))
+        .collect();
+    if let Some(b) = c.baseline {
+        let costs = c.points.iter().map(|p| p.cost).filter(|x| x.is_finite() && *x > 0.0);
+        let (lo, hi) = costs.fold((f64::INFINITY, 0.0_f64), |(lo, hi), x| (lo.min(x), hi.max(x)));
+        if lo <= hi {
+            series.push(Series::line_points("left out (baseline)", vec![(lo, b), (hi, b)]));
+        }
+    }
+    if let Some(d) = c.default_point() {
+        series.push(Series::points(format!("shipped default: {}", d.setting), vec![(d.cost, d.error)]));
+    }
+    Plot {
+        title: format!("{}: error against run time", c.computation),
+        x_label: format!("run time per {}, s", c.cost_unit),
+        // The reference is long: table.md names it beside every row.
+        y_label: c.error_unit.clone(),
+        log_x: true,
+        log_y: true,
+        series,
+    }
 }
 
 #[cfg(test)]

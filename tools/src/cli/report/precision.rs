@@ -4,8 +4,7 @@
 //! setting). The curves come from `evflow_study::precision`.
 
 use anyhow::{Context, Result};
-use evflow_study::precision::{self, table, Curve, Size};
-use evflow_tools::plot::{Plot, Series};
+use evflow_study::precision::{self, table, Size};
 use std::path::PathBuf;
 use std::time::Instant;
 
@@ -26,33 +25,6 @@ pub struct Args {
     /// texture-live-quality.toml, mesh-live.toml … and the model library data/).
     #[arg(long, default_value = "graphs")]
     graphs: PathBuf,
-}
-
-fn plot(c: &Curve) -> Plot {
-    let mut series: Vec<Series> = c
-        .series()
-        .into_iter()
-        .map(|(name, pts)| Series::line_points(name, pts.iter().map(|p| (p.cost, p.error)).collect()))
-        .collect();
-    if let Some(b) = c.baseline {
-        let costs = c.points.iter().map(|p| p.cost).filter(|x| x.is_finite() && *x > 0.0);
-        let (lo, hi) = costs.fold((f64::INFINITY, 0.0_f64), |(lo, hi), x| (lo.min(x), hi.max(x)));
-        if lo <= hi {
-            series.push(Series::line_points("left out (baseline)", vec![(lo, b), (hi, b)]));
-        }
-    }
-    if let Some(d) = c.default_point() {
-        series.push(Series::points(format!("shipped default: {}", d.setting), vec![(d.cost, d.error)]));
-    }
-    Plot {
-        title: format!("{}: error against run time", c.computation),
-        x_label: format!("run time per {}, s", c.cost_unit),
-        // The reference is long: table.md names it beside every row.
-        y_label: c.error_unit.clone(),
-        log_x: true,
-        log_y: true,
-        series,
-    }
 }
 
 /// Runs `evflow report precision`.
@@ -92,7 +64,7 @@ pub fn main(a: Args) -> Result<()> {
         println!("wrote {}", path.display());
     }
     for c in &curves {
-        super::save_png(&plot(c), &a.out.join(format!("precision-{}.png", c.name)));
+        super::save_png(&table::figure(c), &a.out.join(format!("precision-{}.png", c.name)));
     }
     println!("report precision ({}) in {:.1} s", a.size, started.elapsed().as_secs_f64());
     if !failures.is_empty() {

@@ -87,6 +87,72 @@ pub struct Single<'a> {
     pub base_dir: &'a Path,
 }
 
+impl<'a> Single<'a> {
+    /// A node under test with its parameters (the body of a TOML node table),
+    /// no inputs or outputs yet, a base rate of 1 kHz, no ticks, blocks of
+    /// 64 ticks and relative paths taken from the working folder.
+    ///
+    /// ```
+    /// use evflow_engine::harness::{Single, FEED};
+    /// let out = Single::new(&FEED, "values = [1.0, 2.0, 3.0]").output("out").ticks(3).run().unwrap();
+    /// assert_eq!(out, vec![vec![1.0, 2.0, 3.0]]);
+    /// ```
+    pub fn new(spec: &'static NodeSpec, params: &'a str) -> Self {
+        Self {
+            spec,
+            params,
+            inputs: Vec::new(),
+            outputs: Vec::new(),
+            base_rate: 1000.0,
+            ticks: 0,
+            block: 64,
+            base_dir: Path::new("."),
+        }
+    }
+
+    /// Feeds input port `port` with `samples` at `rate` Hz.
+    pub fn input(mut self, port: &'a str, samples: Vec<f64>, rate: f64) -> Self {
+        self.inputs.push((port, samples, rate));
+        self
+    }
+
+    /// Collects output port `port` (in the order asked).
+    pub fn output(mut self, port: &'a str) -> Self {
+        self.outputs.push(port);
+        self
+    }
+
+    /// Collects these output ports, in this order.
+    pub fn outputs(mut self, ports: &[&'a str]) -> Self {
+        self.outputs.extend_from_slice(ports);
+        self
+    }
+
+    /// The base rate in Hz.
+    pub fn base_rate(mut self, hz: f64) -> Self {
+        self.base_rate = hz;
+        self
+    }
+
+    /// Base ticks to run.
+    pub fn ticks(mut self, n: u64) -> Self {
+        self.ticks = n;
+        self
+    }
+
+    /// Base ticks per step (1 = the live tick).
+    pub fn block(mut self, n: usize) -> Self {
+        self.block = n;
+        self
+    }
+
+    /// Folder for relative paths.
+    pub fn base_dir(mut self, dir: &'a Path) -> Self {
+        self.base_dir = dir;
+        self
+    }
+}
+
 impl Single<'_> {
     /// Builds the plan (without running it).
     pub fn plan(&self) -> Result<(Plan, Vec<usize>), String> {

@@ -29,12 +29,13 @@ pub mod suggest;
 pub mod sweep;
 pub mod sweep_files;
 pub mod typed_params;
+pub mod typed_ports;
 
 pub use check::{check, Checked, Override};
 pub use diag::{Diagnostic, Diagnostics};
 pub use graph::Graph;
 pub use load::{load_file, read_graph, LoadError};
-pub use node::{BuildContext, Io, Node, NodeError, PrepareContext, Refused, RunMode, Summary};
+pub use node::{BuildContext, Change, Io, Node, NodeError, PrepareContext, Refused, RunMode, Summary};
 pub use params::{Params, Value};
 pub use plan::{Plan, PlanOptions};
 pub use registry::Registry;

@@ -1,5 +1,6 @@
 //! The node trait and what a node sees while it runs.
 
+use crate::typed_ports::{InPort, OutPort};
 use std::path::{Component, Path, PathBuf};
 
 /// An error raised by a node: at construction (bad file, inconsistent
@@ -45,6 +46,26 @@ impl NodeError {
 #[derive(Debug, Clone, Copy, PartialEq, Eq, thiserror::Error)]
 #[error("this node does not take `{0}` while it runs")]
 pub struct Refused(pub &'static str);
+
+/// A live change of one parameter, as [`Node::set`] receives it: the
+/// declared name and the value, already checked against the declared limits
+/// (flags as 0/1, choices as the index of the word). A node reads it through
+/// its parameter handles (`GAIN.changed(&c)` in [`crate::typed_params`]),
+/// which give the value typed, so no node matches the name as text.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Change {
+    /// The declared name of the parameter.
+    pub param: &'static str,
+    /// The checked value.
+    pub value: f64,
+}
+
+impl Change {
+    /// The refusal of this change, for a node that does not take it.
+    pub fn refused(&self) -> Refused {
+        Refused(self.param)
+    }
+}
 
 /// What a constructor knows besides its parameters.
 #[derive(Debug, Clone)]
@@ -285,18 +306,21 @@ impl<'a> Io<'a> {
     }
     /// The samples of input `i` for this call.
     #[inline]
-    pub fn input(&self, i: usize) -> &[f64] {
+    pub fn input(&self, i: impl Into<InPort>) -> &[f64] {
+        let i = i.into().index();
         &self.pool[self.in_slots[i]][..self.in_lens[i]]
     }
     /// The buffer of output `o` for this call, to be filled completely.
     #[inline]
-    pub fn output(&mut self, o: usize) -> &mut [f64] {
+    pub fn output(&mut self, o: impl Into<OutPort>) -> &mut [f64] {
+        let o = o.into().index();
         let n = self.out_lens[o];
         &mut self.outs[o][..n]
     }
     /// Input `i` and output `o` together.
     #[inline]
-    pub fn io(&mut self, i: usize, o: usize) -> (&[f64], &mut [f64]) {
+    pub fn io(&mut self, i: impl Into<InPort>, o: impl Into<OutPort>) -> (&[f64], &mut [f64]) {
+        let (i, o) = (i.into().index(), o.into().index());
         let n = self.out_lens[o];
         (&self.pool[self.in_slots[i]][..self.in_lens[i]], &mut self.outs[o][..n])
     }
@@ -316,12 +340,12 @@ impl<'a> Io<'a> {
         self.len() == 0
     }
     /// Length of output `o` in this call.
-    pub fn output_len(&self, o: usize) -> usize {
-        self.out_lens[o]
+    pub fn output_len(&self, o: impl Into<OutPort>) -> usize {
+        self.out_lens[o.into().index()]
     }
     /// Length of input `i` in this call.
-    pub fn input_len(&self, i: usize) -> usize {
-        self.in_lens[i]
+    pub fn input_len(&self, i: impl Into<InPort>) -> usize {
+        self.in_lens[i.into().index()]
     }
     /// Index, at the node's rate, of the first sample of this call since t = 0.
     pub fn start(&self) -> u64 {
@@ -380,13 +404,12 @@ pub trait Node: Send {
 
     /// Changes a parameter declared [`crate::spec::ParamSpec::live`] between
     /// two calls of `process` (a live session's parameter queue, or a replay
-    /// applying the session's recorded changes at the same tick). `param` is
-    /// the declared name; `value` is already checked against the declared
-    /// limits (flags as 0/1, choices as the index of the word). Like
-    /// `process`, it must not allocate, lock or block; the node moves to the
-    /// new value without a click (e.g. a ramp). The default refuses.
-    fn set(&mut self, param: &'static str, _value: f64) -> Result<(), Refused> {
-        Err(Refused(param))
+    /// applying the session's recorded changes at the same tick); see
+    /// [`Change`]. Like `process`, it must not allocate, lock or block; the
+    /// node moves to the new value without a click (e.g. a ramp). The
+    /// default refuses.
+    fn set(&mut self, change: Change) -> Result<(), Refused> {
+        Err(change.refused())
     }
 
     /// Asked once, right after the node is built: `Some` when what the node

@@ -7,7 +7,7 @@ mod build;
 use crate::check::prune::Folded;
 use crate::check::{Checked, Pruned};
 use crate::diag::Loc;
-use crate::node::{Io, Node, NodeError, Refused, RunMode, Summary};
+use crate::node::{Change, Io, Node, NodeError, Refused, RunMode, Summary};
 use crate::rate::Ratio;
 use crate::spec::NodeSpec;
 use std::path::PathBuf;
@@ -166,11 +166,11 @@ impl Node for Held {
         Ok(())
     }
     fn reset(&mut self) {}
-    fn set(&mut self, param: &'static str, _value: f64) -> Result<(), Refused> {
+    fn set(&mut self, change: Change) -> Result<(), Refused> {
         if self.takes_changes {
             Ok(())
         } else {
-            Err(Refused(param))
+            Err(change.refused())
         }
     }
 }
@@ -382,7 +382,7 @@ impl Plan {
     /// ([`Node::set`]); `param` is the declared name. Allocation-free.
     #[inline]
     pub fn set(&mut self, k: usize, param: &'static str, value: f64) -> Result<(), Refused> {
-        self.entries[k].node.set(param, value)
+        self.entries[k].node.set(Change { param, value })
     }
 
     /// Nodes left out, and why: those no sink needs, then those that fed

@@ -20,6 +20,7 @@
 //! assert_eq!(PARAMS[0].name, "kind");
 //! ```
 
+use crate::node::Change;
 use crate::params::Params;
 use crate::spec::{ParamKind, ParamSpec};
 
@@ -64,6 +65,11 @@ impl Float {
     pub fn get(&self, p: &Params) -> f64 {
         p.f64(self.0.name)
     }
+
+    /// The new value when `c` changes this parameter.
+    pub fn changed(&self, c: &Change) -> Option<f64> {
+        (c.param == self.0.name).then_some(c.value)
+    }
 }
 
 /// An integer parameter.
@@ -83,6 +89,16 @@ impl Int {
         Self(ParamSpec::int(name, min, max, default, unit, doc))
     }
 
+    /// The same parameter without a default: the graph file must set it.
+    pub const fn required(self) -> Self {
+        Self(self.0.required())
+    }
+
+    /// Its name, as written in the node's table.
+    pub const fn name(&self) -> &'static str {
+        self.0.name
+    }
+
     /// Its declaration.
     pub const fn spec(&self) -> ParamSpec {
         self.0
@@ -96,6 +112,136 @@ impl Int {
     /// Its validated value as a count (the declaration's minimum is ≥ 0).
     pub fn count(&self, p: &Params) -> usize {
         p.usize(self.0.name)
+    }
+
+    /// The same parameter, changeable while the graph runs live.
+    pub const fn live(self) -> Self {
+        Self(self.0.live())
+    }
+
+    /// The new value when `c` changes this parameter (checked against the
+    /// declared limits, so a whole number), as a count.
+    pub fn changed(&self, c: &Change) -> Option<usize> {
+        (c.param == self.0.name && c.value >= 0.0).then_some(c.value as usize)
+    }
+}
+
+/// A true/false parameter.
+#[derive(Debug, Clone, Copy)]
+pub struct Flag(ParamSpec);
+
+impl Flag {
+    /// Declares it: name, default, one-line description.
+    pub const fn new(name: &'static str, default: bool, doc: &'static str) -> Self {
+        Self(ParamSpec::flag(name, default, doc))
+    }
+
+    /// Its declaration.
+    pub const fn spec(&self) -> ParamSpec {
+        self.0
+    }
+
+    /// Its validated value.
+    pub fn get(&self, p: &Params) -> bool {
+        p.bool(self.0.name)
+    }
+
+    /// The same parameter, changeable while the graph runs live.
+    pub const fn live(self) -> Self {
+        Self(self.0.live())
+    }
+
+    /// The new value when `c` changes this parameter.
+    pub fn changed(&self, c: &Change) -> Option<bool> {
+        (c.param == self.0.name).then_some(c.value != 0.0)
+    }
+}
+
+/// A free-text parameter (a file path, a name).
+#[derive(Debug, Clone, Copy)]
+pub struct Text(ParamSpec);
+
+impl Text {
+    /// Declares it: name, default, one-line description.
+    pub const fn new(name: &'static str, default: &'static str, doc: &'static str) -> Self {
+        Self(ParamSpec::text(name, default, doc))
+    }
+
+    /// The same parameter without a default: the graph file must set it.
+    pub const fn required(self) -> Self {
+        Self(self.0.required())
+    }
+
+    /// Its declaration.
+    pub const fn spec(&self) -> ParamSpec {
+        self.0
+    }
+
+    /// Its name, as written in the node's table (and in errors about it).
+    pub const fn name(&self) -> &'static str {
+        self.0.name
+    }
+
+    /// Its validated value.
+    pub fn get<'p>(&self, p: &'p Params) -> &'p str {
+        p.str(self.0.name)
+    }
+}
+
+/// A list-of-words parameter (channel names, gate ports), empty by default.
+#[derive(Debug, Clone, Copy)]
+pub struct Words(ParamSpec);
+
+impl Words {
+    /// Declares it: name, one-line description.
+    pub const fn new(name: &'static str, doc: &'static str) -> Self {
+        Self(ParamSpec::text_list(name, doc))
+    }
+
+    /// The same parameter without a default: the graph file must set it.
+    pub const fn required(self) -> Self {
+        Self(self.0.required())
+    }
+
+    /// Its declaration.
+    pub const fn spec(&self) -> ParamSpec {
+        self.0
+    }
+
+    /// Its name, as a repeated port's declaration ([`crate::PortSpec::per`]) names it.
+    pub const fn name(&self) -> &'static str {
+        self.0.name
+    }
+
+    /// Its validated value.
+    pub fn get<'p>(&self, p: &'p Params) -> &'p [String] {
+        p.text_list(self.0.name)
+    }
+}
+
+/// A list-of-numbers parameter, empty by default.
+#[derive(Debug, Clone, Copy)]
+pub struct Floats(ParamSpec);
+
+impl Floats {
+    /// Declares it: name, limits of each element, unit, one-line description.
+    pub const fn new(name: &'static str, min: f64, max: f64, unit: &'static str, doc: &'static str) -> Self {
+        Self(ParamSpec::float_list(name, min, max, unit, doc))
+    }
+
+    /// The same parameter without a default: the graph file must set it.
+    pub const fn required(self) -> Self {
+        Self(self.0.required())
+    }
+
+    /// Its declaration.
+    pub const fn spec(&self) -> ParamSpec {
+        self.0
+    }
+
+    /// Its validated value.
+    pub fn get<'p>(&self, p: &'p Params) -> &'p [f64] {
+        p.float_list(self.0.name)
     }
 }
 
@@ -125,6 +271,27 @@ impl<E: Copy> Choice<E> {
     /// Its declaration.
     pub const fn spec(&self) -> ParamSpec {
         self.spec
+    }
+
+    /// Its name, as written in the node's table.
+    pub const fn name(&self) -> &'static str {
+        self.spec.name
+    }
+
+    /// The same parameter, changeable while the graph runs live (the node's
+    /// `set` receives the index of the word).
+    pub const fn live(mut self) -> Self {
+        self.spec = self.spec.live();
+        self
+    }
+
+    /// The new value when `c` changes this parameter (`c` carries the index
+    /// of the word, checked against the list).
+    pub fn changed(&self, c: &Change) -> Option<E> {
+        if c.param != self.spec.name || c.value < 0.0 {
+            return None;
+        }
+        self.values.get(c.value as usize).copied()
     }
 
     /// The value of the word the loader accepted. The loader refuses any
@@ -166,6 +333,17 @@ mod tests {
         let s = GAIN.spec();
         assert_eq!((s.name, s.unit, s.live), ("gain", "1", true));
         assert!(matches!(MODE.spec().kind, ParamKind::Choice(&["a", "b"])));
+    }
+
+    #[test]
+    fn a_live_change_is_read_only_by_its_own_handle() {
+        let c = Change { param: "gain", value: 0.25 };
+        assert_eq!((GAIN.changed(&c), ORDER.changed(&c), MODE.changed(&c)), (Some(0.25), None, None));
+        assert_eq!(MODE.changed(&Change { param: "mode", value: 1.0 }), Some(Mode::B));
+        assert_eq!(MODE.changed(&Change { param: "mode", value: 2.0 }), None);
+        assert_eq!(ORDER.changed(&Change { param: "order", value: 3.0 }), Some(3));
+        let on = Flag::new("on", false, "switch").live();
+        assert_eq!((on.changed(&Change { param: "on", value: 1.0 }), on.spec().live), (Some(true), true));
     }
 
     #[test]

@@ -17,16 +17,13 @@ use std::path::Path;
 
 /// `mesh.edges` fed by `tri` from [`gradient`]: its outputs and summary.
 fn edges(dir: &Path, params: &str, x: &[f64], y: &[f64], tri: &[f64]) -> (Vec<Vec<f64>>, Summary) {
-    let s = Single {
-        spec: &edges_node::SPEC,
-        params,
-        inputs: vec![("x", x.to_vec(), 1000.0), ("y", y.to_vec(), 1000.0), ("tri", tri.to_vec(), 1000.0)],
-        outputs: vec!["intensity", "sharpness", "angle"],
-        base_rate: 1000.0,
-        ticks: x.len() as u64,
-        block: 64,
-        base_dir: dir,
-    };
+    let s = Single::new(&edges_node::SPEC, params)
+        .input("x", x.to_vec(), 1000.0)
+        .input("y", y.to_vec(), 1000.0)
+        .input("tri", tri.to_vec(), 1000.0)
+        .outputs(&["intensity", "sharpness", "angle"])
+        .ticks(x.len() as u64)
+        .base_dir(dir);
     (s.run().unwrap(), s.summary().unwrap())
 }
 

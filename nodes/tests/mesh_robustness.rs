@@ -32,18 +32,15 @@ struct Run {
 
 fn gradient(dir: &Path, params: &str, x: Vec<f64>, y: Vec<f64>) -> Result<Run, String> {
     let n = x.len() as u64;
-    Single {
-        spec: &gradient_node::SPEC,
-        params,
-        inputs: vec![("x", x, 1000.0), ("y", y, 1000.0)],
-        outputs: vec!["intensity", "fsq", "slope", "z", "tri"],
-        base_rate: 1000.0,
-        ticks: n,
-        block: 100,
-        base_dir: dir,
-    }
-    .run()
-    .map(|out| Run { out })
+    Single::new(&gradient_node::SPEC, params)
+        .input("x", x, 1000.0)
+        .input("y", y, 1000.0)
+        .outputs(&["intensity", "fsq", "slope", "z", "tri"])
+        .ticks(n)
+        .block(100)
+        .base_dir(dir)
+        .run()
+        .map(|out| Run { out })
 }
 
 fn sane(r: &Run) {
@@ -114,16 +111,13 @@ fn open_and_non_manifold_meshes() {
         let p = format!("file = \"open.obj\"\nup = \"+z\"\nslope = \"{slope}\"");
         let r = gradient(dir.path(), &p, x.clone(), y.clone()).unwrap();
         sane(&r);
-        let edges = Single {
-            spec: &edges_node::SPEC,
-            params: "file = \"open.obj\"\nup = \"+z\"",
-            inputs: vec![("x", x, 1000.0), ("y", y, 1000.0), ("tri", r.out[4].clone(), 1000.0)],
-            outputs: vec!["intensity", "sharpness", "angle"],
-            base_rate: 1000.0,
-            ticks: r.out[4].len() as u64,
-            block: 64,
-            base_dir: dir.path(),
-        };
+        let edges = Single::new(&edges_node::SPEC, "file = \"open.obj\"\nup = \"+z\"")
+            .input("x", x, 1000.0)
+            .input("y", y, 1000.0)
+            .input("tri", r.out[4].clone(), 1000.0)
+            .outputs(&["intensity", "sharpness", "angle"])
+            .ticks(r.out[4].len() as u64)
+            .base_dir(dir.path());
         let s = edges.summary().unwrap();
         assert!(s.lines.iter().any(|l| l.contains("1 non-manifold")), "{:?}", s.lines);
         let out = edges.run().unwrap();
@@ -137,16 +131,13 @@ fn a_flat_mesh_has_f_min_equal_f_max_and_renders_full_intensity() {
     let dir = tempfile::tempdir().unwrap();
     std::fs::write(dir.path().join("flat.obj"), grid_obj(4, 0.0, |_, _| 1.0)).unwrap();
     let (x, y) = scan(0.0, 0.04, 0.02);
-    let s = Single {
-        spec: &gradient_node::SPEC,
-        params: "file = \"flat.obj\"\nup = \"+z\"",
-        inputs: vec![("x", x.clone(), 1000.0), ("y", y.clone(), 1000.0)],
-        outputs: vec!["intensity"],
-        base_rate: 1000.0,
-        ticks: x.len() as u64,
-        block: 100,
-        base_dir: dir.path(),
-    };
+    let s = Single::new(&gradient_node::SPEC, "file = \"flat.obj\"\nup = \"+z\"")
+        .input("x", x.clone(), 1000.0)
+        .input("y", y.clone(), 1000.0)
+        .output("intensity")
+        .ticks(x.len() as u64)
+        .block(100)
+        .base_dir(dir.path());
     let sum = s.summary().unwrap();
     assert_eq!((sum.get("f_min"), sum.get("f_max")), (Some(0.0), Some(0.0)));
     assert!(s.run().unwrap()[0].iter().all(|&v| v == 1.0));
@@ -156,18 +147,15 @@ fn edges_summary(dir: &Path, file: &str, y: f64) -> evflow_engine::Summary {
     let (x, yv) = scan(-0.01, 0.13, y);
     let p = format!("file = \"{file}\"\nup = \"+z\"");
     let tri = gradient(dir, &p, x.clone(), yv.clone()).unwrap().out[4].clone();
-    Single {
-        spec: &edges_node::SPEC,
-        params: &p,
-        inputs: vec![("x", x, 1000.0), ("y", yv, 1000.0), ("tri", tri.clone(), 1000.0)],
-        outputs: vec!["intensity"],
-        base_rate: 1000.0,
-        ticks: tri.len() as u64,
-        block: 64,
-        base_dir: dir,
-    }
-    .summary()
-    .unwrap()
+    Single::new(&edges_node::SPEC, &p)
+        .input("x", x, 1000.0)
+        .input("y", yv, 1000.0)
+        .input("tri", tri.clone(), 1000.0)
+        .output("intensity")
+        .ticks(tri.len() as u64)
+        .base_dir(dir)
+        .summary()
+        .unwrap()
 }
 
 #[test]

@@ -36,35 +36,28 @@ fn force(n: usize) -> Vec<f64> {
 /// `narx.grid` over m0, m1 with the user's load and velocity; outputs u and model.
 fn grid(dir: &Path, f: Vec<f64>, load: Vec<f64>, vel: Vec<f64>, block: usize) -> Result<Vec<Vec<f64>>, String> {
     let n = f.len() as u64;
-    Single {
-        spec: &grid::SPEC,
-        params: "models = [\"m0.json\", \"m1.json\"]\nupdate_rate = 10.0\ncrossfade = 10.0",
-        inputs: vec![("force", f, 1000.0), ("load", load, 1000.0), ("velocity", vel, 1000.0)],
-        outputs: vec!["u", "model"],
-        base_rate: 1000.0,
-        ticks: n,
-        block,
-        base_dir: dir,
-    }
-    .run()
+    Single::new(&grid::SPEC, "models = [\"m0.json\", \"m1.json\"]\nupdate_rate = 10.0\ncrossfade = 10.0")
+        .input("force", f, 1000.0)
+        .input("load", load, 1000.0)
+        .input("velocity", vel, 1000.0)
+        .outputs(&["u", "model"])
+        .ticks(n)
+        .block(block)
+        .base_dir(dir)
+        .run()
 }
 
 fn alone(dir: &Path, model: &str, f: Vec<f64>) -> Vec<f64> {
     let n = f.len() as u64;
     let params = format!("model = \"{model}\"");
-    Single {
-        spec: &node::SPEC,
-        params: &params,
-        inputs: vec![("force", f, 1000.0)],
-        outputs: vec!["u"],
-        base_rate: 1000.0,
-        ticks: n,
-        block: 64,
-        base_dir: dir,
-    }
-    .run()
-    .unwrap()
-    .remove(0)
+    Single::new(&node::SPEC, &params)
+        .input("force", f, 1000.0)
+        .output("u")
+        .ticks(n)
+        .base_dir(dir)
+        .run()
+        .unwrap()
+        .remove(0)
 }
 
 #[test]
@@ -99,22 +92,16 @@ fn models_without_a_place_in_the_grid_are_refused_naming_the_file() {
     models(dir.path());
     let params = |models: &str| format!("models = [{models}]");
     let run = |p: &str| {
-        Single {
-            spec: &grid::SPEC,
-            params: p,
-            inputs: vec![
-                ("force", vec![0.0; 10], 1000.0),
-                ("load", vec![85.0; 10], 1000.0),
-                ("velocity", vec![5.0; 10], 1000.0),
-            ],
-            outputs: vec!["u"],
-            base_rate: 1000.0,
-            ticks: 10,
-            block: 1,
-            base_dir: dir.path(),
-        }
-        .run()
-        .unwrap_err()
+        Single::new(&grid::SPEC, p)
+            .input("force", vec![0.0; 10], 1000.0)
+            .input("load", vec![85.0; 10], 1000.0)
+            .input("velocity", vec![5.0; 10], 1000.0)
+            .output("u")
+            .ticks(10)
+            .block(1)
+            .base_dir(dir.path())
+            .run()
+            .unwrap_err()
     };
     let e = run(&params("\"m0.json\", \"m0.json\""));
     assert!(e.contains("m0.json") && e.contains("60 g, 3 cm/s is also the condition"), "{e}");

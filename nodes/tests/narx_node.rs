@@ -15,30 +15,18 @@ const TRAIN_PARAMS: &str = "path = \"m.json\"\nhidden = [12, 6]\nfeedback = 1\ni
 
 fn train<'a>(dir: &'a Path, params: &'a str, x: Vec<f64>, y: Vec<f64>) -> Single<'a> {
     let n = x.len() as u64;
-    Single {
-        spec: &train_node::SPEC,
-        params,
-        inputs: vec![("x", x, 1000.0), ("y", y, 1000.0)],
-        outputs: vec![],
-        base_rate: 1000.0,
-        ticks: n,
-        block: 512,
-        base_dir: dir,
-    }
+    Single::new(&train_node::SPEC, params).input("x", x, 1000.0).input("y", y, 1000.0).ticks(n).block(512).base_dir(dir)
 }
 
 fn infer<'a>(dir: &'a Path, params: &'a str, force: Vec<f64>, rate: f64, block: usize) -> Single<'a> {
     let n = force.len() as u64;
-    Single {
-        spec: &node::SPEC,
-        params,
-        inputs: vec![("force", force, rate)],
-        outputs: vec!["u"],
-        base_rate: rate,
-        ticks: n,
-        block,
-        base_dir: dir,
-    }
+    Single::new(&node::SPEC, params)
+        .input("force", force, rate)
+        .output("u")
+        .base_rate(rate)
+        .ticks(n)
+        .block(block)
+        .base_dir(dir)
 }
 
 /// A model trained by the node on the lab (RBS, 6000 samples), in a folder

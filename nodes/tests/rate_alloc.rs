@@ -5,7 +5,6 @@
 
 use evflow_engine::harness::Single;
 use evflow_nodes::rate::{decimate, resample};
-use std::path::Path;
 
 #[path = "../../tests/alloc_counter.rs"]
 #[allow(dead_code)] // the live tests' parts of the shared counter are not used here
@@ -59,16 +58,12 @@ fn decimate_and_resample_do_not_allocate_while_processing() {
     for (spec, params, fs_in, base) in cases {
         for block in [1, 64, 4096] {
             let ticks = (x.len() as f64 / fs_in * base) as u64;
-            let single = Single {
-                spec,
-                params,
-                inputs: vec![("in", x.clone(), fs_in)],
-                outputs: vec!["out"],
-                base_rate: base,
-                ticks,
-                block,
-                base_dir: Path::new("."),
-            };
+            let single = Single::new(spec, params)
+                .input("in", x.clone(), fs_in)
+                .output("out")
+                .base_rate(base)
+                .ticks(ticks)
+                .block(block);
             let (n, samples) = count_steps(&single);
             assert!(samples > 0, "{} {params}: no output", spec.name);
             assert_eq!(n, 0, "{} {params} from {fs_in} Hz, block {block}: {n} allocations", spec.name);

@@ -110,16 +110,12 @@ fn switching_tables_does_not_click() {
 fn playback_ignores_what_is_not_a_table() {
     use evflow_engine::harness::Single;
     let noise: Vec<f64> = (0..4000).map(|i| ((i * 7919) % 101) as f64 / 50.0 - 1.0).collect();
-    let single = Single {
-        spec: &evflow_nodes::texture::playback::SPEC,
-        params: "mode = \"time\"",
-        inputs: vec![("table", noise.clone(), 1000.0), ("velocity", vec![5.0; 4000], 1000.0)],
-        outputs: vec!["out"],
-        base_rate: 1000.0,
-        ticks: 4000,
-        block: 256,
-        base_dir: std::path::Path::new("."),
-    };
+    let single = Single::new(&evflow_nodes::texture::playback::SPEC, "mode = \"time\"")
+        .input("table", noise.clone(), 1000.0)
+        .input("velocity", vec![5.0; 4000], 1000.0)
+        .output("out")
+        .ticks(4000)
+        .block(256);
     assert!(single.run().unwrap()[0].iter().all(|y| *y == 0.0));
     let s = single.summary().unwrap();
     assert_eq!(s.get("tables"), Some(0.0));

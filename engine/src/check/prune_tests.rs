@@ -64,8 +64,8 @@ impl Node for Scale {
         Ok(())
     }
     fn reset(&mut self) {}
-    fn set(&mut self, _: &'static str, v: f64) -> Result<(), crate::node::Refused> {
-        self.0 = v;
+    fn set(&mut self, c: crate::node::Change) -> Result<(), crate::node::Refused> {
+        self.0 = c.value;
         Ok(())
     }
 }

@@ -5,11 +5,12 @@ use super::*;
 use crate::check::{check, Checked};
 use crate::graph::parse_graph;
 use crate::harness::TAP;
-use crate::node::{BuildContext, Io, Node, NodeError, Refused};
+use crate::node::{BuildContext, Change, Io, Node, NodeError, Refused};
 use crate::params::Params;
 use crate::plan::{Plan, PlanOptions};
 use crate::registry::Registry;
 use crate::spec::{NodeSpec, ParamSpec, PortSpec, Role};
+use crate::typed_params::{Flag, Float};
 use std::path::Path;
 use std::time::Duration;
 
@@ -18,7 +19,7 @@ use std::time::Duration;
 static COUNTER: NodeSpec = NodeSpec::new("test.counter", "test", Role::Source, "n + level (test only)", build_counter)
     .ports(&[PortSpec::output("out", "1", "n + level")])
     .params(&[
-        ParamSpec::float("level", -1e9, 1e9, 0.0, "1", "offset").live(),
+        LEVEL.spec(),
         ParamSpec::float("stall_ms", 0.0, 100.0, 0.0, "ms", "sleep per sample"),
         ParamSpec::int("stall_from", 0, 1 << 40, 0, "1", "first stalled sample"),
         ParamSpec::int("length", 0, 1 << 40, 0, "1", "samples (0 = endless)"),
@@ -35,7 +36,7 @@ struct Counter {
 fn build_counter(p: &Params, _: &BuildContext) -> Result<Box<dyn Node>, NodeError> {
     Ok(Box::new(Counter {
         n: 0,
-        level: p.f64("level"),
+        level: LEVEL.get(p),
         stall: Duration::from_secs_f64(p.f64("stall_ms") / 1e3),
         stall_from: p.i64("stall_from") as u64,
         length: p.i64("length") as u64,
@@ -59,21 +60,26 @@ impl Node for Counter {
     fn remaining(&self) -> Option<u64> {
         (self.length > 0).then(|| self.length.saturating_sub(self.n))
     }
-    fn set(&mut self, param: &'static str, value: f64) -> Result<(), Refused> {
-        match param {
-            "level" => {
-                self.level = value;
+    fn set(&mut self, c: Change) -> Result<(), Refused> {
+        match LEVEL.changed(&c) {
+            Some(level) => {
+                self.level = level;
                 Ok(())
             }
-            _ => Err(Refused(param)),
+            None => Err(c.refused()),
         }
     }
 }
 
+/// The offset of `test.const`, changeable live.
+const LEVEL: Float = Float::new("level", -1e9, 1e9, 0.0, "1", "offset").live();
+/// The gate of `test.guard`.
+const ENABLE: Flag = Flag::new("enable", true, "gate").live();
+
 /// A guard: passes its input times a gate that closes in 3 samples.
 static GUARD: NodeSpec = NodeSpec::new("test.guard", "test", Role::Filter, "gate (test only)", build_guard)
     .ports(&[PortSpec::input("in", "1", "x"), PortSpec::output("out", "1", "x · gate")])
-    .params(&[ParamSpec::flag("enable", true, "gate").live()])
+    .params(&[ENABLE.spec()])
     .safety_guard();
 
 struct Guard {
@@ -97,13 +103,13 @@ impl Node for Guard {
     fn reset(&mut self) {
         self.gate = 1.0;
     }
-    fn set(&mut self, param: &'static str, value: f64) -> Result<(), Refused> {
-        match param {
-            "enable" => {
-                self.open = value != 0.0;
+    fn set(&mut self, c: Change) -> Result<(), Refused> {
+        match ENABLE.changed(&c) {
+            Some(open) => {
+                self.open = open;
                 Ok(())
             }
-            _ => Err(Refused(param)),
+            None => Err(c.refused()),
         }
     }
 }

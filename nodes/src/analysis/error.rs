@@ -95,20 +95,10 @@ mod tests {
     use super::*;
     use evflow_engine::harness::Single;
     use std::f64::consts::TAU;
-    use std::path::Path;
 
     fn run(x: Vec<f64>, r: Vec<f64>) -> Result<Summary, String> {
         let ticks = x.len() as u64;
-        let s = Single {
-            spec: &SPEC,
-            params: "",
-            inputs: vec![("test", x, 1000.0), ("reference", r, 1000.0)],
-            outputs: vec![],
-            base_rate: 1000.0,
-            ticks,
-            block: 128,
-            base_dir: Path::new("."),
-        };
+        let s = Single::new(&SPEC, "").input("test", x, 1000.0).input("reference", r, 1000.0).ticks(ticks).block(128);
         s.summary()
     }
 

@@ -131,20 +131,14 @@ impl Node for OnOff {
 mod tests {
     use super::*;
     use evflow_engine::harness::Single;
-    use std::path::Path;
 
     fn run(force: Vec<f64>, gate: Vec<f64>, vel: Vec<f64>, params: &str) -> Result<Summary, String> {
         let ticks = force.len() as u64;
-        let s = Single {
-            spec: &SPEC,
-            params,
-            inputs: vec![("force", force, 1000.0), ("gate", gate, 1000.0), ("velocity", vel, 1000.0)],
-            outputs: vec![],
-            base_rate: 1000.0,
-            ticks,
-            block: 64,
-            base_dir: Path::new("."),
-        };
+        let s = Single::new(&SPEC, params)
+            .input("force", force, 1000.0)
+            .input("gate", gate, 1000.0)
+            .input("velocity", vel, 1000.0)
+            .ticks(ticks);
         s.summary()
     }
 

@@ -163,20 +163,10 @@ mod tests {
     use super::*;
     use evflow_engine::harness::Single;
     use std::f64::consts::TAU;
-    use std::path::Path;
 
     fn summary(x: Vec<f64>, params: &str) -> Result<Summary, String> {
         let ticks = x.len() as u64;
-        let s = Single {
-            spec: &SPEC,
-            params,
-            inputs: vec![("in", x, 1000.0)],
-            outputs: vec![],
-            base_rate: 1000.0,
-            ticks,
-            block: 100,
-            base_dir: Path::new("."),
-        };
+        let s = Single::new(&SPEC, params).input("in", x, 1000.0).ticks(ticks).block(100);
         s.summary()
     }
 

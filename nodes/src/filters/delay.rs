@@ -117,22 +117,16 @@ mod tests {
     use super::*;
     use evflow_engine::harness::{Single, FEED, TAP};
     use evflow_engine::{check, run_offline, Graph, Plan, PlanOptions, Registry, RunOptions, Value};
-    use std::path::Path;
 
     fn run(d: usize, x: &[f64], block: usize) -> Vec<f64> {
-        Single {
-            spec: &SPEC,
-            params: &format!("samples = {d}"),
-            inputs: vec![("in", x.to_vec(), 1000.0)],
-            outputs: vec!["out"],
-            base_rate: 1000.0,
-            ticks: x.len() as u64,
-            block,
-            base_dir: Path::new("."),
-        }
-        .run()
-        .unwrap()
-        .remove(0)
+        Single::new(&SPEC, &format!("samples = {d}"))
+            .input("in", x.to_vec(), 1000.0)
+            .output("out")
+            .ticks(x.len() as u64)
+            .block(block)
+            .run()
+            .unwrap()
+            .remove(0)
     }
 
     #[test]
@@ -149,16 +143,7 @@ mod tests {
     #[test]
     fn reset_restores_the_initial_output() {
         let x: Vec<f64> = (0..40).map(|i| (i * i) as f64).collect();
-        let s = Single {
-            spec: &SPEC,
-            params: "samples = 5",
-            inputs: vec![("in", x, 1000.0)],
-            outputs: vec!["out"],
-            base_rate: 1000.0,
-            ticks: 40,
-            block: 8,
-            base_dir: Path::new("."),
-        };
+        let s = Single::new(&SPEC, "samples = 5").input("in", x, 1000.0).output("out").ticks(40).block(8);
         let (mut plan, idx) = s.plan().unwrap();
         let pass = |plan: &mut Plan| {
             let mut out = Vec::new();

@@ -60,22 +60,16 @@ impl Node for Normalize {
 mod tests {
     use super::*;
     use evflow_engine::harness::Single;
-    use std::path::Path;
 
     fn run(params: &str, x: &[f64]) -> Result<Vec<f64>, String> {
-        Single {
-            spec: &SPEC,
-            params,
-            inputs: vec![("in", x.to_vec(), 1000.0)],
-            outputs: vec!["out"],
-            base_rate: 1000.0,
-            ticks: x.len() as u64,
-            block: 7,
-            base_dir: Path::new("."),
-        }
-        .run()
-        .map(|mut o| o.remove(0))
-        .map_err(|e| e.to_string())
+        Single::new(&SPEC, params)
+            .input("in", x.to_vec(), 1000.0)
+            .output("out")
+            .ticks(x.len() as u64)
+            .block(7)
+            .run()
+            .map(|mut o| o.remove(0))
+            .map_err(|e| e.to_string())
     }
 
     #[test]

@@ -189,19 +189,13 @@ pub fn open_runs(gates: &[&[f64]], len: usize, mut keep: impl FnMut(usize, usize
 mod tests {
     use super::*;
     use evflow_engine::harness::Single;
-    use std::path::Path;
 
     fn run(params: &str, v: &[f64], block: usize) -> Vec<f64> {
-        let single = Single {
-            spec: &SPEC,
-            params,
-            inputs: vec![("velocity", v.to_vec(), 1000.0)],
-            outputs: vec!["gate"],
-            base_rate: 1000.0,
-            ticks: v.len() as u64,
-            block,
-            base_dir: Path::new("."),
-        };
+        let single = Single::new(&SPEC, params)
+            .input("velocity", v.to_vec(), 1000.0)
+            .output("gate")
+            .ticks(v.len() as u64)
+            .block(block);
         single.run().expect("runs").remove(0)
     }
 

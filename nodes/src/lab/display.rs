@@ -96,16 +96,14 @@ mod tests {
 
     fn single<'a>(params: &'a str, dir: &'a Path, block: usize, n: usize) -> Single<'a> {
         let v: Vec<f64> = (0..n).map(|i| if (i / 300) % 2 == 0 { 0.05 } else { -0.03 }).collect();
-        Single {
-            spec: &SPEC,
-            params,
-            inputs: vec![("u", prbs(n, 1.0), 1000.0), ("load", vec![0.85; n], 1000.0), ("velocity", v, 1000.0)],
-            outputs: vec!["force"],
-            base_rate: 1000.0,
-            ticks: n as u64,
-            block,
-            base_dir: dir,
-        }
+        Single::new(&SPEC, params)
+            .input("u", prbs(n, 1.0), 1000.0)
+            .input("load", vec![0.85; n], 1000.0)
+            .input("velocity", v, 1000.0)
+            .output("force")
+            .ticks(n as u64)
+            .block(block)
+            .base_dir(dir)
     }
 
     #[test]

@@ -74,16 +74,13 @@ mod tests {
         let n = 2000;
         let f: Vec<f64> = (0..n).map(|i| 0.3 * ((i as f64) * 0.05).sin()).collect();
         let v: Vec<f64> = (0..n).map(|i| if (i / 500) % 2 == 0 { 0.05 } else { -0.05 }).collect();
-        Single {
-            spec: &SPEC,
-            params,
-            inputs: vec![("surface_force", f, 1000.0), ("velocity", v, 1000.0)],
-            outputs: vec!["force"],
-            base_rate: 1000.0,
-            ticks: n as u64,
-            block,
-            base_dir: Path::new(env!("CARGO_MANIFEST_DIR")),
-        }
+        Single::new(&SPEC, params)
+            .input("surface_force", f, 1000.0)
+            .input("velocity", v, 1000.0)
+            .output("force")
+            .ticks(n as u64)
+            .block(block)
+            .base_dir(Path::new(env!("CARGO_MANIFEST_DIR")))
     }
 
     #[test]

@@ -160,18 +160,13 @@ mod node {
 
     fn single(params: &str, block: usize, ticks: u64) -> Vec<Vec<f64>> {
         let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("../graphs/lab");
-        Single {
-            spec: &SPEC,
-            params,
-            inputs: vec![],
-            outputs: vec!["position", "velocity", "load"],
-            base_rate: 1000.0,
-            ticks,
-            block,
-            base_dir: &dir,
-        }
-        .run()
-        .unwrap()
+        Single::new(&SPEC, params)
+            .outputs(&["position", "velocity", "load"])
+            .ticks(ticks)
+            .block(block)
+            .base_dir(&dir)
+            .run()
+            .unwrap()
     }
 
     #[test]
@@ -187,16 +182,7 @@ mod node {
     #[test]
     fn reset_restores_the_start() {
         let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("../graphs/lab");
-        let s = Single {
-            spec: &SPEC,
-            params: "speed = 7.0\nmass = 60.0",
-            inputs: vec![],
-            outputs: vec!["load"],
-            base_rate: 1000.0,
-            ticks: 0,
-            block: 100,
-            base_dir: &dir,
-        };
+        let s = Single::new(&SPEC, "speed = 7.0\nmass = 60.0").output("load").block(100).base_dir(&dir);
         let (mut plan, idx) = s.plan().unwrap();
         let grab = |plan: &mut evflow_engine::Plan| {
             let mut v = Vec::new();

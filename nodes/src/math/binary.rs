@@ -31,22 +31,17 @@ impl<F: Fn(f64, f64) -> f64 + Send> Node for Binary<F> {
 mod tests {
     use evflow_engine::harness::Single;
     use evflow_engine::NodeSpec;
-    use std::path::Path;
 
     fn run(spec: &'static NodeSpec, a: &[f64], b: &[f64]) -> Vec<f64> {
-        Single {
-            spec,
-            params: "",
-            inputs: vec![("a", a.to_vec(), 1000.0), ("b", b.to_vec(), 1000.0)],
-            outputs: vec!["out"],
-            base_rate: 1000.0,
-            ticks: a.len() as u64,
-            block: 7,
-            base_dir: Path::new("."),
-        }
-        .run()
-        .unwrap()
-        .remove(0)
+        Single::new(spec, "")
+            .input("a", a.to_vec(), 1000.0)
+            .input("b", b.to_vec(), 1000.0)
+            .output("out")
+            .ticks(a.len() as u64)
+            .block(7)
+            .run()
+            .unwrap()
+            .remove(0)
     }
 
     #[test]

@@ -5,7 +5,9 @@ use super::edges::{census, EdgeCensus, EdgeTracker};
 use super::gradient_node::placement_note;
 use super::source::{self, Placed};
 use evflow_engine::node::Constant;
-use evflow_engine::{BuildContext, Io, Node, NodeError, NodeSpec, ParamSpec, Params, PortSpec, Refused, Role, Summary};
+use evflow_engine::{
+    BuildContext, Change, Io, Node, NodeError, NodeSpec, ParamSpec, Params, PortSpec, Refused, Role, Summary,
+};
 
 /// Declaration of `mesh.edges`.
 pub static SPEC: NodeSpec = NodeSpec::new(
@@ -86,7 +88,7 @@ fn build(p: &Params, ctx: &BuildContext) -> Result<Box<dyn Node>, NodeError> {
             MeshEdges { placed, census, tracker, crossings: 0 }
         })
         .collect();
-    let initial = p.usize("scene");
+    let initial = source::SCENE.count(p);
     let scenes: Vec<MeshEdges> = scenes;
     let notes = scenes
         .iter()
@@ -154,10 +156,9 @@ impl Node for EdgesNode {
         self.notes.clone()
     }
 
-    fn set(&mut self, param: &'static str, value: f64) -> Result<(), Refused> {
-        match param {
-            "scene" if (value as usize) < self.scenes.len() => {
-                let next = value as usize;
+    fn set(&mut self, c: Change) -> Result<(), Refused> {
+        match source::SCENE.changed(&c) {
+            Some(next) if next < self.scenes.len() => {
                 if next != self.current {
                     // No crossing is counted between two meshes.
                     self.scenes[next].tracker.reset();
@@ -165,7 +166,7 @@ impl Node for EdgesNode {
                 }
                 Ok(())
             }
-            _ => Err(Refused(param)),
+            _ => Err(c.refused()),
         }
     }
 }

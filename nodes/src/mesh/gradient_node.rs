@@ -5,7 +5,9 @@ use super::calibrate::{calibrate, CacheStatus, Range, ScanSettings};
 use super::gradient::{intensity, Gradient, GradientSettings, SlopeMode};
 use super::raycast::RayCaster;
 use super::source::{self, Placed};
-use evflow_engine::{BuildContext, Io, Node, NodeError, NodeSpec, ParamSpec, Params, PortSpec, Refused, Role, Summary};
+use evflow_engine::{
+    BuildContext, Change, Io, Node, NodeError, NodeSpec, ParamSpec, Params, PortSpec, Refused, Role, Summary,
+};
 
 /// Declaration of `mesh.gradient`.
 pub static SPEC: NodeSpec = NodeSpec::new(
@@ -206,7 +208,7 @@ fn build(p: &Params, ctx: &BuildContext) -> Result<Box<dyn Node>, NodeError> {
         .iter()
         .flat_map(|s| std::iter::once(placement_note(&s.placed, p)).chain(s.placed.warnings.iter().cloned()))
         .collect();
-    let initial = p.usize("scene");
+    let initial = source::SCENE.count(p);
     let fade_len = (p.f64("switch_fade") * 1e-3 * ctx.rate).round() as usize;
     Ok(Box::new(GradientNode { scenes, current: initial, initial, fade: None, fade_len, notes, on: 0, off: 0 }))
 }
@@ -335,10 +337,9 @@ impl Node for GradientNode {
         self.notes.clone()
     }
 
-    fn set(&mut self, param: &'static str, value: f64) -> Result<(), Refused> {
-        match param {
-            "scene" if (value as usize) < self.scenes.len() => {
-                let next = value as usize;
+    fn set(&mut self, c: Change) -> Result<(), Refused> {
+        match source::SCENE.changed(&c) {
+            Some(next) if next < self.scenes.len() => {
                 if next != self.current {
                     // The estimate continues on the new mesh from where the finger is.
                     let from = self.scenes[self.current].est;
@@ -354,7 +355,7 @@ impl Node for GradientNode {
                 }
                 Ok(())
             }
-            _ => Err(Refused(param)),
+            _ => Err(c.refused()),
         }
     }
 }
@@ -416,18 +417,15 @@ mod tests {
     fn summary_with(dir: &std::path::Path, on: usize, off: usize, mesh: &str) -> Summary {
         let n = on + off;
         let x: Vec<f64> = (0..n).map(|i| if i < on { 0.002 + 0.001 * i as f64 % 0.006 } else { 0.05 }).collect();
-        Single {
-            spec: &SPEC,
-            params: &format!("{mesh}\nup = \"+z\"\nrange = \"fixed\""),
-            inputs: vec![("x", x, 1000.0), ("y", vec![0.005; n], 1000.0)],
-            outputs: vec!["tri"],
-            base_rate: 1000.0,
-            ticks: n as u64,
-            block: 4,
-            base_dir: dir,
-        }
-        .summary()
-        .unwrap()
+        Single::new(&SPEC, &format!("{mesh}\nup = \"+z\"\nrange = \"fixed\""))
+            .input("x", x, 1000.0)
+            .input("y", vec![0.005; n], 1000.0)
+            .output("tri")
+            .ticks(n as u64)
+            .block(4)
+            .base_dir(dir)
+            .summary()
+            .unwrap()
     }
 
     #[test]

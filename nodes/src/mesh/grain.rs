@@ -287,18 +287,13 @@ mod tests {
 
     #[test]
     fn partials_above_nyquist_are_refused() {
-        let e = Single {
-            spec: &SPEC,
-            params: "tick_frequency = 200.0",
-            inputs: vec![("area", vec![0.0], 1000.0)],
-            outputs: vec!["out"],
-            base_rate: 1000.0,
-            ticks: 1,
-            block: 1,
-            base_dir: Path::new("."),
-        }
-        .run()
-        .unwrap_err();
+        let e = Single::new(&SPEC, "tick_frequency = 200.0")
+            .input("area", vec![0.0], 1000.0)
+            .output("out")
+            .ticks(1)
+            .block(1)
+            .run()
+            .unwrap_err();
         assert!(e.contains("tick_frequency") && e.contains("Nyquist"), "{e}");
     }
 }

@@ -118,16 +118,14 @@ mod tests {
 
     #[test]
     fn lines_run_at_speed_in_their_directions() {
-        let out = Single {
-            spec: &SPEC,
-            params: "directions = [0.0, 90.0]\nspeed = 0.05\nlength = 0.1\nlines = 2\nspacing = 0.02\npause = 0.01",
-            inputs: vec![],
-            outputs: vec!["x", "y", "speed"],
-            base_rate: 1000.0,
-            ticks: 4 * 2010,
-            block: 333,
-            base_dir: FsPath::new("."),
-        }
+        let out = Single::new(
+            &SPEC,
+            "directions = [0.0, 90.0]\nspeed = 0.05\nlength = 0.1\nlines = 2\nspacing = 0.02\npause = 0.01",
+        )
+        .outputs(&["x", "y", "speed"])
+        .ticks(4 * 2010)
+        .block(333)
+        .base_dir(FsPath::new("."))
         .run()
         .unwrap();
         // Line 0: y = −0.01, x from −0.05 at 0.05 mm per tick.

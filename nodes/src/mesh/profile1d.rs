@@ -223,7 +223,6 @@ impl Node for Profile1dNode {
 mod tests {
     use super::*;
     use evflow_engine::harness::Single;
-    use std::path::Path;
 
     #[test]
     fn gaussian_bump_matches_eq_3_1_and_3_2() {
@@ -294,18 +293,13 @@ mod tests {
     #[test]
     fn the_node_takes_metres() {
         let x = vec![-0.005, 0.0, 0.005];
-        let out = Single {
-            spec: &SPEC,
-            params: "shape = \"bump\"\nprofile = \"ip0.5\"",
-            inputs: vec![("x", x, 1000.0)],
-            outputs: vec!["height", "force", "intensity"],
-            base_rate: 1000.0,
-            ticks: 3,
-            block: 2,
-            base_dir: Path::new("."),
-        }
-        .run()
-        .unwrap();
+        let out = Single::new(&SPEC, "shape = \"bump\"\nprofile = \"ip0.5\"")
+            .input("x", x, 1000.0)
+            .outputs(&["height", "force", "intensity"])
+            .ticks(3)
+            .block(2)
+            .run()
+            .unwrap();
         assert!((out[0][1] - 0.7978845608028654).abs() < 1e-15);
         assert!((out[2][0] - 1.0).abs() < 1e-14 && out[2][2].abs() < 1e-14);
         assert!(out[1][0] < 0.0);

@@ -9,6 +9,7 @@ use super::formats::{Format, EXTENSIONS};
 use super::place::{self, Up};
 use super::scenes::{scene, Shape, CONFIGS};
 use super::trimesh::Mesh;
+use evflow_engine::typed_params::Int;
 use evflow_engine::{BuildContext, NodeError, ParamSpec, Params};
 
 /// The parameters of a node that loads its scenes here (`file`, `shape`,
@@ -30,7 +31,7 @@ macro_rules! with_scene_params {
             $crate::mesh::source::FIT_SIZE,
             $crate::mesh::source::WELD,
             $crate::mesh::source::SCENES,
-            $crate::mesh::source::SCENE,
+            $crate::mesh::source::SCENE.spec(),
             $($own),*
         ]
     };
@@ -114,8 +115,7 @@ pub const SCENES: ParamSpec = ParamSpec::text_list(
      (*.obj, *.stl, *.ply, *.gltf, *.glb); empty: the one mesh of `file` or `config`",
 );
 /// `scene`: which of `scenes` is felt (live).
-pub const SCENE: ParamSpec =
-    ParamSpec::int("scene", 0, 255, 0, "1", "index into `scenes` of the mesh felt (changes live)").live();
+pub const SCENE: Int = Int::new("scene", 0, 255, 0, "1", "index into `scenes` of the mesh felt (changes live)").live();
 /// `weld`: vertex weld tolerance.
 pub const WELD: ParamSpec = ParamSpec::float(
     "weld",
@@ -176,7 +176,7 @@ pub fn load(p: &Params, ctx: &BuildContext) -> Result<Placed, NodeError> {
 /// one mesh of [`load`]. Also checks `scene` against the list.
 pub fn load_scenes(p: &Params, ctx: &BuildContext) -> Result<Vec<Placed>, NodeError> {
     let list = p.text_list("scenes");
-    let scene = p.usize("scene");
+    let scene = SCENE.count(p);
     if list.is_empty() {
         if scene != 0 {
             return Err(NodeError::param("scene", format!("{scene}: without a `scenes` list the only scene is 0")));
@@ -366,18 +366,14 @@ mod tests {
     fn run(dir: &Path, params: &str, x: Vec<f64>, y: Vec<f64>) -> Vec<Vec<f64>> {
         let n = x.len() as u64;
         let params = format!("{params}\nrange = \"fixed\"\nmin_step = 0.0");
-        Single {
-            spec: &gradient_node::SPEC,
-            params: &params,
-            inputs: vec![("x", x, 1000.0), ("y", y, 1000.0)],
-            outputs: vec!["intensity", "fsq", "slope", "z", "tri"],
-            base_rate: 1000.0,
-            ticks: n,
-            block: 64,
-            base_dir: dir,
-        }
-        .run()
-        .unwrap()
+        Single::new(&gradient_node::SPEC, &params)
+            .input("x", x, 1000.0)
+            .input("y", y, 1000.0)
+            .outputs(&["intensity", "fsq", "slope", "z", "tri"])
+            .ticks(n)
+            .base_dir(dir)
+            .run()
+            .unwrap()
     }
 
     /// A diagonal scan from a to b (m), 1 kHz.
@@ -413,18 +409,15 @@ mod tests {
     /// The warning lines of `mesh.gradient`'s summary after a short scan.
     fn warnings(dir: &Path, params: &str) -> Vec<String> {
         let params = format!("{params}\nrange = \"fixed\"");
-        let s = Single {
-            spec: &gradient_node::SPEC,
-            params: &params,
-            inputs: vec![("x", vec![0.001; 4], 1000.0), ("y", vec![0.001; 4], 1000.0)],
-            outputs: vec!["tri"],
-            base_rate: 1000.0,
-            ticks: 4,
-            block: 4,
-            base_dir: dir,
-        }
-        .summary()
-        .unwrap();
+        let s = Single::new(&gradient_node::SPEC, &params)
+            .input("x", vec![0.001; 4], 1000.0)
+            .input("y", vec![0.001; 4], 1000.0)
+            .output("tri")
+            .ticks(4)
+            .block(4)
+            .base_dir(dir)
+            .summary()
+            .unwrap();
         s.lines.into_iter().filter(|l| l.starts_with("warning:") && !l.contains("off the mesh")).collect()
     }
 

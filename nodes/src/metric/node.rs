@@ -336,22 +336,17 @@ mod tests {
     use super::*;
     use crate::metric::spectrum::tests::{gaussian, sine};
     use evflow_engine::harness::Single;
-    use std::path::Path;
 
     /// Runs the node through a real plan in blocks of `block` base ticks and
     /// returns its summary (or the error of building, running or finishing).
     fn run_at(rate: f64, params: &str, v: &[f64], r: &[f64], block: usize) -> Result<Summary, String> {
         assert_eq!(v.len(), r.len());
-        let single = Single {
-            spec: &SPEC,
-            params,
-            inputs: vec![("virtual", v.to_vec(), rate), ("real", r.to_vec(), rate)],
-            outputs: vec![],
-            base_rate: rate,
-            ticks: v.len() as u64,
-            block,
-            base_dir: Path::new("."),
-        };
+        let single = Single::new(&SPEC, params)
+            .input("virtual", v.to_vec(), rate)
+            .input("real", r.to_vec(), rate)
+            .base_rate(rate)
+            .ticks(v.len() as u64)
+            .block(block);
         let (mut plan, _) = single.plan()?;
         let mut done = 0;
         while done < v.len() {
@@ -390,20 +385,12 @@ mod tests {
             }
         }
         for block in [1, 77, 4096] {
-            let single = Single {
-                spec: &SPEC,
-                params: "gate = [\"steady\"]",
-                inputs: vec![
-                    ("virtual", v.clone(), 1000.0),
-                    ("real", r.clone(), 1000.0),
-                    ("steady", g.clone(), 1000.0),
-                ],
-                outputs: vec![],
-                base_rate: 1000.0,
-                ticks: v.len() as u64,
-                block,
-                base_dir: Path::new("."),
-            };
+            let single = Single::new(&SPEC, "gate = [\"steady\"]")
+                .input("virtual", v.clone(), 1000.0)
+                .input("real", r.clone(), 1000.0)
+                .input("steady", g.clone(), 1000.0)
+                .ticks(v.len() as u64)
+                .block(block);
             let (mut plan, _) = single.plan().expect("builds");
             let mut done = 0;
             while done < v.len() {
@@ -427,20 +414,12 @@ mod tests {
     }
 
     fn run_gated_never(v: &[f64], r: &[f64]) -> String {
-        let single = Single {
-            spec: &SPEC,
-            params: "gate = [\"steady\"]",
-            inputs: vec![
-                ("virtual", v.to_vec(), 1000.0),
-                ("real", r.to_vec(), 1000.0),
-                ("steady", vec![0.0; v.len()], 1000.0),
-            ],
-            outputs: vec![],
-            base_rate: 1000.0,
-            ticks: v.len() as u64,
-            block: 512,
-            base_dir: Path::new("."),
-        };
+        let single = Single::new(&SPEC, "gate = [\"steady\"]")
+            .input("virtual", v.to_vec(), 1000.0)
+            .input("real", r.to_vec(), 1000.0)
+            .input("steady", vec![0.0; v.len()], 1000.0)
+            .ticks(v.len() as u64)
+            .block(512);
         single.run().expect_err("no samples kept")
     }
 
@@ -517,16 +496,11 @@ mod tests {
     #[test]
     fn reset_returns_to_the_start() {
         let (v, r) = (force(5, 1200), force(6, 1200));
-        let single = Single {
-            spec: &SPEC,
-            params: "nfft = 256",
-            inputs: vec![("virtual", v.clone(), 1000.0), ("real", r.clone(), 1000.0)],
-            outputs: vec![],
-            base_rate: 1000.0,
-            ticks: 1200,
-            block: 100,
-            base_dir: Path::new("."),
-        };
+        let single = Single::new(&SPEC, "nfft = 256")
+            .input("virtual", v.clone(), 1000.0)
+            .input("real", r.clone(), 1000.0)
+            .ticks(1200)
+            .block(100);
         let (mut plan, _) = single.plan().unwrap();
         let mut once = || {
             for _ in 0..12 {

@@ -13,7 +13,6 @@ use crate::lab::sensor_model::SensorModel;
 use crate::lab::LabProfile;
 use crate::rng::Rng;
 use evflow_engine::harness::Single;
-use std::path::Path;
 
 /// A random binary sequence ±1 (independent fair coin flips, seeded): no
 /// past of it predicts its next value.
@@ -25,16 +24,7 @@ pub fn rbs(n: usize, seed: u64) -> Vec<f64> {
 /// `n` samples of the `prbs` node of the given order (c = 1, B = 1).
 pub fn prbs(order: u32, n: usize) -> Vec<f64> {
     let params = format!("order = {order}\nperiods = 100000");
-    let s = Single {
-        spec: &crate::sources::prbs::SPEC,
-        params: &params,
-        inputs: vec![],
-        outputs: vec!["out"],
-        base_rate: 1000.0,
-        ticks: n as u64,
-        block: 4096,
-        base_dir: Path::new("."),
-    };
+    let s = Single::new(&crate::sources::prbs::SPEC, &params).output("out").ticks(n as u64).block(4096);
     s.run().expect("prbs runs").remove(0)
 }
 

@@ -139,17 +139,14 @@ mod tests {
 
     fn score(dir: &Path, x: Vec<f64>, y: Vec<f64>, rate: f64) -> Result<Summary, String> {
         let n = x.len() as u64;
-        Single {
-            spec: &SPEC,
-            params: "model = \"m.json\"",
-            inputs: vec![("x", x, rate), ("y", y, rate)],
-            outputs: vec![],
-            base_rate: rate,
-            ticks: n,
-            block: 256,
-            base_dir: dir,
-        }
-        .summary()
+        Single::new(&SPEC, "model = \"m.json\"")
+            .input("x", x, rate)
+            .input("y", y, rate)
+            .base_rate(rate)
+            .ticks(n)
+            .block(256)
+            .base_dir(dir)
+            .summary()
     }
 
     #[test]

@@ -3,7 +3,8 @@
 use evflow_engine::node::Constant;
 use evflow_engine::spec::FoldArgs;
 use evflow_engine::typed_params::Float;
-use evflow_engine::{BuildContext, Io, Node, NodeError, NodeSpec, Params, PortSpec, Refused, Role};
+use evflow_engine::typed_ports::{InPort, OutPort};
+use evflow_engine::{BuildContext, Change, Io, Node, NodeError, NodeSpec, Params, PortSpec, Refused, Role};
 
 /// Declaration of `gain`.
 pub static SPEC: NodeSpec =
@@ -22,10 +23,15 @@ pub static SPEC: NodeSpec =
          constant input c makes it g·c; the planner then holds the output and leaves out what fed \
          only this node. A live plan never folds on `gain`, which may change while it runs.",
         )
-        .ports(&[PortSpec::input("in", "1", "signal"), PortSpec::output("out", "1", "signal × gain")])
+        .ports(PORTS)
         .params(&[GAIN.spec(), RAMP.spec()])
         .example("gain = 1.2")
         .fold(fold);
+
+/// The ports: one signal in, the scaled signal out.
+const PORTS: &[PortSpec] = &[PortSpec::input("in", "1", "signal"), PortSpec::output("out", "1", "signal × gain")];
+const IN: InPort = InPort::named(PORTS, "in");
+const OUT: OutPort = OutPort::named(PORTS, "out");
 
 /// `gain`: the multiplier, changeable live.
 const GAIN: Float = Float::new("gain", -1e6, 1e6, 1.0, "1", "multiplier").live();
@@ -38,7 +44,8 @@ fn fold(f: &FoldArgs<'_>) -> Option<Constant> {
     if g == 0.0 {
         return Some(Constant::all(1, 0.0, "gain = 0"));
     }
-    f.input(0).map(|x| Constant::all(1, (g * x).clamp(-f64::MAX, f64::MAX), format!("gain {g} × constant input {x}")))
+    f.input(IN.index())
+        .map(|x| Constant::all(1, (g * x).clamp(-f64::MAX, f64::MAX), format!("gain {g} × constant input {x}")))
 }
 
 struct Gain {
@@ -60,7 +67,7 @@ fn build(p: &Params, ctx: &BuildContext) -> Result<Box<dyn Node>, NodeError> {
 
 impl Node for Gain {
     fn process(&mut self, io: &mut Io<'_>) -> Result<(), NodeError> {
-        let (x, y) = io.io(0, 0);
+        let (x, y) = io.io(IN, OUT);
         if self.left == 0 {
             for (y, x) in y.iter_mut().zip(x) {
                 *y = (self.gain * x).clamp(-f64::MAX, f64::MAX);
@@ -83,10 +90,8 @@ impl Node for Gain {
         self.left = 0;
     }
 
-    fn set(&mut self, param: &'static str, value: f64) -> Result<(), Refused> {
-        if param != GAIN.name() {
-            return Err(Refused(param));
-        }
+    fn set(&mut self, c: Change) -> Result<(), Refused> {
+        let Some(value) = GAIN.changed(&c) else { return Err(c.refused()) };
         self.target = value;
         self.left = self.ramp_samples;
         self.delta = (value - self.gain) / self.ramp_samples as f64;
@@ -98,23 +103,17 @@ impl Node for Gain {
 mod tests {
     use super::*;
     use evflow_engine::harness::Single;
-    use std::path::Path;
 
     #[test]
     fn scales_by_the_gain() {
         let x: Vec<f64> = (0..100).map(|i| (i as f64 * 0.1).sin()).collect();
-        let out = Single {
-            spec: &SPEC,
-            params: "gain = -2.5",
-            inputs: vec![("in", x.clone(), 1000.0)],
-            outputs: vec!["out"],
-            base_rate: 1000.0,
-            ticks: 100,
-            block: 32,
-            base_dir: Path::new("."),
-        }
-        .run()
-        .unwrap();
+        let out = Single::new(&SPEC, "gain = -2.5")
+            .input("in", x.clone(), 1000.0)
+            .output("out")
+            .ticks(100)
+            .block(32)
+            .run()
+            .unwrap();
         for (y, x) in out[0].iter().zip(&x) {
             assert_eq!(*y, -2.5 * x);
         }
@@ -140,18 +139,13 @@ mod tests {
 
     #[test]
     fn a_product_beyond_f64_saturates() {
-        let y = evflow_engine::harness::Single {
-            spec: &SPEC,
-            params: "gain = -2.0",
-            inputs: vec![("in", vec![f64::MAX, 1e300, -f64::MAX], 1000.0)],
-            outputs: vec!["out"],
-            base_rate: 1000.0,
-            ticks: 3,
-            block: 2,
-            base_dir: std::path::Path::new("."),
-        }
-        .run()
-        .unwrap();
+        let y = evflow_engine::harness::Single::new(&SPEC, "gain = -2.0")
+            .input("in", vec![f64::MAX, 1e300, -f64::MAX], 1000.0)
+            .output("out")
+            .ticks(3)
+            .block(2)
+            .run()
+            .unwrap();
         assert_eq!(y[0], [-f64::MAX, -2e300, f64::MAX]);
     }
 
@@ -167,14 +161,14 @@ mod tests {
             g.process(&mut io).unwrap();
             y.copy_from_slice(&outs[0]);
         };
-        g.set("gain", 0.2).unwrap();
+        g.set(Change { param: "gain", value: 0.2 }).unwrap();
         run(&mut g, &mut y);
         for (a, b) in y[..3].iter().zip([1.6, 1.2, 0.8]) {
             assert!((a - b).abs() < 1e-15);
         }
         assert_eq!(y[3], 0.4);
         assert!(y[4..].iter().all(|&v| v == 0.4));
-        assert!(g.set("ramp", 1.0).is_err());
+        assert!(g.set(Change { param: "ramp", value: 1.0 }).is_err());
         g.reset();
         run(&mut g, &mut y);
         assert!(y.iter().all(|&v| v == 2.0));

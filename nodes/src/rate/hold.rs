@@ -75,22 +75,16 @@ impl Node for Hold {
 mod tests {
     use super::*;
     use evflow_engine::harness::Single;
-    use std::path::Path;
 
     fn run(input: Vec<f64>, in_rate: f64, params: &str, ticks: u64, block: usize) -> Vec<f64> {
-        Single {
-            spec: &SPEC,
-            params,
-            inputs: vec![("in", input, in_rate)],
-            outputs: vec!["out"],
-            base_rate: 1000.0,
-            ticks,
-            block,
-            base_dir: Path::new("."),
-        }
-        .run()
-        .unwrap()
-        .remove(0)
+        Single::new(&SPEC, params)
+            .input("in", input, in_rate)
+            .output("out")
+            .ticks(ticks)
+            .block(block)
+            .run()
+            .unwrap()
+            .remove(0)
     }
 
     #[test]

@@ -23,7 +23,6 @@ pub static SPECS: &[&NodeSpec] = &[&hold::SPEC, &decimate::SPEC, &resample::SPEC
 pub(crate) mod testing {
     use evflow_engine::harness::Single;
     use evflow_engine::NodeSpec;
-    use std::path::Path;
 
     /// Runs the node `spec` with `params` on `x` at `fs_in` Hz in a graph of
     /// base rate `base`, for `ticks` base ticks in blocks of `block` ticks;
@@ -37,18 +36,14 @@ pub(crate) mod testing {
         ticks: u64,
         block: usize,
     ) -> Result<Vec<f64>, String> {
-        Single {
-            spec,
-            params,
-            inputs: vec![("in", x.to_vec(), fs_in)],
-            outputs: vec!["out"],
-            base_rate: base,
-            ticks,
-            block,
-            base_dir: Path::new("."),
-        }
-        .run()
-        .map(|mut o| o.remove(0))
+        Single::new(spec, params)
+            .input("in", x.to_vec(), fs_in)
+            .output("out")
+            .base_rate(base)
+            .ticks(ticks)
+            .block(block)
+            .run()
+            .map(|mut o| o.remove(0))
     }
 
     /// `len` samples uniform in [−0.5, 0.5) from the lab's generator.

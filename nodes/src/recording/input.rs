@@ -192,16 +192,10 @@ mod tests {
         let dir = tempfile::tempdir().unwrap();
         let (a, _) = signals(100);
         write(dir.path(), "rec.wav", 1000.0, &[("force", a.clone())]);
-        let single = Single {
-            spec: &SPEC,
-            params: "path = \"rec.wav\"\nchannels = [\"force\"]",
-            inputs: vec![],
-            outputs: vec!["force"],
-            base_rate: 1000.0,
-            ticks: 0,
-            block: 40,
-            base_dir: dir.path(),
-        };
+        let single = Single::new(&SPEC, "path = \"rec.wav\"\nchannels = [\"force\"]")
+            .output("force")
+            .block(40)
+            .base_dir(dir.path());
         let (mut plan, idx) = single.plan().unwrap();
         assert_eq!(plan.remaining_ticks(), Some(100));
         plan.step(40).unwrap();
@@ -219,33 +213,23 @@ mod tests {
     fn refuses_wrong_rate_and_unknown_channel() {
         let dir = tempfile::tempdir().unwrap();
         write(dir.path(), "rec.wav", 10_000.0, &[("force", vec![1.0; 10])]);
-        let err = Single {
-            spec: &SPEC,
-            params: "path = \"rec.wav\"\nchannels = [\"force\"]",
-            inputs: vec![],
-            outputs: vec!["force"],
-            base_rate: 1000.0,
-            ticks: 5,
-            block: 4,
-            base_dir: dir.path(),
-        }
-        .run()
-        .unwrap_err();
+        let err = Single::new(&SPEC, "path = \"rec.wav\"\nchannels = [\"force\"]")
+            .output("force")
+            .ticks(5)
+            .block(4)
+            .base_dir(dir.path())
+            .run()
+            .unwrap_err();
         assert!(err.contains("parameter `rate`") && err.contains("1000 Hz") && err.contains("10000 Hz"), "{err}");
 
         write(dir.path(), "one.wav", 1000.0, &[("force", vec![1.0; 10])]);
-        let err = Single {
-            spec: &SPEC,
-            params: "path = \"one.wav\"\nchannels = [\"forse\"]",
-            inputs: vec![],
-            outputs: vec!["forse"],
-            base_rate: 1000.0,
-            ticks: 5,
-            block: 4,
-            base_dir: dir.path(),
-        }
-        .run()
-        .unwrap_err();
+        let err = Single::new(&SPEC, "path = \"one.wav\"\nchannels = [\"forse\"]")
+            .output("forse")
+            .ticks(5)
+            .block(4)
+            .base_dir(dir.path())
+            .run()
+            .unwrap_err();
         assert!(err.contains("parameter `channels`") && err.contains("did you mean `force`?"), "{err}");
     }
 
@@ -257,16 +241,10 @@ mod tests {
         let wav = dir.path().join("cut.wav");
         let bytes = std::fs::read(&wav).unwrap();
         std::fs::write(&wav, &bytes[..58 + 400 * 8 + 3]).unwrap();
-        let single = Single {
-            spec: &SPEC,
-            params: "path = \"cut.wav\"\nchannels = [\"force\"]",
-            inputs: vec![],
-            outputs: vec!["force"],
-            base_rate: 1000.0,
-            ticks: 0,
-            block: 500,
-            base_dir: dir.path(),
-        };
+        let single = Single::new(&SPEC, "path = \"cut.wav\"\nchannels = [\"force\"]")
+            .output("force")
+            .block(500)
+            .base_dir(dir.path());
         let (mut plan, idx) = single.plan().unwrap();
         assert_eq!(plan.remaining_ticks(), Some(400));
         plan.step(400).unwrap();
@@ -281,18 +259,13 @@ mod tests {
     #[test]
     fn missing_file_is_an_error_naming_it() {
         let dir = tempfile::tempdir().unwrap();
-        let err = Single {
-            spec: &SPEC,
-            params: "path = \"nothere.wav\"\nchannels = [\"force\"]",
-            inputs: vec![],
-            outputs: vec!["force"],
-            base_rate: 1000.0,
-            ticks: 5,
-            block: 4,
-            base_dir: dir.path(),
-        }
-        .run()
-        .unwrap_err();
+        let err = Single::new(&SPEC, "path = \"nothere.wav\"\nchannels = [\"force\"]")
+            .output("force")
+            .ticks(5)
+            .block(4)
+            .base_dir(dir.path())
+            .run()
+            .unwrap_err();
         assert!(err.contains("nothere.wav") && err.contains("no such recording"), "{err}");
     }
 }

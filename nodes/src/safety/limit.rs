@@ -1,7 +1,10 @@
 //! `limit`: the safety limiter in front of every hardware output.
 
 use super::envelope::Envelope;
-use evflow_engine::{BuildContext, Io, Node, NodeError, NodeSpec, ParamSpec, Params, PortSpec, Refused, Role, Summary};
+use evflow_engine::typed_params::Flag;
+use evflow_engine::{
+    BuildContext, Change, Io, Node, NodeError, NodeSpec, ParamSpec, Params, PortSpec, Refused, Role, Summary,
+};
 
 /// The longest fade the limiter may take: the live runner's stop sequence
 /// runs this long (plus one tick) before it ends a session.
@@ -131,10 +134,13 @@ input and a disable; the latch and re-arm; the `state` code at each transition; 
     ParamSpec::float("slew", 1e-3, 1e12, 4000.0, "1/s", "largest rate of change of the clamped signal"),
     ParamSpec::float("ramp", 0.0, MAX_RAMP_S, MAX_RAMP_S, "s", "fade time of the gate (at most 10 ms)"),
     ParamSpec::text_list("faults", "names of fault-flag inputs (e.g. [\"link\"]); none by default"),
-    ParamSpec::flag("enable", true, "gate open; false fades to zero, true re-arms after a fault").live(),
+    ENABLE.spec(),
 ])
 .safety_guard()
 .example("amplitude = 1.0\nslew = 4000.0\nramp = 0.01");
+
+/// `enable`: the gate, changeable live.
+const ENABLE: Flag = Flag::new("enable", true, "gate open; false fades to zero, true re-arms after a fault").live();
 
 /// What closed the gate first.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -180,7 +186,7 @@ fn build(p: &Params, ctx: &BuildContext) -> Result<Box<dyn Node>, NodeError> {
         step: p.f64("slew") / ctx.rate,
         ramp_steps: ramp_steps as u32,
         fault_names,
-        enabled: p.bool("enable"),
+        enabled: ENABLE.get(p),
         latched: false,
         held: 0.0,
         gate: Envelope::closed(1),
@@ -190,7 +196,7 @@ fn build(p: &Params, ctx: &BuildContext) -> Result<Box<dyn Node>, NodeError> {
         next: 0,
     };
     node.reset();
-    node.enabled = p.bool("enable");
+    node.enabled = ENABLE.get(p);
     Ok(Box::new(node))
 }
 
@@ -276,16 +282,16 @@ impl Node for Limit {
         self.next = 0;
     }
 
-    fn set(&mut self, param: &'static str, value: f64) -> Result<(), Refused> {
-        match param {
-            "enable" => {
-                self.enabled = value != 0.0;
+    fn set(&mut self, c: Change) -> Result<(), Refused> {
+        match ENABLE.changed(&c) {
+            Some(enabled) => {
+                self.enabled = enabled;
                 if self.enabled {
                     self.latched = false;
                 }
                 Ok(())
             }
-            _ => Err(Refused(param)),
+            None => Err(c.refused()),
         }
     }
 

@@ -207,22 +207,12 @@ mod tests {
     use evflow_engine::{run_offline, RunOptions};
     use rustfft::num_complex::Complex;
     use rustfft::FftPlanner;
-    use std::path::Path;
 
     /// MATLAB `idinput(511,'prbs',[0 1],[-1 1])`, first 32 samples.
     const MATLAB_PRBS9_START: &str = "---------++++----+---++++-+--++-";
 
     fn single(params: &str, ticks: u64, block: usize) -> Single<'_> {
-        Single {
-            spec: &SPEC,
-            params,
-            inputs: vec![],
-            outputs: vec!["out"],
-            base_rate: 1000.0,
-            ticks,
-            block,
-            base_dir: Path::new("."),
-        }
+        Single::new(&SPEC, params).output("out").ticks(ticks).block(block)
     }
 
     fn run(params: &str, ticks: u64, block: usize) -> Vec<f64> {

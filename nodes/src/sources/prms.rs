@@ -180,19 +180,9 @@ impl Node for Prms {
 mod tests {
     use super::*;
     use evflow_engine::harness::Single;
-    use std::path::Path;
 
     fn single(params: &str, ticks: u64, block: usize) -> Single<'_> {
-        Single {
-            spec: &SPEC,
-            params,
-            inputs: vec![],
-            outputs: vec!["out"],
-            base_rate: 1000.0,
-            ticks,
-            block,
-            base_dir: Path::new("."),
-        }
+        Single::new(&SPEC, params).output("out").ticks(ticks).block(block)
     }
 
     fn run(params: &str, ticks: u64, block: usize) -> Vec<f64> {

@@ -71,22 +71,9 @@ impl Node for Pulse {
 mod tests {
     use super::*;
     use evflow_engine::harness::Single;
-    use std::path::Path;
 
     fn run(params: &str, ticks: u64) -> Vec<f64> {
-        Single {
-            spec: &SPEC,
-            params,
-            inputs: vec![],
-            outputs: vec!["out"],
-            base_rate: 1000.0,
-            ticks,
-            block: 64,
-            base_dir: Path::new("."),
-        }
-        .run()
-        .unwrap()
-        .remove(0)
+        Single::new(&SPEC, params).output("out").ticks(ticks).run().unwrap().remove(0)
     }
 
     #[test]

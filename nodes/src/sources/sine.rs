@@ -139,19 +139,10 @@ mod tests {
     use evflow_engine::harness::Single;
     use evflow_engine::Value;
     use std::collections::BTreeMap;
-    use std::path::{Path, PathBuf};
+    use std::path::PathBuf;
 
     fn single(params: &str, ticks: u64, block: usize) -> Single<'_> {
-        Single {
-            spec: &SPEC,
-            params,
-            inputs: vec![],
-            outputs: vec!["out"],
-            base_rate: 1000.0,
-            ticks,
-            block,
-            base_dir: Path::new("."),
-        }
+        Single::new(&SPEC, params).output("out").ticks(ticks).block(block)
     }
 
     fn run(params: &str, ticks: u64, block: usize) -> Vec<f64> {

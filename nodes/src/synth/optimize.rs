@@ -354,16 +354,7 @@ mod tests {
         fixtures(dir.path(), 600);
         for (objective, used) in [("expected", "objective time (fewer counted samples"), ("time", "objective time:")] {
             let params = format!("target = \"short\"\nmodel = \"f.json\"\nobjective = \"{objective}\"\niterations = 5");
-            let single = Single {
-                spec: &SPEC,
-                params: &params,
-                inputs: vec![],
-                outputs: vec!["u"],
-                base_rate: 1000.0,
-                ticks: 600,
-                block: 128,
-                base_dir: dir.path(),
-            };
+            let single = Single::new(&SPEC, &params).output("u").ticks(600).block(128).base_dir(dir.path());
             let u = single.run().unwrap_or_else(|e| panic!("{objective}: {e}")).remove(0);
             assert_eq!(u.len(), 600);
             assert!(u.iter().all(|v| v.is_finite() && v.abs() <= 1.0));

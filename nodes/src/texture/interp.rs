@@ -6,11 +6,16 @@ use super::grid::{Grid, GridSource};
 use super::kernel::SincKernel;
 use super::scheme::{Geometry, Mix, Scheme};
 use crate::rate::clock::Clock;
+use evflow_engine::typed_params::Int;
 use evflow_engine::{
-    BuildContext, Io, Node, NodeError, NodeSpec, ParamSpec, Params, PortSpec, PrepareContext, RateSpec, Refused, Role,
-    Summary,
+    BuildContext, Change, Io, Node, NodeError, NodeSpec, ParamSpec, Params, PortSpec, PrepareContext, RateSpec,
+    Refused, Role, Summary,
 };
 use std::path::PathBuf;
+
+/// `texture`: which of `textures` plays, changeable live.
+const TEXTURE: Int =
+    Int::new("texture", 0, 255, 0, "1", "index into `textures` of the texture played (0: the first)").live();
 
 /// Declaration of `interp`.
 pub static SPEC: NodeSpec = NodeSpec::new(
@@ -79,7 +84,7 @@ single-column grids, a velocity ratio of 10, missing and duplicate cells, envelo
     ParamSpec::text("folder", "", "folder of grid recordings (relative to the graph file); or use `paths` or `textures`"),
     ParamSpec::text_list("paths", "grid recordings, one per cell (instead of `folder`)"),
     ParamSpec::text_list("textures", "folders of grid recordings, one per texture (instead of `folder`); `texture` picks one"),
-    ParamSpec::int("texture", 0, 255, 0, "1", "index into `textures` of the texture played (0: the first)").live(),
+    TEXTURE.spec(),
     ParamSpec::text("material", "", "use only recordings of this condition.material (empty: all)"),
     ParamSpec::text("channel", "", "channel holding U_ij (empty: the recording's only channel)"),
     ParamSpec::choice("scheme", &["improved", "basic"], "improved", "Eq. 6.4 two-part scheme or §5.3.3 basic average"),
@@ -194,7 +199,7 @@ pub fn grid_sources(p: &Params, ctx: &BuildContext) -> Result<Vec<(GridSource, S
 
 fn build(p: &Params, ctx: &BuildContext) -> Result<Box<dyn Node>, NodeError> {
     let sources = grid_sources(p, ctx)?;
-    let initial = p.usize("texture");
+    let initial = TEXTURE.count(p);
     if initial >= sources.len() {
         return Err(NodeError::param(
             "texture",
@@ -384,14 +389,14 @@ impl Node for Interp {
         Ok(s.line(format!("{} frames sent", self.sent / self.frame as u64)))
     }
 
-    fn set(&mut self, param: &'static str, value: f64) -> Result<(), Refused> {
-        match param {
+    fn set(&mut self, c: Change) -> Result<(), Refused> {
+        match TEXTURE.changed(&c) {
             // Taken at the next frame start; playback crossfades into it.
-            "texture" if (value as usize) < self.textures.len() => {
-                self.pending = value as usize;
+            Some(texture) if texture < self.textures.len() => {
+                self.pending = texture;
                 Ok(())
             }
-            _ => Err(Refused(param)),
+            _ => Err(c.refused()),
         }
     }
 }

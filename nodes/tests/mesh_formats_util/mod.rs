@@ -215,15 +215,11 @@ pub fn glb(m: &Mesh, a: Axis) -> Vec<u8> {
 /// extreme-mesh tests.
 pub fn gradient(dir: &Path, params: &str, x: &[f64], y: &[f64]) -> Result<Vec<Vec<f64>>, String> {
     let params = format!("{params}\nrange = \"fixed\"\nmin_step = 0.0");
-    Single {
-        spec: &gradient_node::SPEC,
-        params: &params,
-        inputs: vec![("x", x.to_vec(), 1000.0), ("y", y.to_vec(), 1000.0)],
-        outputs: vec!["intensity", "fsq", "slope", "z", "tri"],
-        base_rate: 1000.0,
-        ticks: x.len() as u64,
-        block: 64,
-        base_dir: dir,
-    }
-    .run()
+    Single::new(&gradient_node::SPEC, &params)
+        .input("x", x.to_vec(), 1000.0)
+        .input("y", y.to_vec(), 1000.0)
+        .outputs(&["intensity", "fsq", "slope", "z", "tri"])
+        .ticks(x.len() as u64)
+        .base_dir(dir)
+        .run()
 }

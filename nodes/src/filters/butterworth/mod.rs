@@ -121,21 +121,16 @@ mod tests {
     use evflow_engine::harness::Single;
     use evflow_engine::Value;
     use std::f64::consts::PI;
-    use std::path::Path;
 
     fn run(params: &str, x: &[f64], fs: f64, block: usize) -> Result<Vec<f64>, String> {
-        Single {
-            spec: &SPEC,
-            params,
-            inputs: vec![("in", x.to_vec(), fs)],
-            outputs: vec!["out"],
-            base_rate: fs,
-            ticks: x.len() as u64,
-            block,
-            base_dir: Path::new("."),
-        }
-        .run()
-        .map(|mut o| o.remove(0))
+        Single::new(&SPEC, params)
+            .input("in", x.to_vec(), fs)
+            .output("out")
+            .base_rate(fs)
+            .ticks(x.len() as u64)
+            .block(block)
+            .run()
+            .map(|mut o| o.remove(0))
     }
 
     fn sine(f: f64, fs: f64, n: usize) -> Vec<f64> {
@@ -203,16 +198,10 @@ mod tests {
     #[test]
     fn reset_restores_the_initial_output() {
         let x = sine(30.0, 1000.0, 300);
-        let s = Single {
-            spec: &SPEC,
-            params: "kind = \"lowpass\"\norder = 5\ncutoff = 50.0",
-            inputs: vec![("in", x, 1000.0)],
-            outputs: vec!["out"],
-            base_rate: 1000.0,
-            ticks: 300,
-            block: 64,
-            base_dir: Path::new("."),
-        };
+        let s = Single::new(&SPEC, "kind = \"lowpass\"\norder = 5\ncutoff = 50.0")
+            .input("in", x, 1000.0)
+            .output("out")
+            .ticks(300);
         let (mut plan, idx) = s.plan().unwrap();
         let pass = |plan: &mut evflow_engine::Plan| {
             let mut out = Vec::new();

@@ -71,24 +71,12 @@ impl Node for FoawNode {
 mod tests {
     use super::*;
     use evflow_engine::harness::Single;
-    use std::path::Path;
 
     #[test]
     fn runs_at_the_rate_of_its_input() {
         // A 40 Hz ramp at 5 cm/s: the estimate is 0.05 m/s once two samples are in.
         let x: Vec<f64> = (0..40).map(|k| 0.05 * k as f64 / 40.0).collect();
-        let out = Single {
-            spec: &SPEC,
-            params: "noise = 1e-9",
-            inputs: vec![("x", x, 40.0)],
-            outputs: vec!["velocity"],
-            base_rate: 1000.0,
-            ticks: 1000,
-            block: 64,
-            base_dir: Path::new("."),
-        }
-        .run()
-        .unwrap();
+        let out = Single::new(&SPEC, "noise = 1e-9").input("x", x, 40.0).output("velocity").ticks(1000).run().unwrap();
         assert_eq!(out[0].len(), 40);
         assert_eq!(out[0][0], 0.0);
         for v in &out[0][1..] {

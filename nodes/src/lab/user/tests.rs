@@ -85,16 +85,6 @@ fn extreme_settings_stay_finite_and_bounded() {
 
 #[test]
 fn inverted_ranges_are_refused() {
-    let r = Single {
-        spec: &SPEC,
-        params: "speed_min = 7.0\nspeed_max = 3.0",
-        inputs: vec![],
-        outputs: vec!["x"],
-        base_rate: 1000.0,
-        ticks: 10,
-        block: 10,
-        base_dir: Path::new("."),
-    }
-    .run();
+    let r = Single::new(&SPEC, "speed_min = 7.0\nspeed_max = 3.0").output("x").ticks(10).block(10).run();
     assert!(r.is_err_and(|e| e.to_string().contains("speed_min")));
 }

@@ -206,18 +206,13 @@ fn reset_empties_the_recording() {
 fn harness_single_writes_the_file() {
     let dir = tempfile::tempdir().unwrap();
     let x: Vec<f64> = (0..50).map(|i| i as f64 * 0.5).collect();
-    Single {
-        spec: &SPEC,
-        params: "path = \"h.wav\"\nchannels = [\"force\"]",
-        inputs: vec![("force", x.clone(), 10_000.0)],
-        outputs: vec![],
-        base_rate: 1000.0,
-        ticks: 5,
-        block: 2,
-        base_dir: dir.path(),
-    }
-    .run()
-    .unwrap();
+    Single::new(&SPEC, "path = \"h.wav\"\nchannels = [\"force\"]")
+        .input("force", x.clone(), 10_000.0)
+        .ticks(5)
+        .block(2)
+        .base_dir(dir.path())
+        .run()
+        .unwrap();
     let rec = Recording::open(&dir.path().join("h.wav")).unwrap();
     assert_eq!(rec.rate(), 10_000.0);
     assert_eq!(rec.channel("force").unwrap(), &x[..]);

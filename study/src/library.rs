@@ -26,7 +26,9 @@ use super::row::{self, Method, Row, RowInputs};
 use super::setup::{Cond, Profile};
 use super::StudyError;
 use evflow_engine::batch::{for_each_ordered, Failures, Shard};
-use serde_json::{json, Value as Json};
+use serde::{Deserialize, Deserializer, Serialize};
+use serde_json::Value as Json;
+use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
 use std::sync::atomic::AtomicBool;
 
@@ -85,23 +87,100 @@ pub struct Outcome {
     pub total: usize,
 }
 
+/// The library's `index.json`. Its fields are declared in the order of
+/// their names, which is the order they are written in.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct Index {
+    /// The plan's condition tags, in the library's order.
+    pub conditions: Vec<String>,
+    /// What the library holds, texture by texture, condition by condition.
+    pub entries: Vec<Entry>,
+    /// [`FORMAT`].
+    pub format: String,
+    /// The plan's texture samples, in order.
+    pub samples: Vec<String>,
+    /// The slice `K/N` of a sharded build; absent for the whole library.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub shard: Option<String>,
+    /// The index format's version (1).
+    pub version: u32,
+}
+
+/// One texture at one condition in the library.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[allow(non_snake_case)]
+pub struct Entry {
+    /// E_s of each method's cell at its chosen gain, by method folder prefix.
+    pub E_s: BTreeMap<String, Es>,
+    /// E_s of the display floor (what the display allows).
+    pub E_s_display_floor: Es,
+    /// E_s between two recordings of the same force (the repeat floor).
+    pub E_s_repeat: Es,
+    /// Each cell's recording sidecar (relative to the library), by method
+    /// folder prefix, and `forces`: the recorded force.
+    pub cells: BTreeMap<String, String>,
+    /// The condition.
+    pub condition: Condition,
+    /// The forward model's file, relative to the library.
+    pub forward_model: String,
+    /// Each method's chosen gain (Table 5.1), by method folder prefix.
+    pub gain: BTreeMap<String, f64>,
+    /// The inverse NARX model's file, relative to the library.
+    pub model: String,
+    /// The lab profile the cells were made on.
+    pub profile: String,
+    /// The condition's tag (`85g-5cms`).
+    pub tag: String,
+    /// The texture sample.
+    pub texture: String,
+    /// The NARX model file's own `training` section (its scores), as written there.
+    pub training: Json,
+}
+
+/// A condition of the grid as the index writes it.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+pub struct Condition {
+    /// Normal load in grams.
+    pub load_g: f64,
+    /// Finger velocity in cm/s.
+    pub velocity_cm_s: f64,
+}
+
+/// E_s with the rectangular and the Welch estimate; a value that could not
+/// be computed (NaN) is written as `null` and read back as NaN.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+pub struct Es {
+    /// With the rectangular-window spectrum.
+    #[serde(deserialize_with = "nan_if_null")]
+    pub rect: f64,
+    /// With the Welch spectrum.
+    #[serde(deserialize_with = "nan_if_null")]
+    pub welch: f64,
+}
+
+/// A number, or `null` (which JSON writes for NaN and the infinities) as NaN.
+fn nan_if_null<'de, D: Deserializer<'de>>(d: D) -> std::result::Result<f64, D::Error> {
+    Ok(Option::<f64>::deserialize(d)?.unwrap_or(f64::NAN))
+}
+
 fn index_path(dir: &Path) -> PathBuf {
     dir.join("index.json")
 }
 
-/// The index's entries from an earlier build (none when there is no index).
-fn read_index(dir: &Path) -> Result<Vec<Json>> {
+/// Reads `dir`'s index; `None` when there is none. Errors name the file.
+fn read_index_file(dir: &Path) -> Result<Option<Index>> {
     let p = index_path(dir);
     let text = match evflow_engine::files::read_regular_to_string(&p) {
         Ok(t) => t,
-        Err(e) if e.kind() == std::io::ErrorKind::NotFound => return Ok(Vec::new()),
+        Err(e) if e.kind() == std::io::ErrorKind::NotFound => return Ok(None),
         Err(e) => return Err(io(&p, format!("cannot read: {e}"))),
     };
-    let doc: Json = serde_json::from_str(&text).map_err(|e| io(&p, e))?;
-    doc.get("entries")
-        .and_then(Json::as_array)
-        .cloned()
-        .ok_or_else(|| io(&p, "no `entries` list (not a library index?)"))
+    serde_json::from_str(&text).map(Some).map_err(|e| io(&p, format!("not a library index: {e}")))
+}
+
+/// The index's entries from an earlier build (none when there is no index).
+fn read_index(dir: &Path) -> Result<Vec<Entry>> {
+    Ok(read_index_file(dir)?.map(|i| i.entries).unwrap_or_default())
 }
 
 /// Writes `text` to `path` through a temporary file beside it.
@@ -117,33 +196,35 @@ pub const FORMAT: &str = "evflow-model-library";
 
 /// Writes the index: the plan's samples and condition tags (the library's
 /// order), the shard when not the whole, and the entries.
-fn write_index(plan: &Plan, entries: &[Json]) -> Result<()> {
-    let tags: Vec<String> = plan.conds.iter().map(Cond::tag).collect();
-    let mut doc =
-        json!({ "format": FORMAT, "version": 1, "samples": plan.samples, "conditions": tags, "entries": entries });
-    if plan.shard != Shard::ALL {
-        doc["shard"] = json!(plan.shard.to_string());
-    }
-    write_atomic(&index_path(&plan.dir), &serde_json::to_string_pretty(&doc).map_err(|e| io(&plan.dir, e))?)
+fn write_index(plan: &Plan, entries: Vec<Entry>) -> Result<()> {
+    let index = Index {
+        conditions: plan.conds.iter().map(Cond::tag).collect(),
+        entries,
+        format: FORMAT.into(),
+        samples: plan.samples.clone(),
+        shard: (plan.shard != Shard::ALL).then(|| plan.shard.to_string()),
+        version: 1,
+    };
+    save_index(&plan.dir, &index)
+}
+
+/// Writes `index` as `dir/index.json`, through a temporary file.
+fn save_index(dir: &Path, index: &Index) -> Result<()> {
+    write_atomic(&index_path(dir), &serde_json::to_string_pretty(index).map_err(|e| io(dir, e))?)
 }
 
 /// The key of an entry: texture and condition tag.
-fn key(e: &Json) -> Option<(String, String)> {
-    Some((e.get("texture")?.as_str()?.to_string(), e.get("tag")?.as_str()?.to_string()))
+fn key(e: &Entry) -> (&str, &str) {
+    (&e.texture, &e.tag)
 }
 
 /// Whether every file an entry names is in the library: its models, and
 /// each cell's recording (the sidecar the index names and its samples).
-fn complete(dir: &Path, e: &Json) -> bool {
-    let models = ["model", "forward_model"]
-        .iter()
-        .all(|k| e.get(*k).and_then(Json::as_str).is_some_and(|f| dir.join(f).is_file()));
-    let Some(cells) = e.get("cells").and_then(Json::as_object) else { return false };
-    let cells = cells.values().all(|f| {
-        f.as_str().is_some_and(|f| {
-            let p = dir.join(f);
-            p.is_file() && p.with_extension("wav").is_file()
-        })
+fn complete(dir: &Path, e: &Entry) -> bool {
+    let models = [&e.model, &e.forward_model].iter().all(|f| dir.join(f).is_file());
+    let cells = e.cells.values().all(|f| {
+        let p = dir.join(f);
+        p.is_file() && p.with_extension("wav").is_file()
     });
     models && cells
 }
@@ -185,7 +266,7 @@ fn rel(dir: &Path, p: &Path) -> String {
 
 /// One texture at one condition: recordings, the row (every method over
 /// the gain sweep), the cells moved into the library; returns its entry.
-fn texture_cell(plan: &Plan, m: &Models, sample: &str, c: &Cond) -> Result<Json> {
+fn texture_cell(plan: &Plan, m: &Models, sample: &str, c: &Cond) -> Result<Entry> {
     let partial = plan.dir.join(".partial").join(format!("{sample}-{}", c.tag()));
     let _ = std::fs::remove_dir_all(&partial);
     let rec_dir = partial.join("recordings");
@@ -204,9 +285,9 @@ fn texture_cell(plan: &Plan, m: &Models, sample: &str, c: &Cond) -> Result<Json>
         dir: partial.join("row"),
     };
     let r: Row = row::run(&inputs)?;
-    let mut cells = serde_json::Map::new();
-    let mut es = serde_json::Map::new();
-    let mut gains = serde_json::Map::new();
+    let mut cells = BTreeMap::new();
+    let mut es = BTreeMap::new();
+    let mut gains = BTreeMap::new();
     for (method, channel, folder) in CELLS {
         let Some(res) = r.method(method) else { continue };
         let gain = res.chosen.table51.gain;
@@ -222,9 +303,9 @@ fn texture_cell(plan: &Plan, m: &Models, sample: &str, c: &Cond) -> Result<Json>
             let to = to_dir.join(format!("{name}.{ext}"));
             std::fs::rename(&from, &to).map_err(|e| io(&to, format!("cannot move into the library: {e}")))?;
         }
-        cells.insert(folder.into(), json!(rel(&plan.dir, &to_dir.join(format!("{name}.json")))));
-        es.insert(folder.into(), json!({ "rect": res.chosen.table51.rect, "welch": res.chosen.table51.welch }));
-        gains.insert(folder.into(), json!(gain));
+        cells.insert(folder.into(), rel(&plan.dir, &to_dir.join(format!("{name}.json"))));
+        es.insert(folder.into(), Es { rect: res.chosen.table51.rect, welch: res.chosen.table51.welch });
+        gains.insert(folder.into(), gain);
     }
     // The recorded force itself (newtons, gain 1): the grid that forces
     // first and the live synthesis (`synth.live`) render from.
@@ -238,22 +319,22 @@ fn texture_cell(plan: &Plan, m: &Models, sample: &str, c: &Cond) -> Result<Json>
         let to = to_dir.join(format!("{name}.{ext}"));
         std::fs::rename(&from, &to).map_err(|e| io(&to, format!("cannot move into the library: {e}")))?;
     }
-    cells.insert("forces".into(), json!(rel(&plan.dir, &to_dir.join(format!("{name}.json")))));
+    cells.insert("forces".into(), rel(&plan.dir, &to_dir.join(format!("{name}.json"))));
     let _ = std::fs::remove_dir_all(&partial);
-    Ok(json!({
-        "texture": sample,
-        "tag": c.tag(),
-        "condition": { "load_g": c.mass, "velocity_cm_s": c.speed },
-        "profile": plan.profile.name,
-        "model": rel(&plan.dir, &m.narx),
-        "forward_model": rel(&plan.dir, &m.forward),
-        "training": training(&m.narx),
-        "cells": cells,
-        "gain": gains,
-        "E_s": es,
-        "E_s_repeat": { "rect": r.repeat.rect, "welch": r.repeat.welch },
-        "E_s_display_floor": { "rect": r.display_floor.rect, "welch": r.display_floor.welch },
-    }))
+    Ok(Entry {
+        E_s: es,
+        E_s_display_floor: Es { rect: r.display_floor.rect, welch: r.display_floor.welch },
+        E_s_repeat: Es { rect: r.repeat.rect, welch: r.repeat.welch },
+        cells,
+        condition: Condition { load_g: c.mass, velocity_cm_s: c.speed },
+        forward_model: rel(&plan.dir, &m.forward),
+        gain: gains,
+        model: rel(&plan.dir, &m.narx),
+        profile: plan.profile.name.clone(),
+        tag: c.tag(),
+        texture: sample.to_string(),
+        training: training(&m.narx),
+    })
 }
 
 /// Builds (or completes) the library; `progress` is called once per item
@@ -297,7 +378,7 @@ pub fn build(plan: &Plan, progress: &(dyn Fn(&str) + Sync)) -> Result<Outcome> {
     let mut todo = Vec::new();
     for (k, c) in conds.iter().enumerate() {
         for s in &plan.samples {
-            let done = entries.iter().any(|e| key(e) == Some((s.clone(), c.tag())));
+            let done = entries.iter().any(|e| key(e) == (s.as_str(), c.tag().as_str()));
             if done {
                 out.skipped += 1;
             } else if built[k].is_some() {
@@ -322,7 +403,7 @@ pub fn build(plan: &Plan, progress: &(dyn Fn(&str) + Sync)) -> Result<Outcome> {
                 entries.push(entry);
                 out.built += 1;
                 // The index after every item: an interruption loses at most the items in flight.
-                if let Err(e) = write_index(plan, &sorted(plan, &entries)) {
+                if let Err(e) = write_index(plan, sorted(plan, &entries)) {
                     write_error.get_or_insert(e);
                 }
             }
@@ -332,20 +413,20 @@ pub fn build(plan: &Plan, progress: &(dyn Fn(&str) + Sync)) -> Result<Outcome> {
     if let Some(e) = write_error {
         return Err(e);
     }
-    write_index(plan, &sorted(plan, &entries))?;
+    write_index(plan, sorted(plan, &entries))?;
     let _ = std::fs::remove_dir(plan.dir.join(".partial"));
     Ok(out)
 }
 
 /// The entries in library order: texture by texture (as the plan lists
 /// them, others after), condition by condition.
-fn sorted(plan: &Plan, entries: &[Json]) -> Vec<Json> {
+fn sorted(plan: &Plan, entries: &[Entry]) -> Vec<Entry> {
     let mut v = entries.to_vec();
-    let rank = |e: &Json| {
-        let (s, t) = key(e).unwrap_or_default();
-        let si = plan.samples.iter().position(|x| *x == s).unwrap_or(usize::MAX);
+    let rank = |e: &Entry| {
+        let (s, t) = key(e);
+        let si = plan.samples.iter().position(|x| x == s).unwrap_or(usize::MAX);
         let ci = plan.conds.iter().position(|c| c.tag() == t).unwrap_or(usize::MAX);
-        (si, ci, s, t)
+        (si, ci, s.to_string(), t.to_string())
     };
     v.sort_by_key(rank);
     v
@@ -362,37 +443,25 @@ pub struct ShardIndex {
     /// The plan's condition tags, in order.
     pub conditions: Vec<String>,
     /// Its entries.
-    pub entries: Vec<Json>,
+    pub entries: Vec<Entry>,
 }
 
 /// Whether `dir` holds a library (its index.json).
 pub fn is_library(dir: &Path) -> bool {
-    evflow_engine::files::read_regular_to_string(&index_path(dir))
-        .ok()
-        .and_then(|t| serde_json::from_str::<Json>(&t).ok())
-        .is_some_and(|d| d.get("format").and_then(Json::as_str) == Some(FORMAT))
+    matches!(read_index_file(dir), Ok(Some(i)) if i.format == FORMAT)
 }
 
 /// Reads a sharded library's index; errors name the file.
 pub fn read_shard(dir: &Path) -> Result<ShardIndex> {
     let p = index_path(dir);
-    let doc: Json = serde_json::from_str(
-        &evflow_engine::files::read_regular_to_string(&p).map_err(|e| io(&p, format!("cannot read: {e}")))?,
-    )
-    .map_err(|e| io(&p, e))?;
-    let texts = |k: &str| -> Result<Vec<String>> {
-        doc.get(k)
-            .and_then(Json::as_array)
-            .and_then(|l| l.iter().map(|x| x.as_str().map(str::to_string)).collect())
-            .ok_or_else(|| io(&p, format!("`{k}` is not a list of text")))
-    };
-    let shard = doc.get("shard").and_then(Json::as_str).ok_or_else(|| io(&p, "not a shard (built without --shard)"))?;
+    let index = read_index_file(dir)?.ok_or_else(|| io(&p, "cannot read: no such file"))?;
+    let shard = index.shard.as_deref().ok_or_else(|| io(&p, "not a shard (built without --shard)"))?;
     Ok(ShardIndex {
         dir: dir.to_path_buf(),
         shard: Shard::parse(shard).map_err(|e| io(&p, e))?,
-        samples: texts("samples")?,
-        conditions: texts("conditions")?,
-        entries: read_index(dir)?,
+        samples: index.samples,
+        conditions: index.conditions,
+        entries: index.entries,
     })
 }
 
@@ -409,14 +478,105 @@ pub fn merge_index(out: &Path, shards: &[ShardIndex]) -> Result<usize> {
             )));
         }
     }
-    let mut entries: Vec<Json> = shards.iter().flat_map(|s| s.entries.iter().cloned()).collect();
-    let rank = |e: &Json| {
-        let (s, t) = key(e).unwrap_or_default();
-        (first.samples.iter().position(|x| *x == s), first.conditions.iter().position(|x| *x == t))
+    let mut entries: Vec<Entry> = shards.iter().flat_map(|s| s.entries.iter().cloned()).collect();
+    let rank = |e: &Entry| {
+        let (s, t) = key(e);
+        (first.samples.iter().position(|x| x == s), first.conditions.iter().position(|x| x == t))
     };
     entries.sort_by_key(rank);
-    let doc = json!({ "format": FORMAT, "version": 1, "samples": first.samples, "conditions": first.conditions, "entries": entries });
+    let n = entries.len();
+    let index = Index {
+        conditions: first.conditions.clone(),
+        entries,
+        format: FORMAT.into(),
+        samples: first.samples.clone(),
+        shard: None,
+        version: 1,
+    };
     std::fs::create_dir_all(out).map_err(|e| io(out, format!("cannot create: {e}")))?;
-    write_atomic(&index_path(out), &serde_json::to_string_pretty(&doc).map_err(|e| io(out, e))?)?;
-    Ok(entries.len())
+    save_index(out, &index)?;
+    Ok(n)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use serde_json::json;
+
+    fn entry(texture: &str, tag: &str, floor: f64) -> Entry {
+        Entry {
+            E_s: BTreeMap::from([("narx".into(), Es { rect: 0.5, welch: 0.25 })]),
+            E_s_display_floor: Es { rect: floor, welch: 0.125 },
+            E_s_repeat: Es { rect: 0.1, welch: 0.2 },
+            cells: BTreeMap::from([("forces".into(), "f.json".into()), ("narx".into(), "n.json".into())]),
+            condition: Condition { load_g: 85.0, velocity_cm_s: 5.0 },
+            forward_model: "models/forward-85g-5cms.json".into(),
+            gain: BTreeMap::from([("narx".into(), 1.2)]),
+            model: "models/narx-85g-5cms.json".into(),
+            profile: "nominal".into(),
+            tag: tag.into(),
+            texture: texture.into(),
+            training: json!({ "validation_mse": 0.003 }),
+        }
+    }
+
+    #[test]
+    fn the_index_is_written_as_the_hand_written_one_was_and_reads_back() {
+        let index = Index {
+            conditions: vec!["85g-5cms".into()],
+            entries: vec![entry("felt", "85g-5cms", 0.75)],
+            format: FORMAT.into(),
+            samples: vec!["felt".into()],
+            shard: Some("1/2".into()),
+            version: 1,
+        };
+        // The document the library wrote before its index had types (keys
+        // in the order of their names).
+        let old = json!({ "format": FORMAT, "version": 1, "samples": ["felt"], "conditions": ["85g-5cms"], "shard": "1/2",
+            "entries": [{
+                "texture": "felt", "tag": "85g-5cms", "condition": { "load_g": 85.0, "velocity_cm_s": 5.0 },
+                "profile": "nominal", "model": "models/narx-85g-5cms.json", "forward_model": "models/forward-85g-5cms.json",
+                "training": { "validation_mse": 0.003 }, "cells": { "narx": "n.json", "forces": "f.json" },
+                "gain": { "narx": 1.2 }, "E_s": { "narx": { "rect": 0.5, "welch": 0.25 } },
+                "E_s_repeat": { "rect": 0.1, "welch": 0.2 }, "E_s_display_floor": { "rect": 0.75, "welch": 0.125 },
+            }] });
+        let text = serde_json::to_string_pretty(&index).unwrap();
+        assert_eq!(text, serde_json::to_string_pretty(&old).unwrap());
+        assert_eq!(serde_json::from_str::<Index>(&text).unwrap(), index);
+        // A floor that could not be computed is written as null and read as NaN.
+        let mut nan = index.clone();
+        nan.entries[0].E_s_display_floor.rect = f64::NAN;
+        let back: Index = serde_json::from_str(&serde_json::to_string(&nan).unwrap()).unwrap();
+        assert!(back.entries[0].E_s_display_floor.rect.is_nan());
+    }
+
+    #[test]
+    fn a_bad_index_is_named_and_a_missing_one_is_empty() {
+        let dir = tempfile::tempdir().unwrap();
+        assert!(read_index(dir.path()).unwrap().is_empty());
+        assert!(!is_library(dir.path()));
+        std::fs::write(dir.path().join("index.json"), r#"{"format": "evflow-model-library", "entries": 3}"#).unwrap();
+        let e = read_index(dir.path()).unwrap_err().to_string();
+        assert!(e.contains("index.json") && e.contains("not a library index"), "{e}");
+        assert!(read_shard(dir.path()).is_err());
+    }
+
+    #[test]
+    fn merging_shards_sorts_their_entries_as_one_build_does() {
+        let dir = tempfile::tempdir().unwrap();
+        let shard = |k: usize, entries: Vec<Entry>| ShardIndex {
+            dir: dir.path().join(format!("s{k}")),
+            shard: Shard { k, n: 2 },
+            samples: vec!["a".into(), "b".into()],
+            conditions: vec!["c1".into(), "c2".into()],
+            entries,
+        };
+        let shards =
+            [shard(2, vec![entry("b", "c2", 0.1), entry("a", "c2", 0.1)]), shard(1, vec![entry("b", "c1", 0.1)])];
+        assert_eq!(merge_index(dir.path(), &shards).unwrap(), 3);
+        let merged = read_index_file(dir.path()).unwrap().unwrap();
+        let keys: Vec<(&str, &str)> = merged.entries.iter().map(key).collect();
+        assert_eq!(keys, [("a", "c2"), ("b", "c1"), ("b", "c2")]);
+        assert!(merged.shard.is_none() && is_library(dir.path()));
+    }
 }

@@ -1,8 +1,10 @@
 //! A sweep's shard record (`shard.json`, [`super::shard_record`]) as a JSON
-//! document: written through a temporary file, read back with every error
-//! naming the file, and its fields read with the fault named.
+//! file: written through a temporary file, read back with every error
+//! naming the file and what is wrong.
 
-use serde_json::Value as Json;
+use serde::de::DeserializeOwned;
+use serde::Serialize;
+use serde_json::error::Category;
 use std::path::{Path, PathBuf};
 
 /// Why a shard's record could not be written or read; each names the file.
@@ -45,32 +47,9 @@ pub enum RecordError {
     },
 }
 
-/// What is wrong inside a record, before the file's name is put to it.
-pub type Fault<T> = Result<T, String>;
-
-/// The field `key` of `v`.
-pub fn field<'a>(v: &'a Json, key: &str) -> Fault<&'a Json> {
-    v.get(key).ok_or_else(|| format!("missing `{key}`"))
-}
-
-/// The text field `key` of `v`.
-pub fn text<'a>(v: &'a Json, key: &str) -> Fault<&'a str> {
-    field(v, key)?.as_str().ok_or_else(|| format!("`{key}` is not text"))
-}
-
-/// The whole-number field `key` of `v`.
-pub fn count(v: &Json, key: &str) -> Fault<u64> {
-    field(v, key)?.as_u64().ok_or_else(|| format!("`{key}` is not a whole number"))
-}
-
-/// The list field `key` of `v`.
-pub fn list<'a>(v: &'a Json, key: &str) -> Fault<&'a Vec<Json>> {
-    field(v, key)?.as_array().ok_or_else(|| format!("`{key}` is not a list"))
-}
-
 /// Writes `doc` as `dir/name` through a temporary file beside it, so a
 /// record is whole or absent.
-pub fn write_doc(dir: &Path, name: &str, doc: &Json) -> Result<(), RecordError> {
+pub fn write_doc<T: Serialize>(dir: &Path, name: &str, doc: &T) -> Result<(), RecordError> {
     let path = dir.join(name);
     let tmp = dir.join(format!(".{name}.tmp"));
     serde_json::to_string_pretty(doc)
@@ -80,17 +59,26 @@ pub fn write_doc(dir: &Path, name: &str, doc: &Json) -> Result<(), RecordError> 
         .map_err(|source| RecordError::Write { path, source })
 }
 
-/// Reads `dir/name` as JSON and `parse`s it; errors name the file and what
-/// is wrong.
-pub fn read_doc<T>(dir: &Path, name: &str, parse: impl Fn(&Json) -> Fault<T>) -> Result<T, RecordError> {
+/// Reads `dir/name` as the JSON of a `T` and `check`s what it holds; errors
+/// name the file and what is wrong: not JSON at all ([`RecordError::Json`]),
+/// or JSON that is not the record (a field missing or of the wrong kind, or
+/// refused by `check`: [`RecordError::Invalid`]).
+pub fn read_doc<T: DeserializeOwned, R>(
+    dir: &Path,
+    name: &str,
+    check: impl Fn(T) -> Result<R, String>,
+) -> Result<R, RecordError> {
     let path = dir.join(name);
     let text = match evflow_engine::files::read_regular_to_string(&path) {
         Ok(text) => text,
         Err(source) => return Err(RecordError::Read { path, source }),
     };
-    let doc: Json = match serde_json::from_str(&text) {
+    let doc: T = match serde_json::from_str(&text) {
         Ok(doc) => doc,
+        Err(error) if error.classify() == Category::Data => {
+            return Err(RecordError::Invalid { path, what: error.to_string() })
+        }
         Err(error) => return Err(RecordError::Json { path, error }),
     };
-    parse(&doc).map_err(|what| RecordError::Invalid { path, what })
+    check(doc).map_err(|what| RecordError::Invalid { path, what })
 }

@@ -5,7 +5,7 @@
 //! Written and read here, in one place.
 
 pub use super::record_json::RecordError;
-use super::record_json::{count, field, list, read_doc, text, write_doc, Fault};
+use super::record_json::{read_doc, write_doc};
 use super::tables::Timings;
 use evflow_engine::batch::Shard;
 use evflow_engine::graph::parse_cli_value;
@@ -13,7 +13,7 @@ use evflow_engine::params::Value;
 use evflow_engine::plan::NodeTime;
 use evflow_engine::sweep::Point;
 use evflow_engine::{Override, RunReport, Summary};
-use serde_json::{json, Value as Json};
+use serde::{Deserialize, Serialize};
 use std::ops::Range;
 use std::path::Path;
 use std::time::Duration;
@@ -57,30 +57,150 @@ pub fn relative_to(path: &Path, dir: &Path) -> String {
     p.strip_prefix(&d).map(Path::to_path_buf).unwrap_or(p).to_string_lossy().replace('\\', "/")
 }
 
+// The file's shape. Fields are declared in the order of their names, which
+// is the order they are written in (as the record was before it had types).
+
+/// `shard.json`.
+#[derive(Serialize, Deserialize)]
+struct RecordFile {
+    csv: Option<String>,
+    failures: Vec<FailureFile>,
+    graph: String,
+    json: Option<String>,
+    range: [usize; 2],
+    runs: Vec<RunFile>,
+    /// Absent in records written before `sets` was: no --set to read.
+    #[serde(default)]
+    sets: Vec<(String, String)>,
+    shard: String,
+    sweep: bool,
+    times: bool,
+    total: usize,
+}
+
+/// A run that failed.
+#[derive(Serialize, Deserialize)]
+struct FailureFile {
+    reason: String,
+    run: String,
+}
+
+/// A run that succeeded: its sweep index, report and variables
+/// (`[name, exact text]`).
+#[derive(Serialize, Deserialize)]
+struct RunFile {
+    index: usize,
+    report: ReportFile,
+    vars: Vec<(String, String)>,
+}
+
+/// A float as Rust's shortest exact text: it reads back bit for bit.
+#[derive(Serialize, Deserialize)]
+struct Exact(#[serde(with = "evflow_study::exact")] f64);
+
+/// A run's report; times in nanoseconds.
+#[derive(Serialize, Deserialize)]
+struct ReportFile {
+    base_rate: Exact,
+    elapsed_ns: u64,
+    summaries: Vec<SummaryFile>,
+    ticks: u64,
+    times: Vec<TimeFile>,
+}
+
+/// A node's summary: its values as `[name, exact text, unit]` and its lines.
+#[derive(Serialize, Deserialize)]
+struct SummaryFile {
+    lines: Vec<String>,
+    node: String,
+    values: Vec<(String, Exact, String)>,
+}
+
+/// A node's times.
+#[derive(Serialize, Deserialize)]
+struct TimeFile {
+    elapsed_ns: u64,
+    finish_ns: u64,
+    node: String,
+    process_ns: u64,
+    setup_ns: u64,
+    #[serde(rename = "type")]
+    kind: String,
+}
+
 fn nanos(d: Duration) -> u64 {
     d.as_nanos().min(u64::MAX as u128) as u64
 }
 
-fn report_to_json(r: &RunReport) -> Json {
-    let times: Vec<Json> = r
-        .times
-        .iter()
-        .map(|t| {
-            json!({ "node": t.node, "type": t.kind, "setup_ns": nanos(t.setup), "process_ns": nanos(t.process),
-                    "finish_ns": nanos(t.finish), "elapsed_ns": nanos(t.elapsed) })
-        })
-        .collect();
-    let summaries: Vec<Json> = r
-        .summaries
-        .iter()
-        .map(|(node, s)| {
-            // Floats as Rust's shortest exact text: they read back bit for bit.
-            let values: Vec<Json> = s.values.iter().map(|(k, v, u)| json!([k, format!("{v:?}"), u])).collect();
-            json!({ "node": node, "values": values, "lines": s.lines })
-        })
-        .collect();
-    json!({ "ticks": r.ticks, "base_rate": format!("{:?}", r.base_rate), "elapsed_ns": nanos(r.elapsed),
-            "times": times, "summaries": summaries })
+impl ReportFile {
+    fn of(r: &RunReport) -> Self {
+        ReportFile {
+            base_rate: Exact(r.base_rate),
+            elapsed_ns: nanos(r.elapsed),
+            summaries: r
+                .summaries
+                .iter()
+                .map(|(node, s)| SummaryFile {
+                    lines: s.lines.clone(),
+                    node: node.clone(),
+                    values: s.values.iter().map(|(k, v, u)| (k.clone(), Exact(*v), u.clone())).collect(),
+                })
+                .collect(),
+            ticks: r.ticks,
+            times: r
+                .times
+                .iter()
+                .map(|t| TimeFile {
+                    elapsed_ns: nanos(t.elapsed),
+                    finish_ns: nanos(t.finish),
+                    node: t.node.clone(),
+                    process_ns: nanos(t.process),
+                    setup_ns: nanos(t.setup),
+                    kind: t.kind.to_string(),
+                })
+                .collect(),
+        }
+    }
+
+    fn report(self) -> RunReport {
+        let registry = evflow_nodes::registry();
+        let times = self
+            .times
+            .into_iter()
+            .map(|t| {
+                // Node types are the registry's static names; one this build
+                // does not know keeps its name for the life of the program.
+                let kind: &'static str =
+                    registry.get(&t.kind).map(|s| s.name).unwrap_or_else(|| Box::leak(t.kind.into_boxed_str()));
+                NodeTime {
+                    node: t.node,
+                    kind,
+                    setup: Duration::from_nanos(t.setup_ns),
+                    process: Duration::from_nanos(t.process_ns),
+                    finish: Duration::from_nanos(t.finish_ns),
+                    elapsed: Duration::from_nanos(t.elapsed_ns),
+                }
+            })
+            .collect();
+        let summaries = self
+            .summaries
+            .into_iter()
+            .map(|s| {
+                (
+                    s.node,
+                    Summary { values: s.values.into_iter().map(|(k, v, u)| (k, v.0, u)).collect(), lines: s.lines },
+                )
+            })
+            .collect();
+        RunReport {
+            ticks: self.ticks,
+            base_rate: self.base_rate.0,
+            elapsed: Duration::from_nanos(self.elapsed_ns),
+            times,
+            summaries,
+            left_out: Vec::new(),
+        }
+    }
 }
 
 /// A swept value as text that [`parse_cli_value`] reads back as the same
@@ -105,147 +225,68 @@ fn exact_text(v: &Value) -> String {
 impl ShardRecord {
     /// Writes the record into `dir` (through a temporary file).
     pub fn write(&self, dir: &Path) -> Result<(), RecordError> {
-        let runs: Vec<Json> = self
-            .runs
-            .iter()
-            .zip(&self.indices)
-            .map(|((p, r), i)| {
-                let vars: Vec<Json> = p.values.iter().map(|(k, v)| json!([k, exact_text(v)])).collect();
-                json!({ "index": i, "vars": vars, "report": report_to_json(r) })
-            })
-            .collect();
-        let failures: Vec<Json> = self.failures.iter().map(|(l, r)| json!({ "run": l, "reason": r })).collect();
-        let doc = json!({
-            "graph": self.graph,
-            "shard": self.shard.to_string(),
-            "total": self.total,
-            "range": [self.range.start, self.range.end],
-            "sweep": self.sweep,
-            "times": self.timings == Timings::Show,
-            "csv": self.csv,
-            "json": self.json,
-            "sets": self.sets.iter().map(|o| json!([o.key, exact_text(&o.value)])).collect::<Vec<_>>(),
-            "runs": runs,
-            "failures": failures,
-        });
-        write_doc(dir, RECORD, &doc)
+        let file = RecordFile {
+            csv: self.csv.clone(),
+            failures: self.failures.iter().map(|(l, r)| FailureFile { reason: r.clone(), run: l.clone() }).collect(),
+            graph: self.graph.clone(),
+            json: self.json.clone(),
+            range: [self.range.start, self.range.end],
+            runs: self
+                .runs
+                .iter()
+                .zip(&self.indices)
+                .map(|((p, r), i)| RunFile {
+                    index: *i,
+                    report: ReportFile::of(r),
+                    vars: p.values.iter().map(|(k, v)| (k.clone(), exact_text(v))).collect(),
+                })
+                .collect(),
+            sets: self.sets.iter().map(|o| (o.key.clone(), exact_text(&o.value))).collect(),
+            shard: self.shard.to_string(),
+            sweep: self.sweep,
+            times: self.timings == Timings::Show,
+            total: self.total,
+        };
+        write_doc(dir, RECORD, &file)
     }
 
     /// Reads the record in `dir`; errors name the file and what is wrong.
     pub fn read(dir: &Path) -> Result<ShardRecord, RecordError> {
-        read_doc(dir, RECORD, parse_record)
+        read_doc(dir, RECORD, |f: RecordFile| f.record())
     }
 }
 
-fn float(v: &Json, what: &str) -> Fault<f64> {
-    v.as_str().and_then(|s| s.parse().ok()).ok_or_else(|| format!("{what}: not a number written as text"))
-}
-fn optional_text(v: &Json, key: &str) -> Fault<Option<String>> {
-    match field(v, key)? {
-        Json::Null => Ok(None),
-        Json::String(s) => Ok(Some(s.clone())),
-        _ => Err(format!("`{key}` is not text")),
-    }
-}
-
-fn parse_report(v: &Json) -> Fault<RunReport> {
-    let registry = evflow_nodes::registry();
-    let mut times = Vec::new();
-    for t in list(v, "times")? {
-        let kind = text(t, "type")?;
-        // Node types are the registry's static names; one this build does
-        // not know keeps its name for the life of the program.
-        let kind: &'static str =
-            registry.get(kind).map(|s| s.name).unwrap_or_else(|| Box::leak(kind.to_string().into_boxed_str()));
-        times.push(NodeTime {
-            node: text(t, "node")?.to_string(),
-            kind,
-            setup: Duration::from_nanos(count(t, "setup_ns")?),
-            process: Duration::from_nanos(count(t, "process_ns")?),
-            finish: Duration::from_nanos(count(t, "finish_ns")?),
-            elapsed: Duration::from_nanos(count(t, "elapsed_ns")?),
-        });
-    }
-    let mut summaries = Vec::new();
-    for s in list(v, "summaries")? {
-        let node = text(s, "node")?.to_string();
-        let mut values = Vec::new();
-        for x in list(s, "values")? {
-            match x.as_array().map(Vec::as_slice) {
-                Some([Json::String(k), v, Json::String(u)]) => {
-                    values.push((k.clone(), float(v, &format!("`{node}.{k}`"))?, u.clone()))
-                }
-                _ => return Err(format!("`{node}`: a value is not [name, \"number\", unit]")),
-            }
+impl RecordFile {
+    /// The record it holds, its shard and range checked.
+    fn record(self) -> Result<ShardRecord, String> {
+        let shard = Shard::parse(&self.shard).map_err(|e| e.to_string())?;
+        let [start, end] = self.range;
+        if start > end {
+            return Err(format!("`range` [{start}, {end}] is not [first, end]"));
         }
-        let lines = list(s, "lines")?
-            .iter()
-            .map(|l| l.as_str().map(str::to_string).ok_or_else(|| format!("`{node}`: a line is not text")))
-            .collect::<Fault<Vec<_>>>()?;
-        summaries.push((node, Summary { values, lines }));
+        let (indices, runs) = self
+            .runs
+            .into_iter()
+            .map(|r| {
+                let values = r.vars.iter().map(|(k, t)| (k.clone(), parse_cli_value(t))).collect();
+                (r.index, (Point { values }, r.report.report()))
+            })
+            .unzip();
+        Ok(ShardRecord {
+            graph: self.graph,
+            shard,
+            total: self.total,
+            range: start..end,
+            indices,
+            runs,
+            failures: self.failures.into_iter().map(|f| (f.run, f.reason)).collect(),
+            sweep: self.sweep,
+            timings: if self.times { Timings::Show } else { Timings::Leave },
+            csv: self.csv,
+            json: self.json,
+            sets: self.sets.into_iter().map(|(k, t)| Override { key: k, value: parse_cli_value(&t) }).collect(),
+        })
     }
-    Ok(RunReport {
-        ticks: count(v, "ticks")?,
-        base_rate: float(field(v, "base_rate")?, "`base_rate`")?,
-        elapsed: Duration::from_nanos(count(v, "elapsed_ns")?),
-        times,
-        summaries,
-        left_out: Vec::new(),
-    })
-}
-
-fn parse_record(doc: &Json) -> Fault<ShardRecord> {
-    let shard = Shard::parse(text(doc, "shard")?).map_err(|e| e.to_string())?;
-    let range = match list(doc, "range")?.as_slice() {
-        [a, b] => a.as_u64().zip(b.as_u64()).map(|(a, b)| a as usize..b as usize),
-        _ => None,
-    }
-    .ok_or_else(|| "`range` is not [first, end]".to_string())?;
-    let mut runs = Vec::new();
-    let mut indices = Vec::new();
-    for (n, r) in list(doc, "runs")?.iter().enumerate() {
-        let at = |e: String| format!("run {}: {e}", n + 1);
-        let mut values = Vec::new();
-        for v in list(r, "vars").map_err(at)? {
-            match v.as_array().map(Vec::as_slice) {
-                Some([Json::String(k), Json::String(t)]) => values.push((k.clone(), parse_cli_value(t))),
-                _ => return Err(at("a variable is not [name, text]".to_string())),
-            }
-        }
-        indices.push(count(r, "index").map_err(at)? as usize);
-        runs.push((Point { values }, parse_report(field(r, "report").map_err(at)?).map_err(at)?));
-    }
-    let failures = list(doc, "failures")?
-        .iter()
-        .map(|f| Ok((text(f, "run")?.to_string(), text(f, "reason")?.to_string())))
-        .collect::<Fault<Vec<_>>>()?;
-    let flag = |key: &str| field(doc, key)?.as_bool().ok_or_else(|| format!("`{key}` is not true or false"));
-    Ok(ShardRecord {
-        graph: text(doc, "graph")?.to_string(),
-        shard,
-        total: count(doc, "total")? as usize,
-        range,
-        indices,
-        runs,
-        failures,
-        sweep: flag("sweep")?,
-        timings: if flag("times")? { Timings::Show } else { Timings::Leave },
-        csv: optional_text(doc, "csv")?,
-        json: optional_text(doc, "json")?,
-        sets: match doc.get("sets") {
-            // Records written before `sets` was: no --set to read.
-            None => Vec::new(),
-            Some(_) => list(doc, "sets")?
-                .iter()
-                .map(|v| match v.as_array().map(Vec::as_slice) {
-                    Some([Json::String(k), Json::String(t)]) => {
-                        Ok(Override { key: k.clone(), value: parse_cli_value(t) })
-                    }
-                    _ => Err("a `sets` entry is not [name, text]".to_string()),
-                })
-                .collect::<Fault<Vec<_>>>()?,
-        },
-    })
 }
 
 /// Records for tests here and in the merge's.
@@ -253,6 +294,7 @@ fn parse_record(doc: &Json) -> Fault<ShardRecord> {
 pub(crate) mod tests {
     use super::*;
     use evflow_engine::graph::parse_cli_value;
+    use serde_json::{json, Value as Json};
 
     /// A run with awkward floats and a node type no build knows.
     pub(crate) fn run(x: f64, elapsed_ns: u64) -> (Point, RunReport) {
@@ -390,16 +432,14 @@ pub(crate) mod tests {
         let good: Json = serde_json::from_str(&std::fs::read_to_string(&path).unwrap()).unwrap();
         /// Spoils one field of a good record.
         type Spoil = fn(&mut Json);
-        let cases: [(Spoil, &str); 6] = [
+        let cases: [(Spoil, &str); 7] = [
             (|d| d["shard"] = json!("4/3"), "shard `4/3`: expected K/N with 1 ≤ K ≤ N (e.g. 3/8)"),
-            (|d| _ = d.as_object_mut().unwrap().remove("graph"), "missing `graph`"),
-            (|d| d["range"] = json!([0]), "`range` is not [first, end]"),
-            (|d| d["runs"][0]["vars"][0] = json!([1, 2]), "run 1: a variable is not [name, text]"),
-            (
-                |d| d["runs"][0]["report"]["summaries"][0]["values"][0][1] = json!(0.5),
-                "run 1: `probe.rms`: not a number written as text",
-            ),
-            (|d| d["times"] = json!("yes"), "`times` is not true or false"),
+            (|d| _ = d.as_object_mut().unwrap().remove("graph"), "missing field `graph`"),
+            (|d| d["range"] = json!([0]), "invalid length 1, expected an array of length 2"),
+            (|d| d["range"] = json!([3, 1]), "`range` [3, 1] is not [first, end]"),
+            (|d| d["runs"][0]["vars"][0] = json!([1, 2]), "invalid type: integer `1`, expected a string"),
+            (|d| d["runs"][0]["report"]["summaries"][0]["values"][0][1] = json!("half"), "`half` is not a number"),
+            (|d| d["times"] = json!("yes"), "invalid type: string \"yes\", expected a boolean"),
         ];
         for (spoil, what) in cases {
             let mut doc = good.clone();
@@ -407,8 +447,24 @@ pub(crate) mod tests {
             std::fs::write(&path, doc.to_string()).unwrap();
             let e = ShardRecord::read(dir.path()).unwrap_err();
             assert!(matches!(e, RecordError::Invalid { .. }), "{e}");
-            assert_eq!(e.to_string(), format!("{}: {what}", path.display()));
+            let prefix = format!("{}: {what}", path.display());
+            assert!(e.to_string().starts_with(&prefix), "{e}\nshould start with\n{prefix}");
         }
+    }
+
+    #[test]
+    fn the_record_is_written_with_its_keys_in_name_order_and_old_records_read() {
+        let dir = tempfile::tempdir().unwrap();
+        record(Shard { k: 1, n: 1 }, 1, vec![run(2.0, 5)]).write(dir.path()).unwrap();
+        let text = std::fs::read_to_string(dir.path().join(RECORD)).unwrap();
+        // The layout the hand-built document had: serde_json's map sorts keys.
+        let as_map: Json = serde_json::from_str(&text).unwrap();
+        assert_eq!(text, serde_json::to_string_pretty(&as_map).unwrap());
+        // A record written before `sets` existed reads, with none.
+        let mut old = as_map.clone();
+        old.as_object_mut().unwrap().remove("sets");
+        std::fs::write(dir.path().join(RECORD), old.to_string()).unwrap();
+        assert!(ShardRecord::read(dir.path()).unwrap().sets.is_empty());
     }
 
     #[test]

@@ -20,6 +20,7 @@ pub mod load;
 pub mod node;
 pub mod params;
 pub mod plan;
+pub mod ports;
 pub mod rate;
 pub mod reference;
 pub mod registry;

@@ -1,6 +1,6 @@
 //! The node trait and what a node sees while it runs.
 
-use crate::typed_ports::{InPort, OutPort};
+use crate::ports::{InPort, OutPort};
 use std::path::{Component, Path, PathBuf};
 
 /// An error raised by a node: at construction (bad file, inconsistent

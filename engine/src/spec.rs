@@ -7,67 +7,7 @@
 use crate::node::{BuildContext, Constant, Node, NodeError};
 use crate::params::{Params, Value};
 
-/// Which way samples flow through a port.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub enum Direction {
-    /// The node reads samples from this port.
-    In,
-    /// The node writes samples to this port.
-    Out,
-}
-
-/// The sample rate a port runs at.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub enum RateSpec {
-    /// The node's own rate: the rate of its `Node` inputs, or for a node
-    /// without such inputs the value of its rate parameter
-    /// ([`NodeSpec::rate_param`]), or else the graph's base rate.
-    Node,
-    /// An input that accepts any rate (used by rate-changing nodes).
-    Any,
-    /// The rate in Hz given by the named parameter (e.g. a resampler's output).
-    Param(&'static str),
-}
-
-/// One port of a node type.
-#[derive(Debug, Clone, Copy)]
-pub struct PortSpec {
-    /// Port name, as written in connections (`node.port`).
-    pub name: &'static str,
-    /// Input or output.
-    pub dir: Direction,
-    /// The port's rate.
-    pub rate: RateSpec,
-    /// Unit of the samples (e.g. `N`, `1` for normalized, `m/s`).
-    pub unit: &'static str,
-    /// One-line description.
-    pub doc: &'static str,
-    /// When set, this declaration stands for several ports whose names are
-    /// the entries of the named text-list parameter (e.g. one port per
-    /// channel of a recording).
-    pub multi: Option<&'static str>,
-}
-
-impl PortSpec {
-    /// An input port at the node's rate.
-    pub const fn input(name: &'static str, unit: &'static str, doc: &'static str) -> Self {
-        Self { name, dir: Direction::In, rate: RateSpec::Node, unit, doc, multi: None }
-    }
-    /// An output port at the node's rate.
-    pub const fn output(name: &'static str, unit: &'static str, doc: &'static str) -> Self {
-        Self { name, dir: Direction::Out, rate: RateSpec::Node, unit, doc, multi: None }
-    }
-    /// The same port with another rate.
-    pub const fn at(mut self, rate: RateSpec) -> Self {
-        self.rate = rate;
-        self
-    }
-    /// The same port repeated once per entry of a text-list parameter.
-    pub const fn per(mut self, list_param: &'static str) -> Self {
-        self.multi = Some(list_param);
-        self
-    }
-}
+pub use crate::ports::{Direction, PortSpec, RateSpec};
 
 /// The type and limits of a parameter.
 #[derive(Debug, Clone, Copy, PartialEq)]

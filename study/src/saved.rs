@@ -15,6 +15,7 @@ use super::row::Row;
 use super::run::{Study, StudyConfig};
 use super::scope::Scope;
 use super::setup::Cond;
+use super::shard_file::{self, SavedFailure};
 use super::StudyError;
 use evflow_engine::batch::Shard;
 use serde::{Deserialize, Serialize};
@@ -32,15 +33,6 @@ pub struct SavedModels {
     pub cond: Cond,
     /// The model files (relative to the shard's folder when saved).
     pub models: Models,
-}
-
-/// A step that failed.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-pub struct SavedFailure {
-    /// The step.
-    pub step: String,
-    /// Why.
-    pub reason: String,
 }
 
 /// One shard's study, as saved.
@@ -104,15 +96,14 @@ impl SavedStudy {
     /// Writes the record into `dir` (through a temporary file, so a record
     /// is whole or absent).
     pub fn write(&self, dir: &Path) -> Result<(), StudyError> {
-        super::shard_file::write(dir, RECORD, self)
+        shard_file::write(dir, RECORD, self)
     }
 
     /// Reads the record in `dir`; errors name the file and, for a malformed
     /// record, the line and column.
     pub fn read(dir: &Path) -> Result<Self, StudyError> {
-        let saved: Self =
-            super::shard_file::read(dir, RECORD, "evflow report textures --shard", "a study shard's record")?;
-        super::shard_file::slice(dir, RECORD, &saved.shard, saved.cells, saved.range, "cells")?;
+        let saved: Self = shard_file::read(dir, RECORD, "evflow report textures --shard", "a study shard's record")?;
+        shard_file::slice(dir, RECORD, &saved.shard, saved.cells, saved.range, "cells")?;
         Ok(saved)
     }
 
@@ -130,14 +121,12 @@ impl SavedStudy {
     /// put under `base`: rows and models one after another, the failures
     /// labelled with their shard, the times added up.
     pub fn join(shards: &[SavedStudy], base: &Path) -> Study {
-        let under = |p: &Path| if p.is_absolute() { p.to_path_buf() } else { base.join(p) };
+        let under = |p: &Path| shard_file::under(base, p);
         let mut study = Study { rows: Vec::new(), models: Vec::new(), seconds: 0.0, failures: Vec::new() };
         for s in shards {
             study.rows.extend(s.rows.iter().map(|r| Row { dir: under(&r.dir), ..r.clone() }));
             study.models.extend(s.models.iter().map(|m| (m.profile.clone(), m.cond, rebase_models(&m.models, &under))));
-            study
-                .failures
-                .extend(s.failures.iter().map(|f| (format!("{} (shard {})", f.step, s.shard), f.reason.clone())));
+            study.failures.extend(shard_file::failures_of(&s.shard, &s.failures));
             study.seconds += s.seconds;
         }
         study

@@ -7,8 +7,34 @@
 use super::StudyError;
 use evflow_engine::batch::Shard;
 use serde::de::DeserializeOwned;
-use serde::Serialize;
-use std::path::Path;
+use serde::{Deserialize, Serialize};
+use std::path::{Path, PathBuf};
+
+/// A step of a shard that failed, as its record saves it.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct SavedFailure {
+    /// The step.
+    pub step: String,
+    /// Why.
+    pub reason: String,
+}
+
+/// The failures of a shard's steps as one run lists them, each step
+/// labelled with the shard (`K/N`) it failed in.
+pub fn failures_of<'a>(shard: &str, failures: &'a [SavedFailure]) -> impl Iterator<Item = (String, String)> + 'a {
+    let shard = shard.to_string();
+    failures.iter().map(move |f| (format!("{} (shard {shard})", f.step), f.reason.clone()))
+}
+
+/// A saved folder: as saved when absolute, else taken from `base` (the
+/// shard's output folder the record was read from).
+pub fn under(base: &Path, dir: &Path) -> PathBuf {
+    if dir.is_absolute() {
+        dir.to_path_buf()
+    } else {
+        base.join(dir)
+    }
+}
 
 /// Writes `value` to `dir/name` as JSON, through `dir/.name.tmp`.
 pub fn write<T: Serialize>(dir: &Path, name: &str, value: &T) -> Result<(), StudyError> {

@@ -8,8 +8,7 @@
 use super::row::LiveRow;
 use super::run::{LiveConfig, LiveStudy};
 use super::scope::LiveScope;
-use crate::saved::SavedFailure;
-use crate::shard_file;
+use crate::shard_file::{self, SavedFailure};
 use crate::StudyError;
 use evflow_engine::batch::Shard;
 use serde::{Deserialize, Serialize};
@@ -86,13 +85,8 @@ impl LiveRecord {
     pub fn join(shards: &[LiveRecord], base: &Path) -> LiveStudy {
         let mut study = LiveStudy { rows: Vec::new(), failures: Vec::new(), seconds: 0.0 };
         for s in shards {
-            study.rows.extend(s.rows.iter().map(|r| LiveRow {
-                dir: if r.dir.is_absolute() { r.dir.clone() } else { base.join(&r.dir) },
-                ..r.clone()
-            }));
-            study
-                .failures
-                .extend(s.failures.iter().map(|f| (format!("{} (shard {})", f.step, s.shard), f.reason.clone())));
+            study.rows.extend(s.rows.iter().map(|r| LiveRow { dir: shard_file::under(base, &r.dir), ..r.clone() }));
+            study.failures.extend(shard_file::failures_of(&s.shard, &s.failures));
             study.seconds += s.seconds;
         }
         study

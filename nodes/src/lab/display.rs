@@ -1,7 +1,8 @@
 //! `sim.display`: the virtual electrovibration display.
 
 use super::display_model::DisplayModel;
-use super::{method_of, profile_of, seed_of, INTEGRATOR_PARAM, NOISE_PARAM, PROFILE_PARAM, SEED_PARAM, SUBSTEPS_PARAM};
+use super::{profile_of, seed_of, INTEGRATOR, NOISE, PROFILE, SEED, SUBSTEPS};
+use evflow_engine::typed_ports::{InPort, OutPort};
 use evflow_engine::{BuildContext, Io, Node, NodeError, NodeSpec, Params, PortSpec, Role, Summary};
 
 /// Declaration of `sim.display`.
@@ -38,14 +39,25 @@ pub static SPEC: NodeSpec = NodeSpec::new(
      node's name) lets several copies of the display in one graph draw the same noise (common random \
      numbers), e.g. to compare integrators or actuations on one noise realization.",
 )
-.ports(&[
+.ports(PORTS)
+.params(&[PROFILE.spec(), INTEGRATOR.spec(), SUBSTEPS.spec(), NOISE.spec(), SEED.spec()])
+.example("profile = \"\"\nintegrator = \"exact\"\nsubsteps = 4\nnoise = 1.0");
+
+/// The ports: actuation, load and sliding velocity in, the friction force out.
+const PORTS: &[PortSpec] = &[
     PortSpec::input("u", "1", "actuation (1.0 = 50 V at the amplifier output; ±1 = 100 Vpp)"),
     PortSpec::input("load", "N", "normal force pressing the pen (or finger) on the display"),
     PortSpec::input("velocity", "m/s", "sliding velocity of the holder along the display"),
     PortSpec::output("force", "N", "lateral friction force transmitted to the holder (positive opposes +x motion)"),
-])
-.params(&[PROFILE_PARAM, INTEGRATOR_PARAM, SUBSTEPS_PARAM, NOISE_PARAM, SEED_PARAM])
-.example("profile = \"\"\nintegrator = \"exact\"\nsubsteps = 4\nnoise = 1.0");
+];
+/// `u`: the actuation.
+const U: InPort = InPort::named(PORTS, "u");
+/// `load`: the normal force.
+const LOAD: InPort = InPort::named(PORTS, "load");
+/// `velocity`: the sliding velocity.
+const VELOCITY: InPort = InPort::named(PORTS, "velocity");
+/// `force`: the lateral friction force.
+const FORCE: OutPort = OutPort::named(PORTS, "force");
 
 struct SimDisplay {
     model: DisplayModel,
@@ -53,18 +65,18 @@ struct SimDisplay {
 
 fn build(p: &Params, ctx: &BuildContext) -> Result<Box<dyn Node>, NodeError> {
     let profile = profile_of(p, ctx)?;
-    let method = method_of(p)?;
+    let method = INTEGRATOR.get(p);
     let seed = seed_of(p, ctx);
-    let model = DisplayModel::new(&profile, ctx.rate, method, p.usize("substeps"), p.f64("noise"), seed)
-        .map_err(|m| NodeError::param("profile", m))?;
+    let model = DisplayModel::new(&profile, ctx.rate, method, SUBSTEPS.count(p), NOISE.get(p), seed)
+        .map_err(|m| NodeError::param(PROFILE.name(), m))?;
     Ok(Box::new(SimDisplay { model }))
 }
 
 impl Node for SimDisplay {
     fn process(&mut self, io: &mut Io<'_>) -> Result<(), NodeError> {
         for i in 0..io.len() {
-            let (u, load, v) = (io.input(0)[i], io.input(1)[i], io.input(2)[i]);
-            io.output(0)[i] = self.model.step(u, load, v);
+            let (u, load, v) = (io.input(U)[i], io.input(LOAD)[i], io.input(VELOCITY)[i]);
+            io.output(FORCE)[i] = self.model.step(u, load, v);
         }
         Ok(())
     }

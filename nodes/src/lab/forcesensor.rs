@@ -1,7 +1,8 @@
 //! `sim.forcesensor`: the tribometer's force sensor and acquisition.
 
 use super::sensor_model::SensorModel;
-use super::{method_of, profile_of, INTEGRATOR_PARAM, NOISE_PARAM, PROFILE_PARAM, SEED_PARAM, SUBSTEPS_PARAM};
+use super::{profile_of, seed_of, INTEGRATOR, NOISE, PROFILE, SEED, SUBSTEPS};
+use evflow_engine::typed_ports::{InPort, OutPort};
 use evflow_engine::{BuildContext, Io, Node, NodeError, NodeSpec, Params, PortSpec, Role, Summary};
 
 /// Declaration of `sim.forcesensor`.
@@ -25,13 +26,22 @@ pub static SPEC: NodeSpec = NodeSpec::new(
      for comparison. Checked against: the analytic step response of a damped oscillator, the bias \
      difference between directions, the noise rms, quantization to the converter's step, passivity.",
 )
-.ports(&[
+.ports(PORTS)
+.params(&[PROFILE.spec(), INTEGRATOR.spec(), SUBSTEPS.spec(), NOISE.spec(), SEED.spec()])
+.example("profile = \"\"\nnoise = 1.0");
+
+/// The ports: the surface's force and the carriage velocity in, the acquired force out.
+const PORTS: &[PortSpec] = &[
     PortSpec::input("surface_force", "N", "lateral force the surface applies to the pen"),
     PortSpec::input("velocity", "m/s", "carriage velocity (its sign selects the bias)"),
     PortSpec::output("force", "N", "acquired lateral force"),
-])
-.params(&[PROFILE_PARAM, INTEGRATOR_PARAM, SUBSTEPS_PARAM, NOISE_PARAM, SEED_PARAM])
-.example("profile = \"\"\nnoise = 1.0");
+];
+/// `surface_force`: the force the surface applies to the pen.
+const SURFACE_FORCE: InPort = InPort::named(PORTS, "surface_force");
+/// `velocity`: the carriage velocity.
+const VELOCITY: InPort = InPort::named(PORTS, "velocity");
+/// `force`: the acquired lateral force.
+const FORCE: OutPort = OutPort::named(PORTS, "force");
 
 struct SimForceSensor {
     model: SensorModel,
@@ -39,18 +49,18 @@ struct SimForceSensor {
 
 fn build(p: &Params, ctx: &BuildContext) -> Result<Box<dyn Node>, NodeError> {
     let profile = profile_of(p, ctx)?;
-    let method = method_of(p)?;
-    let seed = crate::lab::seed_of(p, ctx);
-    let model = SensorModel::new(&profile, ctx.rate, method, p.usize("substeps"), p.f64("noise"), seed)
-        .map_err(|m| NodeError::param("profile", m))?;
+    let method = INTEGRATOR.get(p);
+    let seed = seed_of(p, ctx);
+    let model = SensorModel::new(&profile, ctx.rate, method, SUBSTEPS.count(p), NOISE.get(p), seed)
+        .map_err(|m| NodeError::param(PROFILE.name(), m))?;
     Ok(Box::new(SimForceSensor { model }))
 }
 
 impl Node for SimForceSensor {
     fn process(&mut self, io: &mut Io<'_>) -> Result<(), NodeError> {
         for i in 0..io.len() {
-            let (f, v) = (io.input(0)[i], io.input(1)[i]);
-            io.output(0)[i] = self.model.step(f, v);
+            let (f, v) = (io.input(SURFACE_FORCE)[i], io.input(VELOCITY)[i]);
+            io.output(FORCE)[i] = self.model.step(f, v);
         }
         Ok(())
     }

@@ -35,16 +35,23 @@ mod tribometer_tests;
 pub use profile::LabProfile;
 pub use profile_load::ProfileError;
 
-use evflow_engine::{BuildContext, NodeError, NodeSpec, ParamSpec, Params, Summary};
+use evflow_engine::typed_params::{Choice, Float, Int, Text};
+use evflow_engine::{BuildContext, NodeError, NodeSpec, Params, Summary};
 use integrator::Method;
 
 /// The node types of this family.
 pub static SPECS: &[&NodeSpec] = &[&display::SPEC, &tribometer::SPEC, &forcesensor::SPEC, &texture::SPEC, &user::SPEC];
 
-/// The seed a node's `seed` parameter asks for: its value when ≥ 0, else
+/// The seed a node's [`SEED`] parameter asks for: its value when ≥ 0, else
 /// the graph's seed mixed with the node's name.
 pub fn seed_of(p: &Params, ctx: &BuildContext) -> u64 {
-    match p.i64("seed") {
+    seed_or_node(SEED.get(p), ctx)
+}
+
+/// The seed a `seed` value asks for: itself when ≥ 0, else the graph's seed
+/// mixed with the node's name.
+pub fn seed_or_node(seed: i64, ctx: &BuildContext) -> u64 {
+    match seed {
         s if s >= 0 => s as u64,
         _ => ctx.node_seed(),
     }
@@ -52,7 +59,7 @@ pub fn seed_of(p: &Params, ctx: &BuildContext) -> u64 {
 
 /// The `seed` parameter of the lab's noisy nodes: copies of a node given the
 /// same seed draw the same noise (common random numbers).
-pub const SEED_PARAM: ParamSpec = ParamSpec::int(
+pub const SEED: Int = Int::new(
     "seed",
     -1,
     i64::MAX,
@@ -62,27 +69,28 @@ pub const SEED_PARAM: ParamSpec = ParamSpec::int(
 );
 
 /// The `profile` parameter shared by the lab's nodes.
-pub const PROFILE_PARAM: ParamSpec = ParamSpec::text(
+pub const PROFILE: Text = Text::new(
     "profile",
     "",
     "lab profile file (TOML, relative to the graph file); empty = the built-in nominal lab (graphs/lab/nominal.toml)",
 );
 /// The `integrator` parameter shared by the lab's nodes.
-pub const INTEGRATOR_PARAM: ParamSpec = ParamSpec::choice(
+pub const INTEGRATOR: Choice<Method> = Choice::new(
     "integrator",
     Method::WORDS,
+    &[Method::Exact, Method::Rk4, Method::Euler],
     "exact",
     "exact (zero-order-hold matrix exponential + implicit Coulomb), rk4 or euler (explicit, for comparison only)",
 );
 /// The `substeps` parameter shared by the lab's nodes.
-pub const SUBSTEPS_PARAM: ParamSpec = ParamSpec::int("substeps", 1, 10_000, 4, "1", "integration steps per sample");
+pub const SUBSTEPS: Int = Int::new("substeps", 1, 10_000, 4, "1", "integration steps per sample");
 /// The `noise` parameter shared by the lab's nodes.
-pub const NOISE_PARAM: ParamSpec =
-    ParamSpec::float("noise", 0.0, 100.0, 1.0, "1", "scale of every random term of the profile (0 = noiseless)");
+pub const NOISE: Float =
+    Float::new("noise", 0.0, 100.0, 1.0, "1", "scale of every random term of the profile (0 = noiseless)");
 
 /// The profile named by the `profile` parameter (nominal when empty).
 pub fn profile_of(p: &Params, ctx: &BuildContext) -> Result<LabProfile, NodeError> {
-    let name = p.str("profile");
+    let name = PROFILE.get(p);
     if name.is_empty() {
         return Ok(LabProfile::default());
     }
@@ -102,10 +110,4 @@ pub(crate) fn health(node: &str, diverged: u64, hint: &str, bad_inputs: u64) -> 
         s = s.line(format!("{node}: {bad_inputs} NaN or infinite input samples were read as 0"));
     }
     s
-}
-
-/// The method named by the `integrator` parameter.
-pub fn method_of(p: &Params) -> Result<Method, NodeError> {
-    Method::from_word(p.str("integrator"))
-        .ok_or_else(|| NodeError::param("integrator", format!("unknown integrator `{}`", p.str("integrator"))))
 }

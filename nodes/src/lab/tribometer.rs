@@ -1,8 +1,10 @@
 //! `sim.tribometer`: the linear tribometer's carriage and stylus.
 
 use super::tribometer_model::TribometerModel;
-use super::{method_of, profile_of, INTEGRATOR_PARAM, PROFILE_PARAM, SUBSTEPS_PARAM};
-use evflow_engine::{BuildContext, Io, Node, NodeError, NodeSpec, ParamSpec, Params, PortSpec, Role, Summary};
+use super::{profile_of, INTEGRATOR, PROFILE, SUBSTEPS};
+use evflow_engine::typed_params::{Float, Int};
+use evflow_engine::typed_ports::OutPort;
+use evflow_engine::{BuildContext, Io, Node, NodeError, NodeSpec, Params, PortSpec, Role, Summary};
 
 /// Declaration of `sim.tribometer`.
 pub static SPEC: NodeSpec = NodeSpec::new(
@@ -34,22 +36,33 @@ pub static SPEC: NodeSpec = NodeSpec::new(
      trapezoid, the static load m·g, the m·g ± F_b loads of the two directions, passivity, and the \
      stiff profile at 1 kHz.",
 )
-.ports(&[
+.ports(PORTS)
+.params(&[PROFILE.spec(), SPEED.spec(), MASS.spec(), PASSES.spec(), RATE.spec(), INTEGRATOR.spec(), SUBSTEPS.spec()])
+.rate_param(RATE.name())
+.example("speed = 5.0\nmass = 85.0\npasses = 2\nrate = 1000.0");
+
+/// The ports: the carriage's position and velocity and the stylus's load out.
+const PORTS: &[PortSpec] = &[
     PortSpec::output("position", "m", "carriage position from the left end of the travel"),
     PortSpec::output("velocity", "m/s", "carriage velocity (mean over the sample; + is rightward)"),
     PortSpec::output("load", "N", "normal force of the pen tip on the sample"),
-])
-.params(&[
-    PROFILE_PARAM,
-    ParamSpec::float("speed", 0.0, 50.0, 5.0, "cm/s", "carriage speed of the constant-speed part (0 = rest)"),
-    ParamSpec::float("mass", 1.0, 1000.0, 85.0, "g", "stylus mass (sets the load m·g)"),
-    ParamSpec::int("passes", 0, 1_000_000, 2, "1", "passes to run, alternating right and left (0 = endless)"),
-    ParamSpec::float("rate", 1.0, 1e6, 1000.0, "Hz", "sample rate"),
-    INTEGRATOR_PARAM,
-    SUBSTEPS_PARAM,
-])
-.rate_param("rate")
-.example("speed = 5.0\nmass = 85.0\npasses = 2\nrate = 1000.0");
+];
+/// `position`: the carriage position.
+const POSITION: OutPort = OutPort::named(PORTS, "position");
+/// `velocity`: the carriage velocity.
+const VELOCITY: OutPort = OutPort::named(PORTS, "velocity");
+/// `load`: the pen tip's normal force.
+const LOAD: OutPort = OutPort::named(PORTS, "load");
+
+/// `speed`: the carriage speed of the constant-speed part.
+const SPEED: Float =
+    Float::new("speed", 0.0, 50.0, 5.0, "cm/s", "carriage speed of the constant-speed part (0 = rest)");
+/// `mass`: the stylus mass.
+const MASS: Float = Float::new("mass", 1.0, 1000.0, 85.0, "g", "stylus mass (sets the load m·g)");
+/// `passes`: passes to run (0: endless).
+const PASSES: Int = Int::new("passes", 0, 1_000_000, 2, "1", "passes to run, alternating right and left (0 = endless)");
+/// `rate`: the node's sample rate.
+const RATE: Float = Float::new("rate", 1.0, 1e6, 1000.0, "Hz", "sample rate");
 
 struct SimTribometer {
     model: TribometerModel,
@@ -57,27 +70,27 @@ struct SimTribometer {
 
 fn build(p: &Params, ctx: &BuildContext) -> Result<Box<dyn Node>, NodeError> {
     let profile = profile_of(p, ctx)?;
-    let method = method_of(p)?;
+    let method = INTEGRATOR.get(p);
     let model = TribometerModel::new(
         &profile,
         ctx.rate,
-        p.f64("speed") * 1e-2,
-        p.f64("mass") * 1e-3,
-        p.i64("passes") as u64,
+        SPEED.get(p) * 1e-2,
+        MASS.get(p) * 1e-3,
+        PASSES.get(p) as u64,
         method,
-        p.usize("substeps"),
+        SUBSTEPS.count(p),
     )
-    .map_err(|m| NodeError::param("profile", m))?;
+    .map_err(|m| NodeError::param(PROFILE.name(), m))?;
     Ok(Box::new(SimTribometer { model }))
 }
 
 impl Node for SimTribometer {
     fn process(&mut self, io: &mut Io<'_>) -> Result<(), NodeError> {
-        let n = io.len();
-        if let [pos, vel, load] = io.outputs() {
-            for ((p, v), l) in pos[..n].iter_mut().zip(&mut vel[..n]).zip(&mut load[..n]) {
-                (*p, *v, *l) = self.model.step();
-            }
+        for i in 0..io.len() {
+            let (p, v, l) = self.model.step();
+            io.output(POSITION)[i] = p;
+            io.output(VELOCITY)[i] = v;
+            io.output(LOAD)[i] = l;
         }
         Ok(())
     }

@@ -5,9 +5,9 @@ use super::edges::{census, EdgeCensus, EdgeTracker};
 use super::gradient_node::placement_note;
 use super::source::{self, Placed};
 use evflow_engine::node::Constant;
-use evflow_engine::{
-    BuildContext, Change, Io, Node, NodeError, NodeSpec, ParamSpec, Params, PortSpec, Refused, Role, Summary,
-};
+use evflow_engine::typed_params::Float;
+use evflow_engine::typed_ports::{InPort, OutPort};
+use evflow_engine::{BuildContext, Change, Io, Node, NodeError, NodeSpec, Params, PortSpec, Refused, Role, Summary};
 
 /// Declaration of `mesh.edges`.
 pub static SPEC: NodeSpec = NodeSpec::new(
@@ -47,19 +47,39 @@ against:** a cube standing on an edge (90°, either winding), an axis-aligned cu
 wall), frustum top/side and hip angles (180° − atan 2, 180° − acos(1/5)), a valley (no convex edge), \
 boundary and non-manifold cases (unit tests); fandisk's dihedral angles in the fidelity report.",
 )
-.ports(&[
+.ports(PORTS)
+.params(source::with_scene_params![MAX_ANGLE.spec(), MAX_STEP.spec()])
+.example("shape = \"frustum\"\nconfig = \"1B3H\"");
+
+/// The ports: the touch point and the triangle hit in; EDGE-TICK
+/// intensity, sharpness and the angle crossed out.
+const PORTS: &[PortSpec] = &[
     PortSpec::input("x", "m", "touch x on the screen"),
     PortSpec::input("y", "m", "touch y on the screen"),
     PortSpec::input("tri", "1", "triangle hit (mesh.gradient's `tri`), −1 off the mesh"),
     PortSpec::output("intensity", "1", "EDGE-TICK intensity I_e (Eq. 4.9) on the crossing tick, else 0"),
     PortSpec::output("sharpness", "1", "sharpness S (Eq. 4.8) on the crossing tick, else 0"),
     PortSpec::output("angle", "deg", "dihedral angle θ crossed this tick (180: none)"),
-])
-.params(source::with_scene_params![
-    ParamSpec::float("max_angle", 1.0, 180.0, 160.0, "deg", "convex bends flatter than this are not edges"),
-    ParamSpec::float("max_step", 1e-6, 1e3, 0.01, "m", "largest move per tick taken as motion (longer: a jump)"),
-])
-.example("shape = \"frustum\"\nconfig = \"1B3H\"");
+];
+/// `x`: touch x.
+const X: InPort = InPort::named(PORTS, "x");
+/// `y`: touch y.
+const Y: InPort = InPort::named(PORTS, "y");
+/// `tri`: the triangle hit.
+const TRI: InPort = InPort::named(PORTS, "tri");
+/// `intensity`: I_e.
+const INTENSITY: OutPort = OutPort::named(PORTS, "intensity");
+/// `sharpness`: S.
+const SHARPNESS: OutPort = OutPort::named(PORTS, "sharpness");
+/// `angle`: θ crossed this tick.
+const ANGLE: OutPort = OutPort::named(PORTS, "angle");
+
+/// `max_angle`: convex bends flatter than this are not edges.
+const MAX_ANGLE: Float =
+    Float::new("max_angle", 1.0, 180.0, 160.0, "deg", "convex bends flatter than this are not edges");
+/// `max_step`: the largest move per tick taken as motion.
+const MAX_STEP: Float =
+    Float::new("max_step", 1e-6, 1e3, 0.01, "m", "largest move per tick taken as motion (longer: a jump)");
 
 /// One mesh's edges and the tracker of the finger on it.
 struct MeshEdges {
@@ -79,12 +99,12 @@ struct EdgesNode {
 }
 
 fn build(p: &Params, ctx: &BuildContext) -> Result<Box<dyn Node>, NodeError> {
-    let max_angle = p.f64("max_angle");
+    let max_angle = MAX_ANGLE.get(p);
     let scenes = source::load_scenes(p, ctx)?
         .into_iter()
         .map(|placed| {
             let census = census(&placed.mesh, placed.floor, max_angle);
-            let tracker = EdgeTracker::new(census.theta_min, max_angle, p.f64("max_step") / placed.unit, placed.floor);
+            let tracker = EdgeTracker::new(census.theta_min, max_angle, MAX_STEP.get(p) / placed.unit, placed.floor);
             MeshEdges { placed, census, tracker, crossings: 0 }
         })
         .collect();
@@ -174,17 +194,17 @@ impl Node for EdgesNode {
 impl MeshEdges {
     fn process(&mut self, io: &mut Io<'_>) {
         for i in 0..io.len() {
-            let (x, y) = self.placed.to_mesh(io.input(0)[i], io.input(1)[i]);
-            let t = io.input(2)[i];
+            let (x, y) = self.placed.to_mesh(io.input(X)[i], io.input(Y)[i]);
+            let t = io.input(TRI)[i];
             let tri = (t >= 0.0 && t.fract() == 0.0 && t < u32::MAX as f64).then_some(t as u32);
             let (p, tri) = self.tracker.locate(&self.placed.mesh, x, y, tri);
             let e = self.tracker.step(&self.placed.mesh, p, tri);
             if e.intensity > 0.0 {
                 self.crossings += 1;
             }
-            io.output(0)[i] = e.intensity;
-            io.output(1)[i] = e.sharpness;
-            io.output(2)[i] = e.theta;
+            io.output(INTENSITY)[i] = e.intensity;
+            io.output(SHARPNESS)[i] = e.sharpness;
+            io.output(ANGLE)[i] = e.theta;
         }
     }
 

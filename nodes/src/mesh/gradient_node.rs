@@ -4,10 +4,10 @@
 use super::calibrate::{calibrate, CacheStatus, Range, ScanSettings};
 use super::gradient::{intensity, Gradient, GradientSettings, SlopeMode};
 use super::raycast::RayCaster;
-use super::source::{self, Placed};
-use evflow_engine::{
-    BuildContext, Change, Io, Node, NodeError, NodeSpec, ParamSpec, Params, PortSpec, Refused, Role, Summary,
-};
+use super::source::{self, Fit, Placed};
+use evflow_engine::typed_params::{Choice, Float, Floats, Int, Text};
+use evflow_engine::typed_ports::{InPort, OutPort};
+use evflow_engine::{BuildContext, Change, Io, Node, NodeError, NodeSpec, Params, PortSpec, Refused, Role, Summary};
 
 /// Declaration of `mesh.gradient`.
 pub static SPEC: NodeSpec = NodeSpec::new(
@@ -62,7 +62,28 @@ Change `mesh.gradient` and `mesh.edges` together through a graph variable bound 
 a brute-force loop over all triangles on grid meshes hit exactly at vertices and edges, the analytic \
 gradient of the Gaussian scene (fidelity report), and the robustness cases of `docs/mesh.md`.",
 )
-.ports(&[
+.ports(PORTS)
+.params(source::with_scene_params![
+    SWITCH_FADE.spec(),
+    SLOPE.spec(),
+    MIN_STEP.spec(),
+    MAX_STEP.spec(),
+    NORMAL_FORCE.spec(),
+    RANGE.spec(),
+    F_MIN.spec(),
+    F_MAX.spec(),
+    I_MAX.spec(),
+    I_MIN.spec(),
+    CALIB_SPEEDS.spec(),
+    CALIB_DIRECTIONS.spec(),
+    CALIB_LINES.spec(),
+    CACHE.spec(),
+])
+.example("shape = \"gaussian\"\nconfig = \"bump\"\nresolution = 12\ncalib_directions = 4\ncalib_lines = 8");
+
+/// The ports: the touch point in; intensity, F^sq, slope, height and the
+/// triangle hit out, in the order of a [`TickOut`].
+const PORTS: &[PortSpec] = &[
     PortSpec::input("x", "m", "touch x on the screen"),
     PortSpec::input("y", "m", "touch y on the screen"),
     PortSpec::output("intensity", "1", "AREA-EVEN intensity I (Eq. 4.7), 0.3 … 1.0"),
@@ -70,34 +91,83 @@ gradient of the Gaussian scene (fidelity report), and the robustness cases of `d
     PortSpec::output("slope", "1", "tan α, the surface slope along the motion"),
     PortSpec::output("z", "m", "height of the surface under the finger"),
     PortSpec::output("tri", "1", "index of the triangle hit, −1 off the mesh"),
-])
-.params(source::with_scene_params![
-    ParamSpec::float("switch_fade", 0.0, 1000.0, 10.0, "ms", "intensity crossfade when `scene` changes"),
-    ParamSpec::choice("slope", &["secant", "normal"], "secant", "slope estimate: Eq. 4.1 secant or triangle normal"),
-    ParamSpec::float("min_step", 0.0, 1.0, 0.0005, "m", "smallest move that updates the previous hit point"),
-    ParamSpec::float("max_step", 1e-6, 1e3, 0.01, "m", "largest move per tick taken as motion (longer: a jump)"),
-    ParamSpec::float("normal_force", 0.0, 100.0, 1.0, "N", "F_pz of Eq. 4.4"),
-    ParamSpec::choice("range", &["auto", "fixed"], "auto", "F_min/F_max: simulated scan (§4.1.1) or fixed"),
-    ParamSpec::float("f_min", -1e3, 1e3, -1.0, "sqrt(N)", "F_min when range = fixed"),
-    ParamSpec::float("f_max", -1e3, 1e3, 1.0, "sqrt(N)", "F_max when range = fixed"),
-    ParamSpec::float("i_max", 0.0, 1.0, 1.0, "1", "intensity at F_min (most friction)"),
-    ParamSpec::float("i_min", 0.0, 1.0, 0.3, "1", "intensity at F_max (least perceivable friction)"),
-    ParamSpec::float_list(
-        "calib_speeds",
-        1e-6,
-        100.0,
-        "m/s",
-        "finger speeds of the calibration scan; empty: 0.02, 0.05, 0.1",
-    ),
-    ParamSpec::int("calib_directions", 1, 360, 12, "1", "directions of the calibration scan (over 360°)"),
-    ParamSpec::int("calib_lines", 1, 1000, 24, "1", "parallel lines per direction in the calibration scan"),
-    ParamSpec::text(
-        "cache",
-        "",
-        "calibration cache folder (relative to the output folder); empty: the user's cache folder; \"none\": no cache",
-    ),
-])
-.example("shape = \"gaussian\"\nconfig = \"bump\"\nresolution = 12\ncalib_directions = 4\ncalib_lines = 8");
+];
+/// `x`: touch x.
+const X: InPort = InPort::named(PORTS, "x");
+/// `y`: touch y.
+const Y: InPort = InPort::named(PORTS, "y");
+/// `intensity`: the AREA-EVEN intensity.
+const INTENSITY: OutPort = OutPort::named(PORTS, "intensity");
+/// `fsq`: F^sq.
+const FSQ: OutPort = OutPort::named(PORTS, "fsq");
+/// `slope` (the port): tan α.
+const SLOPE_OUT: OutPort = OutPort::named(PORTS, "slope");
+/// `z`: the height under the finger.
+const Z: OutPort = OutPort::named(PORTS, "z");
+/// `tri`: the triangle hit.
+const TRI: OutPort = OutPort::named(PORTS, "tri");
+/// The output each entry of a [`TickOut`] goes to.
+const TICK_PORTS: [OutPort; 5] = [INTENSITY, FSQ, SLOPE_OUT, Z, TRI];
+
+/// Where F_min and F_max come from (`range`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+enum RangeMode {
+    /// A simulated scan of the mesh (§4.1.1).
+    Auto,
+    /// `f_min` and `f_max`.
+    Fixed,
+}
+
+/// `switch_fade`: the crossfade of a scene change.
+const SWITCH_FADE: Float =
+    Float::new("switch_fade", 0.0, 1000.0, 10.0, "ms", "intensity crossfade when `scene` changes");
+/// `slope`: how the slope is estimated.
+const SLOPE: Choice<SlopeMode> = Choice::new(
+    "slope",
+    &["secant", "normal"],
+    &[SlopeMode::Secant, SlopeMode::Normal],
+    "secant",
+    "slope estimate: Eq. 4.1 secant or triangle normal",
+);
+/// `min_step`: the smallest move that updates the previous hit point.
+const MIN_STEP: Float =
+    Float::new("min_step", 0.0, 1.0, 0.0005, "m", "smallest move that updates the previous hit point");
+/// `max_step`: the largest move per tick taken as motion.
+const MAX_STEP: Float =
+    Float::new("max_step", 1e-6, 1e3, 0.01, "m", "largest move per tick taken as motion (longer: a jump)");
+/// `normal_force`: F_pz.
+const NORMAL_FORCE: Float = Float::new("normal_force", 0.0, 100.0, 1.0, "N", "F_pz of Eq. 4.4");
+/// `range`: where F_min and F_max come from.
+const RANGE: Choice<RangeMode> = Choice::new(
+    "range",
+    &["auto", "fixed"],
+    &[RangeMode::Auto, RangeMode::Fixed],
+    "auto",
+    "F_min/F_max: simulated scan (§4.1.1) or fixed",
+);
+/// `f_min`: F_min when fixed.
+const F_MIN: Float = Float::new("f_min", -1e3, 1e3, -1.0, "sqrt(N)", "F_min when range = fixed");
+/// `f_max`: F_max when fixed.
+const F_MAX: Float = Float::new("f_max", -1e3, 1e3, 1.0, "sqrt(N)", "F_max when range = fixed");
+/// `i_max`: the intensity at F_min.
+const I_MAX: Float = Float::new("i_max", 0.0, 1.0, 1.0, "1", "intensity at F_min (most friction)");
+/// `i_min`: the intensity at F_max.
+const I_MIN: Float = Float::new("i_min", 0.0, 1.0, 0.3, "1", "intensity at F_max (least perceivable friction)");
+/// `calib_speeds`: the calibration scan's finger speeds.
+const CALIB_SPEEDS: Floats =
+    Floats::new("calib_speeds", 1e-6, 100.0, "m/s", "finger speeds of the calibration scan; empty: 0.02, 0.05, 0.1");
+/// `calib_directions`: the calibration scan's directions.
+const CALIB_DIRECTIONS: Int =
+    Int::new("calib_directions", 1, 360, 12, "1", "directions of the calibration scan (over 360°)");
+/// `calib_lines`: parallel lines per direction in the calibration scan.
+const CALIB_LINES: Int =
+    Int::new("calib_lines", 1, 1000, 24, "1", "parallel lines per direction in the calibration scan");
+/// `cache`: the calibration cache folder, or `none`.
+const CACHE: Text = Text::new(
+    "cache",
+    "",
+    "calibration cache folder (relative to the output folder); empty: the user's cache folder; \"none\": no cache",
+);
 
 /// Default calibration speeds, m/s (3–7 cm/s is the study's range; slower and faster included).
 pub const DEFAULT_SPEEDS: [f64; 3] = [0.02, 0.05, 0.1];
@@ -128,34 +198,34 @@ pub fn build_state(p: &Params, ctx: &BuildContext, placed: Placed) -> Result<Mes
     let rc = RayCaster::new(&placed.mesh);
     let unit = placed.unit;
     let gs = GradientSettings {
-        mode: if p.str("slope") == "normal" { SlopeMode::Normal } else { SlopeMode::Secant },
-        min_step: p.f64("min_step") / unit,
-        max_step: p.f64("max_step") / unit,
-        normal_force: p.f64("normal_force"),
+        mode: SLOPE.get(p),
+        min_step: MIN_STEP.get(p) / unit,
+        max_step: MAX_STEP.get(p) / unit,
+        normal_force: NORMAL_FORCE.get(p),
         floor: placed.floor,
     };
     if gs.max_step < gs.min_step {
-        return Err(NodeError::param("max_step", "must not be smaller than min_step"));
+        return Err(NodeError::param(MAX_STEP.name(), "must not be smaller than min_step"));
     }
-    let (range, cache) = if p.str("range") == "fixed" {
-        let (f_min, f_max) = (p.f64("f_min"), p.f64("f_max"));
+    let (range, cache) = if RANGE.get(p) == RangeMode::Fixed {
+        let (f_min, f_max) = (F_MIN.get(p), F_MAX.get(p));
         if f_min > f_max {
-            return Err(NodeError::param("f_min", format!("{f_min} exceeds f_max = {f_max}")));
+            return Err(NodeError::param(F_MIN.name(), format!("{f_min} exceeds f_max = {f_max}")));
         }
         (
             Range { f_min, f_max, mean: 0.5 * (f_min + f_max), std: 0.25 * (f_max - f_min), samples: 0 },
             CacheStatus::Disabled,
         )
     } else {
-        let speeds = p.float_list("calib_speeds");
+        let speeds = CALIB_SPEEDS.get(p);
         let speeds = if speeds.is_empty() { DEFAULT_SPEEDS.to_vec() } else { speeds.to_vec() };
         let ss = ScanSettings {
             speeds: speeds.iter().map(|v| v / unit).collect(),
             rate: ctx.rate,
-            directions: p.usize("calib_directions"),
-            lines: p.usize("calib_lines"),
+            directions: CALIB_DIRECTIONS.count(p),
+            lines: CALIB_LINES.count(p),
         };
-        let dir = match p.str("cache") {
+        let dir = match CACHE.get(p) {
             "none" => None,
             "" => user_cache_dir(),
             d => Some(ctx.out_path(d)),
@@ -167,8 +237,8 @@ pub fn build_state(p: &Params, ctx: &BuildContext, placed: Placed) -> Result<Mes
         rc,
         est: Gradient::new(gs),
         range,
-        i_hi: p.f64("i_max"),
-        i_lo: p.f64("i_min"),
+        i_hi: I_MAX.get(p),
+        i_lo: I_MIN.get(p),
         cache,
         hits: 0,
         misses: 0,
@@ -209,7 +279,7 @@ fn build(p: &Params, ctx: &BuildContext) -> Result<Box<dyn Node>, NodeError> {
         .flat_map(|s| std::iter::once(placement_note(&s.placed, p)).chain(s.placed.warnings.iter().cloned()))
         .collect();
     let initial = source::SCENE.count(p);
-    let fade_len = (p.f64("switch_fade") * 1e-3 * ctx.rate).round() as usize;
+    let fade_len = (SWITCH_FADE.get(p) * 1e-3 * ctx.rate).round() as usize;
     Ok(Box::new(GradientNode { scenes, current: initial, initial, fade: None, fade_len, notes, on: 0, off: 0 }))
 }
 
@@ -219,8 +289,8 @@ fn build(p: &Params, ctx: &BuildContext) -> Result<Box<dyn Node>, NodeError> {
 /// where it lands on the screen in metres.
 pub fn placement_note(placed: &Placed, p: &Params) -> String {
     let b = placed.mesh.bounds();
-    let up = format!("{} ({})", placed.up.word(), if p.str("up") == "auto" { "auto" } else { "set" });
-    let how = if p.str("fit") == "footprint" { "fit = footprint" } else { "unit" };
+    let up = format!("{} ({})", placed.up.word(), if source::UP.get(p).is_none() { "auto" } else { "set" });
+    let how = if source::FIT.get(p) == Fit::Footprint { "fit = footprint" } else { "unit" };
     let (u, o) = (placed.unit, placed.offset);
     let g = |x: f64| format!("{:.4}", x + 0.0);
     format!(
@@ -295,7 +365,7 @@ impl MeshGradient {
 impl Node for GradientNode {
     fn process(&mut self, io: &mut Io<'_>) -> Result<(), NodeError> {
         for i in 0..io.len() {
-            let (x, y) = (io.input(0)[i], io.input(1)[i]);
+            let (x, y) = (io.input(X)[i], io.input(Y)[i]);
             let mut out = self.scenes[self.current].tick(x, y);
             if let Some((from, done)) = self.fade {
                 // The old mesh keeps being felt, fading out, while the new one fades in.
@@ -309,8 +379,8 @@ impl Node for GradientNode {
             } else {
                 self.off += 1;
             }
-            for (k, v) in out.into_iter().enumerate() {
-                io.output(k)[i] = v;
+            for (port, v) in TICK_PORTS.into_iter().zip(out) {
+                io.output(port)[i] = v;
             }
         }
         Ok(())

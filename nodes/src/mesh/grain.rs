@@ -4,7 +4,9 @@
 
 use evflow_engine::node::Constant;
 use evflow_engine::spec::FoldArgs;
-use evflow_engine::{BuildContext, Io, Node, NodeError, NodeSpec, ParamSpec, Params, PortSpec, Role};
+use evflow_engine::typed_params::{Float, Words};
+use evflow_engine::typed_ports::{InPort, OutPort};
+use evflow_engine::{BuildContext, Io, Node, NodeError, NodeSpec, Params, PortSpec, Role};
 use std::f64::consts::TAU;
 
 /// Partials of EDGE-TICK relative to `tick_frequency`, and their weights.
@@ -46,21 +48,44 @@ empty) are a constant 0 — e.g. fed by a `mesh.edges` the planner replaced by i
 `gain` of 0 — the output is the constant 0: the planner holds it and leaves out what fed only this \
 node.",
 )
-.ports(&[
-    PortSpec::input("area", "1", "AREA-EVEN intensity (mesh.gradient's `intensity`)"),
-    PortSpec::input("edge", "1", "EDGE-TICK intensity, > 0 on the tick an edge is crossed").per("edges"),
-    PortSpec::output("out", "1", "actuation (1.0 = full scale)"),
-])
+.ports(PORTS)
 .params(&[
-    ParamSpec::float("area_frequency", 0.0, 1e5, 100.0, "Hz", "f_a of AREA-EVEN"),
-    ParamSpec::float("smoothing", 0.0, 1.0, 0.002, "s", "time constant of the area amplitude"),
-    ParamSpec::float("tick_frequency", 1.0, 1e5, 80.0, "Hz", "lowest partial of EDGE-TICK"),
-    ParamSpec::float("tick_decay", 1e-4, 1.0, 0.008, "s", "decay time constant τ of EDGE-TICK"),
-    ParamSpec::float("tick_length", 1e-3, 1.0, 0.04, "s", "duration of one EDGE-TICK burst"),
-    ParamSpec::text_list("edges", "names of EDGE-TICK inputs (e.g. [\"edge\"]); none: area grain only"),
+    AREA_FREQUENCY.spec(),
+    SMOOTHING.spec(),
+    TICK_FREQUENCY.spec(),
+    TICK_DECAY.spec(),
+    TICK_LENGTH.spec(),
+    EDGES.spec(),
 ])
 .example("area_frequency = 100.0\nedges = [\"edge\"]")
 .fold(fold);
+
+/// The ports: the area intensity and one edge intensity per `edges` entry
+/// in, the actuation out.
+const PORTS: &[PortSpec] = &[
+    PortSpec::input("area", "1", "AREA-EVEN intensity (mesh.gradient's `intensity`)"),
+    PortSpec::input("edge", "1", "EDGE-TICK intensity, > 0 on the tick an edge is crossed").per(EDGES.name()),
+    PortSpec::output("out", "1", "actuation (1.0 = full scale)"),
+];
+/// `area`: the AREA-EVEN intensity.
+const AREA: InPort = InPort::named(PORTS, "area");
+/// `edge`: the first EDGE-TICK intensity; the k-th is `EDGE.nth(k)`.
+const EDGE: InPort = InPort::named(PORTS, "edge");
+/// `out`: the actuation.
+const OUT: OutPort = OutPort::named(PORTS, "out");
+
+/// `area_frequency`: f_a of AREA-EVEN.
+const AREA_FREQUENCY: Float = Float::new("area_frequency", 0.0, 1e5, 100.0, "Hz", "f_a of AREA-EVEN");
+/// `smoothing`: the area amplitude's time constant.
+const SMOOTHING: Float = Float::new("smoothing", 0.0, 1.0, 0.002, "s", "time constant of the area amplitude");
+/// `tick_frequency`: the lowest partial of EDGE-TICK.
+const TICK_FREQUENCY: Float = Float::new("tick_frequency", 1.0, 1e5, 80.0, "Hz", "lowest partial of EDGE-TICK");
+/// `tick_decay`: τ of EDGE-TICK.
+const TICK_DECAY: Float = Float::new("tick_decay", 1e-4, 1.0, 0.008, "s", "decay time constant τ of EDGE-TICK");
+/// `tick_length`: the duration of one burst.
+const TICK_LENGTH: Float = Float::new("tick_length", 1e-3, 1.0, 0.04, "s", "duration of one EDGE-TICK burst");
+/// `edges`: the names of the EDGE-TICK inputs.
+const EDGES: Words = Words::new("edges", "names of EDGE-TICK inputs (e.g. [\"edge\"]); none: area grain only");
 
 /// Constant 0 when every intensity is a constant 0 (NaN counts as 0): the
 /// smoothed amplitude stays 0 and no burst starts.
@@ -96,30 +121,30 @@ struct Grain {
 
 fn build(p: &Params, ctx: &BuildContext) -> Result<Box<dyn Node>, NodeError> {
     let fs = ctx.rate;
-    let fa = p.f64("area_frequency");
+    let fa = AREA_FREQUENCY.get(p);
     if fa > fs / 2.0 {
         return Err(NodeError::param(
-            "area_frequency",
+            AREA_FREQUENCY.name(),
             format!("{fa} Hz is above the Nyquist frequency {} Hz", fs / 2.0),
         ));
     }
-    let f0 = p.f64("tick_frequency");
+    let f0 = TICK_FREQUENCY.get(p);
     let top = f0 * TICK_RATIOS[2];
     if top >= fs / 2.0 {
         return Err(NodeError::param(
-            "tick_frequency",
+            TICK_FREQUENCY.name(),
             format!("the highest partial {top} Hz must lie below the Nyquist frequency {} Hz", fs / 2.0),
         ));
     }
-    let tau_s = p.f64("smoothing");
+    let tau_s = SMOOTHING.get(p);
     let smooth_k = if tau_s > 0.0 { 1.0 - (-1.0 / (tau_s * fs)).exp() } else { 1.0 };
     let mut g = Grain {
         area_step: fa / fs,
         smooth_k,
         tick_steps: TICK_RATIOS.map(|r| r * f0 / fs),
-        decay: (-1.0 / (p.f64("tick_decay") * fs)).exp(),
-        tick_samples: (p.f64("tick_length") * fs).round().max(1.0) as u64,
-        n_edges: p.text_list("edges").len(),
+        decay: (-1.0 / (TICK_DECAY.get(p) * fs)).exp(),
+        tick_samples: (TICK_LENGTH.get(p) * fs).round().max(1.0) as u64,
+        n_edges: EDGES.get(p).len(),
         phase: 0.0,
         amp: 0.0,
         prev_edge: 0.0,
@@ -174,12 +199,12 @@ impl Grain {
 impl Node for Grain {
     fn process(&mut self, io: &mut Io<'_>) -> Result<(), NodeError> {
         for i in 0..io.len() {
-            let area = io.input(0)[i];
+            let area = io.input(AREA)[i];
             let mut edge: f64 = 0.0;
             for k in 0..self.n_edges {
-                edge = edge.max(level(io.input(1 + k)[i]));
+                edge = edge.max(level(io.input(EDGE.nth(k))[i]));
             }
-            io.output(0)[i] = self.sample(area, edge);
+            io.output(OUT)[i] = self.sample(area, edge);
         }
         Ok(())
     }

@@ -1,7 +1,9 @@
 //! `mesh.path`: a scripted finger — straight scan lines over a scene in
 //! given directions at a given speed — for end-to-end tests and reports.
 
-use evflow_engine::{BuildContext, Io, Node, NodeError, NodeSpec, ParamSpec, Params, PortSpec, Role};
+use evflow_engine::typed_params::{Float, Floats, Int};
+use evflow_engine::typed_ports::OutPort;
+use evflow_engine::{BuildContext, Io, Node, NodeError, NodeSpec, Params, PortSpec, Role};
 
 /// Declaration of `mesh.path`.
 pub static SPEC: NodeSpec = NodeSpec::new(
@@ -22,24 +24,52 @@ per-sample runs agree exactly.\n\n\
 input; 0 during pauses). **Checked against:** the analytic positions of the first and last samples \
 of each line (unit test).",
 )
-.ports(&[
+.ports(PORTS)
+.params(&[
+    DIRECTIONS.spec(),
+    SPEED.spec(),
+    LENGTH.spec(),
+    LINES.spec(),
+    SPACING.spec(),
+    CENTER_X.spec(),
+    CENTER_Y.spec(),
+    PAUSE.spec(),
+    RATE.spec(),
+])
+.rate_param(RATE.name())
+.example("directions = [0.0, 90.0]\nspeed = 0.05\nlength = 0.06\nlines = 2");
+
+/// The ports: the touch point and the finger's speed out.
+const PORTS: &[PortSpec] = &[
     PortSpec::output("x", "m", "touch x"),
     PortSpec::output("y", "m", "touch y"),
     PortSpec::output("speed", "m/s", "finger speed (0 while resting)"),
-])
-.params(&[
-    ParamSpec::float_list("directions", -360.0, 360.0, "deg", "scan directions; empty: 0 (left to right)"),
-    ParamSpec::float("speed", 1e-4, 10.0, 0.05, "m/s", "scanning speed"),
-    ParamSpec::float("length", 1e-4, 10.0, 0.12, "m", "length of each line"),
-    ParamSpec::int("lines", 1, 10_000, 3, "1", "parallel lines per direction"),
-    ParamSpec::float("spacing", 0.0, 10.0, 0.02, "m", "distance between parallel lines"),
-    ParamSpec::float("center_x", -1e6, 1e6, 0.0, "m", "centre of the scanned area, x"),
-    ParamSpec::float("center_y", -1e6, 1e6, 0.0, "m", "centre of the scanned area, y"),
-    ParamSpec::float("pause", 0.0, 10.0, 0.05, "s", "rest at the end of each line"),
-    ParamSpec::float("rate", 1e-3, 1e7, 1000.0, "Hz", "sample rate"),
-])
-.rate_param("rate")
-.example("directions = [0.0, 90.0]\nspeed = 0.05\nlength = 0.06\nlines = 2");
+];
+/// `x`: touch x.
+const X: OutPort = OutPort::named(PORTS, "x");
+/// `y`: touch y.
+const Y: OutPort = OutPort::named(PORTS, "y");
+/// `speed` (the port): the finger's speed, 0 while resting.
+const SPEED_OUT: OutPort = OutPort::named(PORTS, "speed");
+
+/// `directions`: the scan directions.
+const DIRECTIONS: Floats = Floats::new("directions", -360.0, 360.0, "deg", "scan directions; empty: 0 (left to right)");
+/// `speed`: the scanning speed.
+const SPEED: Float = Float::new("speed", 1e-4, 10.0, 0.05, "m/s", "scanning speed");
+/// `length`: the length of each line.
+const LENGTH: Float = Float::new("length", 1e-4, 10.0, 0.12, "m", "length of each line");
+/// `lines`: parallel lines per direction.
+const LINES: Int = Int::new("lines", 1, 10_000, 3, "1", "parallel lines per direction");
+/// `spacing`: the distance between parallel lines.
+const SPACING: Float = Float::new("spacing", 0.0, 10.0, 0.02, "m", "distance between parallel lines");
+/// `center_x`: the scanned area's centre, x.
+const CENTER_X: Float = Float::new("center_x", -1e6, 1e6, 0.0, "m", "centre of the scanned area, x");
+/// `center_y`: the scanned area's centre, y.
+const CENTER_Y: Float = Float::new("center_y", -1e6, 1e6, 0.0, "m", "centre of the scanned area, y");
+/// `pause`: the rest at the end of each line.
+const PAUSE: Float = Float::new("pause", 0.0, 10.0, 0.05, "s", "rest at the end of each line");
+/// `rate`: the node's sample rate.
+const RATE: Float = Float::new("rate", 1e-3, 1e7, 1000.0, "Hz", "sample rate");
 
 /// One scan line.
 #[derive(Debug, Clone, Copy)]
@@ -58,23 +88,23 @@ struct Path {
 
 fn build(p: &Params, ctx: &BuildContext) -> Result<Box<dyn Node>, NodeError> {
     let fs = ctx.rate;
-    let (speed, length) = (p.f64("speed"), p.f64("length"));
-    let dirs = p.float_list("directions");
+    let (speed, length) = (SPEED.get(p), LENGTH.get(p));
+    let dirs = DIRECTIONS.get(p);
     let dirs = if dirs.is_empty() { vec![0.0] } else { dirs.to_vec() };
-    let count = p.usize("lines");
-    let c = [p.f64("center_x"), p.f64("center_y")];
+    let count = LINES.count(p);
+    let c = [CENTER_X.get(p), CENTER_Y.get(p)];
     let moving = (length / speed * fs).round().max(1.0) as u64;
     let mut lines = Vec::with_capacity(dirs.len() * count);
     for deg in dirs {
         let a = deg.to_radians();
         let (d, q) = ([a.cos(), a.sin()], [-a.sin(), a.cos()]);
         for k in 0..count {
-            let o = (k as f64 - 0.5 * (count - 1) as f64) * p.f64("spacing");
+            let o = (k as f64 - 0.5 * (count - 1) as f64) * SPACING.get(p);
             let start = [c[0] + o * q[0] - 0.5 * length * d[0], c[1] + o * q[1] - 0.5 * length * d[1]];
             lines.push(Line { start, step: [speed / fs * d[0], speed / fs * d[1]] });
         }
     }
-    Ok(Box::new(Path { lines, moving, resting: (p.f64("pause") * fs).round() as u64, speed, n: 0 }))
+    Ok(Box::new(Path { lines, moving, resting: (PAUSE.get(p) * fs).round() as u64, speed, n: 0 }))
 }
 
 impl Path {
@@ -93,9 +123,9 @@ impl Node for Path {
             let l = self.lines[(n / self.per_line()) as usize];
             let k = n % self.per_line();
             let (j, v) = if k < self.moving { (k, self.speed) } else { (self.moving - 1, 0.0) };
-            io.output(0)[i] = l.start[0] + j as f64 * l.step[0];
-            io.output(1)[i] = l.start[1] + j as f64 * l.step[1];
-            io.output(2)[i] = v;
+            io.output(X)[i] = l.start[0] + j as f64 * l.step[0];
+            io.output(Y)[i] = l.start[1] + j as f64 * l.step[1];
+            io.output(SPEED_OUT)[i] = v;
             self.n += 1;
         }
         Ok(())

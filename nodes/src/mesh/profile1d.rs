@@ -2,7 +2,9 @@
 //! (dissertation §3.2.1) — a 1-D Gaussian bump, hole or flat surface, its
 //! tangential force profile and the IP0.5 / IP0.7 intensity profiles.
 
-use evflow_engine::{BuildContext, Io, Node, NodeError, NodeSpec, ParamSpec, Params, PortSpec, Role};
+use evflow_engine::typed_params::{Choice, Float};
+use evflow_engine::typed_ports::{InPort, OutPort};
+use evflow_engine::{BuildContext, Io, Node, NodeError, NodeSpec, Params, PortSpec, Role};
 
 /// Declaration of `profile1d`.
 pub static SPEC: NodeSpec = NodeSpec::new(
@@ -32,23 +34,63 @@ intensity 1.0 under both profiles, as in the study.\n\n\
 the analytic peak height, slope and force at x = μ ± σ, a numerical derivative of y, and the \
 IP0.5/IP0.7 knot values (unit tests).",
 )
-.ports(&[
+.ports(PORTS)
+.params(&[
+    SHAPE.spec(),
+    PROFILE.spec(),
+    CENTER.spec(),
+    SIGMA.spec(),
+    HEIGHT.spec(),
+    LENGTH.spec(),
+    WIDTH.spec(),
+    NORMAL_FORCE.spec(),
+])
+.example("shape = \"bump\"\nprofile = \"ip0.7\"");
+
+/// The ports: the touch position in; height, force and intensity out.
+const PORTS: &[PortSpec] = &[
     PortSpec::input("x", "m", "touch position along the scan"),
     PortSpec::output("height", "cm", "surface height y(x)"),
     PortSpec::output("force", "N", "tangential force F_px (Eq. 3.2), positive assists +x motion"),
     PortSpec::output("intensity", "1", "grain intensity (IP0.5 or IP0.7)"),
-])
-.params(&[
-    ParamSpec::choice("shape", &["bump", "hole", "flat"], "bump", "the surface"),
-    ParamSpec::choice("profile", &["ip0.5", "ip0.7"], "ip0.5", "force-to-intensity mapping"),
-    ParamSpec::float("center", -1e3, 1e3, 0.0, "cm", "μ, centre of the feature"),
-    ParamSpec::float("sigma", 1e-3, 100.0, 0.5, "cm", "σ of the Gaussian"),
-    ParamSpec::float("height", 0.0, 100.0, 0.0, "cm", "peak height h; 0 = Eq. 3.1's 1/(√(2π)σ)"),
-    ParamSpec::float("length", 1e-3, 1e3, 5.0, "cm", "length of the profile (zero outside)"),
-    ParamSpec::float("width", 1e-3, 1e3, 2.6, "cm", "feature width w (IP0.7 knots at μ ± w/2)"),
-    ParamSpec::float("normal_force", 0.0, 100.0, 1.0, "N", "F_py, the assumed normal force"),
-])
-.example("shape = \"bump\"\nprofile = \"ip0.7\"");
+];
+/// `x`: the touch position.
+const X: InPort = InPort::named(PORTS, "x");
+/// `height` (the port): the surface height y(x).
+const HEIGHT_OUT: OutPort = OutPort::named(PORTS, "height");
+/// `force`: the tangential force F_px.
+const FORCE: OutPort = OutPort::named(PORTS, "force");
+/// `intensity`: the grain intensity.
+const INTENSITY: OutPort = OutPort::named(PORTS, "intensity");
+
+/// `shape`: the surface.
+const SHAPE: Choice<Shape1d> = Choice::new(
+    "shape",
+    &["bump", "hole", "flat"],
+    &[Shape1d::Bump, Shape1d::Hole, Shape1d::Flat],
+    "bump",
+    "the surface",
+);
+/// `profile`: the force-to-intensity mapping.
+const PROFILE: Choice<IntensityProfile> = Choice::new(
+    "profile",
+    &["ip0.5", "ip0.7"],
+    &[IntensityProfile::Ip05, IntensityProfile::Ip07],
+    "ip0.5",
+    "force-to-intensity mapping",
+);
+/// `center`: μ.
+const CENTER: Float = Float::new("center", -1e3, 1e3, 0.0, "cm", "μ, centre of the feature");
+/// `sigma`: σ of the Gaussian.
+const SIGMA: Float = Float::new("sigma", 1e-3, 100.0, 0.5, "cm", "σ of the Gaussian");
+/// `height`: the peak height h.
+const HEIGHT: Float = Float::new("height", 0.0, 100.0, 0.0, "cm", "peak height h; 0 = Eq. 3.1's 1/(√(2π)σ)");
+/// `length`: the profile's length.
+const LENGTH: Float = Float::new("length", 1e-3, 1e3, 5.0, "cm", "length of the profile (zero outside)");
+/// `width`: the feature width w.
+const WIDTH: Float = Float::new("width", 1e-3, 1e3, 2.6, "cm", "feature width w (IP0.7 knots at μ ± w/2)");
+/// `normal_force`: F_py.
+const NORMAL_FORCE: Float = Float::new("normal_force", 0.0, 100.0, 1.0, "N", "F_py, the assumed normal force");
 
 /// Surface kind.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -179,27 +221,25 @@ impl Profile1d {
 struct Profile1dNode(Profile1d);
 
 fn build(p: &Params, _: &BuildContext) -> Result<Box<dyn Node>, NodeError> {
-    let shape = match p.str("shape") {
-        "hole" => Shape1d::Hole,
-        "flat" => Shape1d::Flat,
-        _ => Shape1d::Bump,
-    };
-    let profile = if p.str("profile") == "ip0.7" { IntensityProfile::Ip07 } else { IntensityProfile::Ip05 };
-    let width = p.f64("width");
-    let sigma = p.f64("sigma");
+    let (shape, profile) = (SHAPE.get(p), PROFILE.get(p));
+    let width = WIDTH.get(p);
+    let sigma = SIGMA.get(p);
     if width <= 2.0 * sigma {
-        return Err(NodeError::param("width", format!("must exceed 2σ = {} cm (the IP0.7 knots at ±σ)", 2.0 * sigma)));
+        return Err(NodeError::param(
+            WIDTH.name(),
+            format!("must exceed 2σ = {} cm (the IP0.7 knots at ±σ)", 2.0 * sigma),
+        ));
     }
     Ok(Box::new(Profile1dNode(
         Profile1d {
             shape,
             profile,
-            mu: p.f64("center"),
+            mu: CENTER.get(p),
             sigma,
-            h: p.f64("height"),
-            length: p.f64("length"),
+            h: HEIGHT.get(p),
+            length: LENGTH.get(p),
             width,
-            f_py: p.f64("normal_force"),
+            f_py: NORMAL_FORCE.get(p),
         }
         .resolved(),
     )))
@@ -208,10 +248,10 @@ fn build(p: &Params, _: &BuildContext) -> Result<Box<dyn Node>, NodeError> {
 impl Node for Profile1dNode {
     fn process(&mut self, io: &mut Io<'_>) -> Result<(), NodeError> {
         for i in 0..io.len() {
-            let s = self.0.at(io.input(0)[i] * 100.0);
-            io.output(0)[i] = s.y;
-            io.output(1)[i] = s.force;
-            io.output(2)[i] = s.intensity;
+            let s = self.0.at(io.input(X)[i] * 100.0);
+            io.output(HEIGHT_OUT)[i] = s.y;
+            io.output(FORCE)[i] = s.force;
+            io.output(INTENSITY)[i] = s.intensity;
         }
         Ok(())
     }

@@ -17,6 +17,16 @@ pub enum Shape {
     Frustum,
 }
 
+impl Shape {
+    /// The word a graph file writes for it (`gaussian`, `frustum`).
+    pub const fn word(self) -> &'static str {
+        match self {
+            Shape::Gaussian => "gaussian",
+            Shape::Frustum => "frustum",
+        }
+    }
+}
+
 /// Which objects are bumps (+1) and which holes (−1), with their centres.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Layout {

@@ -9,8 +9,8 @@ use super::formats::{Format, EXTENSIONS};
 use super::place::{self, Up};
 use super::scenes::{scene, Shape, CONFIGS};
 use super::trimesh::Mesh;
-use evflow_engine::typed_params::Int;
-use evflow_engine::{BuildContext, NodeError, ParamSpec, Params};
+use evflow_engine::typed_params::{Choice, Float, Int, Text, Words};
+use evflow_engine::{BuildContext, NodeError, Params};
 
 /// The parameters of a node that loads its scenes here (`file`, `shape`,
 /// `config`, `resolution`, `unit`, `offset_x`, `offset_y`, `up`, `fit`,
@@ -19,18 +19,18 @@ use evflow_engine::{BuildContext, NodeError, ParamSpec, Params};
 macro_rules! with_scene_params {
     ($($own:expr),* $(,)?) => {
         &[
-            $crate::mesh::source::FILE,
-            $crate::mesh::source::SHAPE,
-            $crate::mesh::source::CONFIG,
-            $crate::mesh::source::RESOLUTION,
-            $crate::mesh::source::UNIT,
-            $crate::mesh::source::OFFSET_X,
-            $crate::mesh::source::OFFSET_Y,
-            $crate::mesh::source::UP,
-            $crate::mesh::source::FIT,
-            $crate::mesh::source::FIT_SIZE,
-            $crate::mesh::source::WELD,
-            $crate::mesh::source::SCENES,
+            $crate::mesh::source::FILE.spec(),
+            $crate::mesh::source::SHAPE.spec(),
+            $crate::mesh::source::CONFIG.spec(),
+            $crate::mesh::source::RESOLUTION.spec(),
+            $crate::mesh::source::UNIT.spec(),
+            $crate::mesh::source::OFFSET_X.spec(),
+            $crate::mesh::source::OFFSET_Y.spec(),
+            $crate::mesh::source::UP.spec(),
+            $crate::mesh::source::FIT.spec(),
+            $crate::mesh::source::FIT_SIZE.spec(),
+            $crate::mesh::source::WELD.spec(),
+            $crate::mesh::source::SCENES.spec(),
             $crate::mesh::source::SCENE.spec(),
             $($own),*
         ]
@@ -39,23 +39,29 @@ macro_rules! with_scene_params {
 pub(crate) use with_scene_params;
 
 /// `file`: a mesh file; empty for a generated scene.
-pub const FILE: ParamSpec = ParamSpec::text(
+pub const FILE: Text = Text::new(
     "file",
     "",
     "mesh file (relative to the graph file), by extension: .obj, .stl (ASCII or binary), .ply (ASCII or binary), \
      .gltf or .glb; empty: the generated scene below",
 );
 /// `shape` of a generated scene.
-pub const SHAPE: ParamSpec =
-    ParamSpec::choice("shape", &["gaussian", "frustum"], "gaussian", "generated scene: object profile (Fig. 4.5)");
-/// `config` of a generated scene.
-pub const CONFIG: ParamSpec =
-    ParamSpec::choice("config", CONFIGS, "2B2H", "generated scene: bumps and holes (Fig. 4.6), or one bump/hole");
+pub const SHAPE: Choice<Shape> = Choice::new(
+    "shape",
+    &["gaussian", "frustum"],
+    &[Shape::Gaussian, Shape::Frustum],
+    "gaussian",
+    "generated scene: object profile (Fig. 4.5)",
+);
+/// `config` of a generated scene, read as its word (the same words name
+/// scenes in a `scenes` list).
+pub const CONFIG: Choice<&str> =
+    Choice::new("config", CONFIGS, CONFIGS, "2B2H", "generated scene: bumps and holes (Fig. 4.6), or one bump/hole");
 /// `resolution` of a generated Gaussian scene.
-pub const RESOLUTION: ParamSpec =
-    ParamSpec::int("resolution", 2, 4096, 48, "1", "generated Gaussian scene: grid cells per 6 cm object side");
+pub const RESOLUTION: Int =
+    Int::new("resolution", 2, 4096, 48, "1", "generated Gaussian scene: grid cells per 6 cm object side");
 /// `unit`: metres per mesh unit.
-pub const UNIT: ParamSpec = ParamSpec::float(
+pub const UNIT: Float = Float::new(
     "unit",
     1e-9,
     1e3,
@@ -64,7 +70,7 @@ pub const UNIT: ParamSpec = ParamSpec::float(
     "length of one mesh unit (0.01: the mesh is in cm); with fit = \"footprint\" the fit's scale replaces it",
 );
 /// `offset_x`: screen position of the mesh origin (or, fitted, of its footprint's centre).
-pub const OFFSET_X: ParamSpec = ParamSpec::float(
+pub const OFFSET_X: Float = Float::new(
     "offset_x",
     -1e6,
     1e6,
@@ -73,7 +79,7 @@ pub const OFFSET_X: ParamSpec = ParamSpec::float(
     "touch x of the mesh's origin; with fit = \"footprint\", of the footprint's centre",
 );
 /// `offset_y`: screen position of the mesh origin (or, fitted, of its footprint's centre).
-pub const OFFSET_Y: ParamSpec = ParamSpec::float(
+pub const OFFSET_Y: Float = Float::new(
     "offset_y",
     -1e6,
     1e6,
@@ -81,26 +87,38 @@ pub const OFFSET_Y: ParamSpec = ParamSpec::float(
     "m",
     "touch y of the mesh's origin; with fit = \"footprint\", of the footprint's centre",
 );
-/// `up`: the mesh axis that points out of the screen.
-pub const UP: ParamSpec = ParamSpec::choice(
+/// `up`: the mesh axis that points out of the screen; `None` for `auto`
+/// (the convention of the mesh's format).
+pub const UP: Choice<Option<Up>> = Choice::new(
     "up",
     &["auto", "+x", "-x", "+y", "-y", "+z", "-z"],
+    &[None, Some(Up::PlusX), Some(Up::MinusX), Some(Up::PlusY), Some(Up::MinusY), Some(Up::PlusZ), Some(Up::MinusZ)],
     "auto",
     "mesh axis pointing up, out of the screen (turned to height z by a rotation, never a mirror); \
      auto: +y for OBJ (convention) and glTF/GLB (specification), +z for STL and PLY (CAD and scanners) and for \
      generated scenes",
 );
+/// How a mesh is placed on the screen (`fit`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Fit {
+    /// Mesh units × `unit`, the mesh origin at `offset_x/y`.
+    None,
+    /// The footprint centred at `offset_x/y`, its larger side `fit_size`.
+    Footprint,
+}
+
 /// `fit`: how the mesh's footprint is placed on the screen.
-pub const FIT: ParamSpec = ParamSpec::choice(
+pub const FIT: Choice<Fit> = Choice::new(
     "fit",
     &["none", "footprint"],
+    &[Fit::None, Fit::Footprint],
     "none",
     "none: mesh units × `unit`, mesh origin at `offset_x/y`; footprint: the x–y bounds (after `up`) centred \
      at `offset_x/y` and scaled uniformly, heights too, so the larger side is `fit_size`, the lowest point at \
      height 0",
 );
 /// `fit_size`: the fitted footprint's larger side.
-pub const FIT_SIZE: ParamSpec = ParamSpec::float(
+pub const FIT_SIZE: Float = Float::new(
     "fit_size",
     1e-6,
     1e3,
@@ -109,7 +127,7 @@ pub const FIT_SIZE: ParamSpec = ParamSpec::float(
     "with fit = \"footprint\": length on the screen of the footprint's larger side",
 );
 /// `scenes`: the meshes a session can switch between.
-pub const SCENES: ParamSpec = ParamSpec::text_list(
+pub const SCENES: Words = Words::new(
     "scenes",
     "meshes to switch between live: each a generated-scene config (with `shape`, e.g. \"4B0H\") or a mesh file \
      (*.obj, *.stl, *.ply, *.gltf, *.glb); empty: the one mesh of `file` or `config`",
@@ -117,7 +135,7 @@ pub const SCENES: ParamSpec = ParamSpec::text_list(
 /// `scene`: which of `scenes` is felt (live).
 pub const SCENE: Int = Int::new("scene", 0, 255, 0, "1", "index into `scenes` of the mesh felt (changes live)").live();
 /// `weld`: vertex weld tolerance.
-pub const WELD: ParamSpec = ParamSpec::float(
+pub const WELD: Float = Float::new(
     "weld",
     0.0,
     1e3,
@@ -165,37 +183,40 @@ impl Placed {
 /// Loads the mesh the parameters name (`file`, else the generated scene
 /// `shape` × `config`).
 pub fn load(p: &Params, ctx: &BuildContext) -> Result<Placed, NodeError> {
-    let file = p.str("file");
+    let file = FILE.get(p);
     if !file.is_empty() {
         return load_entry(p, ctx, file);
     }
-    load_entry(p, ctx, p.str("config"))
+    load_entry(p, ctx, CONFIG.get(p))
 }
 
 /// Loads every mesh a node can switch between: the `scenes` list, or the
 /// one mesh of [`load`]. Also checks `scene` against the list.
 pub fn load_scenes(p: &Params, ctx: &BuildContext) -> Result<Vec<Placed>, NodeError> {
-    let list = p.text_list("scenes");
+    let list = SCENES.get(p);
     let scene = SCENE.count(p);
     if list.is_empty() {
         if scene != 0 {
-            return Err(NodeError::param("scene", format!("{scene}: without a `scenes` list the only scene is 0")));
+            return Err(NodeError::param(
+                SCENE.name(),
+                format!("{scene}: without a `scenes` list the only scene is 0"),
+            ));
         }
         return Ok(vec![load(p, ctx)?]);
     }
-    if !p.str("file").is_empty() {
-        return Err(NodeError::param("scenes", "give `file` or `scenes` (which may list mesh files), not both"));
+    if !FILE.get(p).is_empty() {
+        return Err(NodeError::param(SCENES.name(), "give `file` or `scenes` (which may list mesh files), not both"));
     }
     if scene >= list.len() {
         return Err(NodeError::param(
-            "scene",
+            SCENE.name(),
             format!("{scene} is not an index into the {} scenes given (0 … {})", list.len(), list.len() - 1),
         ));
     }
     list.iter()
         .enumerate()
         .map(|(k, e)| {
-            load_entry(p, ctx, e).map_err(|err| NodeError::param("scenes", format!("entry {k} `{e}`: {err}")))
+            load_entry(p, ctx, e).map_err(|err| NodeError::param(SCENES.name(), format!("entry {k} `{e}`: {err}")))
         })
         .collect()
 }
@@ -209,22 +230,23 @@ fn load_entry(p: &Params, ctx: &BuildContext, entry: &str) -> Result<Placed, Nod
         up,
         floor,
         z0: 0.0,
-        unit: p.f64("unit"),
-        offset: [p.f64("offset_x"), p.f64("offset_y")],
+        unit: UNIT.get(p),
+        offset: [OFFSET_X.get(p), OFFSET_Y.get(p)],
         name,
         warnings: Vec::new(),
     };
-    if p.str("fit") == "footprint" {
+    let fitted = FIT.get(p) == Fit::Footprint;
+    if fitted {
         let footprint = place::footprint(&placed.mesh)
-            .ok_or_else(|| NodeError::param("fit", format!("{}: the mesh has no triangles", placed.name)))?;
-        let fitted = place::fit(footprint, p.f64("fit_size"), placed.offset)
-            .map_err(|e| NodeError::param("fit", format!("{}: {e}", placed.name)))?;
+            .ok_or_else(|| NodeError::param(FIT.name(), format!("{}: the mesh has no triangles", placed.name)))?;
+        let fitted = place::fit(footprint, FIT_SIZE.get(p), placed.offset)
+            .map_err(|e| NodeError::param(FIT.name(), format!("{}: {e}", placed.name)))?;
         placed.unit = fitted.unit;
         placed.offset = fitted.offset;
         placed.z0 = placed.floor;
     }
-    let auto = (p.str("up") == "auto").then(|| Format::of(entry)).flatten();
-    placed.warnings = placement_warnings(&placed, auto, p.str("fit") == "footprint");
+    let auto = UP.get(p).is_none().then(|| Format::of(entry)).flatten();
+    placed.warnings = placement_warnings(&placed, auto, fitted);
     Ok(placed)
 }
 
@@ -294,31 +316,34 @@ pub fn placement_warnings(placed: &Placed, auto: Option<Format>, fitted: bool) -
 /// (mesh units), name and the axis turned.
 fn load_mesh(p: &Params, ctx: &BuildContext, entry: &str) -> Result<(Mesh, f64, String, Up), NodeError> {
     let format = Format::of(entry);
-    let up = match (p.str("up"), format) {
-        ("auto", Some(f)) => f.default_up(),
-        ("auto", None) => Up::PlusZ,
-        (w, _) => Up::parse(w).ok_or_else(|| NodeError::param("up", format!("unknown axis `{w}`")))?,
+    let up = match (UP.get(p), format) {
+        (Some(up), _) => up,
+        (None, Some(f)) => f.default_up(),
+        (None, None) => Up::PlusZ,
     };
     if let Some(format) = format {
         let path = ctx.path(entry);
-        let mesh = format.load(&path, p.f64("weld")).map_err(|e| NodeError::Other(e.to_string()))?;
+        let mesh = format.load(&path, WELD.get(p)).map_err(|e| NodeError::Other(e.to_string()))?;
         let mesh = place::reorient(mesh, up);
         let floor = mesh.bounds().min[2];
         return Ok((mesh, floor, path.display().to_string(), up));
     }
-    let shape = if p.str("shape") == "frustum" { Shape::Frustum } else { Shape::Gaussian };
+    let shape = SHAPE.get(p);
     if !CONFIGS.contains(&entry) && (entry.contains('.') || entry.contains('/')) {
         let known: Vec<String> = EXTENSIONS.iter().map(|(e, _)| format!(".{e}")).collect();
-        return Err(NodeError::param("file", format!("`{entry}`: unknown mesh format (one of {})", known.join(", "))));
+        return Err(NodeError::param(
+            FILE.name(),
+            format!("`{entry}`: unknown mesh format (one of {})", known.join(", ")),
+        ));
     }
     if !CONFIGS.contains(&entry) {
         let help = evflow_engine::suggest::help(entry, CONFIGS.iter().copied());
         return Err(NodeError::param(
-            "config",
+            CONFIG.name(),
             format!("unknown scene `{entry}` (one of {}, or a mesh file); {help}", CONFIGS.join(", ")),
         ));
     }
-    let mesh = scene(shape, entry, p.usize("resolution")).map_err(|e| NodeError::param("config", e.to_string()))?;
+    let mesh = scene(shape, entry, RESOLUTION.count(p)).map_err(|e| NodeError::param(CONFIG.name(), e.to_string()))?;
     // Scenes stand on the screen plane z = 0; turned, on their lowest point.
     let (mesh, floor) = match up {
         Up::PlusZ => (mesh, 0.0),
@@ -328,7 +353,7 @@ fn load_mesh(p: &Params, ctx: &BuildContext, entry: &str) -> Result<(Mesh, f64, 
             (mesh, floor)
         }
     };
-    Ok((mesh, floor, format!("{} {entry}", p.str("shape")), up))
+    Ok((mesh, floor, format!("{} {entry}", shape.word()), up))
 }
 
 #[cfg(test)]

@@ -1,10 +1,9 @@
 //! `limit`: the safety limiter in front of every hardware output.
 
 use super::envelope::Envelope;
-use evflow_engine::typed_params::Flag;
-use evflow_engine::{
-    BuildContext, Change, Io, Node, NodeError, NodeSpec, ParamSpec, Params, PortSpec, Refused, Role, Summary,
-};
+use evflow_engine::typed_params::{Flag, Float, Words};
+use evflow_engine::typed_ports::{InPort, OutPort};
+use evflow_engine::{BuildContext, Change, Io, Node, NodeError, NodeSpec, Params, PortSpec, Refused, Role, Summary};
 
 /// The longest fade the limiter may take: the live runner's stop sequence
 /// runs this long (plus one tick) before it ends a session.
@@ -119,26 +118,40 @@ how many samples were clamped and slew-limited, and every fault with its sample 
 bursts); the fade reaching exactly zero within round(ramp·rate) samples after a NaN, a fault \
 input and a disable; the latch and re-arm; the `state` code at each transition; block ≡ per-sample processing (generic node test).",
 )
-.ports(&[
+.ports(PORTS)
+.params(&[AMPLITUDE.spec(), SLEW.spec(), RAMP.spec(), FAULTS.spec(), ENABLE.spec()])
+.safety_guard()
+.example("amplitude = 1.0\nslew = 4000.0\nramp = 0.01");
+
+/// The ports: the signal and one fault flag per `faults` entry in; the
+/// limited signal and the limiter's state out.
+const PORTS: &[PortSpec] = &[
     PortSpec::input("in", "1", "actuation signal"),
-    PortSpec::input("fault", "1", "fault flag: nonzero (or NaN) closes the gate and latches").per("faults"),
+    PortSpec::input("fault", "1", "fault flag: nonzero (or NaN) closes the gate and latches").per(FAULTS.name()),
     PortSpec::output("out", "1", "limited actuation signal"),
     PortSpec::output(
         "state",
         "1",
         "what the limiter did at each sample: 0 armed, 1 clamping, 2 fading, 3 faded, 4 faulted",
     ),
-])
-.params(&[
-    ParamSpec::float("amplitude", 0.0, 10.0, 1.0, "1", "largest |out| (1.0 = 50 V peak, 100 Vpp)"),
-    ParamSpec::float("slew", 1e-3, 1e12, 4000.0, "1/s", "largest rate of change of the clamped signal"),
-    ParamSpec::float("ramp", 0.0, MAX_RAMP_S, MAX_RAMP_S, "s", "fade time of the gate (at most 10 ms)"),
-    ParamSpec::text_list("faults", "names of fault-flag inputs (e.g. [\"link\"]); none by default"),
-    ENABLE.spec(),
-])
-.safety_guard()
-.example("amplitude = 1.0\nslew = 4000.0\nramp = 0.01");
+];
+/// `in`: the actuation signal.
+const IN: InPort = InPort::named(PORTS, "in");
+/// `fault`: the first fault flag; the k-th is `FAULT.nth(k)`.
+const FAULT: InPort = InPort::named(PORTS, "fault");
+/// `out`: the limited actuation signal.
+const OUT: OutPort = OutPort::named(PORTS, "out");
+/// `state`: what the limiter did, as a [`State`] code.
+const STATE: OutPort = OutPort::named(PORTS, "state");
 
+/// `amplitude`: the largest |out|.
+const AMPLITUDE: Float = Float::new("amplitude", 0.0, 10.0, 1.0, "1", "largest |out| (1.0 = 50 V peak, 100 Vpp)");
+/// `slew`: the largest rate of change.
+const SLEW: Float = Float::new("slew", 1e-3, 1e12, 4000.0, "1/s", "largest rate of change of the clamped signal");
+/// `ramp`: the gate's fade time.
+const RAMP: Float = Float::new("ramp", 0.0, MAX_RAMP_S, MAX_RAMP_S, "s", "fade time of the gate (at most 10 ms)");
+/// `faults`: the names of the fault-flag inputs.
+const FAULTS: Words = Words::new("faults", "names of fault-flag inputs (e.g. [\"link\"]); none by default");
 /// `enable`: the gate, changeable live.
 const ENABLE: Flag = Flag::new("enable", true, "gate open; false fades to zero, true re-arms after a fault").live();
 
@@ -171,19 +184,22 @@ struct Limit {
 const FAULTS_LISTED: usize = 16;
 
 fn build(p: &Params, ctx: &BuildContext) -> Result<Box<dyn Node>, NodeError> {
-    let ramp_steps = (p.f64("ramp") * ctx.rate).round().max(1.0);
+    let ramp_steps = (RAMP.get(p) * ctx.rate).round().max(1.0);
     if ramp_steps > u32::MAX as f64 {
-        return Err(NodeError::param("ramp", "too many samples at this rate"));
+        return Err(NodeError::param(RAMP.name(), "too many samples at this rate"));
     }
-    let fault_names = p.text_list("faults").to_vec();
+    let fault_names = FAULTS.get(p).to_vec();
     for reserved in ["in", "out"] {
         if fault_names.iter().any(|n| n == reserved) {
-            return Err(NodeError::param("faults", format!("`{reserved}` is taken by the signal port; rename it")));
+            return Err(NodeError::param(
+                FAULTS.name(),
+                format!("`{reserved}` is taken by the signal port; rename it"),
+            ));
         }
     }
     let mut node = Limit {
-        amplitude: p.f64("amplitude"),
-        step: p.f64("slew") / ctx.rate,
+        amplitude: AMPLITUDE.get(p),
+        step: SLEW.get(p) / ctx.rate,
         ramp_steps: ramp_steps as u32,
         fault_names,
         enabled: ENABLE.get(p),
@@ -218,15 +234,15 @@ impl Node for Limit {
         let n = io.len();
         let n_faults = io.n_inputs() - 1;
         for i in 0..n {
-            let x = io.input(0)[i];
+            let x = io.input(IN)[i];
             let sample = self.next + i as u64;
             if !self.latched {
                 if !x.is_finite() {
                     self.latched = true;
                     self.record(Fault::NotFinite { sample });
-                } else if let Some(port) = (1..=n_faults).find(|&k| io.input(k)[i] != 0.0) {
+                } else if let Some(port) = (0..n_faults).find(|&k| io.input(FAULT.nth(k))[i] != 0.0) {
                     self.latched = true;
-                    self.record(Fault::Input { port: port - 1, sample });
+                    self.record(Fault::Input { port, sample });
                 }
             }
             let mut acted = false;
@@ -252,7 +268,7 @@ impl Node for Limit {
                 self.held = self.held.clamp(-self.amplitude, self.amplitude);
             }
             let g = self.gate.advance(self.enabled && !self.latched);
-            io.output(0)[i] = g * self.held;
+            io.output(OUT)[i] = g * self.held;
             let state = if self.latched {
                 State::Faulted
             } else if !self.enabled {
@@ -266,7 +282,7 @@ impl Node for Limit {
             } else {
                 State::Armed
             };
-            io.output(1)[i] = state.code();
+            io.output(STATE)[i] = state.code();
         }
         self.next += n as u64;
         Ok(())

@@ -4,6 +4,7 @@
 use super::link::{self, InEnd, Link, LinkConfig};
 use super::message::fault_names;
 use super::params::{self, PORT_PARAMS};
+use evflow_engine::typed_ports::OutPort;
 use evflow_engine::{
     BuildContext, Io, Node, NodeError, NodeSpec, Params, PortSpec, PrepareContext, Role, RunMode, Summary,
 };
@@ -53,7 +54,12 @@ device (`nodes/src/serial/*_tests.rs`), and end to end over a pseudo-terminal ag
 (`tools/tests/serial_e2e.rs`: the force the emulated display renders comes back; unplugging fades the \
 output to zero, reconnecting works; injected corrupt frames are counted and skipped).",
 )
-.ports(&[
+.ports(PORTS)
+.params(&PORT_PARAMS)
+.example("port = \"\"   # e.g. \"/dev/ttyACM0\"; empty runs without a device\nbaud = 921600\nwait = 2.0");
+
+/// The ports: what the device reports, and the link's state.
+const PORTS: &[PortSpec] = &[
     PortSpec::output("x", "m", "finger position along x (held between 40 Hz touch frames)"),
     PortSpec::output("y", "m", "finger position along y (held)"),
     PortSpec::output("load", "N", "normal load of the finger (held)"),
@@ -61,9 +67,21 @@ output to zero, reconnecting works; injected corrupt frames are counted and skip
     PortSpec::output("contact", "1", "1 while the device reports the finger on the display"),
     PortSpec::output("connected", "1", "1 while the link is up"),
     PortSpec::output("fault", "1", "1 while the link is down or the device reports a fault (feed a limit fault input)"),
-])
-.params(&PORT_PARAMS)
-.example("port = \"\"   # e.g. \"/dev/ttyACM0\"; empty runs without a device\nbaud = 921600\nwait = 2.0");
+];
+/// `x`: finger position along x.
+const X: OutPort = OutPort::named(PORTS, "x");
+/// `y`: finger position along y.
+const Y: OutPort = OutPort::named(PORTS, "y");
+/// `load`: normal load of the finger.
+const LOAD: OutPort = OutPort::named(PORTS, "load");
+/// `force`: lateral force.
+const FORCE: OutPort = OutPort::named(PORTS, "force");
+/// `contact`: 1 while the finger is on the display.
+const CONTACT: OutPort = OutPort::named(PORTS, "contact");
+/// `connected`: 1 while the link is up.
+const CONNECTED: OutPort = OutPort::named(PORTS, "connected");
+/// `fault`: 1 while the link is down or the device reports a fault.
+const FAULT: OutPort = OutPort::named(PORTS, "fault");
 
 /// More queued force samples than this: skip the oldest, keep [`FORCE_KEEP`].
 const FORCE_LAG: usize = 16;
@@ -166,9 +184,17 @@ impl Node for SerialIn {
                 }
             };
             let h = self.held;
-            let outs = io.outputs();
-            for (o, v) in [h.x, h.y, h.load, h.force, h.contact, connected, fault].into_iter().enumerate() {
-                outs[o][i] = v;
+            let values = [
+                (X, h.x),
+                (Y, h.y),
+                (LOAD, h.load),
+                (FORCE, h.force),
+                (CONTACT, h.contact),
+                (CONNECTED, connected),
+                (FAULT, fault),
+            ];
+            for (port, v) in values {
+                io.output(port)[i] = v;
             }
         }
         self.samples += n as u64;

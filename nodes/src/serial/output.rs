@@ -2,6 +2,7 @@
 
 use super::link::{self, Link, LinkConfig};
 use super::params::{self, PORT_PARAMS};
+use evflow_engine::typed_ports::InPort;
 use evflow_engine::{
     BuildContext, Io, Node, NodeError, NodeSpec, Params, PortSpec, PrepareContext, Role, RunMode, Summary,
 };
@@ -43,10 +44,16 @@ the stall fade ending at exactly 0, nothing but HELLO before the handshake) and 
 pseudo-terminal against `evflow devsim` (`tools/tests/serial_e2e.rs`: the samples the emulated device \
 receives are the `limit` output the session recorded).",
 )
-.ports(&[PortSpec::input("u", "1", "actuation from `limit` (1.0 = 50 V at the amplifier; clipped to ±1)")])
+.ports(PORTS)
 .params(&PORT_PARAMS)
 .hardware()
 .example("port = \"\"   # e.g. \"/dev/ttyACM0\"; empty runs without a device\nbaud = 921600\nwait = 2.0");
+
+/// The port: the actuation in.
+const PORTS: &[PortSpec] =
+    &[PortSpec::input("u", "1", "actuation from `limit` (1.0 = 50 V at the amplifier; clipped to ±1)")];
+/// `u`: the actuation sent to the device.
+const U: InPort = InPort::named(PORTS, "u");
 
 struct Live {
     link: Arc<Link>,
@@ -95,7 +102,7 @@ impl Node for SerialOut {
     }
 
     fn process(&mut self, io: &mut Io<'_>) -> Result<(), NodeError> {
-        let u = io.input(0);
+        let u = io.input(U);
         if let Some(l) = &mut self.live {
             for &x in u {
                 if l.ring.push(x as f32).is_err() {

@@ -2,7 +2,9 @@
 //! the one MATLAB `idinput` generates.
 
 use super::prbs_taps::{self, Taps};
-use evflow_engine::{BuildContext, Io, Node, NodeError, NodeSpec, ParamSpec, Params, PortSpec, Role};
+use evflow_engine::typed_params::{Float, Int};
+use evflow_engine::typed_ports::OutPort;
+use evflow_engine::{BuildContext, Io, Node, NodeError, NodeSpec, Params, PortSpec, Role};
 
 /// Declaration of `prbs`.
 pub static SPEC: NodeSpec = NodeSpec::new(
@@ -74,16 +76,26 @@ spectrum (every non-DC bin of the 511-point DFT has |X|² = 512·c²); maximal p
 order 2–30 (full walk up to n = 22, and for all orders the register's return after exactly 2ⁿ − 1 \
 steps and after no proper divisor, by GF(2) matrix powers).",
 )
-.ports(&[PortSpec::output("out", "1", "the signal, ±level")])
-.params(&[
-    ParamSpec::int("order", 2, 30, 9, "1", "shift-register order n: the period is 2^n − 1 chips"),
-    ParamSpec::int("clock", 1, 100_000, 1, "samples", "clock period B: samples each chip is held"),
-    ParamSpec::float("level", 1e-9, 1e6, 1.0, "1", "signal level c: the output is +c or −c"),
-    ParamSpec::int("periods", 1, 100_000, 6, "1", "full periods to play before the source ends"),
-    ParamSpec::float("rate", 1e-3, 1e7, 1000.0, "Hz", "sample rate"),
-])
-.rate_param("rate")
+.ports(PORTS)
+.params(&[ORDER.spec(), CLOCK.spec(), LEVEL.spec(), PERIODS.spec(), RATE.spec()])
+.rate_param(RATE.name())
 .example("order = 9\nclock = 1\nlevel = 1.0\nperiods = 6\nrate = 1000.0");
+
+/// The port: the signal out.
+const PORTS: &[PortSpec] = &[PortSpec::output("out", "1", "the signal, ±level")];
+/// `out`: the signal.
+const OUT: OutPort = OutPort::named(PORTS, "out");
+
+/// `order`: the shift register's order n.
+const ORDER: Int = Int::new("order", 2, 30, 9, "1", "shift-register order n: the period is 2^n − 1 chips");
+/// `clock`: samples each chip is held.
+const CLOCK: Int = Int::new("clock", 1, 100_000, 1, "samples", "clock period B: samples each chip is held");
+/// `level`: the signal level c.
+const LEVEL: Float = Float::new("level", 1e-9, 1e6, 1.0, "1", "signal level c: the output is +c or −c");
+/// `periods`: full periods before the source ends.
+const PERIODS: Int = Int::new("periods", 1, 100_000, 6, "1", "full periods to play before the source ends");
+/// `rate`: the node's sample rate.
+const RATE: Float = Float::new("rate", 1e-3, 1e7, 1000.0, "Hz", "sample rate");
 
 /// The shift register: bit i holds u[k−1−i] with −1 as 1 and +1 as 0, so
 /// the ±1 product of the tapped values is the parity of the tapped bits.
@@ -133,33 +145,32 @@ struct Prbs {
 }
 
 fn build(p: &Params, _: &BuildContext) -> Result<Box<dyn Node>, NodeError> {
-    let order = p.i64("order");
+    let order = ORDER.get(p);
     let taps = u32::try_from(order).ok().and_then(prbs_taps::taps).ok_or_else(|| {
         NodeError::param(
-            "order",
+            ORDER.name(),
             format!("{order} is not a supported order ({} ..= {})", prbs_taps::MIN_ORDER, prbs_taps::MAX_ORDER),
         )
     })?;
-    let clock = u64::try_from(p.i64("clock")).ok().filter(|&b| b >= 1);
-    let clock = clock.ok_or_else(|| NodeError::param("clock", "the clock period must be at least 1 sample"))?;
-    let periods = u64::try_from(p.i64("periods")).ok().filter(|&m| m >= 1);
-    let periods = periods.ok_or_else(|| NodeError::param("periods", "at least one period is needed"))?;
-    let level = p.f64("level");
+    let clock = u64::try_from(CLOCK.get(p)).ok().filter(|&b| b >= 1);
+    let clock = clock.ok_or_else(|| NodeError::param(CLOCK.name(), "the clock period must be at least 1 sample"))?;
+    let periods = u64::try_from(PERIODS.get(p)).ok().filter(|&m| m >= 1);
+    let periods = periods.ok_or_else(|| NodeError::param(PERIODS.name(), "at least one period is needed"))?;
+    let level = LEVEL.get(p);
     if !(level.is_finite() && level > 0.0) {
-        return Err(NodeError::param("level", format!("the level must be a positive number, not {level}")));
+        return Err(NodeError::param(LEVEL.name(), format!("the level must be a positive number, not {level}")));
     }
     let chips = (1u64 << taps.order) - 1;
-    let total = periods
-        .checked_mul(chips)
-        .and_then(|x| x.checked_mul(clock))
-        .ok_or_else(|| NodeError::param("periods", "periods × (2^order − 1) × clock is too many samples to count"))?;
+    let total = periods.checked_mul(chips).and_then(|x| x.checked_mul(clock)).ok_or_else(|| {
+        NodeError::param(PERIODS.name(), "periods × (2^order − 1) × clock is too many samples to count")
+    })?;
     let lfsr = Lfsr::new(taps);
     Ok(Box::new(Prbs { start: lfsr, lfsr, level, clock, total, pos: 0, held: 0, value: 0.0 }))
 }
 
 impl Node for Prbs {
     fn process(&mut self, io: &mut Io<'_>) -> Result<(), NodeError> {
-        let out = io.output(0);
+        let out = io.output(OUT);
         let live = (out.len() as u64).min(self.total - self.pos.min(self.total)) as usize;
         let (out, past_end) = out.split_at_mut(live);
         past_end.fill(0.0);

@@ -3,7 +3,9 @@
 
 use super::prms_field::{self, Recurrence};
 use crate::rng::Rng;
-use evflow_engine::{BuildContext, Io, Node, NodeError, NodeSpec, ParamSpec, Params, PortSpec, Role};
+use evflow_engine::typed_params::{Choice, Float, Int};
+use evflow_engine::typed_ports::OutPort;
+use evflow_engine::{BuildContext, Io, Node, NodeError, NodeSpec, Params, PortSpec, Role};
 
 /// Declaration of `prms`.
 pub static SPEC: NodeSpec = NodeSpec::new(
@@ -45,19 +47,47 @@ samples and writes 0 past the end.\n\
 GF(7)); for q = 3, 5, 7 full periods qⁿ − 1 (and no shorter one), level balance, the complex \
 two-valued autocorrelation and the real one above; the random mode's level frequencies.",
 )
-.ports(&[PortSpec::output("out", "1", "the signal, one of q levels in [−level, level]")])
-.params(&[
-    ParamSpec::int("q", 2, 13, 3, "1", "number of levels, a prime (2, 3, 5, 7, 11, 13)"),
-    ParamSpec::int("order", 1, 40, 6, "1", "register order n: the period is q^n − 1 chips"),
-    ParamSpec::int("clock", 1, 100_000, 1, "samples", "samples each chip is held"),
-    ParamSpec::float("level", 1e-9, 1e6, 1.0, "1", "largest level c: the levels lie in [−c, c]"),
-    ParamSpec::int("periods", 1, 100_000, 1, "1", "full periods to play before the source ends"),
-    ParamSpec::choice("mode", &["mls", "random"], "mls", "maximum-length sequence, or independent random levels"),
-    ParamSpec::int("seed", 0, i64::MAX, 0, "1", "random mode's seed (0: derived from the node's name)"),
-    ParamSpec::float("rate", 1e-3, 1e7, 1000.0, "Hz", "sample rate"),
-])
-.rate_param("rate")
+.ports(PORTS)
+.params(&[Q.spec(), ORDER.spec(), CLOCK.spec(), LEVEL.spec(), PERIODS.spec(), MODE.spec(), SEED.spec(), RATE.spec()])
+.rate_param(RATE.name())
 .example("q = 5\norder = 6\nclock = 1\nlevel = 1.0\nperiods = 1\nmode = \"mls\"\nrate = 1000.0");
+
+/// The port: the signal out.
+const PORTS: &[PortSpec] = &[PortSpec::output("out", "1", "the signal, one of q levels in [−level, level]")];
+/// `out`: the signal.
+const OUT: OutPort = OutPort::named(PORTS, "out");
+
+/// How the symbols are drawn.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+enum Mode {
+    /// The maximum-length sequence over GF(q).
+    Mls,
+    /// Independent uniform draws.
+    Random,
+}
+
+/// `q`: the number of levels, a prime.
+const Q: Int = Int::new("q", 2, 13, 3, "1", "number of levels, a prime (2, 3, 5, 7, 11, 13)");
+/// `order`: the register's order n.
+const ORDER: Int = Int::new("order", 1, 40, 6, "1", "register order n: the period is q^n − 1 chips");
+/// `clock`: samples each chip is held.
+const CLOCK: Int = Int::new("clock", 1, 100_000, 1, "samples", "samples each chip is held");
+/// `level`: the largest level c.
+const LEVEL: Float = Float::new("level", 1e-9, 1e6, 1.0, "1", "largest level c: the levels lie in [−c, c]");
+/// `periods`: full periods before the source ends.
+const PERIODS: Int = Int::new("periods", 1, 100_000, 1, "1", "full periods to play before the source ends");
+/// `mode`: maximum-length or random sequence.
+const MODE: Choice<Mode> = Choice::new(
+    "mode",
+    &["mls", "random"],
+    &[Mode::Mls, Mode::Random],
+    "mls",
+    "maximum-length sequence, or independent random levels",
+);
+/// `seed`: the random mode's seed.
+const SEED: Int = Int::new("seed", 0, i64::MAX, 0, "1", "random mode's seed (0: derived from the node's name)");
+/// `rate`: the node's sample rate.
+const RATE: Float = Float::new("rate", 1e-3, 1e7, 1000.0, "Hz", "sample rate");
 
 /// The symmetric level map φ of the node's doc, for every symbol of GF(q).
 pub fn levels(q: u32) -> Vec<f64> {
@@ -104,37 +134,36 @@ struct Prms {
 }
 
 fn build(p: &Params, ctx: &BuildContext) -> Result<Box<dyn Node>, NodeError> {
-    let q = p.i64("q");
+    let q = Q.get(p);
     let q = u32::try_from(q)
         .ok()
         .filter(|q| prms_field::PRIMES.contains(q))
-        .ok_or_else(|| NodeError::param("q", format!("{q} is not one of the primes {:?}", prms_field::PRIMES)))?;
-    let n = u32::try_from(p.i64("order")).ok().filter(|&n| n >= 1);
-    let n = n.ok_or_else(|| NodeError::param("order", "the order must be at least 1"))?;
+        .ok_or_else(|| NodeError::param(Q.name(), format!("{q} is not one of the primes {:?}", prms_field::PRIMES)))?;
+    let n = u32::try_from(ORDER.get(p)).ok().filter(|&n| n >= 1);
+    let n = n.ok_or_else(|| NodeError::param(ORDER.name(), "the order must be at least 1"))?;
     let chips = prms_field::period(q, n).ok_or_else(|| {
-        NodeError::param("order", format!("{q}^{n} − 1 chips is longer than the largest period, 2^40"))
+        NodeError::param(ORDER.name(), format!("{q}^{n} − 1 chips is longer than the largest period, 2^40"))
     })?;
-    let clock = u64::try_from(p.i64("clock")).ok().filter(|&b| b >= 1);
-    let clock = clock.ok_or_else(|| NodeError::param("clock", "the clock period must be at least 1 sample"))?;
-    let periods = u64::try_from(p.i64("periods")).ok().filter(|&m| m >= 1);
-    let periods = periods.ok_or_else(|| NodeError::param("periods", "at least one period is needed"))?;
-    let level = p.f64("level");
+    let clock = u64::try_from(CLOCK.get(p)).ok().filter(|&b| b >= 1);
+    let clock = clock.ok_or_else(|| NodeError::param(CLOCK.name(), "the clock period must be at least 1 sample"))?;
+    let periods = u64::try_from(PERIODS.get(p)).ok().filter(|&m| m >= 1);
+    let periods = periods.ok_or_else(|| NodeError::param(PERIODS.name(), "at least one period is needed"))?;
+    let level = LEVEL.get(p);
     if !(level.is_finite() && level > 0.0) {
-        return Err(NodeError::param("level", format!("the level must be a positive number, not {level}")));
+        return Err(NodeError::param(LEVEL.name(), format!("the level must be a positive number, not {level}")));
     }
-    let total = periods
-        .checked_mul(chips)
-        .and_then(|x| x.checked_mul(clock))
-        .ok_or_else(|| NodeError::param("periods", "periods × (q^order − 1) × clock is too many samples to count"))?;
-    let symbols = match p.str("mode") {
-        "random" => {
-            let seed = u64::try_from(p.i64("seed")).unwrap_or(0);
+    let total = periods.checked_mul(chips).and_then(|x| x.checked_mul(clock)).ok_or_else(|| {
+        NodeError::param(PERIODS.name(), "periods × (q^order − 1) × clock is too many samples to count")
+    })?;
+    let symbols = match MODE.get(p) {
+        Mode::Random => {
+            let seed = u64::try_from(SEED.get(p)).unwrap_or(0);
             let seed = if seed == 0 { ctx.node_seed() } else { seed };
             Symbols::Random { rng: Rng::new(seed), q: u64::from(q) }
         }
-        _ => {
+        Mode::Mls => {
             let c = prms_field::primitive(q, n).ok_or_else(|| {
-                NodeError::param("order", format!("no primitive polynomial of degree {n} over GF({q})"))
+                NodeError::param(ORDER.name(), format!("no primitive polynomial of degree {n} over GF({q})"))
             })?;
             let start = Recurrence::new(&c, q);
             Symbols::Mls { rec: start.clone(), start }
@@ -146,7 +175,7 @@ fn build(p: &Params, ctx: &BuildContext) -> Result<Box<dyn Node>, NodeError> {
 
 impl Node for Prms {
     fn process(&mut self, io: &mut Io<'_>) -> Result<(), NodeError> {
-        let out = io.output(0);
+        let out = io.output(OUT);
         let live = (out.len() as u64).min(self.total - self.pos.min(self.total)) as usize;
         let (out, past_end) = out.split_at_mut(live);
         past_end.fill(0.0);

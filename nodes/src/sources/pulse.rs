@@ -1,6 +1,8 @@
 //! `pulse`: a rectangular gate that switches between two levels.
 
-use evflow_engine::{BuildContext, Io, Node, NodeError, NodeSpec, ParamSpec, Params, PortSpec, Role};
+use evflow_engine::typed_params::Float;
+use evflow_engine::typed_ports::OutPort;
+use evflow_engine::{BuildContext, Io, Node, NodeError, NodeSpec, Params, PortSpec, Role};
 
 /// Declaration of `pulse`.
 pub static SPEC: NodeSpec = NodeSpec::new(
@@ -22,17 +24,28 @@ one-sample processing agree and `reset` returns to n = 0.\n\
 \n\
 **Checked against:** the exact count of high samples per period and the switching indices.",
 )
-.ports(&[PortSpec::output("out", "1", "the gate: high or low")])
-.params(&[
-    ParamSpec::float("period", 1e-6, 1e6, 1.0, "s", "period P (rounded to whole samples, at least 1)"),
-    ParamSpec::float("duty", 0.0, 1.0, 0.5, "1", "fraction of each period at `high`"),
-    ParamSpec::float("delay", 0.0, 1e6, 0.0, "s", "time of the first period's start"),
-    ParamSpec::float("high", -1e6, 1e6, 1.0, "1", "level during the first part of a period"),
-    ParamSpec::float("low", -1e6, 1e6, 0.0, "1", "level during the rest"),
-    ParamSpec::float("rate", 1e-3, 1e7, 1000.0, "Hz", "sample rate"),
-])
-.rate_param("rate")
+.ports(PORTS)
+.params(&[PERIOD.spec(), DUTY.spec(), DELAY.spec(), HIGH.spec(), LOW.spec(), RATE.spec()])
+.rate_param(RATE.name())
 .example("period = 1.0\nduty = 0.125\nrate = 1000.0");
+
+/// The port: the gate out.
+const PORTS: &[PortSpec] = &[PortSpec::output("out", "1", "the gate: high or low")];
+/// `out`: the gate.
+const OUT: OutPort = OutPort::named(PORTS, "out");
+
+/// `period`: P, rounded to whole samples.
+const PERIOD: Float = Float::new("period", 1e-6, 1e6, 1.0, "s", "period P (rounded to whole samples, at least 1)");
+/// `duty`: the fraction of each period at `high`.
+const DUTY: Float = Float::new("duty", 0.0, 1.0, 0.5, "1", "fraction of each period at `high`");
+/// `delay`: when the first period starts.
+const DELAY: Float = Float::new("delay", 0.0, 1e6, 0.0, "s", "time of the first period's start");
+/// `high`: the level of the first part of a period.
+const HIGH: Float = Float::new("high", -1e6, 1e6, 1.0, "1", "level during the first part of a period");
+/// `low`: the level of the rest.
+const LOW: Float = Float::new("low", -1e6, 1e6, 0.0, "1", "level during the rest");
+/// `rate`: the node's sample rate.
+const RATE: Float = Float::new("rate", 1e-3, 1e7, 1000.0, "Hz", "sample rate");
 
 struct Pulse {
     period: u64,
@@ -44,20 +57,20 @@ struct Pulse {
 
 fn build(p: &Params, ctx: &BuildContext) -> Result<Box<dyn Node>, NodeError> {
     let fs = ctx.rate;
-    let period = (p.f64("period") * fs).round().max(1.0);
-    let delay = (p.f64("delay") * fs).round();
+    let period = (PERIOD.get(p) * fs).round().max(1.0);
+    let delay = (DELAY.get(p) * fs).round();
     if period >= 1e15 || delay >= 1e15 {
-        return Err(NodeError::param("period", "period or delay is too long at this rate"));
+        return Err(NodeError::param(PERIOD.name(), "period or delay is too long at this rate"));
     }
     let period = period as u64;
-    let on = ((p.f64("duty") * period as f64).round() as u64).min(period);
-    Ok(Box::new(Pulse { period, on, delay: delay as u64, high: p.f64("high"), low: p.f64("low") }))
+    let on = ((DUTY.get(p) * period as f64).round() as u64).min(period);
+    Ok(Box::new(Pulse { period, on, delay: delay as u64, high: HIGH.get(p), low: LOW.get(p) }))
 }
 
 impl Node for Pulse {
     fn process(&mut self, io: &mut Io<'_>) -> Result<(), NodeError> {
         let start = io.start();
-        for (k, y) in io.output(0).iter_mut().enumerate() {
+        for (k, y) in io.output(OUT).iter_mut().enumerate() {
             let n = start + k as u64;
             *y = if n >= self.delay && (n - self.delay) % self.period < self.on { self.high } else { self.low };
         }

@@ -1,6 +1,8 @@
 //! `sine`: a sine wave whose phase is exact at any sample index.
 
-use evflow_engine::{BuildContext, Io, Node, NodeError, NodeSpec, ParamSpec, Params, PortSpec, Role};
+use evflow_engine::typed_params::Float;
+use evflow_engine::typed_ports::OutPort;
+use evflow_engine::{BuildContext, Io, Node, NodeError, NodeSpec, Params, PortSpec, Role};
 use std::f64::consts::TAU;
 
 /// Declaration of `sine`.
@@ -30,16 +32,26 @@ rate/2 (checked when the node is built).\n\
 integers), including n around 10⁹ and 10¹², the Nyquist case f = fs/2, f = 0, and the \
 rejection of f > fs/2.",
 )
-.ports(&[PortSpec::output("out", "1", "the sine wave")])
-.params(&[
-    ParamSpec::float("frequency", 0.0, 5e6, 10.0, "Hz", "frequency f, at most rate/2"),
-    ParamSpec::float("amplitude", 0.0, 1e6, 1.0, "1", "peak amplitude A"),
-    ParamSpec::float("phase", -1e3, 1e3, 0.0, "rad", "phase φ at sample 0"),
-    ParamSpec::float("offset", -1e6, 1e6, 0.0, "1", "constant added to the wave"),
-    ParamSpec::float("rate", 1e-3, 1e7, 1000.0, "Hz", "sample rate"),
-])
-.rate_param("rate")
+.ports(PORTS)
+.params(&[FREQUENCY.spec(), AMPLITUDE.spec(), PHASE.spec(), OFFSET.spec(), RATE.spec()])
+.rate_param(RATE.name())
 .example("frequency = 10.0\namplitude = 1.0\nrate = 1000.0");
+
+/// The port: the wave out.
+const PORTS: &[PortSpec] = &[PortSpec::output("out", "1", "the sine wave")];
+/// `out`: the sine wave.
+const OUT: OutPort = OutPort::named(PORTS, "out");
+
+/// `frequency`: f, at most rate/2.
+const FREQUENCY: Float = Float::new("frequency", 0.0, 5e6, 10.0, "Hz", "frequency f, at most rate/2");
+/// `amplitude`: the peak amplitude A.
+const AMPLITUDE: Float = Float::new("amplitude", 0.0, 1e6, 1.0, "1", "peak amplitude A");
+/// `phase`: φ at sample 0.
+const PHASE: Float = Float::new("phase", -1e3, 1e3, 0.0, "rad", "phase φ at sample 0");
+/// `offset`: the constant added to the wave.
+const OFFSET: Float = Float::new("offset", -1e6, 1e6, 0.0, "1", "constant added to the wave");
+/// `rate`: the node's sample rate.
+const RATE: Float = Float::new("rate", 1e-3, 1e7, 1000.0, "Hz", "sample rate");
 
 /// 2⁶⁴ and 2¹²⁸ as f64 (exact powers of two).
 const TWO64: f64 = 18_446_744_073_709_551_616.0;
@@ -89,17 +101,17 @@ impl Sine {
 }
 
 fn build(p: &Params, ctx: &BuildContext) -> Result<Box<dyn Node>, NodeError> {
-    let f = p.f64("frequency");
+    let f = FREQUENCY.get(p);
     let fs = ctx.rate;
     if !(fs.is_finite() && fs > 0.0) {
-        return Err(NodeError::param("rate", format!("the sample rate must be positive, not {fs} Hz")));
+        return Err(NodeError::param(RATE.name(), format!("the sample rate must be positive, not {fs} Hz")));
     }
     if !(f.is_finite() && f >= 0.0) {
-        return Err(NodeError::param("frequency", format!("must be a frequency ≥ 0 Hz, not {f}")));
+        return Err(NodeError::param(FREQUENCY.name(), format!("must be a frequency ≥ 0 Hz, not {f}")));
     }
     if f > fs / 2.0 {
         return Err(NodeError::param(
-            "frequency",
+            FREQUENCY.name(),
             format!(
                 "{f} Hz is above the Nyquist frequency {} Hz of this node (rate = {fs} Hz); \
                  lower `frequency` to at most rate/2 or raise `rate`",
@@ -107,10 +119,10 @@ fn build(p: &Params, ctx: &BuildContext) -> Result<Box<dyn Node>, NodeError> {
             ),
         ));
     }
-    let phase = p.f64("phase");
-    let (amplitude, offset) = (p.f64("amplitude"), p.f64("offset"));
+    let phase = PHASE.get(p);
+    let (amplitude, offset) = (AMPLITUDE.get(p), OFFSET.get(p));
     if ![phase, amplitude, offset].iter().all(|v| v.is_finite()) {
-        return Err(NodeError::param("phase", "phase, amplitude and offset must be finite numbers"));
+        return Err(NodeError::param(PHASE.name(), "phase, amplitude and offset must be finite numbers"));
     }
     Ok(Box::new(Sine {
         step: cycles_per_sample(f, fs),
@@ -123,7 +135,7 @@ fn build(p: &Params, ctx: &BuildContext) -> Result<Box<dyn Node>, NodeError> {
 impl Node for Sine {
     fn process(&mut self, io: &mut Io<'_>) -> Result<(), NodeError> {
         let start = io.start();
-        for (i, y) in io.output(0).iter_mut().enumerate() {
+        for (i, y) in io.output(OUT).iter_mut().enumerate() {
             *y = self.at(start + i as u64);
         }
         Ok(())

@@ -6,10 +6,11 @@ use super::grid::{Grid, GridSource};
 use super::kernel::SincKernel;
 use super::scheme::{Geometry, Mix, Scheme};
 use crate::rate::clock::Clock;
-use evflow_engine::typed_params::Int;
+use evflow_engine::typed_params::{Choice, Flag, Float, Floats, Int, Text, Words};
+use evflow_engine::typed_ports::{InPort, OutPort};
 use evflow_engine::{
-    BuildContext, Change, Io, Node, NodeError, NodeSpec, ParamSpec, Params, PortSpec, PrepareContext, RateSpec,
-    Refused, Role, Summary,
+    BuildContext, Change, Io, Node, NodeError, NodeSpec, Params, PortSpec, PrepareContext, RateSpec, Refused, Role,
+    Summary,
 };
 use std::path::PathBuf;
 
@@ -75,49 +76,144 @@ two half-amplitude peaks; 19 Hz with weights 0.1/0.9 and 12 Hz with 0.8/0.2), cl
 single-column grids, a velocity ratio of 10, missing and duplicate cells, envelopes on a carrier \
 (`nodes/tests/texture_*.rs`).",
 )
-.ports(&[
-    PortSpec::input("load", "g", "user's normal load m_u"),
-    PortSpec::input("velocity", "cm/s", "user's scanning velocity v_u (its magnitude is used)"),
-    PortSpec::output("table", "frame", "table frames for `playback` (header + U_uu)").at(RateSpec::Param("stream_rate")),
-])
+.ports(PORTS)
 .params(&[
-    ParamSpec::text("folder", "", "folder of grid recordings (relative to the graph file); or use `paths` or `textures`"),
-    ParamSpec::text_list("paths", "grid recordings, one per cell (instead of `folder`)"),
-    ParamSpec::text_list("textures", "folders of grid recordings, one per texture (instead of `folder`); `texture` picks one"),
+    FOLDER.spec(),
+    PATHS.spec(),
+    TEXTURES.spec(),
     TEXTURE.spec(),
-    ParamSpec::text("material", "", "use only recordings of this condition.material (empty: all)"),
-    ParamSpec::text("channel", "", "channel holding U_ij (empty: the recording's only channel)"),
-    ParamSpec::choice("scheme", &["improved", "basic"], "improved", "Eq. 6.4 two-part scheme or §5.3.3 basic average"),
-    ParamSpec::float_list("load_range", 0.0, 1e6, "g", "[lo, hi] loads a session can reach (empty: whole grid)"),
-    ParamSpec::float_list("velocity_range", 0.0, 1e6, "cm/s", "[lo, hi] velocities a session can reach (empty: whole grid)"),
-    ParamSpec::float("update_rate", 0.01, 1000.0, 10.0, "Hz", "table updates per second (§6.5.1: 10 Hz)"),
-    ParamSpec::float("stream_rate", 1.0, 1e7, 20_000.0, "Hz", "rate of the `table` port; frame length = stream_rate/update_rate"),
-    ParamSpec::float("loop", 0.0, 1e4, 0.0, "cm", "length of texture each table covers (0: the longest the recordings allow)"),
-    ParamSpec::float(
-        "period",
-        0.0,
-        1e3,
-        0.0,
-        "cm",
-        "round the loop down to a whole number of this spatial period (0: off; with `textures`, the same for each)",
-    ),
-    ParamSpec::float("overlap", 0.0, 1000.0, 10.0, "ms", "seam overlap read past the loop's end"),
-    ParamSpec::int("half_width", 2, 64, 16, "1", "re-sampling kernel half-width W (zero crossings)"),
-    ParamSpec::flag("apply_gain", false, "multiply each cell by its condition.gain (Table 5.1)"),
-    ParamSpec::choice(
-        "load_beyond",
-        &["clamp", "proportional"],
-        "clamp",
-        "outside the grid's loads: the nearest load's table (clamp, §6.4), or it scaled by m_u/m_edge (proportional: a grid of forces)",
-    ),
-    ParamSpec::choice(
-        "carrier",
-        &["auto", "nyquist", "none"],
-        "auto",
-        "cells riding a Nyquist-rate carrier are interpolated as envelopes (auto: as their condition.carrier says)",
-    ),
+    MATERIAL.spec(),
+    CHANNEL.spec(),
+    SCHEME.spec(),
+    LOAD_RANGE.spec(),
+    VELOCITY_RANGE.spec(),
+    UPDATE_RATE.spec(),
+    STREAM_RATE.spec(),
+    LOOP.spec(),
+    PERIOD.spec(),
+    OVERLAP.spec(),
+    HALF_WIDTH.spec(),
+    APPLY_GAIN.spec(),
+    LOAD_BEYOND.spec(),
+    CARRIER_MODE.spec(),
 ])
 .example("folder = \"recordings/grid\"\nscheme = \"improved\"\nupdate_rate = 10.0\nstream_rate = 20000.0");
+
+/// The ports: the user's load and velocity in, table frames out.
+const PORTS: &[PortSpec] = &[
+    PortSpec::input("load", "g", "user's normal load m_u"),
+    PortSpec::input("velocity", "cm/s", "user's scanning velocity v_u (its magnitude is used)"),
+    PortSpec::output("table", "frame", "table frames for `playback` (header + U_uu)")
+        .at(RateSpec::Param(STREAM_RATE.name())),
+];
+/// `load`: the user's normal load.
+const LOAD: InPort = InPort::named(PORTS, "load");
+/// `velocity`: the user's scanning velocity.
+const VELOCITY: InPort = InPort::named(PORTS, "velocity");
+/// `table`: the table frames.
+const TABLE: OutPort = OutPort::named(PORTS, "table");
+/// Where `table` sits among all the ports, as [`BuildContext::port_rates`]
+/// counts them (in declaration order): after the two inputs.
+const TABLE_RATE_AT: usize = VELOCITY.index() + 1 + TABLE.index();
+
+/// Outside the grid's loads (`load_beyond`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+enum LoadBeyond {
+    /// The nearest load's table (§6.4).
+    Clamp,
+    /// The nearest load's table scaled by m_u/m_edge (a grid of forces).
+    Proportional,
+}
+
+/// Whether the cells ride a Nyquist-rate carrier (`carrier`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+enum CarrierMode {
+    /// As each grid's sidecars say.
+    Auto,
+    /// They do.
+    Nyquist,
+    /// They do not.
+    None,
+}
+
+/// `folder`: a folder of grid recordings.
+const FOLDER: Text =
+    Text::new("folder", "", "folder of grid recordings (relative to the graph file); or use `paths` or `textures`");
+/// `paths`: grid recordings, one per cell.
+const PATHS: Words = Words::new("paths", "grid recordings, one per cell (instead of `folder`)");
+/// `textures`: folders of grid recordings, one per texture.
+const TEXTURES: Words =
+    Words::new("textures", "folders of grid recordings, one per texture (instead of `folder`); `texture` picks one");
+/// `material`: the recordings' material to use.
+const MATERIAL: Text = Text::new("material", "", "use only recordings of this condition.material (empty: all)");
+/// `channel`: the channel holding U_ij.
+const CHANNEL: Text = Text::new("channel", "", "channel holding U_ij (empty: the recording's only channel)");
+/// `scheme`: Eq. 6.4 or §5.3.3.
+const SCHEME: Choice<Scheme> = Choice::new(
+    "scheme",
+    &["improved", "basic"],
+    &[Scheme::Improved, Scheme::Basic],
+    "improved",
+    "Eq. 6.4 two-part scheme or §5.3.3 basic average",
+);
+/// `load_range`: the loads a session can reach.
+const LOAD_RANGE: Floats =
+    Floats::new("load_range", 0.0, 1e6, "g", "[lo, hi] loads a session can reach (empty: whole grid)");
+/// `velocity_range`: the velocities a session can reach.
+const VELOCITY_RANGE: Floats =
+    Floats::new("velocity_range", 0.0, 1e6, "cm/s", "[lo, hi] velocities a session can reach (empty: whole grid)");
+/// `update_rate`: table updates per second.
+const UPDATE_RATE: Float =
+    Float::new("update_rate", 0.01, 1000.0, 10.0, "Hz", "table updates per second (§6.5.1: 10 Hz)");
+/// `stream_rate`: the rate of the `table` port.
+const STREAM_RATE: Float = Float::new(
+    "stream_rate",
+    1.0,
+    1e7,
+    20_000.0,
+    "Hz",
+    "rate of the `table` port; frame length = stream_rate/update_rate",
+);
+/// `loop`: the length of texture each table covers.
+const LOOP: Float = Float::new(
+    "loop",
+    0.0,
+    1e4,
+    0.0,
+    "cm",
+    "length of texture each table covers (0: the longest the recordings allow)",
+);
+/// `period`: the spatial period the loop is a whole number of.
+const PERIOD: Float = Float::new(
+    "period",
+    0.0,
+    1e3,
+    0.0,
+    "cm",
+    "round the loop down to a whole number of this spatial period (0: off; with `textures`, the same for each)",
+);
+/// `overlap`: the seam overlap.
+const OVERLAP: Float = Float::new("overlap", 0.0, 1000.0, 10.0, "ms", "seam overlap read past the loop's end");
+/// `half_width`: the re-sampling kernel's half-width W.
+const HALF_WIDTH: Int = Int::new("half_width", 2, 64, 16, "1", "re-sampling kernel half-width W (zero crossings)");
+/// `apply_gain`: multiply each cell by its gain.
+const APPLY_GAIN: Flag = Flag::new("apply_gain", false, "multiply each cell by its condition.gain (Table 5.1)");
+/// `load_beyond`: what a load outside the grid gets.
+const LOAD_BEYOND: Choice<LoadBeyond> = Choice::new(
+    "load_beyond",
+    &["clamp", "proportional"],
+    &[LoadBeyond::Clamp, LoadBeyond::Proportional],
+    "clamp",
+    "outside the grid's loads: the nearest load's table (clamp, §6.4), or it scaled by m_u/m_edge (proportional: a grid of forces)",
+);
+/// `carrier`: whether the cells ride a Nyquist-rate carrier.
+const CARRIER_MODE: Choice<CarrierMode> = Choice::new(
+    "carrier",
+    &["auto", "nyquist", "none"],
+    &[CarrierMode::Auto, CarrierMode::Nyquist, CarrierMode::None],
+    "auto",
+    "cells riding a Nyquist-rate carrier are interpolated as envelopes (auto: as their condition.carrier says)",
+);
 
 /// One texture's grid and the geometry of its tables.
 struct Texture {
@@ -160,32 +256,35 @@ struct Interp {
 /// errors and the summary name it. Shared with whatever shows the node's
 /// grids (the studio), so both read the parameters alike.
 pub fn grid_sources(p: &Params, ctx: &BuildContext) -> Result<Vec<(GridSource, String)>, NodeError> {
-    let folder = p.str("folder");
-    let paths = p.text_list("paths");
-    let textures = p.text_list("textures");
+    let folder = FOLDER.get(p);
+    let paths = PATHS.get(p);
+    let textures = TEXTURES.get(p);
     let given = [!folder.is_empty(), !paths.is_empty(), !textures.is_empty()];
     if given.iter().filter(|&&g| g).count() != 1 {
         return Err(NodeError::param(
-            "folder",
+            FOLDER.name(),
             "give one of `folder` (a folder of grid recordings), `paths` (a list of recordings) or `textures` \
              (a list of folders, one per texture)",
         ));
     }
-    let range = |name: &str| -> Result<Option<(f64, f64)>, NodeError> {
-        match p.float_list(name) {
+    let range = |list: Floats| -> Result<Option<(f64, f64)>, NodeError> {
+        match list.get(p) {
             [] => Ok(None),
             [lo, hi] => Ok(Some((*lo, *hi))),
-            other => Err(NodeError::param(name, format!("give two numbers [lo, hi], not {} values", other.len()))),
+            other => Err(NodeError::param(
+                list.spec().name,
+                format!("give two numbers [lo, hi], not {} values", other.len()),
+            )),
         }
     };
     let base = GridSource {
         folder: None,
         paths: Vec::new(),
-        material: p.str("material").to_string(),
-        channel: p.str("channel").to_string(),
-        load_range: range("load_range")?,
-        velocity_range: range("velocity_range")?,
-        apply_gain: p.bool("apply_gain"),
+        material: MATERIAL.get(p).to_string(),
+        channel: CHANNEL.get(p).to_string(),
+        load_range: range(LOAD_RANGE)?,
+        velocity_range: range(VELOCITY_RANGE)?,
+        apply_gain: APPLY_GAIN.get(p),
     };
     Ok(if !textures.is_empty() {
         textures.iter().map(|t| (GridSource { folder: Some(ctx.path(t)), ..base.clone() }, t.to_string())).collect()
@@ -193,7 +292,7 @@ pub fn grid_sources(p: &Params, ctx: &BuildContext) -> Result<Vec<(GridSource, S
         vec![(GridSource { folder: Some(ctx.path(folder)), ..base.clone() }, folder.to_string())]
     } else {
         let paths = paths.iter().map(|s| ctx.path(s)).collect::<Vec<PathBuf>>();
-        vec![(GridSource { paths, ..base.clone() }, format!("{} recordings", p.text_list("paths").len()))]
+        vec![(GridSource { paths, ..base.clone() }, format!("{} recordings", PATHS.get(p).len()))]
     })
 }
 
@@ -202,7 +301,7 @@ fn build(p: &Params, ctx: &BuildContext) -> Result<Box<dyn Node>, NodeError> {
     let initial = TEXTURE.count(p);
     if initial >= sources.len() {
         return Err(NodeError::param(
-            "texture",
+            TEXTURE.name(),
             format!(
                 "{initial} is not an index into the {} texture(s) given (0 … {})",
                 sources.len(),
@@ -210,25 +309,25 @@ fn build(p: &Params, ctx: &BuildContext) -> Result<Box<dyn Node>, NodeError> {
             ),
         ));
     }
-    let update = p.f64("update_rate");
-    let stream = ctx.port_rates[2];
+    let update = UPDATE_RATE.get(p);
+    let stream = ctx.port_rates[TABLE_RATE_AT];
     let frame_f = stream / update;
     let frame = frame_f.round() as usize;
     if (frame_f - frame as f64).abs() > 1e-9 * frame_f || frame < HEADER + 32 {
         return Err(NodeError::param(
-            "stream_rate",
+            STREAM_RATE.name(),
             format!("stream_rate/update_rate = {stream}/{update} = {frame_f} must be a whole number of samples ≥ {} (the frame length)", HEADER + 32),
         ));
     }
-    let kernel = SincKernel::for_interp(p.usize("half_width"));
-    let period = p.f64("period");
+    let kernel = SincKernel::for_interp(HALF_WIDTH.count(p));
+    let period = PERIOD.get(p);
     let mut loaded: Vec<Texture> = Vec::with_capacity(sources.len());
     for (src, shown) in sources {
         let mut grid = Grid::load(&src).map_err(|e| NodeError::Data(format!("grid {shown}: {e}")))?;
-        let carrier = match p.str("carrier") {
-            "nyquist" => true,
-            "none" => false,
-            _ => grid.carrier,
+        let carrier = match CARRIER_MODE.get(p) {
+            CarrierMode::Nyquist => true,
+            CarrierMode::None => false,
+            CarrierMode::Auto => grid.carrier,
         };
         if carrier {
             // u[n] = (−1)ⁿ·a[n]: interpolate the envelopes, which live far
@@ -245,17 +344,17 @@ fn build(p: &Params, ctx: &BuildContext) -> Result<Box<dyn Node>, NodeError> {
                 )));
             }
         }
-        let overlap = (p.f64("overlap") * 1e-3 * grid.rate).round() as usize;
+        let overlap = (OVERLAP.get(p) * 1e-3 * grid.rate).round() as usize;
         let geometry = |want: f64| {
             Geometry::new(&grid, &kernel, frame - HEADER, overlap, want)
                 .map_err(|e| NodeError::Data(format!("grid {shown}: {e}")))
         };
-        let mut geo = geometry(p.f64("loop"))?;
+        let mut geo = geometry(LOOP.get(p))?;
         if period > 0.0 {
             let whole = (geo.loop_cm / period).floor();
             if whole < 1.0 {
                 return Err(NodeError::param(
-                    "period",
+                    PERIOD.name(),
                     format!("a period of {period} cm is longer than the loop of {:.3} cm ({shown})", geo.loop_cm),
                 ));
             }
@@ -263,9 +362,9 @@ fn build(p: &Params, ctx: &BuildContext) -> Result<Box<dyn Node>, NodeError> {
         }
         loaded.push(Texture { grid, geo, shown, carrier });
     }
-    let scheme = if p.str("scheme") == "basic" { Scheme::Basic } else { Scheme::Improved };
+    let scheme = SCHEME.get(p);
     Ok(Box::new(Interp {
-        in_clock: Clock::new(ctx.port_rates[0], ctx.base_rate, "load")?,
+        in_clock: Clock::new(ctx.port_rates[LOAD.index()], ctx.base_rate, "load")?,
         out_clock: Clock::new(stream, ctx.base_rate, "table")?,
         textures: loaded,
         current: initial,
@@ -273,7 +372,7 @@ fn build(p: &Params, ctx: &BuildContext) -> Result<Box<dyn Node>, NodeError> {
         initial,
         kernel,
         scheme,
-        proportional: p.str("load_beyond") == "proportional",
+        proportional: LOAD_BEYOND.get(p) == LoadBeyond::Proportional,
         frame,
         sent: 0,
         received: 0,
@@ -333,11 +432,11 @@ impl Node for Interp {
     }
 
     fn process(&mut self, io: &mut Io<'_>) -> Result<(), NodeError> {
-        let n_in = io.input_len(0).min(io.input_len(1));
-        self.scratch[0][..n_in].copy_from_slice(&io.input(0)[..n_in]);
-        self.scratch[1][..n_in].copy_from_slice(&io.input(1)[..n_in]);
+        let n_in = io.input_len(LOAD).min(io.input_len(VELOCITY));
+        self.scratch[0][..n_in].copy_from_slice(&io.input(LOAD)[..n_in]);
+        self.scratch[1][..n_in].copy_from_slice(&io.input(VELOCITY)[..n_in]);
         let first = self.received;
-        let out = io.output(0);
+        let out = io.output(TABLE);
         for (q, y) in out.iter_mut().enumerate() {
             let s = self.sent + q as u64;
             let pos = (s % self.frame as u64) as usize;

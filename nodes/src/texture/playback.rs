@@ -3,8 +3,10 @@
 
 use super::frame::{Header, HEADER};
 use crate::rate::clock::Clock;
+use evflow_engine::typed_params::{Choice, Float, Int};
+use evflow_engine::typed_ports::{InPort, OutPort};
 use evflow_engine::{
-    BuildContext, Io, Node, NodeError, NodeSpec, ParamSpec, Params, PortSpec, PrepareContext, RateSpec, Role, Summary,
+    BuildContext, Io, Node, NodeError, NodeSpec, Params, PortSpec, PrepareContext, RateSpec, Role, Summary,
 };
 
 /// Declaration of `playback`.
@@ -44,27 +46,59 @@ must equal `interp`'s, so the frame length matches (a mismatch shows as rejected
 **Checked against:** constant tables (level and phase continuity across switches and seams), time and \
 position modes on known travel (forward, reversed, at rest), block ≡ tick processing.",
 )
-.ports(&[
+.ports(PORTS)
+.params(&[MODE.spec(), UPDATE_RATE.spec(), CROSSFADE.spec(), REST_SPEED.spec(), REST_FADE.spec(), LOOKAHEAD.spec()])
+.example("mode = \"time\"\nupdate_rate = 10.0\ncrossfade = 20.0");
+
+/// The ports: table frames and the finger's velocity in, the actuation out.
+const PORTS: &[PortSpec] = &[
     PortSpec::input("table", "frame", "table frames from `interp.table`").at(RateSpec::Any),
     PortSpec::input("velocity", "cm/s", "signed finger velocity (rest detection; playhead in position mode)"),
     PortSpec::output("out", "1", "the actuation signal"),
-])
-.params(&[
-    ParamSpec::choice("mode", &["time", "position"], "time", "time-based (§6.5) or position-locked playhead"),
-    ParamSpec::float("update_rate", 0.01, 1000.0, 10.0, "Hz", "interp's update rate (sets the frame length)"),
-    ParamSpec::float("crossfade", 0.0, 5000.0, 20.0, "ms", "crossfade from one table to the next"),
-    ParamSpec::float("rest_speed", 0.0, 1e3, 0.3, "cm/s", "below this speed the output fades to silence (0: never)"),
-    ParamSpec::float("rest_fade", 0.1, 1000.0, 10.0, "ms", "fade time to and from silence at rest"),
-    ParamSpec::int(
-        "lookahead",
-        0,
-        10_000,
-        0,
-        "samples",
-        "play the texture this many samples ahead along the current velocity",
-    ),
-])
-.example("mode = \"time\"\nupdate_rate = 10.0\ncrossfade = 20.0");
+];
+/// `table`: the table frames.
+const TABLE: InPort = InPort::named(PORTS, "table");
+/// `velocity`: the signed finger velocity.
+const VELOCITY: InPort = InPort::named(PORTS, "velocity");
+/// `out`: the actuation signal.
+const OUT: OutPort = OutPort::named(PORTS, "out");
+
+/// How the playhead moves (`mode`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+enum Mode {
+    /// At the table's own sample rate (§6.5).
+    Time,
+    /// With the finger's travel.
+    Position,
+}
+
+/// `mode`: time-based or position-locked playhead.
+const MODE: Choice<Mode> = Choice::new(
+    "mode",
+    &["time", "position"],
+    &[Mode::Time, Mode::Position],
+    "time",
+    "time-based (§6.5) or position-locked playhead",
+);
+/// `update_rate`: interp's update rate.
+const UPDATE_RATE: Float =
+    Float::new("update_rate", 0.01, 1000.0, 10.0, "Hz", "interp's update rate (sets the frame length)");
+/// `crossfade`: the crossfade from one table to the next.
+const CROSSFADE: Float = Float::new("crossfade", 0.0, 5000.0, 20.0, "ms", "crossfade from one table to the next");
+/// `rest_speed`: below it the output fades to silence.
+const REST_SPEED: Float =
+    Float::new("rest_speed", 0.0, 1e3, 0.3, "cm/s", "below this speed the output fades to silence (0: never)");
+/// `rest_fade`: the fade time to and from silence.
+const REST_FADE: Float = Float::new("rest_fade", 0.1, 1000.0, 10.0, "ms", "fade time to and from silence at rest");
+/// `lookahead`: how far ahead the texture is played.
+const LOOKAHEAD: Int = Int::new(
+    "lookahead",
+    0,
+    10_000,
+    0,
+    "samples",
+    "play the texture this many samples ahead along the current velocity",
+);
 
 /// A table in one of the three buffers.
 #[derive(Debug, Clone, Copy)]
@@ -99,34 +133,34 @@ struct Playback {
 }
 
 fn build(p: &Params, ctx: &BuildContext) -> Result<Box<dyn Node>, NodeError> {
-    let table_rate = ctx.port_rates[0];
-    let update = p.f64("update_rate");
+    let table_rate = ctx.port_rates[TABLE.index()];
+    let update = UPDATE_RATE.get(p);
     let frame_f = table_rate / update;
     let frame = frame_f.round() as usize;
     if (frame_f - frame as f64).abs() > 1e-9 * frame_f || frame <= HEADER {
         return Err(NodeError::param(
-            "update_rate",
+            UPDATE_RATE.name(),
             format!("the table arrives at {table_rate} Hz, which is not a whole number (> {HEADER}) of samples per update at {update} Hz; use interp's update_rate"),
         ));
     }
     let out_rate = ctx.rate;
-    let xfade = p.f64("crossfade") * 1e-3 * out_rate;
-    if p.f64("crossfade") * 1e-3 > 0.5 / update {
+    let xfade = CROSSFADE.get(p) * 1e-3 * out_rate;
+    if CROSSFADE.get(p) * 1e-3 > 0.5 / update {
         return Err(NodeError::param(
-            "crossfade",
+            CROSSFADE.name(),
             format!("must be at most half the update period ({} ms)", 500.0 / update),
         ));
     }
     Ok(Box::new(Playback {
-        position: p.str("mode") == "position",
-        lookahead: p.i64("lookahead") as f64,
+        position: MODE.get(p) == Mode::Position,
+        lookahead: LOOKAHEAD.get(p) as f64,
         frame,
         table_clock: Clock::new(table_rate, ctx.base_rate, "table")?,
         out_clock: Clock::new(out_rate, ctx.base_rate, "out")?,
         out_rate,
         xfade_step: if xfade >= 1.0 { 1.0 / xfade } else { 1.0 },
-        rest_speed: p.f64("rest_speed"),
-        gate_step: 1.0 / (p.f64("rest_fade") * 1e-3 * out_rate).max(1.0),
+        rest_speed: REST_SPEED.get(p),
+        gate_step: 1.0 / (REST_FADE.get(p) * 1e-3 * out_rate).max(1.0),
         bufs: [Vec::new(), Vec::new(), Vec::new()],
         incoming: 0,
         cur: None,
@@ -254,12 +288,12 @@ impl Node for Playback {
     }
 
     fn process(&mut self, io: &mut Io<'_>) -> Result<(), NodeError> {
-        let n_t = io.input_len(0);
-        let n_v = io.input_len(1);
-        self.scratch[0][..n_t].copy_from_slice(io.input(0));
-        self.scratch[1][..n_v].copy_from_slice(io.input(1));
+        let n_t = io.input_len(TABLE);
+        let n_v = io.input_len(VELOCITY);
+        self.scratch[0][..n_t].copy_from_slice(io.input(TABLE));
+        self.scratch[1][..n_v].copy_from_slice(io.input(VELOCITY));
         let s_first = self.received;
-        let out = io.output(0);
+        let out = io.output(OUT);
         for (q, y) in out.iter_mut().enumerate() {
             let o = self.written + q as u64;
             self.absorb(s_first, n_t, o + 1);

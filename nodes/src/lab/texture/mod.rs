@@ -12,7 +12,9 @@ mod chain_tests;
 #[cfg(test)]
 mod tests;
 
-use evflow_engine::{BuildContext, Io, Node, NodeError, NodeSpec, ParamSpec, Params, PortSpec, Role};
+use evflow_engine::typed_params::{Float, Text};
+use evflow_engine::typed_ports::{InPort, OutPort};
+use evflow_engine::{BuildContext, Io, Node, NodeError, NodeSpec, Params, PortSpec, Role};
 use surface::Surface;
 
 /// Declaration of `sim.texture`.
@@ -50,23 +52,37 @@ high-frequency power; mean friction 0.075–0.25 N at 60–110 g (§3.2.1); repe
 seeds) against different samples (E_s); finite bounded force at speed 0 and 50 cm/s and loads of 1 g \
 and 1000 g.",
 )
-.ports(&[
+.ports(PORTS)
+.params(&[SAMPLE.spec(), FRICTION.spec(), CONTACT.spec()])
+.example("sample = \"felt-fabric\"");
+
+/// The ports: the contact's position, velocity and load in, the friction force out.
+const PORTS: &[PortSpec] = &[
     PortSpec::input("position", "m", "position of the contact along the scan"),
     PortSpec::input("velocity", "m/s", "sliding velocity of the contact"),
     PortSpec::input("load", "N", "normal load of the contact"),
     PortSpec::output("force", "N", "lateral friction force (positive opposes +x motion)"),
-])
-.params(&[
-    ParamSpec::text(
-        "sample",
-        "dotted-sheet",
-        "texture sample (§5.3, §6.3): dotted-sheet, chair-fabric, felt-fabric, painting-canvas, plastic-sheet, \
+];
+/// `position`: the contact's position along the scan.
+const POSITION: InPort = InPort::named(PORTS, "position");
+/// `velocity`: the contact's sliding velocity.
+const VELOCITY: InPort = InPort::named(PORTS, "velocity");
+/// `load`: the contact's normal load.
+const LOAD: InPort = InPort::named(PORTS, "load");
+/// `force`: the lateral friction force.
+const FORCE: OutPort = OutPort::named(PORTS, "force");
+
+/// `sample`: the texture sample, by name.
+const SAMPLE: Text = Text::new(
+    "sample",
+    "dotted-sheet",
+    "texture sample (§5.3, §6.3): dotted-sheet, chair-fabric, felt-fabric, painting-canvas, plastic-sheet, \
 scrunched-paper, rippled-paper, or generated-<seed> (a generated sample, seed 0–2⁶⁴−1)",
-    ),
-    ParamSpec::float("friction", 0.0, 2.0, 0.0, "1", "base friction coefficient μ₀ (0: the sample's)"),
-    ParamSpec::float("contact", 0.0, 0.01, 0.0, "m", "contact half-width at 1 N, σ₁ (0: the sample's)"),
-])
-.example("sample = \"felt-fabric\"");
+);
+/// `friction`: μ₀, overriding the sample's.
+const FRICTION: Float = Float::new("friction", 0.0, 2.0, 0.0, "1", "base friction coefficient μ₀ (0: the sample's)");
+/// `contact`: σ₁, overriding the sample's.
+const CONTACT: Float = Float::new("contact", 0.0, 0.01, 0.0, "m", "contact half-width at 1 N, σ₁ (0: the sample's)");
 
 /// A scan over a sample: the surface and its per-component gains, updated
 /// as the load moves — the force `sim.texture` outputs, sample by sample,
@@ -129,13 +145,13 @@ struct SimTexture {
 }
 
 fn build(p: &Params, _ctx: &BuildContext) -> Result<Box<dyn Node>, NodeError> {
-    let name = p.str("sample");
-    let mut surface = samples::lookup(name).map_err(|e| NodeError::param("sample", e))?;
-    if p.f64("friction") > 0.0 {
-        surface.mu = p.f64("friction");
+    let name = SAMPLE.get(p);
+    let mut surface = samples::lookup(name).map_err(|e| NodeError::param(SAMPLE.name(), e))?;
+    if FRICTION.get(p) > 0.0 {
+        surface.mu = FRICTION.get(p);
     }
-    if p.f64("contact") > 0.0 {
-        surface.sigma_1n = p.f64("contact");
+    if CONTACT.get(p) > 0.0 {
+        surface.sigma_1n = CONTACT.get(p);
     }
     Ok(Box::new(SimTexture { scan: TextureScan::new(surface) }))
 }
@@ -144,8 +160,8 @@ impl Node for SimTexture {
     fn process(&mut self, io: &mut Io<'_>) -> Result<(), NodeError> {
         let n = io.len();
         for k in 0..n {
-            let (x, v, load) = (io.input(0)[k], io.input(1)[k], io.input(2)[k]);
-            io.output(0)[k] = self.scan.force(x, v, load);
+            let (x, v, load) = (io.input(POSITION)[k], io.input(VELOCITY)[k], io.input(LOAD)[k]);
+            io.output(FORCE)[k] = self.scan.force(x, v, load);
         }
         Ok(())
     }

@@ -6,9 +6,9 @@ pub mod finger;
 
 use crate::rate::clock::Clock;
 use crate::rng::Rng;
-use evflow_engine::{
-    BuildContext, Io, Node, NodeError, NodeSpec, ParamSpec, Params, PortSpec, RateSpec, Role, Summary,
-};
+use evflow_engine::typed_params::{Float, Int};
+use evflow_engine::typed_ports::OutPort;
+use evflow_engine::{BuildContext, Io, Node, NodeError, NodeSpec, Params, PortSpec, RateSpec, Role, Summary};
 use finger::{Finger, FingerSettings};
 
 /// Declaration of `sim.user`.
@@ -44,35 +44,89 @@ travel, speed and load stay in their ranges, the velocity is the derivative of t
 reversals at both ends, bounded acceleration, frames exactly every 1/`ir_rate`, quantization to the \
 resolution, determinism per seed, and finite bounded outputs at the extremes.",
 )
-.ports(&[
+.ports(PORTS)
+.params(&[
+    SPEED_MIN.spec(),
+    SPEED_MAX.spec(),
+    MASS_MIN.spec(),
+    MASS_MAX.spec(),
+    TRAVEL.spec(),
+    DIRECTION.spec(),
+    ORIGIN_X.spec(),
+    ORIGIN_Y.spec(),
+    REVERSAL.spec(),
+    WANDER.spec(),
+    IR_RATE.spec(),
+    IR_RESOLUTION.spec(),
+    LOAD_NOISE.spec(),
+    SEED.spec(),
+    RATE.spec(),
+])
+.rate_param(RATE.name())
+.example("speed_min = 3.0\nspeed_max = 7.0\nmass_min = 60.0\nmass_max = 110.0\nir_rate = 40.0");
+
+/// The ports: the finger's truth at the node's rate, the sensors' reports
+/// at `ir_rate`.
+const PORTS: &[PortSpec] = &[
     PortSpec::output("position", "m", "finger position along the stroke, from its start"),
     PortSpec::output("velocity", "m/s", "signed finger velocity along the stroke"),
     PortSpec::output("load", "N", "normal load of the finger"),
     PortSpec::output("x", "m", "touch point x on the screen"),
     PortSpec::output("y", "m", "touch point y on the screen"),
-    PortSpec::output("ir_x", "m", "touch x as the IR frame reports it (quantized)").at(RateSpec::Param("ir_rate")),
-    PortSpec::output("ir_y", "m", "touch y as the IR frame reports it (quantized)").at(RateSpec::Param("ir_rate")),
-    PortSpec::output("load_cell", "N", "load as the load cell reports it (noisy)").at(RateSpec::Param("ir_rate")),
-])
-.params(&[
-    ParamSpec::float("speed_min", 0.0, 50.0, 3.0, "cm/s", "slowest cruising speed"),
-    ParamSpec::float("speed_max", 0.0, 50.0, 7.0, "cm/s", "fastest cruising speed"),
-    ParamSpec::float("mass_min", 1.0, 1000.0, 60.0, "g", "lightest pressure, as a mass (load = mass·g)"),
-    ParamSpec::float("mass_max", 1.0, 1000.0, 110.0, "g", "heaviest pressure, as a mass"),
-    ParamSpec::float("travel", 0.001, 1.0, 0.08, "m", "length of a stroke"),
-    ParamSpec::float("direction", -360.0, 360.0, 0.0, "deg", "direction of the strokes on the screen (0 = +x)"),
-    ParamSpec::float("origin_x", -1e6, 1e6, 0.0, "m", "screen x of the strokes' start"),
-    ParamSpec::float("origin_y", -1e6, 1e6, 0.0, "m", "screen y of the strokes' start"),
-    ParamSpec::float("reversal", 0.002, 10.0, 0.1, "s", "time to stop and restart at a reversal"),
-    ParamSpec::float("wander", 0.01, 100.0, 1.0, "s", "correlation time of the speed and pressure drift"),
-    ParamSpec::float("ir_rate", 1.0, 1000.0, 40.0, "Hz", "report rate of the IR frame and load cell"),
-    ParamSpec::float("ir_resolution", 0.0, 0.1, 0.0005, "m", "IR frame resolution (0: exact)"),
-    ParamSpec::float("load_noise", 0.0, 10.0, 0.005, "N", "rms noise of the load cell"),
-    ParamSpec::int("seed", -1, i64::MAX, -1, "1", "random seed (−1: from the graph's seed and the node name)"),
-    ParamSpec::float("rate", 1.0, 1e6, 1000.0, "Hz", "sample rate of the true outputs"),
-])
-.rate_param("rate")
-.example("speed_min = 3.0\nspeed_max = 7.0\nmass_min = 60.0\nmass_max = 110.0\nir_rate = 40.0");
+    PortSpec::output("ir_x", "m", "touch x as the IR frame reports it (quantized)").at(RateSpec::Param(IR_RATE.name())),
+    PortSpec::output("ir_y", "m", "touch y as the IR frame reports it (quantized)").at(RateSpec::Param(IR_RATE.name())),
+    PortSpec::output("load_cell", "N", "load as the load cell reports it (noisy)").at(RateSpec::Param(IR_RATE.name())),
+];
+/// `position`: the finger position along the stroke.
+const POSITION: OutPort = OutPort::named(PORTS, "position");
+/// `velocity`: the signed finger velocity.
+const VELOCITY: OutPort = OutPort::named(PORTS, "velocity");
+/// `load`: the finger's normal load.
+const LOAD: OutPort = OutPort::named(PORTS, "load");
+/// `x`: the touch point x.
+const X: OutPort = OutPort::named(PORTS, "x");
+/// `y`: the touch point y.
+const Y: OutPort = OutPort::named(PORTS, "y");
+/// `ir_x`: touch x as the IR frame reports it.
+const IR_X: OutPort = OutPort::named(PORTS, "ir_x");
+/// `ir_y`: touch y as the IR frame reports it.
+const IR_Y: OutPort = OutPort::named(PORTS, "ir_y");
+/// `load_cell`: the load as the load cell reports it.
+const LOAD_CELL: OutPort = OutPort::named(PORTS, "load_cell");
+/// The outputs of one report ([`SimUser::report`]), in its order.
+const REPORT_PORTS: [OutPort; 3] = [IR_X, IR_Y, LOAD_CELL];
+
+/// `speed_min`: the slowest cruising speed.
+const SPEED_MIN: Float = Float::new("speed_min", 0.0, 50.0, 3.0, "cm/s", "slowest cruising speed");
+/// `speed_max`: the fastest cruising speed.
+const SPEED_MAX: Float = Float::new("speed_max", 0.0, 50.0, 7.0, "cm/s", "fastest cruising speed");
+/// `mass_min`: the lightest pressure, as a mass.
+const MASS_MIN: Float = Float::new("mass_min", 1.0, 1000.0, 60.0, "g", "lightest pressure, as a mass (load = mass·g)");
+/// `mass_max`: the heaviest pressure, as a mass.
+const MASS_MAX: Float = Float::new("mass_max", 1.0, 1000.0, 110.0, "g", "heaviest pressure, as a mass");
+/// `travel`: the length of a stroke.
+const TRAVEL: Float = Float::new("travel", 0.001, 1.0, 0.08, "m", "length of a stroke");
+/// `direction`: the strokes' direction on the screen.
+const DIRECTION: Float =
+    Float::new("direction", -360.0, 360.0, 0.0, "deg", "direction of the strokes on the screen (0 = +x)");
+/// `origin_x`: the screen x of the strokes' start.
+const ORIGIN_X: Float = Float::new("origin_x", -1e6, 1e6, 0.0, "m", "screen x of the strokes' start");
+/// `origin_y`: the screen y of the strokes' start.
+const ORIGIN_Y: Float = Float::new("origin_y", -1e6, 1e6, 0.0, "m", "screen y of the strokes' start");
+/// `reversal`: the time to stop and restart.
+const REVERSAL: Float = Float::new("reversal", 0.002, 10.0, 0.1, "s", "time to stop and restart at a reversal");
+/// `wander`: the drift's correlation time.
+const WANDER: Float = Float::new("wander", 0.01, 100.0, 1.0, "s", "correlation time of the speed and pressure drift");
+/// `ir_rate`: the report rate of the IR frame and load cell.
+const IR_RATE: Float = Float::new("ir_rate", 1.0, 1000.0, 40.0, "Hz", "report rate of the IR frame and load cell");
+/// `ir_resolution`: the IR frame's resolution.
+const IR_RESOLUTION: Float = Float::new("ir_resolution", 0.0, 0.1, 0.0005, "m", "IR frame resolution (0: exact)");
+/// `load_noise`: the load cell's rms noise.
+const LOAD_NOISE: Float = Float::new("load_noise", 0.0, 10.0, 0.005, "N", "rms noise of the load cell");
+/// `seed`: the random seed.
+const SEED: Int = Int::new("seed", -1, i64::MAX, -1, "1", "random seed (−1: from the graph's seed and the node name)");
+/// `rate`: the sample rate of the true outputs.
+const RATE: Float = Float::new("rate", 1.0, 1e6, 1000.0, "Hz", "sample rate of the true outputs");
 
 struct SimUser {
     settings: FingerSettings,
@@ -93,40 +147,43 @@ struct SimUser {
 }
 
 fn build(p: &Params, ctx: &BuildContext) -> Result<Box<dyn Node>, NodeError> {
-    let range = |lo: &str, hi: &str| -> Result<(f64, f64), NodeError> {
-        let (a, b) = (p.f64(lo), p.f64(hi));
+    let range = |lo: Float, hi: Float| -> Result<(f64, f64), NodeError> {
+        let (a, b) = (lo.get(p), hi.get(p));
         if a > b {
-            return Err(NodeError::param(lo, format!("{lo} = {a} is above {hi} = {b}")));
+            return Err(NodeError::param(lo.name(), format!("{} = {a} is above {} = {b}", lo.name(), hi.name())));
         }
         Ok((a, b))
     };
-    let (s0, s1) = range("speed_min", "speed_max")?;
-    let (m0, m1) = range("mass_min", "mass_max")?;
+    let (s0, s1) = range(SPEED_MIN, SPEED_MAX)?;
+    let (m0, m1) = range(MASS_MIN, MASS_MAX)?;
     let rate = ctx.rate;
-    let ir_rate = p.f64("ir_rate");
+    let ir_rate = IR_RATE.get(p);
     let ir_clock = Clock::new(ir_rate, ctx.base_rate, "ir_x")?;
     let node_clock = Clock::new(rate, ctx.base_rate, "position")?;
     if ir_rate > rate {
-        return Err(NodeError::param("ir_rate", format!("ir_rate = {ir_rate} Hz is above the node's rate {rate} Hz")));
+        return Err(NodeError::param(
+            IR_RATE.name(),
+            format!("ir_rate = {ir_rate} Hz is above the node's rate {rate} Hz"),
+        ));
     }
     let settings = FingerSettings {
-        travel: p.f64("travel"),
+        travel: TRAVEL.get(p),
         speed: (s0 * 0.01, s1 * 0.01),
         mass: (m0 * 1e-3, m1 * 1e-3),
-        reversal: p.f64("reversal"),
-        wander: p.f64("wander"),
+        reversal: REVERSAL.get(p),
+        wander: WANDER.get(p),
         h: 1.0 / rate,
     };
-    let seed = crate::lab::seed_of(p, ctx);
-    let a = p.f64("direction").to_radians();
+    let seed = crate::lab::seed_or_node(SEED.get(p), ctx);
+    let a = DIRECTION.get(p).to_radians();
     let mut node = SimUser {
         settings,
         seed,
         finger: Finger::new(settings, seed),
         dir: (a.cos(), a.sin()),
-        origin: (p.f64("origin_x"), p.f64("origin_y")),
-        resolution: p.f64("ir_resolution"),
-        load_noise: p.f64("load_noise"),
+        origin: (ORIGIN_X.get(p), ORIGIN_Y.get(p)),
+        resolution: IR_RESOLUTION.get(p),
+        load_noise: LOAD_NOISE.get(p),
         noise: Rng::substream(seed, 4),
         node_clock,
         ir_clock,
@@ -163,25 +220,23 @@ impl SimUser {
 impl Node for SimUser {
     fn process(&mut self, io: &mut Io<'_>) -> Result<(), NodeError> {
         let n = io.len();
-        let n_ir = io.output_len(5).min(io.output_len(6)).min(io.output_len(7));
+        let n_ir = io.output_len(IR_X).min(io.output_len(IR_Y)).min(io.output_len(LOAD_CELL));
         let mut k_ir = 0;
         for q in 0..n {
             // Sample `sent` of the node's clock is the state after this step.
             self.finger.step();
             let (x, y) = self.touch();
-            let outs = io.outputs();
-            outs[0][q] = self.finger.position;
-            outs[1][q] = self.finger.velocity;
-            outs[2][q] = self.finger.load();
-            outs[3][q] = x;
-            outs[4][q] = y;
+            io.output(POSITION)[q] = self.finger.position;
+            io.output(VELOCITY)[q] = self.finger.velocity;
+            io.output(LOAD)[q] = self.finger.load();
+            io.output(X)[q] = x;
+            io.output(Y)[q] = y;
             // IR reports due at or before this sample take this state.
             while k_ir < n_ir && self.ir_clock.at_or_before(self.ir_sent, &self.node_clock, self.sent) {
                 let r = self.report();
                 self.last_ir = r;
-                let outs = io.outputs();
-                for (j, v) in r.iter().enumerate() {
-                    outs[5 + j][k_ir] = *v;
+                for (port, v) in REPORT_PORTS.into_iter().zip(r) {
+                    io.output(port)[k_ir] = v;
                 }
                 k_ir += 1;
                 self.ir_sent += 1;
@@ -191,9 +246,8 @@ impl Node for SimUser {
         // Reports the engine counts in this call beyond those due (never expected): hold the last.
         while k_ir < n_ir {
             let r = self.last_ir;
-            let outs = io.outputs();
-            for (j, v) in r.iter().enumerate() {
-                outs[5 + j][k_ir] = *v;
+            for (port, v) in REPORT_PORTS.into_iter().zip(r) {
+                io.output(port)[k_ir] = v;
             }
             k_ir += 1;
             self.ir_sent += 1;

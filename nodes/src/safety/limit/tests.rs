@@ -1,25 +1,33 @@
 use super::{State, SPEC, STATE_ARMED, STATE_CLAMPING, STATE_FADED, STATE_FADING, STATE_FAULTED};
 use evflow_engine::harness::{Single, TAP};
+use evflow_engine::typed_params::Floats;
+use evflow_engine::typed_ports::OutPort;
 use evflow_engine::{
-    check, graph::parse_graph, BuildContext, Io, Node, NodeError, NodeSpec, ParamSpec, Params, Plan, PlanOptions,
-    PortSpec, Registry, Role, Summary,
+    check, graph::parse_graph, BuildContext, Io, Node, NodeError, NodeSpec, Params, Plan, PlanOptions, PortSpec,
+    Registry, Role, Summary,
 };
 use std::path::Path;
 
 /// A test source: `values`, with NaN at the indices in `nan_at` (graph
 /// files cannot hold NaN).
 static SEQ: NodeSpec = NodeSpec::new("test.seq", "test", Role::Source, "values with NaN (test only)", build_seq)
-    .ports(&[PortSpec::output("out", "1", "values")])
-    .params(&[
-        ParamSpec::float_list("values", -1e300, 1e300, "1", "samples"),
-        ParamSpec::float_list("nan_at", 0.0, 1e9, "1", "indices replaced by NaN"),
-    ]);
+    .ports(SEQ_PORTS)
+    .params(&[VALUES.spec(), NAN_AT.spec()]);
+
+/// The test source's port.
+const SEQ_PORTS: &[PortSpec] = &[PortSpec::output("out", "1", "values")];
+/// `out` of the test source.
+const SEQ_OUT: OutPort = OutPort::named(SEQ_PORTS, "out");
+/// `values`: the samples.
+const VALUES: Floats = Floats::new("values", -1e300, 1e300, "1", "samples");
+/// `nan_at`: where NaN replaces a sample.
+const NAN_AT: Floats = Floats::new("nan_at", 0.0, 1e9, "1", "indices replaced by NaN");
 
 struct Seq(Vec<f64>, usize);
 
 impl Node for Seq {
     fn process(&mut self, io: &mut Io<'_>) -> Result<(), NodeError> {
-        for y in io.output(0) {
+        for y in io.output(SEQ_OUT) {
             *y = self.0.get(self.1).copied().unwrap_or(0.0);
             self.1 += 1;
         }
@@ -34,8 +42,8 @@ impl Node for Seq {
 }
 
 fn build_seq(p: &Params, _: &BuildContext) -> Result<Box<dyn Node>, NodeError> {
-    let mut v = p.float_list("values").to_vec();
-    for &i in p.float_list("nan_at") {
+    let mut v = VALUES.get(p).to_vec();
+    for &i in NAN_AT.get(p) {
         v[i as usize] = f64::NAN;
     }
     Ok(Box::new(Seq(v, 0)))

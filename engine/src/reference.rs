@@ -17,7 +17,7 @@ pub fn node_markdown(spec: &NodeSpec, guards: &str) -> String {
     if spec.hardware {
         flags.push(format!("drives hardware (must be fed by {guards})"));
     }
-    if spec.safety_guard {
+    if spec.is_guard() {
         flags.push("safety guard (may feed hardware)".into());
     }
     if let Some(why) = spec.offline_only {

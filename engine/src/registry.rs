@@ -46,7 +46,7 @@ impl Registry {
     /// feed hardware) as messages name them: "`limit`", "`a` or `b`", or
     /// "safety-guard" when the registry has none.
     pub fn guard_words(&self) -> String {
-        let names: Vec<String> = self.specs().filter(|s| s.safety_guard).map(|s| format!("`{}`", s.name)).collect();
+        let names: Vec<String> = self.specs().filter(|s| s.is_guard()).map(|s| format!("`{}`", s.name)).collect();
         if names.is_empty() {
             "safety-guard".to_string()
         } else {

@@ -288,9 +288,11 @@ pub struct NodeSpec {
     /// True for nodes that drive hardware: each of their inputs must come
     /// straight from a node with `safety_guard` (the `limit` node).
     pub hardware: bool,
-    /// True for the safety limiter, the only node allowed to feed hardware,
-    /// and only from its first output.
-    pub safety_guard: bool,
+    /// For the safety limiter, the only node allowed to feed hardware, and
+    /// only from its first output: the name of its live flag parameter that
+    /// keeps the gate open (`true`) or fades the output to zero (`false`),
+    /// which a live session sets to `false` on stop. `None` for other nodes.
+    pub safety_guard: Option<&'static str>,
     /// Why the node cannot run in a live session (e.g. it does blocking file
     /// I/O while processing); `None` for nodes that can.
     pub offline_only: Option<&'static str>,
@@ -323,7 +325,7 @@ impl NodeSpec {
             rate_param: None,
             breaks_cycles: false,
             hardware: false,
-            safety_guard: false,
+            safety_guard: None,
             offline_only: None,
             example: "",
             build,
@@ -360,10 +362,15 @@ impl NodeSpec {
         self.hardware = true;
         self
     }
-    /// Marks the safety limiter.
-    pub const fn safety_guard(mut self) -> Self {
-        self.safety_guard = true;
+    /// Marks the safety limiter, naming its live flag that opens the gate
+    /// (see [`NodeSpec::safety_guard`](struct.NodeSpec.html#structfield.safety_guard)).
+    pub const fn safety_guard(mut self, gate: &'static str) -> Self {
+        self.safety_guard = Some(gate);
         self
+    }
+    /// True for the safety limiter.
+    pub const fn is_guard(&self) -> bool {
+        self.safety_guard.is_some()
     }
     /// Marks a node that cannot run live, saying why (the live runner
     /// refuses a graph that contains it).

@@ -151,6 +151,11 @@ impl Flag {
         Self(self.0.live())
     }
 
+    /// Its name, as written in the node's table.
+    pub const fn name(&self) -> &'static str {
+        self.0.name
+    }
+
     /// The new value when `c` changes this parameter.
     pub fn changed(&self, c: &Change) -> Option<bool> {
         (c.param == self.0.name).then_some(c.value != 0.0)
@@ -237,6 +242,11 @@ impl Floats {
     /// Its declaration.
     pub const fn spec(&self) -> ParamSpec {
         self.0
+    }
+
+    /// Its name, as written in the node's table.
+    pub const fn name(&self) -> &'static str {
+        self.0.name
     }
 
     /// Its validated value.

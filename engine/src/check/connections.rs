@@ -85,7 +85,7 @@ impl Wiring {
                         // Only a guard's first output is the guarded signal (the
                         // others, like `limit.state`, are for monitoring).
                         let guarded = nodes[*src].as_ref().is_some_and(|s| {
-                            s.spec.safety_guard && s.outputs().next().is_some_and(|o| s.ports[o].name == from.port)
+                            s.spec.is_guard() && s.outputs().next().is_some_and(|o| s.ports[o].name == from.port)
                         });
                         if !guarded {
                             sink.err(

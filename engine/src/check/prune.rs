@@ -62,7 +62,7 @@ pub(crate) fn needed(
 /// True for node types the planner may replace by a constant: never a sink
 /// (it has an effect), a hardware output or a safety guard.
 pub fn may_fold(spec: &NodeSpec) -> bool {
-    spec.role != Role::Sink && !spec.hardware && !spec.safety_guard
+    spec.role != Role::Sink && !spec.hardware && !spec.is_guard()
 }
 
 /// A node replaced by a constant.

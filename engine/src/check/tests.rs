@@ -471,7 +471,7 @@ static DEVICE: NodeSpec = NodeSpec::new("device", "test", Role::Sink, "drives ha
     .hardware();
 static CLAMP: NodeSpec = NodeSpec::new("clamp", "test", Role::Filter, "a guard", build_pass)
     .ports(&[PortSpec::input("in", "1", "x"), PortSpec::output("out", "1", "x")])
-    .safety_guard();
+    .safety_guard("enable");
 
 #[test]
 fn hardware_must_be_fed_by_a_guard_named_by_its_spec() {

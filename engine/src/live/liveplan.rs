@@ -24,13 +24,15 @@ pub enum LiveError {
         /// Why.
         reason: &'static str,
     },
-    /// A safety guard without a live `enable` flag.
-    #[error("safety guard `{node}` ({kind}) declares no live flag `enable`, so the runner cannot fade it out on stop")]
-    GuardWithoutEnable {
+    /// A safety guard whose gate is not a live flag.
+    #[error("safety guard `{node}` ({kind}) declares no live flag `{gate}`, so the runner cannot fade it out on stop")]
+    GuardWithoutGate {
         /// The node.
         node: String,
         /// Its type.
         kind: &'static str,
+        /// The gate its declaration names.
+        gate: &'static str,
     },
     /// A tap names a node or port the plan does not have.
     #[error("cannot record `{node}.{port}`: {why}")]
@@ -94,7 +96,8 @@ pub struct TapInfo {
 /// A plan ready to run live.
 pub struct LivePlan {
     pub(crate) plan: Plan,
-    pub(crate) guards: Vec<usize>,
+    /// The safety guards: node index and gate parameter.
+    pub(crate) guards: Vec<(usize, &'static str)>,
     pub(crate) taps: Vec<(usize, usize)>,
     pub(crate) info: Vec<TapInfo>,
 }
@@ -116,12 +119,16 @@ impl LivePlan {
             if let Some(reason) = spec.offline_only {
                 return Err(LiveError::OfflineOnly { node: plan.node_name(k).to_string(), kind: spec.name, reason });
             }
-            if spec.safety_guard {
-                let ok = spec.params.iter().any(|p| p.name == "enable" && p.live && p.kind == ParamKind::Bool);
+            if let Some(gate) = spec.safety_guard {
+                let ok = spec.params.iter().any(|p| p.name == gate && p.live && p.kind == ParamKind::Bool);
                 if !ok {
-                    return Err(LiveError::GuardWithoutEnable { node: plan.node_name(k).to_string(), kind: spec.name });
+                    return Err(LiveError::GuardWithoutGate {
+                        node: plan.node_name(k).to_string(),
+                        kind: spec.name,
+                        gate,
+                    });
                 }
-                guards.push(k);
+                guards.push((k, gate));
             }
         }
         let mut resolved = Vec::new();
@@ -174,7 +181,7 @@ impl LivePlan {
     pub fn guard_taps(plan: &Plan) -> Vec<Tap> {
         let mut v = Vec::new();
         for k in 0..plan.len() {
-            if plan.spec(k).safety_guard {
+            if plan.spec(k).is_guard() {
                 for p in plan.output_names(k) {
                     v.push(Tap::new(plan.node_name(k), p));
                 }
@@ -195,8 +202,8 @@ impl LivePlan {
     pub fn taps(&self) -> &[TapInfo] {
         &self.info
     }
-    /// Indices of the safety guards.
-    pub fn guards(&self) -> &[usize] {
+    /// The safety guards: node index and the live flag that opens its gate.
+    pub fn guards(&self) -> &[(usize, &'static str)] {
         &self.guards
     }
 }

@@ -68,10 +68,10 @@ impl RtState {
     /// Fades every safety guard out from tick `k` on.
     fn disable_guards(&mut self, k: u64) {
         for i in 0..self.plan.guards.len() {
-            let g = self.plan.guards[i];
-            let kind = match self.plan.plan.set(g, "enable", 0.0) {
-                Ok(()) => EventKind::Set { node: g as u32, param: "enable", value: 0.0 },
-                Err(_) => EventKind::Refused { node: g as u32, param: "enable", value: 0.0 },
+            let (g, gate) = self.plan.guards[i];
+            let kind = match self.plan.plan.set(g, gate, 0.0) {
+                Ok(()) => EventKind::Set { node: g as u32, param: gate, value: 0.0 },
+                Err(_) => EventKind::Refused { node: g as u32, param: gate, value: 0.0 },
             };
             self.event(k, kind);
         }
@@ -86,7 +86,7 @@ impl RtState {
             let Ok(c) = self.commands.pop() else { break };
             let node = c.node as usize;
             // While stopping, no command may reopen a guard.
-            let blocked = stopping && self.plan.guards.contains(&node) && c.param == "enable";
+            let blocked = stopping && self.plan.guards.contains(&(node, c.param));
             let ok = node < self.plan.plan.len() && !blocked && self.plan.plan.set(node, c.param, c.value).is_ok();
             let kind = if ok {
                 EventKind::Set { node: c.node, param: c.param, value: c.value }

@@ -80,7 +80,7 @@ const ENABLE: Flag = Flag::new("enable", true, "gate").live();
 static GUARD: NodeSpec = NodeSpec::new("test.guard", "test", Role::Filter, "gate (test only)", build_guard)
     .ports(&[PortSpec::input("in", "1", "x"), PortSpec::output("out", "1", "x · gate")])
     .params(&[ENABLE.spec()])
-    .safety_guard();
+    .safety_guard(ENABLE.name());
 
 struct Guard {
     open: bool,

@@ -120,7 +120,7 @@ input and a disable; the latch and re-arm; the `state` code at each transition; 
 )
 .ports(PORTS)
 .params(&[AMPLITUDE.spec(), SLEW.spec(), RAMP.spec(), FAULTS.spec(), ENABLE.spec()])
-.safety_guard()
+.safety_guard(ENABLE.name())
 .example("amplitude = 1.0\nslew = 4000.0\nramp = 0.01");
 
 /// The ports: the signal and one fault flag per `faults` entry in; the

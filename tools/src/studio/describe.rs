@@ -96,7 +96,7 @@ pub(crate) fn graph_json(checked: &Checked, base: f64, in_plan: &dyn Fn(&str) ->
         .map(|n| {
             json!({
                 "name": n.name, "type": n.spec.name, "rate": n.ratio.hz(base), "in_plan": in_plan(&n.name),
-                "guard": n.spec.safety_guard,
+                "guard": n.spec.is_guard(),
                 "inputs": n.ports.iter().filter(|q| q.dir == Direction::In).map(|q| &q.name).collect::<Vec<_>>(),
                 "outputs": n.ports.iter().filter(|q| q.dir == Direction::Out).map(|q| &q.name).collect::<Vec<_>>(),
             })

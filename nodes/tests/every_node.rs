@@ -8,100 +8,14 @@
 use evflow_engine::graph::parse_graph;
 use evflow_engine::harness::Single;
 use evflow_engine::{NodeSpec, Value};
+use evflow_nodes::example_files::signal;
 use std::path::Path;
 
 const TICKS: u64 = 3000;
 
-/// Deterministic test input: a mix of a chirp and pseudo-random noise.
-fn signal(len: usize, salt: u64) -> Vec<f64> {
-    let mut state = 0x9E37_79B9_7F4A_7C15u64 ^ salt;
-    (0..len)
-        .map(|i| {
-            state ^= state << 13;
-            state ^= state >> 7;
-            state ^= state << 17;
-            let noise = (state >> 11) as f64 / (1u64 << 53) as f64 - 0.5;
-            let t = i as f64 / 1000.0;
-            0.5 * (2.0 * std::f64::consts::PI * (5.0 + 40.0 * t) * t).sin() + 0.3 * noise
-        })
-        .collect()
-}
-
-/// Files some node examples read (e.g. a recording), written into `dir`.
+/// Files the node examples read (a recording, a grid, models), written into `dir`.
 fn fixtures(dir: &Path) {
-    use evflow_nodes::recording::format::{Channel, RecordingMeta, RecordingWriter};
-    std::fs::create_dir_all(dir.join("recordings")).expect("fixture folder");
-    let meta = RecordingMeta::new(1000.0, vec![Channel::new("force", "N")]);
-    let mut w = RecordingWriter::create(&dir.join("recordings/felt.wav"), meta).expect("fixture recording");
-    for x in signal(TICKS as usize + 100, 99) {
-        w.write_frame(&[0.2 + 0.05 * x]).expect("fixture frame");
-    }
-    w.finish().expect("fixture recording finished");
-    // A 2 × 2 grid of actuation signals for `interp` (loads 60/110 g, velocities 3/7 cm/s).
-    std::fs::create_dir_all(dir.join("recordings/grid")).expect("grid folder");
-    for (k, (load, velocity)) in [(60.0, 3.0), (60.0, 7.0), (110.0, 3.0), (110.0, 7.0)].into_iter().enumerate() {
-        let mut meta = RecordingMeta::new(1000.0, vec![Channel::new("u", "1")]);
-        meta.condition.load_g = Some(load);
-        meta.condition.velocity_cm_s = Some(velocity);
-        let mut w =
-            RecordingWriter::create(&dir.join(format!("recordings/grid/cell{k}.wav")), meta).expect("grid cell");
-        for x in signal(4000, 7 + k as u64) {
-            w.write_frame(&[x]).expect("grid frame");
-        }
-        w.finish().expect("grid cell finished");
-    }
-    // A small NARX model (the `narx` node's example), trained on a chirp.
-    use evflow_nodes::narx::fit::{fit, FitConfig};
-    let x = signal(2000, 7);
-    let u: Vec<f64> = x.iter().map(|v| if *v > 0.0 { 1.0 } else { -1.0 }).collect();
-    let cfg = FitConfig {
-        hidden: vec![4],
-        feedback: 1,
-        input: 3,
-        lookahead: Some(1),
-        options: evflow_nodes::narx::train::Options { max_epochs: 3, ..Default::default() },
-        ..FitConfig::default()
-    };
-    let model = fit(&x, &u, &cfg, &mut |_| {}).expect("fixture model");
-    model.save(&dir.join("models/narx.json")).expect("fixture model written");
-    // The same model at two conditions, for `narx.grid`'s example.
-    for (m, v) in [(60.0, 3.0), (110.0, 7.0)] {
-        let mut at = model.clone();
-        at.condition.mass_g = Some(m);
-        at.condition.speed_cm_s = Some(v);
-        at.save(&dir.join(format!("models/narx-{m}g-{v}cms.json"))).expect("fixture grid model written");
-    }
-    // A forward model (`synth.optimize`'s example) of a square law behind a short filter.
-    use evflow_nodes::synth::model_file::{ForwardModel, Training};
-    use evflow_nodes::synth::volterra_fit::{fit as fit_forward, FitConfig as ForwardConfig};
-    let u: Vec<f64> = signal(3000, 5).iter().map(|v| 2.0 * v).collect();
-    let y: Vec<f64> = (0..u.len()).map(|n| (0.8 * u[n] - 0.3 * if n > 0 { u[n - 1] } else { 0.0 }).powi(2)).collect();
-    let cfg = ForwardConfig { memory: 4, ..ForwardConfig::default() };
-    let fitted = fit_forward(&u, &y, &vec![true; u.len()], &cfg).expect("fixture forward model");
-    let training = Training {
-        scores: fitted.scores,
-        actuation_rms: 0.5,
-        actuation_peak: 1.0,
-        data_hash: String::new(),
-        seconds: 0.0,
-    };
-    let forward = ForwardModel::new(
-        &fitted.model,
-        1000.0,
-        &cfg.filter,
-        Default::default(),
-        fitted.noise,
-        fitted.spectrum,
-        training,
-    );
-    forward.save(&dir.join("models/forward.json")).expect("fixture forward model written");
-    // The same forward model at the four corners, for `synth.live`'s example.
-    for (m, v) in [(60.0, 3.0), (60.0, 7.0), (110.0, 3.0), (110.0, 7.0)] {
-        let mut at = forward.clone();
-        at.condition.mass_g = Some(m);
-        at.condition.speed_cm_s = Some(v);
-        at.save(&dir.join(format!("models/forward-{m}g-{v}cms.json"))).expect("fixture grid forward model written");
-    }
+    evflow_nodes::example_files::write(dir).expect("example files");
 }
 
 struct Case {

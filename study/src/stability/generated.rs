@@ -5,12 +5,12 @@
 //! a line of this file.
 
 use super::bounds::{bound, capped, from_table};
-use super::fixtures::signal;
 use super::invariant::{Invariant, Observed};
 use super::signals::Extreme;
 use super::{single, Case, Env, Group, Size};
 use evflow_engine::spec::ParamKind;
 use evflow_engine::{Direction, NodeSpec};
+use evflow_nodes::example_files::signal;
 use toml::{Table, Value};
 
 /// Samples per block of a node case.

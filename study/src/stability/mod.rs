@@ -17,7 +17,6 @@
 //! outputs have a tighter bound than "finite".
 
 pub mod bounds;
-pub mod fixtures;
 pub mod generated;
 pub mod graphs;
 pub mod invariant;
@@ -123,7 +122,7 @@ impl Group {
 #[derive(Debug, Clone)]
 pub struct Env {
     /// Folder holding the fixture files (recordings, models, meshes) the
-    /// node examples and the stiff cases read ([`fixtures::write`]).
+    /// node examples and the stiff cases read ([`evflow_nodes::example_files::write`]).
     pub dir: PathBuf,
     /// The shipped graphs' folder (`graphs/`).
     pub graphs: PathBuf,
@@ -199,7 +198,7 @@ pub enum SuiteError {
 /// Writes the fixtures into `dir` and returns the environment of a suite
 /// of `size` over the shipped graphs in `graphs`.
 pub fn prepare(dir: &Path, graphs: &Path, size: Size) -> Result<Env, SuiteError> {
-    fixtures::write(dir).map_err(SuiteError::Fixtures)?;
+    evflow_nodes::example_files::write(dir).map_err(SuiteError::Fixtures)?;
     Ok(Env { dir: dir.to_path_buf(), graphs: graphs.to_path_buf(), size })
 }
 

@@ -8,9 +8,10 @@
 
 use super::graphs::{check_text, run_checked, Running};
 use super::invariant::{Invariant, Observed};
-use super::{fixtures, single, Case, Env, Group};
+use super::{single, Case, Env, Group};
 use evflow_engine::params::toml_string;
 use evflow_engine::NodeSpec;
+use evflow_nodes::example_files as fixtures;
 use evflow_nodes::lab::profile::{LabProfile, KEYS};
 use std::path::Path;
 

@@ -1,10 +1,11 @@
-//! The files the node examples (`NodeSpec::example`) and the stiff cases
-//! read, written into the suite's folder: a force recording, a 2 × 2 grid
-//! of actuation cells, small NARX and forward models, a mesh of slivers.
-//! The same files the generic node tests write (`nodes/tests/every_node.rs`),
-//! made here because a test's helpers cannot be imported.
+//! The files the node examples (`NodeSpec::example`) read, and the stiff
+//! mesh of the stability suite, written into a folder: a force recording,
+//! a 2 × 2 grid of actuation cells, small NARX and forward models (with the
+//! families that read them), a mesh of slivers. The generic node tests
+//! (`nodes/tests/every_node.rs`) and `evflow report stability` write them
+//! through this one module.
 
-use evflow_nodes::recording::format::{Channel, RecordingMeta, RecordingWriter};
+use crate::recording::format::{Channel, RecordingMeta, RecordingWriter};
 use std::path::Path;
 
 /// Samples of each fixture recording (at 1 kHz).
@@ -112,7 +113,7 @@ pub fn sliver_obj() -> String {
 
 #[cfg(feature = "narx")]
 fn narx_models(dir: &Path) -> Result<(), String> {
-    use evflow_nodes::narx::fit::{fit, FitConfig};
+    use crate::narx::fit::{fit, FitConfig};
     let x = signal(2000, 7);
     let u: Vec<f64> = x.iter().map(|v| if *v > 0.0 { 1.0 } else { -1.0 }).collect();
     let cfg = FitConfig {
@@ -120,7 +121,7 @@ fn narx_models(dir: &Path) -> Result<(), String> {
         feedback: 1,
         input: 3,
         lookahead: Some(1),
-        options: evflow_nodes::narx::train::Options { max_epochs: 3, ..Default::default() },
+        options: crate::narx::train::Options { max_epochs: 3, ..Default::default() },
         ..FitConfig::default()
     };
     let model = fit(&x, &u, &cfg, &mut |_| {}).map_err(|e| e.to_string())?;
@@ -136,8 +137,8 @@ fn narx_models(dir: &Path) -> Result<(), String> {
 
 #[cfg(feature = "synth")]
 fn forward_models(dir: &Path) -> Result<(), String> {
-    use evflow_nodes::synth::model_file::{ForwardModel, Training};
-    use evflow_nodes::synth::volterra_fit::{fit, FitConfig};
+    use crate::synth::model_file::{ForwardModel, Training};
+    use crate::synth::volterra_fit::{fit, FitConfig};
     // A square law behind a short filter, trained on actuations within ±1.
     let u: Vec<f64> = signal(3000, 5).iter().map(|v| 2.0 * v).collect();
     let y: Vec<f64> = (0..u.len()).map(|n| (0.8 * u[n] - 0.3 * if n > 0 { u[n - 1] } else { 0.0 }).powi(2)).collect();

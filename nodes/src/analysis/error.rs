@@ -1,6 +1,7 @@
 //! `error`: how far a stream is from a reference stream.
 
 use crate::sum::Sum;
+use evflow_engine::typed_ports::InPort;
 use evflow_engine::{BuildContext, Io, Node, NodeError, NodeSpec, Params, PortSpec, Role, Summary};
 
 /// Declaration of `error`.
@@ -24,11 +25,18 @@ a diverging method belongs on the diagram, at the top.\n\
 **Checked against:** a sine and the same sine shifted by a known small phase (analytic RMS \
 difference), identical streams (zero), and a reference of zeros (error).",
 )
-.ports(&[
+.ports(PORTS)
+.example("");
+
+/// The ports: the stream under test and its reference.
+const PORTS: &[PortSpec] = &[
     PortSpec::input("test", "1", "the stream under test"),
     PortSpec::input("reference", "1", "the reference (same unit)"),
-])
-.example("");
+];
+/// The stream under test.
+const TEST: InPort = InPort::named(PORTS, "test");
+/// The reference.
+const REFERENCE: InPort = InPort::named(PORTS, "reference");
 
 #[derive(Default)]
 struct ErrorSink {
@@ -46,7 +54,7 @@ fn build(_: &Params, _: &BuildContext) -> Result<Box<dyn Node>, NodeError> {
 impl Node for ErrorSink {
     fn process(&mut self, io: &mut Io<'_>) -> Result<(), NodeError> {
         for k in 0..io.len() {
-            let (x, r) = (io.input(0)[k], io.input(1)[k]);
+            let (x, r) = (io.input(TEST)[k], io.input(REFERENCE)[k]);
             let d = x - r;
             if !d.is_finite() || !r.is_finite() {
                 self.diverged = true;

@@ -1,6 +1,8 @@
 //! `onoff`: the friction increase while an effect is on, against while it is off.
 
-use evflow_engine::{BuildContext, Io, Node, NodeError, NodeSpec, ParamSpec, Params, PortSpec, Role, Summary};
+use evflow_engine::typed_params::Float;
+use evflow_engine::typed_ports::InPort;
+use evflow_engine::{BuildContext, Io, Node, NodeError, NodeSpec, Params, PortSpec, Role, Summary};
 
 /// Declaration of `onoff`.
 pub static SPEC: NodeSpec = NodeSpec::new(
@@ -27,16 +29,29 @@ at any one rate (the node's). An error if either state has no counted sample, or
 **Checked against:** a synthetic force of known friction levels with a known gate, in both \
 directions, with a transient that `settle` removes.",
 )
-.ports(&[
+.ports(PORTS)
+.params(&[MIN_SPEED.spec(), SETTLE.spec()])
+.example("min_speed = 0.005\nsettle = 0.0");
+
+/// The ports: force, gate and velocity, at the node's rate.
+const PORTS: &[PortSpec] = &[
     PortSpec::input("force", "N", "tangential force (low-passed)"),
     PortSpec::input("gate", "1", "the effect's state: on where > 0.5"),
     PortSpec::input("velocity", "m/s", "sliding velocity: its sign gives the friction's direction"),
-])
-.params(&[
-    ParamSpec::float("min_speed", 0.0, 10.0, 0.005, "m/s", "slower samples (rest, turnarounds) are left out"),
-    ParamSpec::float("settle", 0.0, 100.0, 0.05, "s", "time left out after each switch of the gate or start of motion"),
-])
-.example("min_speed = 0.005\nsettle = 0.0");
+];
+/// The tangential force.
+const FORCE: InPort = InPort::named(PORTS, "force");
+/// The effect's state.
+const GATE: InPort = InPort::named(PORTS, "gate");
+/// The sliding velocity.
+const VELOCITY: InPort = InPort::named(PORTS, "velocity");
+
+/// `min_speed`: slower samples are left out.
+const MIN_SPEED: Float =
+    Float::new("min_speed", 0.0, 10.0, 0.005, "m/s", "slower samples (rest, turnarounds) are left out");
+/// `settle`: time left out after a switch or a start.
+const SETTLE: Float =
+    Float::new("settle", 0.0, 100.0, 0.05, "s", "time left out after each switch of the gate or start of motion");
 
 struct OnOff {
     min_speed: f64,
@@ -53,8 +68,8 @@ struct OnOff {
 
 fn build(p: &Params, ctx: &BuildContext) -> Result<Box<dyn Node>, NodeError> {
     Ok(Box::new(OnOff {
-        min_speed: p.f64("min_speed"),
-        settle: (p.f64("settle") * ctx.rate).round() as u64,
+        min_speed: MIN_SPEED.get(p),
+        settle: (SETTLE.get(p) * ctx.rate).round() as u64,
         skip: 0,
         last_on: None,
         moving: false,
@@ -68,7 +83,7 @@ fn build(p: &Params, ctx: &BuildContext) -> Result<Box<dyn Node>, NodeError> {
 impl Node for OnOff {
     fn process(&mut self, io: &mut Io<'_>) -> Result<(), NodeError> {
         for k in 0..io.len() {
-            let (f, g, v) = (io.input(0)[k], io.input(1)[k], io.input(2)[k]);
+            let (f, g, v) = (io.input(FORCE)[k], io.input(GATE)[k], io.input(VELOCITY)[k]);
             self.n += 1;
             if !(f.is_finite() && g.is_finite() && v.is_finite()) {
                 self.bad.get_or_insert(self.n - 1);

@@ -1,6 +1,8 @@
 //! `peaks`: the mean of the largest peak-to-peak amplitudes of a vibration.
 
-use evflow_engine::{BuildContext, Io, Node, NodeError, NodeSpec, ParamSpec, Params, PortSpec, Role, Summary};
+use evflow_engine::typed_params::Int;
+use evflow_engine::typed_ports::InPort;
+use evflow_engine::{BuildContext, Io, Node, NodeError, NodeSpec, Params, PortSpec, Role, Summary};
 use std::cmp::Reverse;
 use std::collections::BinaryHeap;
 
@@ -29,9 +31,18 @@ the largest but split a noisy peak.\n\
 **Checked against:** a sine of amplitude A (every swing 2A), a sum of two sines with a known \
 envelope maximum, and a signal with fewer swings than `count`.",
 )
-.ports(&[PortSpec::input("in", "N", "the vibratory force (low-passed)").at(evflow_engine::RateSpec::Any)])
-.params(&[ParamSpec::int("count", 1, 1_000_000, 50, "1", "how many of the largest swings are averaged")])
+.ports(PORTS)
+.params(&[COUNT.spec()])
 .example("count = 50");
+
+/// The port: the force, at any rate.
+const PORTS: &[PortSpec] =
+    &[PortSpec::input("in", "N", "the vibratory force (low-passed)").at(evflow_engine::RateSpec::Any)];
+/// The vibratory force.
+const IN: InPort = InPort::named(PORTS, "in");
+
+/// `count`: how many of the largest swings are averaged.
+const COUNT: Int = Int::new("count", 1, 1_000_000, 50, "1", "how many of the largest swings are averaged");
 
 /// An f64 ordered by `total_cmp`, for the heap.
 #[derive(Clone, Copy, PartialEq)]
@@ -64,7 +75,7 @@ struct Peaks {
 }
 
 fn build(p: &Params, _: &BuildContext) -> Result<Box<dyn Node>, NodeError> {
-    let count = p.usize("count");
+    let count = COUNT.count(p);
     Ok(Box::new(Peaks {
         count,
         best: BinaryHeap::with_capacity(count + 1),
@@ -116,7 +127,7 @@ impl Peaks {
 
 impl Node for Peaks {
     fn process(&mut self, io: &mut Io<'_>) -> Result<(), NodeError> {
-        for &x in io.input(0) {
+        for &x in io.input(IN) {
             if !x.is_finite() {
                 self.bad.get_or_insert(self.n);
             } else if self.bad.is_none() {

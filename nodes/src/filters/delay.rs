@@ -1,7 +1,9 @@
 //! `delay`: delays a stream by a whole number of samples; the node that
 //! lets a feedback cycle through.
 
-use evflow_engine::{BuildContext, Io, Node, NodeError, NodeSpec, ParamSpec, Params, PortSpec, Role};
+use evflow_engine::typed_params::Int;
+use evflow_engine::typed_ports::{InPort, OutPort};
+use evflow_engine::{BuildContext, Io, Node, NodeError, NodeSpec, Params, PortSpec, Role};
 
 /// Largest delay in samples (80 MB of history).
 pub const MAX_SAMPLES: i64 = 10_000_000;
@@ -23,10 +25,21 @@ pub static SPEC: NodeSpec =
              (dissertation §5.2). Checked against: a delayed ramp for blocks shorter and longer than d, and a feedback \
              accumulator against its recursion for block sizes 1 and d.",
         )
-        .ports(&[PortSpec::input("in", "1", "signal"), PortSpec::output("out", "1", "signal, d samples later")])
-        .params(&[ParamSpec::int("samples", 1, MAX_SAMPLES, 1, "samples", "delay d at the input's rate")])
+        .ports(PORTS)
+        .params(&[SAMPLES.spec()])
         .breaks_cycles()
         .example("samples = 1");
+
+/// The ports: one signal in, the same signal d samples later out.
+const PORTS: &[PortSpec] =
+    &[PortSpec::input("in", "1", "signal"), PortSpec::output("out", "1", "signal, d samples later")];
+/// The signal.
+const IN: InPort = InPort::named(PORTS, "in");
+/// The delayed signal.
+const OUT: OutPort = OutPort::named(PORTS, "out");
+
+/// `samples`: the delay d.
+const SAMPLES: Int = Int::new("samples", 1, MAX_SAMPLES, 1, "samples", "delay d at the input's rate");
 
 /// A ring buffer holding the last `d` inputs; `pos` is the oldest one, the
 /// next to come out.
@@ -36,9 +49,9 @@ struct Delay {
 }
 
 fn build(p: &Params, _: &BuildContext) -> Result<Box<dyn Node>, NodeError> {
-    let d = p.usize("samples");
+    let d = SAMPLES.count(p);
     if d == 0 {
-        return Err(NodeError::param("samples", "a delay must be at least 1 sample"));
+        return Err(NodeError::param(SAMPLES.name(), "a delay must be at least 1 sample"));
     }
     Ok(Box::new(Delay { ring: vec![0.0; d], pos: 0 }))
 }
@@ -73,7 +86,7 @@ impl Delay {
 
 impl Node for Delay {
     fn process(&mut self, io: &mut Io<'_>) -> Result<(), NodeError> {
-        let (x, y) = io.io(0, 0);
+        let (x, y) = io.io(IN, OUT);
         // Chunks of at most d samples: each reads d-old samples, then stores
         // its own inputs in their place.
         let d = self.ring.len();
@@ -85,7 +98,7 @@ impl Node for Delay {
     }
 
     fn emit(&mut self, io: &mut Io<'_>) -> Result<(), NodeError> {
-        let y = io.output(0);
+        let y = io.output(OUT);
         if y.len() > self.ring.len() {
             return Err(self.too_long(y.len()));
         }
@@ -94,7 +107,7 @@ impl Node for Delay {
     }
 
     fn absorb(&mut self, io: &mut Io<'_>) -> Result<(), NodeError> {
-        let x = io.input(0);
+        let x = io.input(IN);
         if x.len() > self.ring.len() {
             return Err(self.too_long(x.len()));
         }
@@ -160,19 +173,29 @@ mod tests {
     }
 
     // A two-input sum, only for these tests (the library has no adder yet).
-    static SUM: NodeSpec = NodeSpec::new("test.sum", "test", Role::Filter, "a + b (test only)", build_sum).ports(&[
+    static SUM: NodeSpec =
+        NodeSpec::new("test.sum", "test", Role::Filter, "a + b (test only)", build_sum).ports(SUM_PORTS);
+
+    /// The test sum's ports.
+    const SUM_PORTS: &[PortSpec] = &[
         PortSpec::input("a", "1", "first term"),
         PortSpec::input("b", "1", "second term"),
         PortSpec::output("out", "1", "a + b"),
-    ]);
+    ];
+    /// The first term.
+    const A: InPort = InPort::named(SUM_PORTS, "a");
+    /// The second term.
+    const B: InPort = InPort::named(SUM_PORTS, "b");
+    /// The sum.
+    const SUM_OUT: OutPort = OutPort::named(SUM_PORTS, "out");
 
     struct Sum;
 
     impl Node for Sum {
         fn process(&mut self, io: &mut Io<'_>) -> Result<(), NodeError> {
             for i in 0..io.len() {
-                let v = io.input(0)[i] + io.input(1)[i];
-                io.output(0)[i] = v;
+                let v = io.input(A)[i] + io.input(B)[i];
+                io.output(SUM_OUT)[i] = v;
             }
             Ok(())
         }

@@ -1,7 +1,9 @@
 //! `normalize`: maps a stream from a given range to [−1, 1] (MATLAB
 //! `mapminmax` with fixed settings).
 
-use evflow_engine::{BuildContext, Io, Node, NodeError, NodeSpec, ParamSpec, Params, PortSpec, Role};
+use evflow_engine::typed_params::{Flag, Float};
+use evflow_engine::typed_ports::{InPort, OutPort};
+use evflow_engine::{BuildContext, Io, Node, NodeError, NodeSpec, Params, PortSpec, Role};
 
 /// Declaration of `normalize`.
 pub static SPEC: NodeSpec = NodeSpec::new(
@@ -21,13 +23,23 @@ pub static SPEC: NodeSpec = NodeSpec::new(
      stream cannot know its own extremes before it has ended. Runs at the rate of its input.\n\n\
      Checked: the ends map to ±1 exactly, the midpoint to 0, clamping, refusal of an empty range.",
 )
-.ports(&[PortSpec::input("in", "1", "signal"), PortSpec::output("out", "1", "normalized signal")])
-.params(&[
-    ParamSpec::float("min", -1e12, 1e12, -1.0, "1", "input value that maps to −1").required(),
-    ParamSpec::float("max", -1e12, 1e12, 1.0, "1", "input value that maps to +1").required(),
-    ParamSpec::flag("clamp", true, "hold the output inside [−1, 1]"),
-])
+.ports(PORTS)
+.params(&[MIN.spec(), MAX.spec(), CLAMP.spec()])
 .example("min = -0.08\nmax = 0.11\nclamp = true");
+
+/// The ports: one signal in, the normalized signal out.
+const PORTS: &[PortSpec] = &[PortSpec::input("in", "1", "signal"), PortSpec::output("out", "1", "normalized signal")];
+/// The signal.
+const IN: InPort = InPort::named(PORTS, "in");
+/// The normalized signal.
+const OUT: OutPort = OutPort::named(PORTS, "out");
+
+/// `min`: the input value that maps to −1.
+const MIN: Float = Float::new("min", -1e12, 1e12, -1.0, "1", "input value that maps to −1").required();
+/// `max`: the input value that maps to +1.
+const MAX: Float = Float::new("max", -1e12, 1e12, 1.0, "1", "input value that maps to +1").required();
+/// `clamp`: whether the output is held inside [−1, 1].
+const CLAMP: Flag = Flag::new("clamp", true, "hold the output inside [−1, 1]");
 
 struct Normalize {
     scale: f64,
@@ -36,16 +48,16 @@ struct Normalize {
 }
 
 fn build(p: &Params, _ctx: &BuildContext) -> Result<Box<dyn Node>, NodeError> {
-    let (min, max) = (p.f64("min"), p.f64("max"));
+    let (min, max) = (MIN.get(p), MAX.get(p));
     if max.partial_cmp(&min) != Some(std::cmp::Ordering::Greater) {
-        return Err(NodeError::param("max", format!("must be above min = {min} (got {max}): the range is empty")));
+        return Err(NodeError::param(MAX.name(), format!("must be above min = {min} (got {max}): the range is empty")));
     }
-    Ok(Box::new(Normalize { scale: 2.0 / (max - min), min, clamp: p.bool("clamp") }))
+    Ok(Box::new(Normalize { scale: 2.0 / (max - min), min, clamp: CLAMP.get(p) }))
 }
 
 impl Node for Normalize {
     fn process(&mut self, io: &mut Io<'_>) -> Result<(), NodeError> {
-        let (x, y) = io.io(0, 0);
+        let (x, y) = io.io(IN, OUT);
         for (y, x) in y.iter_mut().zip(x) {
             let v = self.scale * (x - self.min) - 1.0;
             *y = if self.clamp { v.clamp(-1.0, 1.0) } else { v };

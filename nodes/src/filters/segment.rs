@@ -1,6 +1,8 @@
 //! `segment`: marks the constant-speed stretches of a scan (§5.1.1).
 
-use evflow_engine::{BuildContext, Io, Node, NodeError, NodeSpec, ParamSpec, Params, PortSpec, Role};
+use evflow_engine::typed_params::{Choice, Float, Words};
+use evflow_engine::typed_ports::{InPort, OutPort};
+use evflow_engine::{BuildContext, Io, Node, NodeError, NodeSpec, Params, PortSpec, Role};
 
 /// Declaration of `segment`.
 pub static SPEC: NodeSpec = NodeSpec::new(
@@ -29,17 +31,63 @@ velocity counts as out of tolerance (and restarts the settling).\n\n\
 Checked against: a trapezoidal velocity profile with known plateau starts and ends, both \
 directions, the settling count, a NaN sample, block ≡ per-sample processing.",
 )
-.ports(&[
+.ports(PORTS)
+.params(&[SPEED.spec(), TOLERANCE.spec(), SETTLE.spec(), DIRECTION.spec()])
+.example("speed = 5.0\ntolerance = 0.02\nsettle = 0.1\ndirection = \"both\"");
+
+/// The ports: the velocity in, the gate out, at the same rate.
+const PORTS: &[PortSpec] = &[
     PortSpec::input("velocity", "m/s", "scanning velocity (e.g. the tribometer's)"),
     PortSpec::output("gate", "1", "1 inside a settled constant-speed stretch, else 0"),
-])
-.params(&[
-    ParamSpec::float("speed", 1e-3, 1e4, 5.0, "cm/s", "the constant scanning speed (either direction)").required(),
-    ParamSpec::float("tolerance", 1e-6, 0.5, 0.02, "1", "largest relative deviation of |v| from `speed`"),
-    ParamSpec::float("settle", 0.0, 60.0, 0.1, "s", "time |v| must have stayed in tolerance"),
-    ParamSpec::choice("direction", &["both", "forward", "backward"], "both", "which passes count: both, +x only or −x only"),
-])
-.example("speed = 5.0\ntolerance = 0.02\nsettle = 0.1\ndirection = \"both\"");
+];
+/// The scanning velocity.
+const VELOCITY: InPort = InPort::named(PORTS, "velocity");
+/// The gate.
+const GATE: OutPort = OutPort::named(PORTS, "gate");
+
+/// `speed`: the constant scanning speed.
+const SPEED: Float =
+    Float::new("speed", 1e-3, 1e4, 5.0, "cm/s", "the constant scanning speed (either direction)").required();
+/// `tolerance`: the largest relative deviation of |v| from `speed`.
+const TOLERANCE: Float =
+    Float::new("tolerance", 1e-6, 0.5, 0.02, "1", "largest relative deviation of |v| from `speed`");
+/// `settle`: how long |v| must have stayed in tolerance.
+const SETTLE: Float = Float::new("settle", 0.0, 60.0, 0.1, "s", "time |v| must have stayed in tolerance");
+/// `direction`: which passes count.
+const DIRECTION: Choice<Pass> = Choice::new(
+    "direction",
+    &["both", "forward", "backward"],
+    &[Pass::Both, Pass::Forward, Pass::Backward],
+    "both",
+    "which passes count: both, +x only or −x only",
+);
+
+/// Which passes of the scan count.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+enum Pass {
+    /// Both directions.
+    Both,
+    /// +x only.
+    Forward,
+    /// −x only.
+    Backward,
+}
+
+impl Pass {
+    /// The `direction` argument of [`SpeedRule::new`]: +1, −1 or 0.
+    fn sign(self) -> f64 {
+        match self {
+            Pass::Both => 0.0,
+            Pass::Forward => 1.0,
+            Pass::Backward => -1.0,
+        }
+    }
+}
+
+/// The `gate` parameter of the sinks that take gates (`metric`,
+/// `narx.train`, `narx.score`, `synth.train`): the names of their gate
+/// inputs, one port `gate` each ([`PortSpec::per`]).
+pub const GATES: Words = Words::new("gate", "names of gate inputs (e.g. [\"steady\"] from `segment`); none by default");
 
 /// The constant-speed rule of `segment`, one sample at a time: the one
 /// definition the node and the offline users of a recording's velocity
@@ -96,17 +144,13 @@ struct Segment {
 }
 
 fn build(p: &Params, ctx: &BuildContext) -> Result<Box<dyn Node>, NodeError> {
-    let sign = match p.str("direction") {
-        "forward" => 1.0,
-        "backward" => -1.0,
-        _ => 0.0,
-    };
-    Ok(Box::new(Segment { rule: SpeedRule::new(p.f64("speed"), p.f64("tolerance"), p.f64("settle"), ctx.rate, sign) }))
+    let sign = DIRECTION.get(p).sign();
+    Ok(Box::new(Segment { rule: SpeedRule::new(SPEED.get(p), TOLERANCE.get(p), SETTLE.get(p), ctx.rate, sign) }))
 }
 
 impl Node for Segment {
     fn process(&mut self, io: &mut Io<'_>) -> Result<(), NodeError> {
-        let (v, gate) = io.io(0, 0);
+        let (v, gate) = io.io(VELOCITY, GATE);
         for (g, v) in gate.iter_mut().zip(v) {
             *g = if self.rule.step(*v) { 1.0 } else { 0.0 };
         }
@@ -126,22 +170,22 @@ pub const MAX_GATES: usize = 8;
 /// sinks that take gates (`metric`, `narx.train`).
 #[derive(Debug, Clone, Copy)]
 pub struct Gates {
-    /// Index of the first gate input (they follow the data inputs).
-    first: usize,
+    /// The first gate input (they follow the data inputs).
+    first: InPort,
     /// Number of gates.
     count: usize,
 }
 
 impl Gates {
-    /// Reads the `gate` parameter; the gate inputs follow the node's
-    /// `data_inputs` inputs. (A gate named like another input is refused by
-    /// the validator: port names must be unique.)
-    pub fn from_params(p: &Params, data_inputs: usize) -> Result<Self, NodeError> {
-        let count = p.text_list("gate").len();
+    /// Reads the `gate` parameter ([`GATES`]); the gate inputs start at
+    /// `first`, the node's repeated `gate` port. (A gate named like another
+    /// input is refused by the validator: port names must be unique.)
+    pub fn from_params(p: &Params, first: InPort) -> Result<Self, NodeError> {
+        let count = GATES.get(p).len();
         if count > MAX_GATES {
-            return Err(NodeError::param("gate", format!("{count} gates; at most {MAX_GATES}")));
+            return Err(NodeError::param(GATES.name(), format!("{count} gates; at most {MAX_GATES}")));
         }
-        Ok(Self { first: data_inputs, count })
+        Ok(Self { first, count })
     }
 
     /// Whether there are any gates.
@@ -155,7 +199,7 @@ impl Gates {
     pub fn open_runs(&self, io: &Io<'_>, keep: impl FnMut(usize, usize)) -> usize {
         let mut gates = [&[][..]; MAX_GATES];
         for (g, slot) in gates.iter_mut().enumerate().take(self.count) {
-            *slot = io.input(self.first + g);
+            *slot = io.input(self.first.nth(g));
         }
         let mut kept = 0;
         let mut keep = keep;

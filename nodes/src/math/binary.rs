@@ -1,6 +1,7 @@
 //! The node state shared by the two-input arithmetic nodes (`add`, `mul`):
 //! one operation applied sample by sample to inputs `a` and `b`.
 
+use evflow_engine::typed_ports::{InPort, OutPort};
 use evflow_engine::{Io, Node, NodeError};
 
 /// `v` held within ±f64::MAX: a sum or product of finite samples that
@@ -12,14 +13,23 @@ pub fn saturate(v: f64) -> f64 {
 }
 
 /// y[n] = op(a[n], b[n]), saturated ([`saturate`]); generic over the operation, so it is inlined.
-pub struct Binary<F>(pub F);
+pub struct Binary<F> {
+    /// The node's first operand port.
+    pub a: InPort,
+    /// The node's second operand port.
+    pub b: InPort,
+    /// The node's result port.
+    pub out: OutPort,
+    /// The operation.
+    pub op: F,
+}
 
 impl<F: Fn(f64, f64) -> f64 + Send> Node for Binary<F> {
     fn process(&mut self, io: &mut Io<'_>) -> Result<(), NodeError> {
         let n = io.len();
         for k in 0..n {
-            let v = (self.0)(io.input(0)[k], io.input(1)[k]);
-            io.output(0)[k] = saturate(v);
+            let v = (self.op)(io.input(self.a)[k], io.input(self.b)[k]);
+            io.output(self.out)[k] = saturate(v);
         }
         Ok(())
     }

@@ -3,6 +3,7 @@
 use super::binary::Binary;
 use evflow_engine::node::Constant;
 use evflow_engine::spec::FoldArgs;
+use evflow_engine::typed_ports::{InPort, OutPort};
 use evflow_engine::{BuildContext, Node, NodeError, NodeSpec, Params, PortSpec, Role};
 
 /// Declaration of `mul`.
@@ -17,21 +18,30 @@ producers. Exact: one IEEE multiplication per sample; a product beyond the range
 every node's output is) or two constant inputs make a constant output, which the planner holds and \
 leaves out what fed only the other input (docs/pruning.md).",
         )
-        .ports(&[
-            PortSpec::input("a", "1", "first factor"),
-            PortSpec::input("b", "1", "second factor"),
-            PortSpec::output("out", "1", "a · b"),
-        ])
+        .ports(PORTS)
         .example("")
         .fold(fold);
 
+/// The ports: the two operands and the result.
+const PORTS: &[PortSpec] = &[
+    PortSpec::input("a", "1", "first factor"),
+    PortSpec::input("b", "1", "second factor"),
+    PortSpec::output("out", "1", "a · b"),
+];
+/// The first operand.
+const A: InPort = InPort::named(PORTS, "a");
+/// The second operand.
+const B: InPort = InPort::named(PORTS, "b");
+/// The result.
+const OUT: OutPort = OutPort::named(PORTS, "out");
+
 fn build(_: &Params, _: &BuildContext) -> Result<Box<dyn Node>, NodeError> {
-    Ok(Box::new(Binary(|a, b| a * b)))
+    Ok(Box::new(Binary { a: A, b: B, out: OUT, op: |a, b| a * b }))
 }
 
 /// Constant when either factor is a constant 0, or both are constant.
 fn fold(f: &FoldArgs<'_>) -> Option<Constant> {
-    match (f.input(0), f.input(1)) {
+    match (f.input(A.index()), f.input(B.index())) {
         (Some(a), Some(b)) => {
             Some(Constant::all(1, super::binary::saturate(a * b), format!("{a} · {b}, both constant")))
         }

@@ -2,9 +2,10 @@
 
 use super::spectral_error::{spectral_rms_error, Band, SpectralError};
 use super::spectrum::{Spectrum, SpectrumAccumulator, SpectrumConfig, Window};
-use crate::filters::segment::Gates;
-use evflow_engine::typed_params::Choice;
-use evflow_engine::{BuildContext, Io, Node, NodeError, NodeSpec, ParamSpec, Params, PortSpec, Role, Summary};
+use crate::filters::segment::{Gates, GATES};
+use evflow_engine::typed_params::{Choice, Flag, Float, Int};
+use evflow_engine::typed_ports::InPort;
+use evflow_engine::{BuildContext, Io, Node, NodeError, NodeSpec, Params, PortSpec, Role, Summary};
 
 /// Largest FFT length (2²⁰ samples: 17 min at 1 kHz, 105 s at 10 kHz).
 const MAX_NFFT: i64 = 1 << 20;
@@ -77,21 +78,43 @@ A·nfft/8 with `hann`), the Rayleigh mean √(π/4·nfft·σ²) of white noise, 
 kernel of a zero-padded boxcar, a naive DFT, and the identities E_s(x, x) = 0, E_s(2x, x) = 1, \
 E_s(x, 2x) = 0.5, E_s = √2 for equal sines on different bins.",
 )
-.ports(&[
-    PortSpec::input("virtual", "N", "virtual force f_v, from the display (N or normalized)"),
-    PortSpec::input("real", "N", "real force f_r, recorded on the material (same unit)"),
-    PortSpec::input("gate", "1", "one per `gate` entry: the sample counts only where every gate is above 0.5").per("gate"),
-])
+.ports(PORTS)
 .params(&[
-    ParamSpec::int("nfft", 0, MAX_NFFT, 0, "samples", "FFT (segment) length; 0 = the sampling rate (1 Hz bins)"),
+    NFFT.spec(),
     WINDOW.spec(),
-    ParamSpec::float("overlap", 0.0, 0.9, 0.0, "1", "fraction of a segment shared with the next"),
-    ParamSpec::float("fmin", 0.0, 1e7, 0.0, "Hz", "lowest frequency counted in E_s"),
-    ParamSpec::float("fmax", 0.0, 1e7, 0.0, "Hz", "highest frequency counted in E_s; 0 = Nyquist"),
-    ParamSpec::flag("include_dc", false, "count the 0 Hz bin (the mean force) in E_s"),
-    ParamSpec::text_list("gate", "names of gate inputs (e.g. [\"steady\"] from `segment`); none by default"),
+    OVERLAP.spec(),
+    FMIN.spec(),
+    FMAX.spec(),
+    INCLUDE_DC.spec(),
+    GATES.spec(),
 ])
 .example("nfft = 0\nwindow = \"rect\"\noverlap = 0.0\nfmin = 0.0\nfmax = 0.0\ninclude_dc = false");
+
+/// The ports: the two forces and the gates.
+const PORTS: &[PortSpec] = &[
+    PortSpec::input("virtual", "N", "virtual force f_v, from the display (N or normalized)"),
+    PortSpec::input("real", "N", "real force f_r, recorded on the material (same unit)"),
+    PortSpec::input("gate", "1", "one per `gate` entry: the sample counts only where every gate is above 0.5")
+        .per(GATES.name()),
+];
+/// The virtual force f_v.
+const VIRTUAL: InPort = InPort::named(PORTS, "virtual");
+/// The real force f_r.
+const REAL: InPort = InPort::named(PORTS, "real");
+/// The first gate.
+const GATE: InPort = InPort::named(PORTS, "gate");
+
+/// `nfft`: the FFT (segment) length.
+const NFFT: Int =
+    Int::new("nfft", 0, MAX_NFFT, 0, "samples", "FFT (segment) length; 0 = the sampling rate (1 Hz bins)");
+/// `overlap`: the fraction of a segment shared with the next.
+const OVERLAP: Float = Float::new("overlap", 0.0, 0.9, 0.0, "1", "fraction of a segment shared with the next");
+/// `fmin`: the lowest frequency counted in E_s.
+const FMIN: Float = Float::new("fmin", 0.0, 1e7, 0.0, "Hz", "lowest frequency counted in E_s");
+/// `fmax`: the highest frequency counted in E_s.
+const FMAX: Float = Float::new("fmax", 0.0, 1e7, 0.0, "Hz", "highest frequency counted in E_s; 0 = Nyquist");
+/// `include_dc`: whether the 0 Hz bin counts.
+const INCLUDE_DC: Flag = Flag::new("include_dc", false, "count the 0 Hz bin (the mean force) in E_s");
 
 /// Running RMS (scaled sum of squares, as LAPACK's `dnrm2`, so no
 /// overflow or underflow), extremes, and the first non-finite sample.
@@ -141,6 +164,7 @@ impl Stats {
 /// One input: its statistics and its spectrum.
 struct Channel {
     name: &'static str,
+    port: InPort,
     stats: Stats,
     spectrum: SpectrumAccumulator,
 }
@@ -169,36 +193,36 @@ const WINDOW: Choice<Window> =
 
 fn build(p: &Params, ctx: &BuildContext) -> Result<Box<dyn Node>, NodeError> {
     let rate = ctx.rate;
-    let gates = Gates::from_params(p, 2)?;
-    let nfft = match p.usize("nfft") {
+    let gates = Gates::from_params(p, GATE)?;
+    let nfft = match NFFT.count(p) {
         0 => {
             let n = rate.round();
             if !(2.0..=MAX_NFFT as f64).contains(&n) {
                 return Err(NodeError::param(
-                    "nfft",
+                    NFFT.name(),
                     format!("0 means the sampling rate, {rate} Hz, which is not an FFT length in 2 ..= {MAX_NFFT}; set nfft"),
                 ));
             }
             n as usize
         }
-        1 => return Err(NodeError::param("nfft", "must be 0 (= the sampling rate) or at least 2 samples")),
+        1 => return Err(NodeError::param(NFFT.name(), "must be 0 (= the sampling rate) or at least 2 samples")),
         n => n,
     };
     let window = WINDOW.get(p);
-    let include_dc = p.bool("include_dc");
-    let band = Band::new(rate, nfft, p.f64("fmin"), p.f64("fmax"), include_dc)
+    let include_dc = INCLUDE_DC.get(p);
+    let band = Band::new(rate, nfft, FMIN.get(p), FMAX.get(p), include_dc)
         .map_err(|e| NodeError::param(e.param, e.message))?;
-    let cfg = SpectrumConfig { rate, nfft, window, overlap: p.f64("overlap") };
-    let channel = |name| -> Result<Channel, NodeError> {
-        let spectrum = SpectrumAccumulator::new(cfg).map_err(|e| NodeError::param("nfft", e.to_string()))?;
-        Ok(Channel { name, stats: Stats::new(), spectrum })
+    let cfg = SpectrumConfig { rate, nfft, window, overlap: OVERLAP.get(p) };
+    let channel = |name, port| -> Result<Channel, NodeError> {
+        let spectrum = SpectrumAccumulator::new(cfg).map_err(|e| NodeError::param(NFFT.name(), e.to_string()))?;
+        Ok(Channel { name, port, stats: Stats::new(), spectrum })
     };
     Ok(Box::new(Metric {
         rate,
         band,
-        fmin: p.f64("fmin"),
+        fmin: FMIN.get(p),
         include_dc,
-        channels: [channel("virtual")?, channel("real")?],
+        channels: [channel("virtual", VIRTUAL)?, channel("real", REAL)?],
         gates,
         gated_out: 0,
     }))
@@ -208,8 +232,8 @@ impl Node for Metric {
     fn process(&mut self, io: &mut Io<'_>) -> Result<(), NodeError> {
         let channels = &mut self.channels;
         let kept = self.gates.open_runs(io, |a, b| {
-            for (i, c) in channels.iter_mut().enumerate() {
-                c.push(&io.input(i)[a..b]);
+            for c in channels.iter_mut() {
+                c.push(&io.input(c.port)[a..b]);
             }
         });
         let n = io.len();

@@ -1,46 +1,17 @@
 //! Errors of the NARX family: model files, training data, training.
 
-use std::path::PathBuf;
+use crate::model_file::{ModelFileError, ModelFormat};
+use std::path::Path;
+
+/// The NARX model format, as its errors name it.
+pub const MODEL_FORMAT: ModelFormat = ModelFormat { file: "NARX model", name: "model", redo: "retrain" };
 
 /// Everything that can go wrong reading or writing a model, or training one.
 #[derive(Debug, thiserror::Error)]
 pub enum NarxError {
-    /// A model file that cannot be read or written.
-    #[error("{path}: {message}")]
-    Io {
-        /// The file.
-        path: PathBuf,
-        /// What the operating system said.
-        message: String,
-    },
-    /// A model file that is not valid JSON or not a NARX model.
-    #[error("{path}: not a NARX model file: {message}")]
-    Parse {
-        /// The file.
-        path: PathBuf,
-        /// What the parser said (with line and column).
-        message: String,
-    },
-    /// A model file written by a newer or unknown version of the format.
-    #[error("{path}: model format version {found} is not supported (this evflow reads version {supported}); retrain the model or update evflow")]
-    Version {
-        /// The file.
-        path: PathBuf,
-        /// The version in the file.
-        found: u64,
-        /// The version this code reads.
-        supported: u64,
-    },
-    /// A field of a model file with a value that cannot be right.
-    #[error("{path}: field `{field}`: {message}")]
-    Field {
-        /// The file.
-        path: PathBuf,
-        /// The field, as a dotted path (e.g. `normalization.x.min`).
-        field: String,
-        /// What is wrong with it.
-        message: String,
-    },
+    /// A model file that cannot be read, written or used.
+    #[error(transparent)]
+    File(#[from] ModelFileError),
     /// Training data the network cannot be trained on (too short, constant, NaN).
     #[error("training data: {0}")]
     Data(String),
@@ -50,29 +21,55 @@ pub enum NarxError {
 }
 
 impl NarxError {
+    /// A model file at `path` that cannot be read or written.
+    pub fn io(path: &Path, message: impl Into<String>) -> Self {
+        ModelFileError::Io { path: path.to_path_buf(), message: message.into() }.into()
+    }
+
+    /// A file at `path` that is not valid JSON or not a NARX model.
+    pub fn parse(path: &Path, message: impl Into<String>) -> Self {
+        ModelFileError::Parse { format: MODEL_FORMAT, path: path.to_path_buf(), message: message.into() }.into()
+    }
+
+    /// A model at `path` of format version `found`; this code reads `supported`.
+    pub fn version(path: &Path, found: u64, supported: u64) -> Self {
+        ModelFileError::Version { format: MODEL_FORMAT, path: path.to_path_buf(), found, supported }.into()
+    }
+
     /// A field error for `path`.
-    pub fn field(path: &std::path::Path, field: &str, message: impl Into<String>) -> Self {
-        NarxError::Field { path: path.to_path_buf(), field: field.to_string(), message: message.into() }
+    pub fn field(path: &Path, field: &str, message: impl Into<String>) -> Self {
+        ModelFileError::field(path, field, message).into()
     }
 }
 
 impl From<NarxError> for evflow_engine::NodeError {
     fn from(e: NarxError) -> Self {
         match e {
-            NarxError::Io { path, message } => evflow_engine::NodeError::File { path, message },
-            NarxError::Parse { ref path, .. }
-            | NarxError::Version { ref path, .. }
-            | NarxError::Field { ref path, .. } => {
-                evflow_engine::NodeError::File { path: path.clone(), message: strip(&e.to_string(), path) }
-            }
+            NarxError::File(e) => e.into(),
             NarxError::Data(m) => evflow_engine::NodeError::Data(format!("training data: {m}")),
             NarxError::Config(m) => evflow_engine::NodeError::Other(format!("configuration: {m}")),
         }
     }
 }
 
-/// The message without the leading `path: ` (the node error adds the path itself).
-fn strip(s: &str, path: &std::path::Path) -> String {
-    let prefix = format!("{}: ", path.display());
-    s.strip_prefix(&prefix).unwrap_or(s).to_string()
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn model_file_messages_name_the_narx_format() {
+        let p = Path::new("m.json");
+        assert_eq!(
+            NarxError::version(p, 3, 1).to_string(),
+            "m.json: model format version 3 is not supported (this evflow reads version 1); retrain the model or update evflow"
+        );
+        assert_eq!(NarxError::parse(p, "EOF").to_string(), "m.json: not a NARX model file: EOF");
+        assert_eq!(NarxError::io(p, "denied").to_string(), "m.json: denied");
+        assert_eq!(
+            NarxError::field(p, "delays.input", "negative").to_string(),
+            "m.json: field `delays.input`: negative"
+        );
+        let e: evflow_engine::NodeError = NarxError::Data("constant".into()).into();
+        assert!(matches!(e, evflow_engine::NodeError::Data(m) if m == "training data: constant"));
+    }
 }

@@ -6,8 +6,10 @@
 use super::closed_loop::ClosedLoop;
 use super::model::Model;
 use super::nearest::nearest;
-use super::packed::Tanh;
-use evflow_engine::{BuildContext, Io, Node, NodeError, NodeSpec, ParamSpec, Params, PortSpec, Role, Summary};
+use super::node::TANH;
+use evflow_engine::typed_params::{Float, Words};
+use evflow_engine::typed_ports::{InPort, OutPort};
+use evflow_engine::{BuildContext, Io, Node, NodeError, NodeSpec, Params, PortSpec, Role, Summary};
 
 /// Declaration of `narx.grid`.
 pub static SPEC: NodeSpec = NodeSpec::new(
@@ -37,20 +39,35 @@ pub static SPEC: NodeSpec = NodeSpec::new(
      without a condition or one at another rate are refused when the graph is built, naming the file. \
      Outputs are bounded as `narx`'s. `tanh`: as `narx`'s (`exact` by default, or `fast`).",
 )
-.ports(&[
+.ports(PORTS)
+.params(&[MODELS.spec(), UPDATE_RATE.spec(), CROSSFADE.spec(), TANH.spec()])
+.example("models = [\"models/narx-60g-3cms.json\", \"models/narx-110g-7cms.json\"]");
+
+/// The ports: force, load and velocity in; actuation and the model heard out.
+const PORTS: &[PortSpec] = &[
     PortSpec::input("force", "N", "desired lateral force"),
     PortSpec::input("load", "g", "user's normal load"),
     PortSpec::input("velocity", "cm/s", "user's scanning velocity (its magnitude is used)"),
     PortSpec::output("u", "1", "the nearest model's actuation, crossfaded on a change"),
     PortSpec::output("model", "1", "index into `models` of the model heard"),
-])
-.params(&[
-    ParamSpec::text_list("models", "model files written by narx.train, one per trained condition").required(),
-    ParamSpec::float("update_rate", 0.01, 1000.0, 10.0, "Hz", "how often the nearest model is chosen"),
-    ParamSpec::float("crossfade", 0.0, 1000.0, 10.0, "ms", "crossfade from one model to the next"),
-    ParamSpec::choice("tanh", &["exact", "fast"], "exact", "hidden-layer tanh: exact (std) or fast (|error| ≤ 1e-15)"),
-])
-.example("models = [\"models/narx-60g-3cms.json\", \"models/narx-110g-7cms.json\"]");
+];
+/// The desired force.
+const FORCE: InPort = InPort::named(PORTS, "force");
+/// The user's normal load.
+const LOAD: InPort = InPort::named(PORTS, "load");
+/// The user's scanning velocity.
+const VELOCITY: InPort = InPort::named(PORTS, "velocity");
+/// The actuation.
+const U: OutPort = OutPort::named(PORTS, "u");
+/// The index of the model heard.
+const MODEL: OutPort = OutPort::named(PORTS, "model");
+
+/// `models`: the model files, one per trained condition.
+const MODELS: Words = Words::new("models", "model files written by narx.train, one per trained condition").required();
+/// `update_rate`: how often the nearest model is chosen.
+const UPDATE_RATE: Float = Float::new("update_rate", 0.01, 1000.0, 10.0, "Hz", "how often the nearest model is chosen");
+/// `crossfade`: how long a switch takes.
+const CROSSFADE: Float = Float::new("crossfade", 0.0, 1000.0, 10.0, "ms", "crossfade from one model to the next");
 
 struct NarxGrid {
     loops: Vec<ClosedLoop>,
@@ -70,11 +87,11 @@ struct NarxGrid {
 }
 
 fn build(p: &Params, ctx: &BuildContext) -> Result<Box<dyn Node>, NodeError> {
-    let names = p.text_list("models");
+    let names = MODELS.get(p);
     if names.is_empty() {
-        return Err(NodeError::param("models", "name at least one model file (written by narx.train)"));
+        return Err(NodeError::param(MODELS.name(), "name at least one model file (written by narx.train)"));
     }
-    let tanh = p.str("tanh").parse::<Tanh>().map_err(|m| NodeError::param("tanh", m))?;
+    let tanh = TANH.get(p);
     let (mut loops, mut conditions) = (Vec::new(), Vec::new());
     for name in names {
         let path = ctx.path(name);
@@ -107,8 +124,8 @@ fn build(p: &Params, ctx: &BuildContext) -> Result<Box<dyn Node>, NodeError> {
         loops.push(model.closed_loop_with(tanh)?);
         conditions.push((m, v));
     }
-    let every = ((ctx.rate / p.f64("update_rate")).round() as u64).max(1);
-    let fade_len = (p.f64("crossfade") * 1e-3 * ctx.rate).round() as usize;
+    let every = ((ctx.rate / UPDATE_RATE.get(p)).round() as u64).max(1);
+    let fade_len = (CROSSFADE.get(p) * 1e-3 * ctx.rate).round() as usize;
     let n = loops.len();
     Ok(Box::new(NarxGrid {
         loops,
@@ -127,7 +144,7 @@ fn build(p: &Params, ctx: &BuildContext) -> Result<Box<dyn Node>, NodeError> {
 impl Node for NarxGrid {
     fn process(&mut self, io: &mut Io<'_>) -> Result<(), NodeError> {
         for k in 0..io.len() {
-            let (f, m, v) = (io.input(0)[k], io.input(1)[k], io.input(2)[k]);
+            let (f, m, v) = (io.input(FORCE)[k], io.input(LOAD)[k], io.input(VELOCITY)[k]);
             if self.n.is_multiple_of(self.every) {
                 let want = nearest(&self.conditions, m, v.abs()).unwrap_or(0);
                 if want != self.current {
@@ -146,8 +163,8 @@ impl Node for NarxGrid {
                 u = (1.0 - w) * self.ys[from] + w * u;
                 self.fade = (done + 1 < self.fade_len).then_some((from, done + 1));
             }
-            io.output(0)[k] = u;
-            io.output(1)[k] = self.current as f64;
+            io.output(U)[k] = u;
+            io.output(MODEL)[k] = self.current as f64;
             self.n += 1;
         }
         Ok(())

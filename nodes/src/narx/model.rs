@@ -186,7 +186,7 @@ impl Model {
             return f("format", format!("`{}` is not `{FORMAT}`", self.format));
         }
         if self.version != VERSION {
-            return Err(NarxError::Version { path: path.into(), found: self.version, supported: VERSION });
+            return Err(NarxError::version(path, self.version, VERSION));
         }
         if !(self.rate_hz.is_finite() && self.rate_hz > 0.0) {
             return f("rate_hz", format!("{} is not a sample rate", self.rate_hz));
@@ -241,9 +241,9 @@ impl Model {
     /// Reads and checks a model file.
     pub fn load(path: &Path) -> Result<Self, NarxError> {
         let text = evflow_engine::files::read_regular_to_string(path)
-            .map_err(|e| NarxError::Io { path: path.into(), message: format!("cannot read the model: {e}") })?;
+            .map_err(|e| NarxError::io(path, format!("cannot read the model: {e}")))?;
         let value: serde_json::Value =
-            serde_json::from_str(&text).map_err(|e| NarxError::Parse { path: path.into(), message: e.to_string() })?;
+            serde_json::from_str(&text).map_err(|e| NarxError::parse(path, e.to_string()))?;
         // Format and version first, so a newer file is refused for what it is.
         match value.get("format").and_then(|v| v.as_str()) {
             Some(FORMAT) => {}
@@ -252,7 +252,7 @@ impl Model {
         }
         match value.get("version").and_then(|v| v.as_u64()) {
             Some(VERSION) => {}
-            Some(found) => return Err(NarxError::Version { path: path.into(), found, supported: VERSION }),
+            Some(found) => return Err(NarxError::version(path, found, VERSION)),
             None => return Err(NarxError::field(path, "version", "missing or not a whole number")),
         }
         let model: Model = serde_path_to_error(value, path)?;
@@ -263,9 +263,9 @@ impl Model {
     /// Writes the model to `path` (through `path.tmp` and a rename).
     pub fn save(&self, path: &Path) -> Result<(), NarxError> {
         let text = serde_json::to_string_pretty(self)
-            .map_err(|e| NarxError::Io { path: path.into(), message: format!("cannot encode the model: {e}") })?;
+            .map_err(|e| NarxError::io(path, format!("cannot encode the model: {e}")))?;
         crate::recording::atomic::write_atomically(path, &text)
-            .map_err(|e| NarxError::Io { path: path.into(), message: format!("cannot write the model: {e}") })
+            .map_err(|e| NarxError::io(path, format!("cannot write the model: {e}")))
     }
 }
 
@@ -392,7 +392,7 @@ mod tests {
         let path = dir.path().join("taken");
         std::fs::create_dir(&path).unwrap();
         let e = small().save(&path).unwrap_err();
-        assert!(matches!(e, NarxError::Io { .. }), "{e}");
+        assert!(matches!(e, NarxError::File(crate::model_file::ModelFileError::Io { .. })), "{e}");
         assert!(e.to_string().contains("taken"), "{e}");
         assert!(!dir.path().join("taken.tmp").exists());
     }

@@ -4,7 +4,9 @@
 use super::closed_loop::ClosedLoop;
 use super::model::Model;
 use super::packed::Tanh;
-use evflow_engine::{BuildContext, Io, Node, NodeError, NodeSpec, ParamSpec, Params, PortSpec, Role, Summary};
+use evflow_engine::typed_params::{Choice, Text};
+use evflow_engine::typed_ports::{InPort, OutPort};
+use evflow_engine::{BuildContext, Io, Node, NodeError, NodeSpec, Params, PortSpec, Role, Summary};
 
 /// Declaration of `narx`.
 pub static SPEC: NodeSpec = NodeSpec::new(
@@ -42,15 +44,31 @@ pub static SPEC: NodeSpec = NodeSpec::new(
      throughput of the exact tanh offline; on 60 s of lab force a shipped model's output moves by at most 2.5e-11 of its \
      range). At 1 kHz either costs well under 1 % of a tick.",
 )
-.ports(&[
+.ports(PORTS)
+.params(&[MODEL.spec(), TANH.spec()])
+.example("model = \"models/narx.json\"");
+
+/// The ports: the desired force in, the actuation out.
+const PORTS: &[PortSpec] = &[
     PortSpec::input("force", "N", "desired lateral force (the network's input)"),
     PortSpec::output("u", "1", "estimated actuation, delayed by the model's look-ahead d"),
-])
-.params(&[
-    ParamSpec::text("model", "", "model file written by narx.train (JSON), relative to the graph file").required(),
-    ParamSpec::choice("tanh", &["exact", "fast"], "exact", "hidden-layer tanh: exact (std) or fast (|error| ≤ 1e-15)"),
-])
-.example("model = \"models/narx.json\"");
+];
+/// The desired force.
+const FORCE: InPort = InPort::named(PORTS, "force");
+/// The estimated actuation.
+const U: OutPort = OutPort::named(PORTS, "u");
+
+/// `model`: the model file (also `narx.score`'s).
+pub(super) const MODEL: Text =
+    Text::new("model", "", "model file written by narx.train (JSON), relative to the graph file").required();
+/// `tanh`: which tanh the hidden layers use (also `narx.grid`'s).
+pub(super) const TANH: Choice<Tanh> = Choice::new(
+    "tanh",
+    &["exact", "fast"],
+    &[Tanh::Exact, Tanh::Fast],
+    "exact",
+    "hidden-layer tanh: exact (std) or fast (|error| ≤ 1e-15)",
+);
 
 struct Narx {
     cl: ClosedLoop,
@@ -58,9 +76,9 @@ struct Narx {
 }
 
 fn build(p: &Params, ctx: &BuildContext) -> Result<Box<dyn Node>, NodeError> {
-    let shown = p.str("model").to_string();
+    let shown = MODEL.get(p).to_string();
     if shown.is_empty() {
-        return Err(NodeError::param("model", "name the model file (written by narx.train)"));
+        return Err(NodeError::param(MODEL.name(), "name the model file (written by narx.train)"));
     }
     let path = ctx.path(&shown);
     let model = Model::load(&path)?;
@@ -73,13 +91,12 @@ fn build(p: &Params, ctx: &BuildContext) -> Result<Box<dyn Node>, NodeError> {
             ),
         ));
     }
-    let tanh = p.str("tanh").parse::<Tanh>().map_err(|m| NodeError::param("tanh", m))?;
-    Ok(Box::new(Narx { cl: model.closed_loop_with(tanh)?, shown }))
+    Ok(Box::new(Narx { cl: model.closed_loop_with(TANH.get(p))?, shown }))
 }
 
 impl Node for Narx {
     fn process(&mut self, io: &mut Io<'_>) -> Result<(), NodeError> {
-        let (x, u) = io.io(0, 0);
+        let (x, u) = io.io(FORCE, U);
         for (o, &f) in u.iter_mut().zip(x) {
             *o = self.cl.step(f);
         }

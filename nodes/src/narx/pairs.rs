@@ -3,11 +3,16 @@
 //! when the stream ends.
 
 use crate::filters::segment::Gates;
+use evflow_engine::typed_ports::InPort;
 use evflow_engine::Io;
 
-/// The buffered pairs (inputs 0 and 1 of the node: force `x`, actuation
-/// `y`), the node's gates after them.
+/// The buffered pairs (the node's inputs force `x` and actuation `y`),
+/// kept where the node's gates are open.
 pub struct GatedPairs {
+    /// The node's force input.
+    pub x_port: InPort,
+    /// The node's actuation input.
+    pub y_port: InPort,
     /// The gate inputs.
     pub gates: Gates,
     /// Force samples kept.
@@ -19,9 +24,10 @@ pub struct GatedPairs {
 }
 
 impl GatedPairs {
-    /// Nothing buffered yet.
-    pub fn new(gates: Gates) -> Self {
-        Self { gates, x: Vec::new(), y: Vec::new(), seen: 0 }
+    /// Nothing buffered yet, for the force and actuation inputs `x_port`
+    /// and `y_port`.
+    pub fn new(x_port: InPort, y_port: InPort, gates: Gates) -> Self {
+        Self { x_port, y_port, gates, x: Vec::new(), y: Vec::new(), seen: 0 }
     }
 
     /// Room for a long recording before the run (offline only: the
@@ -34,7 +40,7 @@ impl GatedPairs {
     /// Keeps the block's samples where every gate is open, from stream
     /// sample `skip` on and up to `take` samples in all.
     pub fn push(&mut self, io: &Io<'_>, skip: usize, take: usize) {
-        let (x, y) = (io.input(0), io.input(1));
+        let (x, y) = (io.input(self.x_port), io.input(self.y_port));
         let start = self.seen;
         let (bx, by) = (&mut self.x, &mut self.y);
         self.gates.open_runs(io, |a, b| {

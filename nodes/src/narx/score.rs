@@ -4,11 +4,12 @@
 
 use super::fit::closed_loop_score;
 use super::model::Model;
+use super::node::MODEL;
 use super::pairs::GatedPairs;
-use crate::filters::segment::Gates;
-use evflow_engine::{
-    BuildContext, Io, Node, NodeError, NodeSpec, ParamSpec, Params, PortSpec, PrepareContext, Role, Summary,
-};
+use crate::filters::segment::{Gates, GATES};
+use evflow_engine::typed_params::Int;
+use evflow_engine::typed_ports::InPort;
+use evflow_engine::{BuildContext, Io, Node, NodeError, NodeSpec, Params, PortSpec, PrepareContext, Role, Summary};
 use std::path::PathBuf;
 
 /// Declaration of `narx.score`.
@@ -36,18 +37,26 @@ pub static SPEC: NodeSpec = NodeSpec::new(
      condition well above chance and the noise-force run near it (nodes/src/narx/score.rs tests; \
      tests/rig_recordings.rs end to end).",
 )
-.ports(&[
+.ports(PORTS)
+.params(&[MODEL.spec(), GATES.spec(), SEED.spec()])
+.example("model = \"models/narx.json\"");
+
+/// The ports: force, actuation and the gates.
+const PORTS: &[PortSpec] = &[
     PortSpec::input("x", "N", "force, the network's input (preprocessed as for training)"),
     PortSpec::input("y", "1", "actuation that produced the force, the reference"),
     PortSpec::input("gate", "1", "one per `gate` entry: the sample is scored only where every gate is above 0.5")
-        .per("gate"),
-])
-.params(&[
-    ParamSpec::text("model", "", "model file written by narx.train (JSON), relative to the graph file").required(),
-    ParamSpec::text_list("gate", "names of gate inputs (e.g. [\"steady\"] from `segment`); none by default"),
-    ParamSpec::int("seed", 0, i64::MAX, 1, "1", "seed of the noise force"),
-])
-.example("model = \"models/narx.json\"");
+        .per(GATES.name()),
+];
+/// The force.
+const X: InPort = InPort::named(PORTS, "x");
+/// The actuation, the reference.
+const Y: InPort = InPort::named(PORTS, "y");
+/// The first gate.
+const GATE: InPort = InPort::named(PORTS, "gate");
+
+/// `seed`: the seed of the noise force.
+const SEED: Int = Int::new("seed", 0, i64::MAX, 1, "1", "seed of the noise force");
 
 struct Score {
     model: Model,
@@ -57,20 +66,21 @@ struct Score {
 }
 
 fn build(p: &Params, ctx: &BuildContext) -> Result<Box<dyn Node>, NodeError> {
-    let shown = p.str("model").to_string();
+    let shown = MODEL.get(p).to_string();
     let path: PathBuf = ctx.path(&shown);
-    let model = Model::load(&path).map_err(|e| NodeError::param("model", e.to_string()))?;
+    let model = Model::load(&path).map_err(|e| NodeError::param(MODEL.name(), e.to_string()))?;
     let rate = model.rate_hz;
     if (rate - ctx.rate).abs() > 1e-9 * ctx.rate {
         return Err(NodeError::param(
-            "model",
+            MODEL.name(),
             format!(
                 "{shown} was trained at {rate} Hz; this node runs at {} Hz (resample to the model's rate)",
                 ctx.rate
             ),
         ));
     }
-    Ok(Box::new(Score { model, shown, seed: p.i64("seed") as u64, pairs: GatedPairs::new(Gates::from_params(p, 2)?) }))
+    let pairs = GatedPairs::new(X, Y, Gates::from_params(p, GATE)?);
+    Ok(Box::new(Score { model, shown, seed: SEED.get(p) as u64, pairs }))
 }
 
 impl Node for Score {

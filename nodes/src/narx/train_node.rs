@@ -5,10 +5,10 @@ use super::fit::{fit, Algorithm, FitConfig};
 use super::model::Condition;
 use super::pairs::GatedPairs;
 use super::train::Options;
-use crate::filters::segment::Gates;
-use evflow_engine::{
-    BuildContext, Io, Node, NodeError, NodeSpec, ParamSpec, Params, PortSpec, PrepareContext, Role, Summary,
-};
+use crate::filters::segment::{Gates, GATES};
+use evflow_engine::typed_params::{Choice, Flag, Float, Floats, Int, Text};
+use evflow_engine::typed_ports::InPort;
+use evflow_engine::{BuildContext, Io, Node, NodeError, NodeSpec, Params, PortSpec, PrepareContext, Role, Summary};
 use std::path::PathBuf;
 
 /// Declaration of `narx.train`.
@@ -64,40 +64,135 @@ pub static SPEC: NodeSpec = NodeSpec::new(
      MATLAB's `mapminmax` values, early stopping on pure noise, and the simulated lab \
      (nodes/tests/narx_lab.rs).",
 )
-.ports(&[
-    PortSpec::input("x", "N", "force, the network's input (e.g. the sensor force high-passed at 10 Hz)"),
-    PortSpec::input("y", "1", "actuation that produced the force, the network's target"),
-    PortSpec::input("gate", "1", "one per `gate` entry: the sample is kept only where every gate is above 0.5").per("gate"),
-])
+.ports(PORTS)
 .params(&[
-    ParamSpec::text("path", "", "model file to write (JSON), relative to the run's output folder").required(),
-    ParamSpec::float_list("hidden", 1.0, 1000.0, "neurons", "hidden layer sizes (empty = 15, 10, 5 as §5.2.1)"),
-    ParamSpec::int("feedback", 0, 100, 1, "samples", "feedback taps k_y: y[n−1] … y[n−k_y]"),
-    ParamSpec::int("input", 0, 1000, 10, "samples", "input taps behind the output sample: x[n] … x[n−k_x]"),
-    ParamSpec::choice("alignment", &["xcorr", "fixed"], "xcorr", "how the look-ahead d is chosen"),
-    ParamSpec::int("lookahead", -1000, 1000, 0, "samples", "look-ahead d when `alignment = \"fixed\"` (−1 = Eq. 5.1)"),
-    ParamSpec::int("max_lookahead", 0, 1000, 10, "samples", "largest d the cross-correlation may choose"),
-    ParamSpec::choice("algorithm", &["lm", "adam"], "lm", "Levenberg–Marquardt (trainlm) or Adam"),
-    ParamSpec::int("epochs", 1, 1_000_000, 1000, "1", "largest number of epochs"),
-    ParamSpec::int("max_fail", 1, 1000, 6, "1", "validation failures in a row that stop training"),
-    ParamSpec::float("validation", 0.0, 0.89, 0.15, "1", "fraction of the recording at its end kept for validation"),
-    ParamSpec::float("mu", 1e-12, 1e10, 1e-3, "1", "LM: initial damping μ"),
-    ParamSpec::float("mu_max", 1e-6, 1e30, 1e10, "1", "LM: largest μ before training stops"),
-    ParamSpec::float("min_grad", 0.0, 1.0, 1e-7, "1", "stop when the MSE gradient norm falls below this"),
-    ParamSpec::float("learning_rate", 1e-9, 1.0, 1e-3, "1", "Adam: step size"),
-    ParamSpec::int("batch", 1, 1_000_000, 64, "samples", "Adam: mini-batch size"),
-    ParamSpec::int("skip", 0, 1_000_000_000, 0, "samples", "samples at the start left out (e.g. the tribometer's dwell)"),
-    ParamSpec::int("samples", 0, 1_000_000_000, 0, "samples", "samples used after `skip` (0 = all; e.g. one constant-speed stretch)"),
-    ParamSpec::int("seed", 0, 1 << 53, 0, "1", "seed of the initial weights (0 = derived from the run's seed)"),
-    ParamSpec::float("mass_g", 0.0, 1e6, 0.0, "g", "condition: stylus mass (0 = not recorded)"),
-    ParamSpec::float("speed_cm_s", 0.0, 1e6, 0.0, "cm/s", "condition: scanning speed (0 = not recorded)"),
-    ParamSpec::flag("progress", true, "print each epoch to stderr"),
-    ParamSpec::text_list("gate", "names of gate inputs (e.g. [\"steady\"] from `segment`); none by default"),
-    ParamSpec::flag("record_time", true, "write the training time into the model and the summary (off: byte-identical reruns)"),
+    PATH.spec(),
+    HIDDEN.spec(),
+    FEEDBACK.spec(),
+    INPUT.spec(),
+    ALIGNMENT.spec(),
+    LOOKAHEAD.spec(),
+    MAX_LOOKAHEAD.spec(),
+    ALGORITHM.spec(),
+    EPOCHS.spec(),
+    MAX_FAIL.spec(),
+    VALIDATION.spec(),
+    MU.spec(),
+    MU_MAX.spec(),
+    MIN_GRAD.spec(),
+    LEARNING_RATE.spec(),
+    BATCH.spec(),
+    SKIP.spec(),
+    SAMPLES.spec(),
+    SEED.spec(),
+    MASS_G.spec(),
+    SPEED_CM_S.spec(),
+    PROGRESS.spec(),
+    GATES.spec(),
+    RECORD_TIME.spec(),
 ])
 .offline_only("it buffers the whole recording in memory and trains when the run ends")
 .example(
     "path = \"model.json\"\nhidden = [4]\nfeedback = 1\ninput = 3\nepochs = 5\nmass_g = 85.0\nspeed_cm_s = 4.0\nprogress = false",
+);
+
+/// The ports: force, actuation and the gates.
+const PORTS: &[PortSpec] = &[
+    PortSpec::input("x", "N", "force, the network's input (e.g. the sensor force high-passed at 10 Hz)"),
+    PortSpec::input("y", "1", "actuation that produced the force, the network's target"),
+    PortSpec::input("gate", "1", "one per `gate` entry: the sample is kept only where every gate is above 0.5")
+        .per(GATES.name()),
+];
+/// The force, the network's input.
+const X: InPort = InPort::named(PORTS, "x");
+/// The actuation, the network's target.
+const Y: InPort = InPort::named(PORTS, "y");
+/// The first gate.
+const GATE: InPort = InPort::named(PORTS, "gate");
+
+/// How the look-ahead d is chosen.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+enum Alignment {
+    /// By cross-correlating the squared increment of u with the force.
+    Xcorr,
+    /// `lookahead`, as given.
+    Fixed,
+}
+
+/// `path`: the model file to write.
+const PATH: Text = Text::new("path", "", "model file to write (JSON), relative to the run's output folder").required();
+/// `hidden`: the hidden layer sizes.
+const HIDDEN: Floats =
+    Floats::new("hidden", 1.0, 1000.0, "neurons", "hidden layer sizes (empty = 15, 10, 5 as §5.2.1)");
+/// `feedback`: the feedback taps k_y.
+const FEEDBACK: Int = Int::new("feedback", 0, 100, 1, "samples", "feedback taps k_y: y[n−1] … y[n−k_y]");
+/// `input`: the input taps k_x.
+const INPUT: Int = Int::new("input", 0, 1000, 10, "samples", "input taps behind the output sample: x[n] … x[n−k_x]");
+/// `alignment`: how the look-ahead d is chosen.
+const ALIGNMENT: Choice<Alignment> = Choice::new(
+    "alignment",
+    &["xcorr", "fixed"],
+    &[Alignment::Xcorr, Alignment::Fixed],
+    "xcorr",
+    "how the look-ahead d is chosen",
+);
+/// `lookahead`: d with a fixed alignment.
+const LOOKAHEAD: Int =
+    Int::new("lookahead", -1000, 1000, 0, "samples", "look-ahead d when `alignment = \"fixed\"` (−1 = Eq. 5.1)");
+/// `max_lookahead`: the largest d the cross-correlation may choose.
+const MAX_LOOKAHEAD: Int =
+    Int::new("max_lookahead", 0, 1000, 10, "samples", "largest d the cross-correlation may choose");
+/// `algorithm`: the training algorithm.
+const ALGORITHM: Choice<Algorithm> = Choice::new(
+    "algorithm",
+    &["lm", "adam"],
+    &[Algorithm::Lm, Algorithm::Adam],
+    "lm",
+    "Levenberg–Marquardt (trainlm) or Adam",
+);
+/// `epochs`: the largest number of epochs.
+const EPOCHS: Int = Int::new("epochs", 1, 1_000_000, 1000, "1", "largest number of epochs");
+/// `max_fail`: validation failures in a row that stop training.
+const MAX_FAIL: Int = Int::new("max_fail", 1, 1000, 6, "1", "validation failures in a row that stop training");
+/// `validation`: the fraction kept for validation.
+const VALIDATION: Float =
+    Float::new("validation", 0.0, 0.89, 0.15, "1", "fraction of the recording at its end kept for validation");
+/// `mu`: LM's initial damping.
+const MU: Float = Float::new("mu", 1e-12, 1e10, 1e-3, "1", "LM: initial damping μ");
+/// `mu_max`: LM's largest damping.
+const MU_MAX: Float = Float::new("mu_max", 1e-6, 1e30, 1e10, "1", "LM: largest μ before training stops");
+/// `min_grad`: the gradient norm that stops training.
+const MIN_GRAD: Float = Float::new("min_grad", 0.0, 1.0, 1e-7, "1", "stop when the MSE gradient norm falls below this");
+/// `learning_rate`: Adam's step size.
+const LEARNING_RATE: Float = Float::new("learning_rate", 1e-9, 1.0, 1e-3, "1", "Adam: step size");
+/// `batch`: Adam's mini-batch size.
+const BATCH: Int = Int::new("batch", 1, 1_000_000, 64, "samples", "Adam: mini-batch size");
+/// `skip`: samples left out at the start.
+const SKIP: Int =
+    Int::new("skip", 0, 1_000_000_000, 0, "samples", "samples at the start left out (e.g. the tribometer's dwell)");
+/// `samples`: samples used after `skip`.
+const SAMPLES: Int = Int::new(
+    "samples",
+    0,
+    1_000_000_000,
+    0,
+    "samples",
+    "samples used after `skip` (0 = all; e.g. one constant-speed stretch)",
+);
+/// `seed`: the seed of the initial weights.
+const SEED: Int = Int::new("seed", 0, 1 << 53, 0, "1", "seed of the initial weights (0 = derived from the run's seed)");
+/// `mass_g`: the condition's stylus mass.
+const MASS_G: Float = Float::new("mass_g", 0.0, 1e6, 0.0, "g", "condition: stylus mass (0 = not recorded)");
+/// `speed_cm_s`: the condition's scanning speed.
+const SPEED_CM_S: Float =
+    Float::new("speed_cm_s", 0.0, 1e6, 0.0, "cm/s", "condition: scanning speed (0 = not recorded)");
+/// `progress`: whether each epoch is printed.
+const PROGRESS: Flag = Flag::new("progress", true, "print each epoch to stderr");
+/// `record_time`: whether the training time is written.
+const RECORD_TIME: Flag = Flag::new(
+    "record_time",
+    true,
+    "write the training time into the model and the summary (off: byte-identical reruns)",
 );
 
 struct Train {
@@ -114,42 +209,45 @@ struct Train {
 
 fn build(p: &Params, ctx: &BuildContext) -> Result<Box<dyn Node>, NodeError> {
     let mut hidden = Vec::new();
-    for (i, &h) in p.float_list("hidden").iter().enumerate() {
+    for (i, &h) in HIDDEN.get(p).iter().enumerate() {
         if h.fract() != 0.0 || h < 1.0 {
-            return Err(NodeError::param("hidden", format!("entry {i} is {h}: layer sizes are whole numbers ≥ 1")));
+            return Err(NodeError::param(
+                HIDDEN.spec().name,
+                format!("entry {i} is {h}: layer sizes are whole numbers ≥ 1"),
+            ));
         }
         hidden.push(h as usize);
     }
     if hidden.is_empty() {
         hidden = vec![15, 10, 5];
     }
-    let lookahead = match p.str("alignment") {
-        "fixed" => Some(p.i64("lookahead")),
-        _ => None,
+    let lookahead = match ALIGNMENT.get(p) {
+        Alignment::Fixed => Some(LOOKAHEAD.get(p)),
+        Alignment::Xcorr => None,
     };
-    let (feedback, input) = (p.usize("feedback"), p.usize("input"));
+    let (feedback, input) = (FEEDBACK.count(p), INPUT.count(p));
     if let Some(d) = lookahead {
         if d < -(input as i64) {
             return Err(NodeError::param(
-                "lookahead",
+                LOOKAHEAD.name(),
                 format!("{d} leaves no input tap with input = {input} (the window x[n+d] … x[n−input] is empty)"),
             ));
         }
     }
-    let algorithm = if p.str("algorithm") == "adam" { Algorithm::Adam } else { Algorithm::Lm };
-    let seed = match p.i64("seed") {
+    let algorithm = ALGORITHM.get(p);
+    let seed = match SEED.get(p) {
         0 => ctx.node_seed() >> 11,
         s => s as u64,
     };
     let set = |v: f64| (v != 0.0).then_some(v);
     let options = Options {
-        max_epochs: p.usize("epochs"),
-        max_fail: p.usize("max_fail"),
-        min_grad: p.f64("min_grad"),
-        mu: p.f64("mu"),
-        mu_max: p.f64("mu_max"),
-        learning_rate: p.f64("learning_rate"),
-        batch: p.usize("batch"),
+        max_epochs: EPOCHS.count(p),
+        max_fail: MAX_FAIL.count(p),
+        min_grad: MIN_GRAD.get(p),
+        mu: MU.get(p),
+        mu_max: MU_MAX.get(p),
+        learning_rate: LEARNING_RATE.get(p),
+        batch: BATCH.count(p),
         ..Options::default()
     };
     let cfg = FitConfig {
@@ -157,32 +255,32 @@ fn build(p: &Params, ctx: &BuildContext) -> Result<Box<dyn Node>, NodeError> {
         feedback,
         input,
         lookahead,
-        max_lookahead: p.usize("max_lookahead"),
-        validation: p.f64("validation"),
+        max_lookahead: MAX_LOOKAHEAD.count(p),
+        validation: VALIDATION.get(p),
         algorithm,
         options,
         seed,
-        condition: Condition { mass_g: set(p.f64("mass_g")), speed_cm_s: set(p.f64("speed_cm_s")) },
+        condition: Condition { mass_g: set(MASS_G.get(p)), speed_cm_s: set(SPEED_CM_S.get(p)) },
         rate_hz: ctx.rate,
     };
-    let gates = Gates::from_params(p, 2)?;
-    let path = p.str("path");
+    let gates = Gates::from_params(p, GATE)?;
+    let path = PATH.get(p);
     if path.is_empty() {
-        return Err(NodeError::param("path", "name the model file to write"));
+        return Err(NodeError::param(PATH.name(), "name the model file to write"));
     }
     Ok(Box::new(Train {
-        path: ctx.output_path("path", path)?,
+        path: ctx.output_path(PATH.name(), path)?,
         shown: path.to_string(),
         node: ctx.node.clone(),
         cfg,
-        skip: p.usize("skip"),
-        take: match p.usize("samples") {
+        skip: SKIP.count(p),
+        take: match SAMPLES.count(p) {
             0 => usize::MAX,
             n => n,
         },
-        progress: p.bool("progress"),
-        record_time: p.bool("record_time"),
-        pairs: GatedPairs::new(gates),
+        progress: PROGRESS.get(p),
+        record_time: RECORD_TIME.get(p),
+        pairs: GatedPairs::new(X, Y, gates),
     }))
 }
 

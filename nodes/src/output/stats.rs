@@ -1,6 +1,7 @@
 //! `stats`: a sink that reports count, mean, RMS, min, max and peak-to-peak.
 
 use crate::sum::Sum;
+use evflow_engine::typed_ports::InPort;
 use evflow_engine::{BuildContext, Io, Node, NodeError, NodeSpec, PortSpec, Role, Summary};
 
 /// Declaration of `stats`.
@@ -19,8 +20,13 @@ pub static SPEC: NodeSpec = NodeSpec::new(
              precision. Accepts any rate. A NaN or Inf in the input is an error naming the sample \
              index, since no node may let one through.",
 )
-.ports(&[PortSpec::input("in", "1", "the stream to summarize").at(evflow_engine::RateSpec::Any)])
+.ports(PORTS)
 .example("");
+
+/// The port: the stream to summarize, at any rate.
+const PORTS: &[PortSpec] = &[PortSpec::input("in", "1", "the stream to summarize").at(evflow_engine::RateSpec::Any)];
+/// The stream to summarize.
+const IN: InPort = InPort::named(PORTS, "in");
 
 struct Stats {
     n: u64,
@@ -50,7 +56,7 @@ fn build(_: &evflow_engine::Params, _: &BuildContext) -> Result<Box<dyn Node>, N
 
 impl Node for Stats {
     fn process(&mut self, io: &mut Io<'_>) -> Result<(), NodeError> {
-        for &x in io.input(0) {
+        for &x in io.input(IN) {
             if !x.is_finite() && self.bad.is_none() {
                 self.bad = Some(self.n);
             }

@@ -2,7 +2,9 @@
 //! anti-aliasing filter built in.
 
 use super::decimator::{design, DecimateError, Decimator};
-use evflow_engine::{BuildContext, Io, Node, NodeError, NodeSpec, ParamSpec, Params, PortSpec, RateSpec, Role};
+use evflow_engine::typed_params::Float;
+use evflow_engine::typed_ports::{InPort, OutPort};
+use evflow_engine::{BuildContext, Io, Node, NodeError, NodeSpec, Params, PortSpec, RateSpec, Role};
 
 /// Declaration of `decimate`.
 pub static SPEC: NodeSpec = NodeSpec::new(
@@ -46,17 +48,29 @@ stated ripple, phase = the stated delay) and above it (attenuated by the stated 
 (±1e300, ±f64::MAX).\n\n\
 **Ports.** `in` at any rate that is an integer multiple of `rate`; `out` at `rate`.",
 )
-.ports(&[
+.ports(PORTS)
+.params(&[RATE.spec(), PASSBAND.spec(), ATTENUATION.spec()])
+.rate_param(RATE.name())
+.example("rate = 250.0");
+
+/// The ports: the stream at M × `rate` in, at `rate` out.
+const PORTS: &[PortSpec] = &[
     PortSpec::input("in", "1", "the stream, at M × `rate`").at(RateSpec::Any),
     PortSpec::output("out", "1", "the stream low-passed and decimated to `rate`"),
-])
-.params(&[
-    ParamSpec::float("rate", 1e-3, 1e7, 1000.0, "Hz", "output rate; the input's rate divided by an integer"),
-    ParamSpec::float("passband", 0.05, 0.95, 0.8, "1", "passband edge as a fraction of the new Nyquist frequency"),
-    ParamSpec::float("attenuation", 20.0, 200.0, 100.0, "dB", "stopband attenuation from the new Nyquist frequency up"),
-])
-.rate_param("rate")
-.example("rate = 250.0");
+];
+/// The stream.
+const IN: InPort = InPort::named(PORTS, "in");
+/// The stream decimated.
+const OUT: OutPort = OutPort::named(PORTS, "out");
+
+/// `rate`: the output rate (the node's rate).
+const RATE: Float = Float::new("rate", 1e-3, 1e7, 1000.0, "Hz", "output rate; the input's rate divided by an integer");
+/// `passband`: the passband edge.
+const PASSBAND: Float =
+    Float::new("passband", 0.05, 0.95, 0.8, "1", "passband edge as a fraction of the new Nyquist frequency");
+/// `attenuation`: the stopband attenuation.
+const ATTENUATION: Float =
+    Float::new("attenuation", 20.0, 200.0, 100.0, "dB", "stopband attenuation from the new Nyquist frequency up");
 
 struct Decimate {
     dec: Decimator,
@@ -68,7 +82,7 @@ fn factor(input: f64, output: f64) -> Result<usize, NodeError> {
     let q = input / output;
     if q < 1.0 - 1e-9 {
         return Err(NodeError::param(
-            "rate",
+            RATE.name(),
             format!(
                 "{output} Hz is above the input's {input} Hz, and `decimate` only lowers a rate; use `hold` \
                  (a control stream) or `resample` to raise it"
@@ -79,7 +93,7 @@ fn factor(input: f64, output: f64) -> Result<usize, NodeError> {
     if (q - m).abs() > 1e-9 * q || m > usize::MAX as f64 {
         let (lo, hi) = (q.floor().max(1.0), q.ceil());
         return Err(NodeError::param(
-            "rate",
+            RATE.name(),
             format!(
                 "the input's {input} Hz is {q:.6} × {output} Hz, not an integer multiple; choose `rate` = {} or {} Hz \
                  (factors {hi} and {lo}), or use `resample` for this ratio",
@@ -93,17 +107,17 @@ fn factor(input: f64, output: f64) -> Result<usize, NodeError> {
 
 fn build(p: &Params, ctx: &BuildContext) -> Result<Box<dyn Node>, NodeError> {
     let m = factor(ctx.port_rates[0], ctx.rate)?;
-    let d = design(m, p.f64("passband"), p.f64("attenuation")).map_err(|e| match e {
-        DecimateError::Passband(_) => NodeError::param("passband", e.to_string()),
-        DecimateError::Attenuation(_) => NodeError::param("attenuation", e.to_string()),
-        DecimateError::Factor(_) | DecimateError::TooLong { .. } => NodeError::param("rate", e.to_string()),
+    let d = design(m, PASSBAND.get(p), ATTENUATION.get(p)).map_err(|e| match e {
+        DecimateError::Passband(_) => NodeError::param(PASSBAND.name(), e.to_string()),
+        DecimateError::Attenuation(_) => NodeError::param(ATTENUATION.name(), e.to_string()),
+        DecimateError::Factor(_) | DecimateError::TooLong { .. } => NodeError::param(RATE.name(), e.to_string()),
     })?;
     Ok(Box::new(Decimate { dec: Decimator::new(&d), received: 0 }))
 }
 
 impl Node for Decimate {
     fn process(&mut self, io: &mut Io<'_>) -> Result<(), NodeError> {
-        let (x, y) = io.io(0, 0);
+        let (x, y) = io.io(IN, OUT);
         if let Some(i) = x.iter().position(|v| !v.is_finite()) {
             return Err(NodeError::Data(format!(
                 "input sample {} is {}; the anti-aliasing filter would carry it into the next outputs, so \

@@ -1,7 +1,9 @@
 //! `hold`: a stream at any rate, held to the node's rate (zero-order hold).
 
 use super::clock::Clock;
-use evflow_engine::{BuildContext, Io, Node, NodeError, NodeSpec, ParamSpec, Params, PortSpec, RateSpec, Role};
+use evflow_engine::typed_params::Float;
+use evflow_engine::typed_ports::{InPort, OutPort};
+use evflow_engine::{BuildContext, Io, Node, NodeError, NodeSpec, Params, PortSpec, RateSpec, Role};
 
 /// Declaration of `hold`.
 pub static SPEC: NodeSpec = NodeSpec::new(
@@ -22,12 +24,23 @@ are. Checked against: exact hold timing between 40 Hz and 1 kHz in both directio
 per-sample processing.\n\n\
 **Ports.** `in` at any rate; `out` at `rate`.",
 )
-.ports(&[PortSpec::input("in", "1", "the stream").at(RateSpec::Any), PortSpec::output("out", "1", "the stream held at `rate`")])
-.params(&[
-    ParamSpec::float("rate", 1e-3, 1e7, 1000.0, "Hz", "output rate"),
-])
-.rate_param("rate")
+.ports(PORTS)
+.params(&[RATE.spec()])
+.rate_param(RATE.name())
 .example("rate = 1000.0");
+
+/// The ports: the stream at any rate in, held at `rate` out.
+const PORTS: &[PortSpec] = &[
+    PortSpec::input("in", "1", "the stream").at(RateSpec::Any),
+    PortSpec::output("out", "1", "the stream held at `rate`"),
+];
+/// The stream.
+const IN: InPort = InPort::named(PORTS, "in");
+/// The stream held.
+const OUT: OutPort = OutPort::named(PORTS, "out");
+
+/// `rate`: the output rate (the node's rate).
+const RATE: Float = Float::new("rate", 1e-3, 1e7, 1000.0, "Hz", "output rate");
 
 struct Hold {
     input: Clock,
@@ -45,9 +58,9 @@ fn build(_p: &Params, ctx: &BuildContext) -> Result<Box<dyn Node>, NodeError> {
 
 impl Node for Hold {
     fn process(&mut self, io: &mut Io<'_>) -> Result<(), NodeError> {
-        let n_in = io.input_len(0);
+        let n_in = io.input_len(IN);
         let mut j = 0;
-        let (x, y) = io.io(0, 0);
+        let (x, y) = io.io(IN, OUT);
         for out in y.iter_mut() {
             while j < n_in && self.input.at_or_before(self.received + j as u64, &self.output, self.sent) {
                 self.value = x[j];

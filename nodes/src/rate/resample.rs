@@ -2,10 +2,9 @@
 //! asynchronous resampler, streaming, with a fixed latency.
 
 use super::resampler::{Quality, ResampleError, Stream, QUALITY_NAMES};
-use evflow_engine::typed_params::Choice;
-use evflow_engine::{
-    BuildContext, Io, Node, NodeError, NodeSpec, ParamSpec, Params, PortSpec, PrepareContext, RateSpec, Role,
-};
+use evflow_engine::typed_params::{Choice, Float};
+use evflow_engine::typed_ports::{InPort, OutPort};
+use evflow_engine::{BuildContext, Io, Node, NodeError, NodeSpec, Params, PortSpec, PrepareContext, RateSpec, Role};
 
 /// Declaration of `resample`.
 pub static SPEC: NodeSpec = NodeSpec::new(
@@ -53,13 +52,23 @@ with `fast`, 1.1e-6 with `balanced`; every 1 ms step moves on), linearity, block
 `evflow report resample`.\n\n\
 **Ports.** `in` at any rate; `out` at `rate`.",
 )
-.ports(&[
+.ports(PORTS)
+.params(&[RATE.spec(), QUALITY.spec()])
+.rate_param(RATE.name())
+.example("rate = 2000.0\nquality = \"balanced\"");
+
+/// The ports: the stream at any rate in, resampled to `rate` out.
+const PORTS: &[PortSpec] = &[
     PortSpec::input("in", "1", "the stream").at(RateSpec::Any),
     PortSpec::output("out", "1", "the stream resampled to `rate`, late by the stated latency"),
-])
-.params(&[ParamSpec::float("rate", 1e-3, 1e7, 1000.0, "Hz", "output rate"), QUALITY.spec()])
-.rate_param("rate")
-.example("rate = 2000.0\nquality = \"balanced\"");
+];
+/// The stream.
+const IN: InPort = InPort::named(PORTS, "in");
+/// The stream resampled.
+const OUT: OutPort = OutPort::named(PORTS, "out");
+
+/// `rate`: the output rate (the node's rate).
+const RATE: Float = Float::new("rate", 1e-3, 1e7, 1000.0, "Hz", "output rate");
 
 /// `quality`: the interpolator, arriving as a [`Quality`].
 const QUALITY: Choice<Quality> = Choice::new(
@@ -79,7 +88,7 @@ fn build(p: &Params, ctx: &BuildContext) -> Result<Box<dyn Node>, NodeError> {
     let quality = QUALITY.get(p);
     let ratio = ctx.rate / ctx.port_rates[0];
     let stream = Stream::new(ratio, quality).map_err(|e| match e {
-        ResampleError::StepTooLarge { .. } | ResampleError::Ratio(_) => NodeError::param("rate", e.to_string()),
+        ResampleError::StepTooLarge { .. } | ResampleError::Ratio(_) => NodeError::param(RATE.name(), e.to_string()),
         _ => NodeError::Other(e.to_string()),
     })?;
     Ok(Box::new(Resample { stream, received: 0 }))
@@ -92,7 +101,7 @@ impl Node for Resample {
     }
 
     fn process(&mut self, io: &mut Io<'_>) -> Result<(), NodeError> {
-        let (x, y) = io.io(0, 0);
+        let (x, y) = io.io(IN, OUT);
         if let Some(i) = x.iter().position(|v| !v.is_finite()) {
             return Err(NodeError::Data(format!(
                 "input sample {} is {}; the resampler's filter would carry it into the next outputs, so \

@@ -1,7 +1,9 @@
 //! `recording.in`: plays channels of a recording.
 
 use super::format::{Recording, RecordingError, Shortfall};
-use evflow_engine::{BuildContext, Io, Node, NodeError, NodeSpec, ParamSpec, Params, PortSpec, Role, Summary};
+use evflow_engine::typed_params::{Float, Text, Words};
+use evflow_engine::typed_ports::OutPort;
+use evflow_engine::{BuildContext, Io, Node, NodeError, NodeSpec, Params, PortSpec, Role, Summary};
 
 /// Declaration of `recording.in`.
 pub static SPEC: NodeSpec = NodeSpec::new(
@@ -30,19 +32,32 @@ pub static SPEC: NodeSpec = NodeSpec::new(
      against the writer (`recording.out`) bit for bit, and for equal output at block sizes 1 and \
      large.",
 )
-.ports(&[PortSpec::output("channel", "as recorded", "one port per `channels` entry, named after it").per("channels")])
-.params(&[
-    ParamSpec::text("path", "", "the recording: NAME.wav, NAME.json or NAME (relative to the graph file's folder)")
-        .required(),
-    ParamSpec::text_list("channels", "channels to play, each on an output port of its name").required(),
-    ParamSpec::float(
-        "rate",
-        super::format::MIN_RATE_HZ,
-        super::format::MAX_RATE_HZ,
-        1000.0, "Hz", "the recording's sample rate (must match the file)"),
-])
-.rate_param("rate")
+.ports(PORTS)
+.params(&[PATH.spec(), CHANNELS.spec(), RATE.spec()])
+.rate_param(RATE.name())
 .example("path = \"recordings/felt.wav\"\nchannels = [\"force\"]\nrate = 1000.0");
+
+/// The ports: one output per channel played.
+const PORTS: &[PortSpec] =
+    &[PortSpec::output("channel", "as recorded", "one port per `channels` entry, named after it").per(CHANNELS.name())];
+/// The first channel played (the k-th is `CHANNEL.nth(k)`).
+const CHANNEL: OutPort = OutPort::named(PORTS, "channel");
+
+/// `path`: the recording.
+const PATH: Text =
+    Text::new("path", "", "the recording: NAME.wav, NAME.json or NAME (relative to the graph file's folder)")
+        .required();
+/// `channels`: the channels to play.
+const CHANNELS: Words = Words::new("channels", "channels to play, each on an output port of its name").required();
+/// `rate`: the recording's rate (the node's rate).
+const RATE: Float = Float::new(
+    "rate",
+    super::format::MIN_RATE_HZ,
+    super::format::MAX_RATE_HZ,
+    1000.0,
+    "Hz",
+    "the recording's sample rate (must match the file)",
+);
 
 struct RecordingIn {
     /// Samples of each output port, in port order.
@@ -55,21 +70,21 @@ struct RecordingIn {
 }
 
 fn build(p: &Params, ctx: &BuildContext) -> Result<Box<dyn Node>, NodeError> {
-    let shown = p.str("path").to_string();
-    let names = p.text_list("channels");
+    let shown = PATH.get(p).to_string();
+    let names = CHANNELS.get(p);
     if names.is_empty() {
-        return Err(NodeError::param("channels", "list at least one channel to play"));
+        return Err(NodeError::param(CHANNELS.name(), "list at least one channel to play"));
     }
     // `evflow check` streams through the samples to validate them, keeping none.
     let read = if ctx.check_only { Recording::scan_channels } else { Recording::open_channels };
     let rec = read(&ctx.path(&shown), names).map_err(|e| match e {
-        RecordingError::UnknownChannel { .. } => NodeError::param("channels", e.to_string()),
+        RecordingError::UnknownChannel { .. } => NodeError::param(CHANNELS.name(), e.to_string()),
         e => e.into(),
     })?;
-    let rate = p.f64("rate");
+    let rate = RATE.get(p);
     if (rate - rec.rate()).abs() > 1e-9 * rec.rate() {
         return Err(NodeError::param(
-            "rate",
+            RATE.name(),
             format!(
                 "the node runs at {rate} Hz but {} was recorded at {} Hz; set rate = {} (and add a rate node if the graph needs another rate)",
                 rec.paths().wav.display(),
@@ -91,7 +106,7 @@ impl Node for RecordingIn {
         let start = self.pos.min(self.frames);
         let mut n = 0;
         for (o, data) in self.channels.iter().enumerate() {
-            let out = io.output(o);
+            let out = io.output(CHANNEL.nth(o));
             n = out.len();
             let avail = data.get(start..).unwrap_or(&[]);
             let k = n.min(avail.len());

@@ -1,9 +1,9 @@
 //! `recording.out`: writes its inputs to a recording.
 
 use super::format::{Channel, Condition, RecordingMeta, RecordingPaths, RecordingWriter};
-use evflow_engine::{
-    BuildContext, Io, Node, NodeError, NodeSpec, ParamSpec, Params, PortSpec, PrepareContext, Role, Summary,
-};
+use evflow_engine::typed_params::{Float, Text, Words};
+use evflow_engine::typed_ports::InPort;
+use evflow_engine::{BuildContext, Io, Node, NodeError, NodeSpec, Params, PortSpec, PrepareContext, Role, Summary};
 use std::path::Path;
 
 /// Declaration of `recording.out`.
@@ -34,17 +34,16 @@ pub static SPEC: NodeSpec = NodeSpec::new(
      Checked by reading back what it wrote bit for bit, with byte-identical files at block sizes 1 \
      and large, and files read back by scipy.io.wavfile (see the format document).",
 )
-.ports(&[PortSpec::input("channel", "as recorded", "one port per `channels` entry, named after it").per("channels")])
+.ports(PORTS)
 .params(&[
-    ParamSpec::text("path", "", "where to write: NAME.wav, NAME.json or NAME (relative to the graph file's folder)")
-        .required(),
-    ParamSpec::text_list("channels", "channel names, in file order; each is an input port").required(),
-    ParamSpec::text_list("units", "unit of each channel (e.g. N), same length as `channels`, or empty"),
-    ParamSpec::float("load_g", 0.0, 1e6, 0.0, "g", "condition: normal load (0 = not recorded)"),
-    ParamSpec::float("velocity_cm_s", 0.0, 1e6, 0.0, "cm/s", "condition: scanning velocity (0 = not recorded)"),
-    ParamSpec::text("material", "", "condition: texture material (empty = not recorded)"),
-    ParamSpec::float("gain", 0.0, 1e6, 0.0, "1", "condition: display gain, 1 = 100 Vpp (0 = not recorded)"),
-    ParamSpec::text("source", "", "what wrote it, kept in the sidecar (empty: the node's type and name)"),
+    PATH.spec(),
+    CHANNELS.spec(),
+    UNITS.spec(),
+    LOAD_G.spec(),
+    VELOCITY_CM_S.spec(),
+    MATERIAL.spec(),
+    GAIN.spec(),
+    SOURCE.spec(),
 ])
 .offline_only(
     "it writes its file from the processing thread; a live session records its inputs and outputs itself (docs/live.md)",
@@ -52,6 +51,32 @@ pub static SPEC: NodeSpec = NodeSpec::new(
 .example(
     "path = \"out.wav\"\nchannels = [\"force\"]\nunits = [\"N\"]\nload_g = 85.0\nvelocity_cm_s = 4.0\nmaterial = \"felt\"",
 );
+
+/// The ports: one input per channel recorded.
+const PORTS: &[PortSpec] =
+    &[PortSpec::input("channel", "as recorded", "one port per `channels` entry, named after it").per(CHANNELS.name())];
+/// The first channel recorded (the k-th is `CHANNEL.nth(k)`).
+const CHANNEL: InPort = InPort::named(PORTS, "channel");
+
+/// `path`: where to write.
+const PATH: Text =
+    Text::new("path", "", "where to write: NAME.wav, NAME.json or NAME (relative to the graph file's folder)")
+        .required();
+/// `channels`: the channel names, in file order.
+const CHANNELS: Words = Words::new("channels", "channel names, in file order; each is an input port").required();
+/// `units`: the unit of each channel.
+const UNITS: Words = Words::new("units", "unit of each channel (e.g. N), same length as `channels`, or empty");
+/// `load_g`: the condition's normal load.
+const LOAD_G: Float = Float::new("load_g", 0.0, 1e6, 0.0, "g", "condition: normal load (0 = not recorded)");
+/// `velocity_cm_s`: the condition's scanning velocity.
+const VELOCITY_CM_S: Float =
+    Float::new("velocity_cm_s", 0.0, 1e6, 0.0, "cm/s", "condition: scanning velocity (0 = not recorded)");
+/// `material`: the condition's texture material.
+const MATERIAL: Text = Text::new("material", "", "condition: texture material (empty = not recorded)");
+/// `gain`: the condition's display gain.
+const GAIN: Float = Float::new("gain", 0.0, 1e6, 0.0, "1", "condition: display gain, 1 = 100 Vpp (0 = not recorded)");
+/// `source`: what wrote the recording.
+const SOURCE: Text = Text::new("source", "", "what wrote it, kept in the sidecar (empty: the node's type and name)");
 
 /// Frames the writer buffers at least, whatever the block size.
 const MIN_BUFFER_FRAMES: usize = 8192;
@@ -68,27 +93,27 @@ struct RecordingOut {
 }
 
 fn build(p: &Params, ctx: &BuildContext) -> Result<Box<dyn Node>, NodeError> {
-    let names = p.text_list("channels");
+    let names = CHANNELS.get(p);
     if names.is_empty() {
-        return Err(NodeError::param("channels", "list at least one channel to record"));
+        return Err(NodeError::param(CHANNELS.name(), "list at least one channel to record"));
     }
-    let units = p.text_list("units");
+    let units = UNITS.get(p);
     if !units.is_empty() && units.len() != names.len() {
         return Err(NodeError::param(
-            "units",
+            UNITS.name(),
             format!("{} units for {} channels; give one per channel, or none", units.len(), names.len()),
         ));
     }
     let set = |x: f64| (x != 0.0).then_some(x);
-    let material = p.str("material");
+    let material = MATERIAL.get(p);
     let condition = Condition {
-        load_g: set(p.f64("load_g")),
-        velocity_cm_s: set(p.f64("velocity_cm_s")),
+        load_g: set(LOAD_G.get(p)),
+        velocity_cm_s: set(VELOCITY_CM_S.get(p)),
         material: (!material.is_empty()).then(|| material.to_string()),
-        gain: set(p.f64("gain")),
+        gain: set(GAIN.get(p)),
         extra: Default::default(),
     };
-    let source = match p.str("source") {
+    let source = match SOURCE.get(p) {
         "" => format!("evflow {} node `{}`", SPEC.name, ctx.node),
         s => s.to_string(),
     };
@@ -98,8 +123,8 @@ fn build(p: &Params, ctx: &BuildContext) -> Result<Box<dyn Node>, NodeError> {
         .map(|(i, n)| Channel::new(n.clone(), units.get(i).cloned().unwrap_or_default()))
         .collect();
     let meta = RecordingMeta { rate: ctx.rate, channels, condition, source };
-    let path = p.str("path");
-    let writer = RecordingWriter::create(&ctx.output_path("path", path)?, meta)?;
+    let path = PATH.get(p);
+    let writer = RecordingWriter::create(&ctx.output_path(PATH.name(), path)?, meta)?;
     let shown = RecordingPaths::new(Path::new(path)).wav.display().to_string();
     Ok(Box::new(RecordingOut {
         writer: Some(writer),
@@ -132,7 +157,7 @@ impl Node for RecordingOut {
             return Err(NodeError::Other("a block larger than prepared for".into()));
         };
         for c in 0..ch {
-            for (i, x) in io.input(c).iter().take(n).enumerate() {
+            for (i, x) in io.input(CHANNEL.nth(c)).iter().take(n).enumerate() {
                 frames[i * ch + c] = *x;
             }
         }

@@ -155,7 +155,7 @@ impl ForwardModel {
             return f("format", format!("`{}` is not `{FORMAT}`", self.format));
         }
         if self.version != VERSION {
-            return Err(SynthError::Version { path: path.into(), found: self.version, supported: VERSION });
+            return Err(SynthError::version(path, self.version, VERSION));
         }
         if !(self.rate_hz.is_finite() && self.rate_hz > 0.0) {
             return f("rate_hz", format!("{} is not a sample rate", self.rate_hz));
@@ -208,9 +208,9 @@ impl ForwardModel {
     /// Reads and checks a model file.
     pub fn load(path: &Path) -> Result<Self, SynthError> {
         let text = evflow_engine::files::read_regular_to_string(path)
-            .map_err(|e| SynthError::Io { path: path.into(), message: format!("cannot read the model: {e}") })?;
+            .map_err(|e| SynthError::io(path, format!("cannot read the model: {e}")))?;
         let value: serde_json::Value =
-            serde_json::from_str(&text).map_err(|e| SynthError::Parse { path: path.into(), message: e.to_string() })?;
+            serde_json::from_str(&text).map_err(|e| SynthError::parse(path, e.to_string()))?;
         match value.get("format").and_then(|v| v.as_str()) {
             Some(FORMAT) => {}
             Some(other) => return Err(SynthError::field(path, "format", format!("`{other}` is not `{FORMAT}`"))),
@@ -218,7 +218,7 @@ impl ForwardModel {
         }
         match value.get("version").and_then(|v| v.as_u64()) {
             Some(VERSION) => {}
-            Some(found) => return Err(SynthError::Version { path: path.into(), found, supported: VERSION }),
+            Some(found) => return Err(SynthError::version(path, found, VERSION)),
             None => return Err(SynthError::field(path, "version", "missing or not a whole number")),
         }
         let model: ForwardModel = match serde_json::from_value(value.clone()) {
@@ -250,9 +250,9 @@ impl ForwardModel {
     /// Writes the model to `path` (through `path.tmp` and a rename).
     pub fn save(&self, path: &Path) -> Result<(), SynthError> {
         let text = serde_json::to_string_pretty(self)
-            .map_err(|e| SynthError::Io { path: path.into(), message: format!("cannot encode the model: {e}") })?;
+            .map_err(|e| SynthError::io(path, format!("cannot encode the model: {e}")))?;
         crate::recording::atomic::write_atomically(path, &text)
-            .map_err(|e| SynthError::Io { path: path.into(), message: format!("cannot write the model: {e}") })
+            .map_err(|e| SynthError::io(path, format!("cannot write the model: {e}")))
     }
 }
 

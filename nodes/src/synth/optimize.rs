@@ -11,8 +11,9 @@ use crate::metric::spectral_error::Band;
 use crate::metric::spectrum::{SpectrumConfig, Window};
 use crate::narx::model::Model;
 use crate::recording::format::Recording;
-use evflow_engine::typed_params::Choice;
-use evflow_engine::{BuildContext, Io, Node, NodeError, NodeSpec, ParamSpec, Params, PortSpec, Role, Summary};
+use evflow_engine::typed_params::{Choice, Flag, Float, Int, Text};
+use evflow_engine::typed_ports::OutPort;
+use evflow_engine::{BuildContext, Io, Node, NodeError, NodeSpec, Params, PortSpec, Role, Summary};
 
 /// Declaration of `synth.optimize`.
 pub static SPEC: NodeSpec = NodeSpec::new(
@@ -56,28 +57,28 @@ pub static SPEC: NodeSpec = NodeSpec::new(
      time. **Summary.** `objective_start`, `objective_end` (never above the start), `iterations`, \
      `evaluations`, `lambda`, `seconds` (with `record_time`), and why the optimizer stopped.",
 )
-.ports(&[PortSpec::output("u", "1", "the synthesized actuation (1 = 50 V)")])
+.ports(PORTS)
 .params(&[
-    ParamSpec::text("target", "", "the recording of the real texture force (NAME, relative to the graph file)").required(),
-    ParamSpec::text("channel", "force", "its force channel"),
-    ParamSpec::text("model", "", "forward model file (forward.train)").required(),
-    ParamSpec::float("speed", 0.0, 1e4, 0.0, "cm/s", "count only the constant-speed samples at this speed (0 = all)"),
-    ParamSpec::float("tolerance", 1e-6, 0.5, 0.02, "1", "largest relative deviation from `speed`"),
-    ParamSpec::float("settle", 0.0, 60.0, 0.1, "s", "time the speed must have held"),
-    ParamSpec::choice("start", &["best", "carrier", "narx", "zero"], "best", "starting actuation (best: every start, the lowest objective kept)"),
-    ParamSpec::float("start_margin", 0.0, 1.0, 0.05, "1", "start = best: another start is kept over the carrier's only when its objective ends lower by this fraction"),
-    ParamSpec::text("narx_model", "", "inverse NARX model for start = \"narx\""),
-    ParamSpec::choice("objective", &["time", "spectral", "expected"], "time", "what to match"),
-    ParamSpec::int("nfft", 0, 1 << 20, 0, "samples", "spectral objective: segment length (0 = the rate)"),
+    TARGET.spec(),
+    CHANNEL.spec(),
+    MODEL.spec(),
+    SPEED.spec(),
+    TOLERANCE.spec(),
+    SETTLE.spec(),
+    START.spec(),
+    START_MARGIN.spec(),
+    NARX_MODEL.spec(),
+    OBJECTIVE.spec(),
+    NFFT.spec(),
     WINDOW.spec(),
-    ParamSpec::float("overlap", 0.0, 0.9, 0.0, "1", "spectral objective: overlap of segments"),
-    ParamSpec::float("fmin", 0.0, 1e7, 2.0, "Hz", "spectral objective: lowest frequency"),
-    ParamSpec::float("fmax", 0.0, 1e7, 200.0, "Hz", "spectral objective: highest frequency (0 = Nyquist)"),
-    ParamSpec::choice("noise", &["learned", "fixed"], "learned", "noise weight from the model, or `lambda`"),
-    ParamSpec::float("lambda", 0.0, 1e6, 0.0, "1", "noise weight λ when noise = \"fixed\""),
-    ParamSpec::int("iterations", 0, 100_000, 100, "1", "largest number of optimizer iterations"),
-    ParamSpec::float("bound", 1e-6, 2.0, 1.0, "1", "|u| ≤ bound"),
-    ParamSpec::flag("record_time", true, "report the synthesis time as the `seconds` value (off: identical reruns)"),
+    OVERLAP.spec(),
+    FMIN.spec(),
+    FMAX.spec(),
+    NOISE.spec(),
+    LAMBDA.spec(),
+    ITERATIONS.spec(),
+    BOUND.spec(),
+    RECORD_TIME.spec(),
 ])
 .offline_only("it synthesizes the whole actuation from a recording before playing it")
 .example("target = \"recordings/felt\"\nmodel = \"models/forward.json\"\niterations = 5");
@@ -100,14 +101,118 @@ struct Optimize {
     record_time: bool,
 }
 
+/// The port: the synthesized actuation.
+const PORTS: &[PortSpec] = &[PortSpec::output("u", "1", "the synthesized actuation (1 = 50 V)")];
+/// The synthesized actuation.
+const U: OutPort = OutPort::named(PORTS, "u");
+
+/// Where the optimization starts.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+enum Start {
+    /// From every start there is; the lowest objective (within `start_margin`) is kept.
+    Best,
+    /// The square-law envelope on a Nyquist-rate carrier.
+    Carrier,
+    /// The inverse NARX model's actuation.
+    Narx,
+    /// u = 0.
+    Zero,
+}
+
+/// What the optimization matches.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+enum Objective {
+    /// The waveform.
+    Time,
+    /// The spectra E_s compares.
+    Spectral,
+    /// The spectra the display is expected to deliver, with its learned noise.
+    Expected,
+}
+
+/// Where the noise weight λ comes from.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+enum Noise {
+    /// The model's noise model.
+    Learned,
+    /// `lambda`.
+    Fixed,
+}
+
+/// `target`: the recording of the real texture force.
+const TARGET: Text =
+    Text::new("target", "", "the recording of the real texture force (NAME, relative to the graph file)").required();
+/// `channel`: its force channel.
+const CHANNEL: Text = Text::new("channel", "force", "its force channel");
+/// `model`: the forward model file.
+const MODEL: Text = Text::new("model", "", "forward model file (forward.train)").required();
+/// `speed`: count only the constant-speed samples at this speed.
+const SPEED: Float =
+    Float::new("speed", 0.0, 1e4, 0.0, "cm/s", "count only the constant-speed samples at this speed (0 = all)");
+/// `tolerance`: the largest relative deviation from `speed`.
+const TOLERANCE: Float = Float::new("tolerance", 1e-6, 0.5, 0.02, "1", "largest relative deviation from `speed`");
+/// `settle`: how long the speed must have held.
+const SETTLE: Float = Float::new("settle", 0.0, 60.0, 0.1, "s", "time the speed must have held");
+/// `start`: the starting actuation.
+const START: Choice<Start> = Choice::new(
+    "start",
+    &["best", "carrier", "narx", "zero"],
+    &[Start::Best, Start::Carrier, Start::Narx, Start::Zero],
+    "best",
+    "starting actuation (best: every start, the lowest objective kept)",
+);
+/// `start_margin`: how much lower another start must end to be kept over the carrier's.
+const START_MARGIN: Float = Float::new(
+    "start_margin",
+    0.0,
+    1.0,
+    0.05,
+    "1",
+    "start = best: another start is kept over the carrier's only when its objective ends lower by this fraction",
+);
+/// `narx_model`: the inverse NARX model file.
+const NARX_MODEL: Text = Text::new("narx_model", "", "inverse NARX model for start = \"narx\"");
+/// `objective`: what to match.
+const OBJECTIVE: Choice<Objective> = Choice::new(
+    "objective",
+    &["time", "spectral", "expected"],
+    &[Objective::Time, Objective::Spectral, Objective::Expected],
+    "time",
+    "what to match",
+);
+/// `nfft`: the spectral objective's segment length.
+const NFFT: Int = Int::new("nfft", 0, 1 << 20, 0, "samples", "spectral objective: segment length (0 = the rate)");
 /// `window`: the spectral objective's window, arriving as a [`Window`].
 const WINDOW: Choice<Window> =
     Choice::new("window", &["rect", "hann"], &[Window::Rect, Window::Hann], "rect", "spectral objective: window");
+/// `overlap`: the spectral objective's overlap of segments.
+const OVERLAP: Float = Float::new("overlap", 0.0, 0.9, 0.0, "1", "spectral objective: overlap of segments");
+/// `fmin`: the spectral objective's lowest frequency.
+const FMIN: Float = Float::new("fmin", 0.0, 1e7, 2.0, "Hz", "spectral objective: lowest frequency");
+/// `fmax`: the spectral objective's highest frequency.
+const FMAX: Float = Float::new("fmax", 0.0, 1e7, 200.0, "Hz", "spectral objective: highest frequency (0 = Nyquist)");
+/// `noise`: where the noise weight comes from.
+const NOISE: Choice<Noise> = Choice::new(
+    "noise",
+    &["learned", "fixed"],
+    &[Noise::Learned, Noise::Fixed],
+    "learned",
+    "noise weight from the model, or `lambda`",
+);
+/// `lambda`: the fixed noise weight λ.
+const LAMBDA: Float = Float::new("lambda", 0.0, 1e6, 0.0, "1", "noise weight λ when noise = \"fixed\"");
+/// `iterations`: the largest number of optimizer iterations.
+const ITERATIONS: Int = Int::new("iterations", 0, 100_000, 100, "1", "largest number of optimizer iterations");
+/// `bound`: the actuation's bound.
+const BOUND: Float = Float::new("bound", 1e-6, 2.0, 1.0, "1", "|u| ≤ bound");
+/// `record_time`: whether the synthesis time is reported.
+const RECORD_TIME: Flag =
+    Flag::new("record_time", true, "report the synthesis time as the `seconds` value (off: identical reruns)");
 
 fn build(p: &Params, ctx: &BuildContext) -> Result<Box<dyn Node>, NodeError> {
-    let shown = p.str("target");
-    let channel = p.str("channel");
-    let speed = p.f64("speed");
+    let shown = TARGET.get(p);
+    let channel = CHANNEL.get(p);
+    let speed = SPEED.get(p);
     let mut wanted = vec![channel.to_string()];
     if speed > 0.0 {
         wanted.push("velocity".into());
@@ -115,47 +220,47 @@ fn build(p: &Params, ctx: &BuildContext) -> Result<Box<dyn Node>, NodeError> {
     let rec = Recording::open_channels(&ctx.path(shown), &wanted)?;
     if (rec.rate() - ctx.rate).abs() > 1e-9 * ctx.rate {
         return Err(NodeError::param(
-            "target",
+            TARGET.name(),
             format!("{shown} was recorded at {} Hz, the node runs at {} Hz", rec.rate(), ctx.rate),
         ));
     }
     let force = rec.channel(channel).unwrap_or_default().to_vec();
     let keep = if speed > 0.0 {
         let v = rec.channel("velocity").unwrap_or_default();
-        SpeedRule::new(speed, p.f64("tolerance"), p.f64("settle"), ctx.rate, 0.0).gate(v)
+        SpeedRule::new(speed, TOLERANCE.get(p), SETTLE.get(p), ctx.rate, 0.0).gate(v)
     } else {
         vec![true; force.len()]
     };
     if !keep.iter().any(|k| *k) {
         return Err(NodeError::param(
-            "speed",
+            SPEED.name(),
             format!("{shown}: its velocity never holds {speed} cm/s within the tolerance; is the speed right?"),
         ));
     }
-    let model = ForwardModel::load(&ctx.path(p.str("model")))?;
+    let model = ForwardModel::load(&ctx.path(MODEL.get(p)))?;
     if (model.rate_hz - ctx.rate).abs() > 1e-9 * ctx.rate {
         return Err(NodeError::param(
-            "model",
+            MODEL.name(),
             format!("the model was identified at {} Hz, the node runs at {} Hz", model.rate_hz, ctx.rate),
         ));
     }
-    let bound = p.f64("bound");
+    let bound = BOUND.get(p);
     let narx_start = |why: &str| -> Result<Vec<f64>, NodeError> {
-        let path = p.str("narx_model");
+        let path = NARX_MODEL.get(p);
         if path.is_empty() {
-            return Err(NodeError::param("narx_model", format!("{why} needs the inverse model's file")));
+            return Err(NodeError::param(NARX_MODEL.name(), format!("{why} needs the inverse model's file")));
         }
         let m = Model::load(&ctx.path(path))?;
         Ok(m.closed_loop()?.run(&force).into_iter().map(|u| u.clamp(-bound, bound)).collect())
     };
     let kappa = model.carrier_gain_n;
     let kappa_positive = kappa.is_finite() && kappa > 0.0;
-    let has_narx = !p.str("narx_model").is_empty();
-    let starts: Vec<(String, Vec<f64>)> = match p.str("start") {
-        "narx" => vec![("narx".into(), narx_start("start = \"narx\"")?)],
-        "zero" => vec![("zero".into(), vec![0.0; force.len()])],
+    let has_narx = !NARX_MODEL.get(p).is_empty();
+    let starts: Vec<(String, Vec<f64>)> = match START.get(p) {
+        Start::Narx => vec![("narx".into(), narx_start("start = \"narx\"")?)],
+        Start::Zero => vec![("zero".into(), vec![0.0; force.len()])],
         // Every start there is; the objective picks.
-        "best" => {
+        Start::Best => {
             let mut v = Vec::new();
             if kappa_positive {
                 v.push(("carrier".into(), carrier(&force, &keep, kappa, bound)?));
@@ -171,12 +276,12 @@ fn build(p: &Params, ctx: &BuildContext) -> Result<Box<dyn Node>, NodeError> {
         // A model whose carrier gain is not positive (a display whose force the
         // model hardly explains) gives the square-law start no meaning: start
         // from the inverse model when one is given.
-        _ if has_narx && !kappa_positive => {
+        Start::Carrier if has_narx && !kappa_positive => {
             vec![("narx (the model's carrier gain is not positive)".into(), narx_start("the fallback start")?)]
         }
-        _ => vec![("carrier".into(), carrier(&force, &keep, kappa, bound)?)],
+        Start::Carrier => vec![("carrier".into(), carrier(&force, &keep, kappa, bound)?)],
     };
-    let nfft = match p.usize("nfft") {
+    let nfft = match NFFT.count(p) {
         0 => ctx.rate.round() as usize,
         n => n,
     };
@@ -184,44 +289,47 @@ fn build(p: &Params, ctx: &BuildContext) -> Result<Box<dyn Node>, NodeError> {
     // 7 cm/s keeps less than a second) has no spectrum: the spectral
     // objectives give way to the waveform, and the summary says so.
     let short = keep.iter().filter(|k| **k).count() < nfft;
-    let (objective, objective_used) = match p.str("objective") {
-        "expected" | "spectral" if short => {
+    let (objective, objective_used) = match OBJECTIVE.get(p) {
+        Objective::Expected | Objective::Spectral if short => {
             (ObjectiveKind::Time, "time (fewer counted samples than one spectral segment)")
         }
-        "expected" => {
-            let band = Band::new(ctx.rate, nfft, p.f64("fmin"), p.f64("fmax"), false)
+        Objective::Expected => {
+            let band = Band::new(ctx.rate, nfft, FMIN.get(p), FMAX.get(p), false)
                 .map_err(|e| NodeError::param(e.param, e.message))?;
             let cfg = SpectrumConfig { rate: ctx.rate, nfft, window: Window::Hann, overlap: 0.5 };
             (ObjectiveKind::Expected { cfg, band }, "expected")
         }
-        "spectral" => {
+        Objective::Spectral => {
             let window = WINDOW.get(p);
-            let band = Band::new(ctx.rate, nfft, p.f64("fmin"), p.f64("fmax"), false)
+            let band = Band::new(ctx.rate, nfft, FMIN.get(p), FMAX.get(p), false)
                 .map_err(|e| NodeError::param(e.param, e.message))?;
-            let cfg = SpectrumConfig { rate: ctx.rate, nfft, window, overlap: p.f64("overlap") };
+            let cfg = SpectrumConfig { rate: ctx.rate, nfft, window, overlap: OVERLAP.get(p) };
             (ObjectiveKind::Spectral { cfg, band }, "spectral")
         }
-        _ => (ObjectiveKind::Time, "time"),
+        Objective::Time => (ObjectiveKind::Time, "time"),
     };
-    let noise = if p.str("noise") == "fixed" { NoiseWeight::Fixed(p.f64("lambda")) } else { NoiseWeight::Learned };
+    let noise = match NOISE.get(p) {
+        Noise::Fixed => NoiseWeight::Fixed(LAMBDA.get(p)),
+        Noise::Learned => NoiseWeight::Learned,
+    };
     let cfg = SynthConfig {
         objective,
         noise,
         bound,
-        options: Options { max_iter: p.usize("iterations"), ..Options::default() },
+        options: Options { max_iter: ITERATIONS.count(p), ..Options::default() },
     };
     Ok(Box::new(Optimize {
         force,
         keep,
         starts,
-        margin: p.f64("start_margin"),
+        margin: START_MARGIN.get(p),
         objective_used,
         model,
         cfg,
         u: None,
         summary: Summary::default(),
         pos: 0,
-        record_time: p.bool("record_time"),
+        record_time: RECORD_TIME.get(p),
     }))
 }
 
@@ -284,7 +392,7 @@ impl Node for Optimize {
             self.run()?;
         }
         let u = self.u.as_deref().unwrap_or_default();
-        let out = io.output(0);
+        let out = io.output(U);
         let start = self.pos.min(u.len());
         let k = out.len().min(u.len() - start);
         out[..k].copy_from_slice(&u[start..start + k]);

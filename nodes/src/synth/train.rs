@@ -5,11 +5,11 @@
 use super::model_file::{ForwardModel, Training};
 use super::output_filter::OutputFilter;
 use super::volterra_fit::{fit, FitConfig};
-use crate::filters::segment::Gates;
+use crate::filters::segment::{Gates, GATES};
 use crate::narx::model::{data_hash, Condition};
-use evflow_engine::{
-    BuildContext, Io, Node, NodeError, NodeSpec, ParamSpec, Params, PortSpec, PrepareContext, Role, Summary,
-};
+use evflow_engine::typed_params::{Flag, Float, Int, Text};
+use evflow_engine::typed_ports::InPort;
+use evflow_engine::{BuildContext, Io, Node, NodeError, NodeSpec, Params, PortSpec, PrepareContext, Role, Summary};
 use std::path::PathBuf;
 use std::time::Instant;
 
@@ -52,34 +52,76 @@ pub static SPEC: NodeSpec = NodeSpec::new(
      Checked against: exact recovery of a square law behind an FIR filter and a high-pass, a noise \
      model with known growth, the simulated lab (nodes/tests/forward_lab.rs).",
 )
-.ports(&[
-    PortSpec::input("u", "1", "actuation that drove the display"),
-    PortSpec::input("force", "N", "force it produced, after the high-pass"),
-    PortSpec::input("gate", "1", "one per `gate` entry: the sample is kept only where every gate is above 0.5").per("gate"),
-])
+.ports(PORTS)
 .params(&[
-    ParamSpec::text("path", "", "model file to write (JSON), relative to the run's output folder").required(),
-    ParamSpec::int("memory", 1, 128, 20, "samples", "memory M of the kernels (20 ms at 1 kHz)"),
-    ParamSpec::int(
-        "highpass_order",
-        0,
-        crate::filters::butterworth::design::MAX_ORDER as i64,
-        4,
-        "1",
-        "order of the Butterworth high-pass the force went through (0 = none)",
-    ),
-    ParamSpec::float("highpass_hz", 0.001, 1e6, 10.0, "Hz", "its cut-off (as `butterworth`'s `cutoff`)"),
-    ParamSpec::float("validation", 0.0, 0.89, 0.15, "1", "fraction of the kept samples, at their end, held out"),
-    ParamSpec::float("ridge", 0.0, 1.0, 1e-9, "1", "ridge δ relative to the mean diagonal of ΦᵀΦ"),
-    ParamSpec::float("noise_window", 0.001, 10.0, 0.25, "s", "window of the local actuation power in the noise model"),
-    ParamSpec::flag("reweight", true, "refit weighted by the inverse residual variance at each actuation power"),
-    ParamSpec::float("mass_g", 0.0, 1e6, 0.0, "g", "condition: stylus mass (0 = not recorded)"),
-    ParamSpec::float("speed_cm_s", 0.0, 1e6, 0.0, "cm/s", "condition: scanning speed (0 = not recorded)"),
-    ParamSpec::text_list("gate", "names of gate inputs (e.g. [\"steady\"] from `segment`); none by default"),
-    ParamSpec::flag("record_time", true, "write the identification time into the model and the summary (off: byte-identical reruns)"),
+    PATH.spec(),
+    MEMORY.spec(),
+    HIGHPASS_ORDER.spec(),
+    HIGHPASS_HZ.spec(),
+    VALIDATION.spec(),
+    RIDGE.spec(),
+    NOISE_WINDOW.spec(),
+    REWEIGHT.spec(),
+    MASS_G.spec(),
+    SPEED_CM_S.spec(),
+    GATES.spec(),
+    RECORD_TIME.spec(),
 ])
 .offline_only("it buffers the whole recording in memory and identifies the model when the run ends")
 .example("path = \"forward.json\"\nmemory = 8\nhighpass_order = 4\nhighpass_hz = 10.0\nmass_g = 85.0\nspeed_cm_s = 5.0");
+
+/// The ports: actuation, force and the gates.
+const PORTS: &[PortSpec] = &[
+    PortSpec::input("u", "1", "actuation that drove the display"),
+    PortSpec::input("force", "N", "force it produced, after the high-pass"),
+    PortSpec::input("gate", "1", "one per `gate` entry: the sample is kept only where every gate is above 0.5")
+        .per(GATES.name()),
+];
+/// The actuation.
+const U: InPort = InPort::named(PORTS, "u");
+/// The force it produced.
+const FORCE: InPort = InPort::named(PORTS, "force");
+/// The first gate.
+const GATE: InPort = InPort::named(PORTS, "gate");
+
+/// `path`: the model file to write.
+const PATH: Text = Text::new("path", "", "model file to write (JSON), relative to the run's output folder").required();
+/// `memory`: the memory M of the kernels.
+const MEMORY: Int = Int::new("memory", 1, 128, 20, "samples", "memory M of the kernels (20 ms at 1 kHz)");
+/// `highpass_order`: the order of the high-pass the force went through.
+const HIGHPASS_ORDER: Int = Int::new(
+    "highpass_order",
+    0,
+    crate::filters::butterworth::design::MAX_ORDER as i64,
+    4,
+    "1",
+    "order of the Butterworth high-pass the force went through (0 = none)",
+);
+/// `highpass_hz`: its cut-off.
+const HIGHPASS_HZ: Float =
+    Float::new("highpass_hz", 0.001, 1e6, 10.0, "Hz", "its cut-off (as `butterworth`'s `cutoff`)");
+/// `validation`: the fraction held out.
+const VALIDATION: Float =
+    Float::new("validation", 0.0, 0.89, 0.15, "1", "fraction of the kept samples, at their end, held out");
+/// `ridge`: the ridge δ.
+const RIDGE: Float = Float::new("ridge", 0.0, 1.0, 1e-9, "1", "ridge δ relative to the mean diagonal of ΦᵀΦ");
+/// `noise_window`: the window of the local actuation power.
+const NOISE_WINDOW: Float =
+    Float::new("noise_window", 0.001, 10.0, 0.25, "s", "window of the local actuation power in the noise model");
+/// `reweight`: whether the fit is redone with weights.
+const REWEIGHT: Flag =
+    Flag::new("reweight", true, "refit weighted by the inverse residual variance at each actuation power");
+/// `mass_g`: the condition's stylus mass.
+const MASS_G: Float = Float::new("mass_g", 0.0, 1e6, 0.0, "g", "condition: stylus mass (0 = not recorded)");
+/// `speed_cm_s`: the condition's scanning speed.
+const SPEED_CM_S: Float =
+    Float::new("speed_cm_s", 0.0, 1e6, 0.0, "cm/s", "condition: scanning speed (0 = not recorded)");
+/// `record_time`: whether the identification time is written.
+const RECORD_TIME: Flag = Flag::new(
+    "record_time",
+    true,
+    "write the identification time into the model and the summary (off: byte-identical reruns)",
+);
 
 struct Train {
     path: PathBuf,
@@ -95,30 +137,30 @@ struct Train {
 }
 
 fn build(p: &Params, ctx: &BuildContext) -> Result<Box<dyn Node>, NodeError> {
-    let path = p.str("path");
+    let path = PATH.get(p);
     if path.is_empty() {
-        return Err(NodeError::param("path", "name the model file to write"));
+        return Err(NodeError::param(PATH.name(), "name the model file to write"));
     }
-    let filter = OutputFilter::highpass(p.usize("highpass_order"), p.f64("highpass_hz"), ctx.rate)
-        .map_err(|e| NodeError::param("highpass_hz", e.to_string()))?;
-    let window = (p.f64("noise_window") * ctx.rate).round().max(1.0) as usize;
+    let filter = OutputFilter::highpass(HIGHPASS_ORDER.count(p), HIGHPASS_HZ.get(p), ctx.rate)
+        .map_err(|e| NodeError::param(HIGHPASS_HZ.name(), e.to_string()))?;
+    let window = (NOISE_WINDOW.get(p) * ctx.rate).round().max(1.0) as usize;
     let set = |v: f64| (v != 0.0).then_some(v);
     Ok(Box::new(Train {
-        path: ctx.output_path("path", path)?,
+        path: ctx.output_path(PATH.name(), path)?,
         shown: path.to_string(),
         cfg: FitConfig {
-            memory: p.usize("memory"),
+            memory: MEMORY.count(p),
             filter,
-            validation: p.f64("validation"),
-            ridge: p.f64("ridge"),
+            validation: VALIDATION.get(p),
+            ridge: RIDGE.get(p),
             noise_window: window,
             rate: ctx.rate,
-            reweight: p.bool("reweight"),
+            reweight: REWEIGHT.get(p),
         },
         rate: ctx.rate,
-        condition: Condition { mass_g: set(p.f64("mass_g")), speed_cm_s: set(p.f64("speed_cm_s")) },
-        record_time: p.bool("record_time"),
-        gates: Gates::from_params(p, 2)?,
+        condition: Condition { mass_g: set(MASS_G.get(p)), speed_cm_s: set(SPEED_CM_S.get(p)) },
+        record_time: RECORD_TIME.get(p),
+        gates: Gates::from_params(p, GATE)?,
         u: Vec::new(),
         y: Vec::new(),
         keep: Vec::new(),
@@ -138,7 +180,7 @@ impl Node for Train {
         // Offline only: the buffers grow with the recording. Every sample is
         // kept (the filter and the memory need the whole series); the gates
         // mark the rows.
-        let (u, y) = (io.input(0), io.input(1));
+        let (u, y) = (io.input(U), io.input(FORCE));
         let start = self.keep.len();
         self.u.extend_from_slice(u);
         self.y.extend_from_slice(y);

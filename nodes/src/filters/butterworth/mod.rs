@@ -5,6 +5,7 @@ pub mod sos;
 
 use design::{butterworth, DesignError, Kind, MIN_RELATIVE_CUTOFF};
 use evflow_engine::typed_params::{Choice, Float, Int};
+use evflow_engine::typed_ports::{InPort, OutPort};
 use evflow_engine::{BuildContext, Io, Node, NodeError, NodeSpec, Params, PortSpec, Role};
 use sos::Cascade;
 
@@ -41,9 +42,16 @@ pub static SPEC: NodeSpec = NodeSpec::new(
      difference equation, steady-state sine amplitudes of the running filter, and stability at \
      cut-offs of 0.01 Hz and 499 Hz at 1 kHz.",
 )
-.ports(&[PortSpec::input("in", "1", "signal"), PortSpec::output("out", "1", "filtered signal")])
+.ports(PORTS)
 .params(&[KIND.spec(), ORDER.spec(), CUTOFF.spec()])
 .example("kind = \"highpass\"\norder = 4\ncutoff = 10.0");
+
+/// The ports: one signal in, the filtered signal out.
+const PORTS: &[PortSpec] = &[PortSpec::input("in", "1", "signal"), PortSpec::output("out", "1", "filtered signal")];
+/// The signal.
+const IN: InPort = InPort::named(PORTS, "in");
+/// The filtered signal.
+const OUT: OutPort = OutPort::named(PORTS, "out");
 
 /// `kind`: which band passes.
 const KIND: Choice<Kind> =
@@ -62,17 +70,17 @@ struct Butterworth {
 fn build(p: &Params, ctx: &BuildContext) -> Result<Box<dyn Node>, NodeError> {
     let (kind, order, cutoff) = (KIND.get(p), ORDER.count(p), CUTOFF.get(p));
     let sections = butterworth(kind, order, cutoff, ctx.rate).map_err(|e| match e {
-        DesignError::Order(_) => NodeError::param("order", e.to_string()),
+        DesignError::Order(_) => NodeError::param(ORDER.name(), e.to_string()),
         DesignError::Rate(_) => NodeError::Other(e.to_string()),
         DesignError::AboveNyquist { nyquist, rate, .. } => NodeError::param(
-            "cutoff",
+            CUTOFF.name(),
             format!(
                 "{cutoff} Hz is not below the Nyquist frequency {nyquist} Hz of this node's input \
                  ({rate} Hz); choose a cut-off below {nyquist} Hz or raise the input's rate"
             ),
         ),
         DesignError::TooLow { min, rate, .. } => NodeError::param(
-            "cutoff",
+            CUTOFF.name(),
             format!(
                 "{cutoff} Hz is below {min} Hz ({MIN_RELATIVE_CUTOFF} × the input's rate {rate} Hz), where \
                  f64 second-order sections lose their accuracy; decimate the signal first"
@@ -85,7 +93,7 @@ fn build(p: &Params, ctx: &BuildContext) -> Result<Box<dyn Node>, NodeError> {
 impl Node for Butterworth {
     fn process(&mut self, io: &mut Io<'_>) -> Result<(), NodeError> {
         let start = io.start();
-        let (x, y) = io.io(0, 0);
+        let (x, y) = io.io(IN, OUT);
         if let Some(i) = x.iter().position(|v| !v.is_finite()) {
             return Err(NodeError::Data(format!(
                 "input sample {} is {}; a recursive filter cannot recover from a non-finite value \

@@ -6,7 +6,9 @@ pub mod compare;
 pub mod estimator;
 
 use estimator::{Fit, Foaw};
-use evflow_engine::{BuildContext, Io, Node, NodeError, NodeSpec, ParamSpec, Params, PortSpec, Role};
+use evflow_engine::typed_params::{Choice, Float, Int};
+use evflow_engine::typed_ports::{InPort, OutPort};
+use evflow_engine::{BuildContext, Io, Node, NodeError, NodeSpec, Params, PortSpec, Role};
 
 /// Declaration of `foaw`.
 pub static SPEC: NodeSpec = NodeSpec::new(
@@ -35,27 +37,43 @@ Checked against exact slopes on noiseless ramps, a direct least-squares fit, vel
 known trajectories sampled at 40 Hz and quantized to 0.5 mm — against finite differences (RMS error) \
 and a moving average (lag); figures in `docs/texture.md` (`evflow report foaw`).",
 )
-.ports(&[PortSpec::input("x", "m", "position"), PortSpec::output("velocity", "m/s", "velocity estimate")])
-.params(&[
-    ParamSpec::float("noise", 0.0, 1.0, 0.0004, "m", "bound d on the position error (quantization + noise)"),
-    ParamSpec::int("max_window", 1, 1024, 4, "1", "longest window, samples"),
-    ParamSpec::choice("fit", &["best", "end"], "best", "slope of a window: least squares or through its ends"),
-])
+.ports(PORTS)
+.params(&[NOISE.spec(), MAX_WINDOW.spec(), FIT.spec()])
 .example("noise = 0.0004\nmax_window = 4\nfit = \"best\"");
+
+/// The ports: positions in, velocities out, at the same rate.
+const PORTS: &[PortSpec] =
+    &[PortSpec::input("x", "m", "position"), PortSpec::output("velocity", "m/s", "velocity estimate")];
+/// The position.
+const X: InPort = InPort::named(PORTS, "x");
+/// The velocity estimate.
+const VELOCITY: OutPort = OutPort::named(PORTS, "velocity");
+
+/// `noise`: the bound d on the position error.
+const NOISE: Float = Float::new("noise", 0.0, 1.0, 0.0004, "m", "bound d on the position error (quantization + noise)");
+/// `max_window`: the longest window.
+const MAX_WINDOW: Int = Int::new("max_window", 1, 1024, 4, "1", "longest window, samples");
+/// `fit`: which slope a window gets.
+const FIT: Choice<Fit> = Choice::new(
+    "fit",
+    &["best", "end"],
+    &[Fit::Best, Fit::End],
+    "best",
+    "slope of a window: least squares or through its ends",
+);
 
 struct FoawNode {
     foaw: Foaw,
 }
 
 fn build(p: &Params, ctx: &BuildContext) -> Result<Box<dyn Node>, NodeError> {
-    let fit = if p.str("fit") == "end" { Fit::End } else { Fit::Best };
-    let window = p.usize("max_window");
-    Ok(Box::new(FoawNode { foaw: Foaw::new(fit, p.f64("noise"), 1.0 / ctx.rate, window) }))
+    let window = MAX_WINDOW.count(p);
+    Ok(Box::new(FoawNode { foaw: Foaw::new(FIT.get(p), NOISE.get(p), 1.0 / ctx.rate, window) }))
 }
 
 impl Node for FoawNode {
     fn process(&mut self, io: &mut Io<'_>) -> Result<(), NodeError> {
-        let (x, v) = io.io(0, 0);
+        let (x, v) = io.io(X, VELOCITY);
         for (v, &x) in v.iter_mut().zip(x) {
             *v = self.foaw.push(x);
         }

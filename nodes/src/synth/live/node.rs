@@ -6,7 +6,9 @@ use super::envelope::{EnvelopeModel, ModelGrid};
 use super::horizon::Horizon;
 use super::window_min::WindowMin;
 use crate::synth::model_file::ForwardModel;
-use evflow_engine::{BuildContext, Io, Node, NodeError, NodeSpec, ParamSpec, Params, PortSpec, Role, Summary};
+use evflow_engine::typed_params::{Float, Int, Words};
+use evflow_engine::typed_ports::{InPort, OutPort};
+use evflow_engine::{BuildContext, Io, Node, NodeError, NodeSpec, Params, PortSpec, Role, Summary};
 use std::time::{Duration, Instant};
 
 /// Declaration of `synth.live`.
@@ -49,7 +51,25 @@ pub static SPEC: NodeSpec = NodeSpec::new(
      counted. Summary: mean iterations, \
      fallbacks, budget stops, the objective's mean reduction.",
 )
-.ports(&[
+.ports(PORTS)
+.params(&[
+    MODELS.spec(),
+    LOOKAHEAD.spec(),
+    ITERATIONS.spec(),
+    OFFSET.spec(),
+    WINDOW.spec(),
+    BOUND.spec(),
+    NOISE.spec(),
+    REST_SPEED.spec(),
+    FULL_SPEED.spec(),
+    UPDATE_RATE.spec(),
+    BUDGET.spec(),
+])
+.example("models = [\"models/forward-60g-3cms.json\", \"models/forward-60g-7cms.json\", \"models/forward-110g-3cms.json\", \"models/forward-110g-7cms.json\"]\nlookahead = 15\niterations = 4");
+
+/// The ports: the target force and the finger's condition in; the
+/// actuation and what the synthesis did out.
+const PORTS: &[PortSpec] = &[
     PortSpec::input("force", "N", "target friction force, `lookahead` samples ahead"),
     PortSpec::input("load", "g", "finger's normal load"),
     PortSpec::input("velocity", "cm/s", "finger's signed velocity"),
@@ -58,21 +78,58 @@ pub static SPEC: NodeSpec = NodeSpec::new(
     PortSpec::output("predicted", "N", "the force change the model expects from the actuation now"),
     PortSpec::output("iterations", "1", "optimizer iterations made since the start (a running count)"),
     PortSpec::output("fallbacks", "1", "ticks played from a fallback since the start (a running count)"),
-])
-.params(&[
-    ParamSpec::text_list("models", "forward model files (forward.train), one per trained condition").required(),
-    ParamSpec::int("lookahead", 0, 63, 15, "samples", "how far ahead the target arrives (playback's lookahead); the horizon is one more"),
-    ParamSpec::int("iterations", 0, 200, 4, "1", "optimizer iterations per tick (the fixed worst case)"),
-    ParamSpec::float("offset", 0.0, 10.0, 0.25, "1", "offset, in units of the least that renders every trough"),
-    ParamSpec::float("window", 1.0, 10_000.0, 200.0, "ms", "how far back the target's troughs count for the offset"),
-    ParamSpec::float("bound", 1e-6, 2.0, 1.0, "1", "largest envelope |u| (1 = 50 V)"),
-    ParamSpec::float("noise", 0.0, 1e6, 1.0, "1", "scale on the models' learned noise slope β"),
-    ParamSpec::float("rest_speed", 0.0, 1e3, 0.3, "cm/s", "below this speed nothing is played"),
-    ParamSpec::float("full_speed", 0.0, 1e3, 1.0, "cm/s", "from this speed on the synthesis plays in full"),
-    ParamSpec::float("update_rate", 0.01, 1e6, 100.0, "Hz", "how often the models are blended at the finger's condition"),
-    ParamSpec::float("budget", 0.0, 1e6, 0.0, "µs", "stop iterating once a tick has taken this long (0: no deadline)"),
-])
-.example("models = [\"models/forward-60g-3cms.json\", \"models/forward-60g-7cms.json\", \"models/forward-110g-3cms.json\", \"models/forward-110g-7cms.json\"]\nlookahead = 15\niterations = 4");
+];
+/// The target force, `lookahead` samples ahead.
+const FORCE: InPort = InPort::named(PORTS, "force");
+/// The finger's normal load.
+const LOAD: InPort = InPort::named(PORTS, "load");
+/// The finger's signed velocity.
+const VELOCITY: InPort = InPort::named(PORTS, "velocity");
+/// The actuation.
+const U: OutPort = OutPort::named(PORTS, "u");
+/// The target force at this tick.
+const TARGET: OutPort = OutPort::named(PORTS, "target");
+/// The force change the model expects.
+const PREDICTED: OutPort = OutPort::named(PORTS, "predicted");
+/// The running count of optimizer iterations (the port `iterations`).
+const ITERATIONS_OUT: OutPort = OutPort::named(PORTS, "iterations");
+/// The running count of fallbacks.
+const FALLBACKS: OutPort = OutPort::named(PORTS, "fallbacks");
+
+/// `models`: the forward model files, one per trained condition.
+const MODELS: Words = Words::new("models", "forward model files (forward.train), one per trained condition").required();
+/// `lookahead`: how far ahead the target arrives.
+const LOOKAHEAD: Int = Int::new(
+    "lookahead",
+    0,
+    63,
+    15,
+    "samples",
+    "how far ahead the target arrives (playback's lookahead); the horizon is one more",
+);
+/// `iterations`: optimizer iterations per tick.
+const ITERATIONS: Int = Int::new("iterations", 0, 200, 4, "1", "optimizer iterations per tick (the fixed worst case)");
+/// `offset`: the offset, in units of the least that renders every trough.
+const OFFSET: Float =
+    Float::new("offset", 0.0, 10.0, 0.25, "1", "offset, in units of the least that renders every trough");
+/// `window`: how far back the troughs count.
+const WINDOW: Float =
+    Float::new("window", 1.0, 10_000.0, 200.0, "ms", "how far back the target's troughs count for the offset");
+/// `bound`: the largest envelope.
+const BOUND: Float = Float::new("bound", 1e-6, 2.0, 1.0, "1", "largest envelope |u| (1 = 50 V)");
+/// `noise`: the scale on the learned noise slope.
+const NOISE: Float = Float::new("noise", 0.0, 1e6, 1.0, "1", "scale on the models' learned noise slope β");
+/// `rest_speed`: below it nothing is played.
+const REST_SPEED: Float = Float::new("rest_speed", 0.0, 1e3, 0.3, "cm/s", "below this speed nothing is played");
+/// `full_speed`: from it on the synthesis plays in full.
+const FULL_SPEED: Float =
+    Float::new("full_speed", 0.0, 1e3, 1.0, "cm/s", "from this speed on the synthesis plays in full");
+/// `update_rate`: how often the models are blended.
+const UPDATE_RATE: Float =
+    Float::new("update_rate", 0.01, 1e6, 100.0, "Hz", "how often the models are blended at the finger's condition");
+/// `budget`: the time a tick may take.
+const BUDGET: Float =
+    Float::new("budget", 0.0, 1e6, 0.0, "µs", "stop iterating once a tick has taken this long (0: no deadline)");
 
 struct Live {
     grid: ModelGrid,
@@ -100,9 +157,9 @@ struct Live {
 }
 
 fn build(p: &Params, ctx: &BuildContext) -> Result<Box<dyn Node>, NodeError> {
-    let names = p.text_list("models");
+    let names = MODELS.get(p);
     if names.is_empty() {
-        return Err(NodeError::param("models", "name at least one forward model file (written by forward.train)"));
+        return Err(NodeError::param(MODELS.name(), "name at least one forward model file (written by forward.train)"));
     }
     let mut entries = Vec::with_capacity(names.len());
     for name in names {
@@ -127,29 +184,29 @@ fn build(p: &Params, ctx: &BuildContext) -> Result<Box<dyn Node>, NodeError> {
         let volterra = fm.volterra().map_err(|e| NodeError::file(&path, e))?;
         entries.push(((mass, speed.abs()), EnvelopeModel::of(&volterra, fm.noise.per_u2_n2)));
     }
-    let grid = ModelGrid::new(entries, names).map_err(|e| NodeError::param("models", e.to_string()))?;
-    let (rest, full) = (p.f64("rest_speed"), p.f64("full_speed"));
+    let grid = ModelGrid::new(entries, names).map_err(|e| NodeError::param(MODELS.name(), e.to_string()))?;
+    let (rest, full) = (REST_SPEED.get(p), FULL_SPEED.get(p));
     if full < rest {
-        return Err(NodeError::param("full_speed", format!("{full} cm/s is below rest_speed = {rest} cm/s")));
+        return Err(NodeError::param(FULL_SPEED.name(), format!("{full} cm/s is below rest_speed = {rest} cm/s")));
     }
-    let h = p.usize("lookahead") + 1;
+    let h = LOOKAHEAD.count(p) + 1;
     let m = grid.memory();
-    let window = ((p.f64("window") * 1e-3 * ctx.rate).round() as usize).max(1);
-    let budget = p.f64("budget");
+    let window = ((WINDOW.get(p) * 1e-3 * ctx.rate).round() as usize).max(1);
+    let budget = BUDGET.get(p);
     Ok(Box::new(Live {
         model: EnvelopeModel::zeros(m),
         horizon: Horizon::new(m, h),
         troughs: WindowMin::new(window),
         ahead: vec![0.0; h],
         grid,
-        offset: p.f64("offset"),
-        bound: p.f64("bound"),
-        noise: p.f64("noise"),
+        offset: OFFSET.get(p),
+        bound: BOUND.get(p),
+        noise: NOISE.get(p),
         rest,
         full,
-        every: ((ctx.rate / p.f64("update_rate")).round() as u64).max(1),
+        every: ((ctx.rate / UPDATE_RATE.get(p)).round() as u64).max(1),
         budget: (budget > 0.0).then(|| Duration::from_secs_f64(budget * 1e-6)),
-        iterations: p.usize("iterations"),
+        iterations: ITERATIONS.count(p),
         n: 0,
         total_iterations: 0,
         fallbacks: 0,
@@ -189,9 +246,9 @@ impl Node for Live {
     fn process(&mut self, io: &mut Io<'_>) -> Result<(), NodeError> {
         let h = self.ahead.len();
         for k in 0..io.len() {
-            let f = self.finite(io.input(0)[k]);
-            let load = self.finite(io.input(1)[k]);
-            let v = self.finite(io.input(2)[k]);
+            let f = self.finite(io.input(FORCE)[k]);
+            let load = self.finite(io.input(LOAD)[k]);
+            let v = self.finite(io.input(VELOCITY)[k]);
             if self.n == 0 {
                 self.ahead.fill(f);
             } else {
@@ -209,13 +266,13 @@ impl Node for Live {
             let a = (self.gate(v) * out.envelope).clamp(0.0, self.bound);
             self.horizon.commit(a);
             let sign = if self.n.is_multiple_of(2) { 1.0 } else { -1.0 };
-            io.output(0)[k] = sign * a;
-            io.output(1)[k] = self.ahead[0];
-            io.output(2)[k] = if out.predicted.is_finite() { out.predicted - b } else { 0.0 };
+            io.output(U)[k] = sign * a;
+            io.output(TARGET)[k] = self.ahead[0];
+            io.output(PREDICTED)[k] = if out.predicted.is_finite() { out.predicted - b } else { 0.0 };
             self.total_iterations += out.iterations as u64;
             self.fallbacks += u64::from(out.fallback);
-            io.output(3)[k] = self.total_iterations as f64;
-            io.output(4)[k] = self.fallbacks as f64;
+            io.output(ITERATIONS_OUT)[k] = self.total_iterations as f64;
+            io.output(FALLBACKS)[k] = self.fallbacks as f64;
             self.budget_stops += u64::from(out.budget_stop);
             if !out.fallback && out.start_objective > 0.0 {
                 self.reduction += 1.0 - out.objective / out.start_objective;

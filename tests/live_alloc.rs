@@ -281,7 +281,7 @@ mod allocating {
     }
     impl Node for A {
         fn process(&mut self, io: &mut Io<'_>) -> Result<(), NodeError> {
-            self.0.push(io.input(0).to_vec());
+            self.0.push(io.input(evflow_engine::ports::InPort::at(0)).to_vec());
             // File I/O: a system call the filter traps.
             let _ = std::fs::metadata("/");
             Ok(())

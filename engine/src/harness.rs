@@ -9,6 +9,7 @@ use crate::graph::parse_graph;
 use crate::node::{BuildContext, Io, Node, NodeError, RunMode};
 use crate::params::{toml_float, Params};
 use crate::plan::{Folding, Plan, PlanOptions};
+use crate::ports::OutPort;
 use crate::registry::Registry;
 use crate::spec::{NodeSpec, ParamSpec, PortSpec, RateSpec, Role};
 use std::path::Path;
@@ -36,7 +37,7 @@ struct Feed {
 
 impl Node for Feed {
     fn process(&mut self, io: &mut Io<'_>) -> Result<(), NodeError> {
-        for y in io.output(0).iter_mut() {
+        for y in io.output(OutPort::at(0)).iter_mut() {
             *y = self.values.get(self.pos).copied().unwrap_or(0.0);
             self.pos += 1;
         }

@@ -30,7 +30,6 @@ pub mod suggest;
 pub mod sweep;
 pub mod sweep_files;
 pub mod typed_params;
-pub mod typed_ports;
 
 pub use check::{check, Checked, Override};
 pub use diag::{Diagnostic, Diagnostics};

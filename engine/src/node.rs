@@ -76,8 +76,10 @@ pub struct BuildContext {
     pub base_rate: f64,
     /// This node's rate in Hz (see [`crate::spec::RateSpec::Node`]).
     pub rate: f64,
-    /// The rate of each port in Hz, in the order of the node's resolved ports.
-    pub port_rates: Vec<f64>,
+    /// The rate in Hz of each input port, in order (read with [`BuildContext::input_rate`]).
+    pub input_rates: Vec<f64>,
+    /// The rate in Hz of each output port, in order (read with [`BuildContext::output_rate`]).
+    pub output_rates: Vec<f64>,
     /// The folder relative input paths are taken from (the graph file's folder).
     pub base_dir: PathBuf,
     /// The folder relative output paths are written to (the run's output
@@ -94,6 +96,16 @@ pub struct BuildContext {
 }
 
 impl BuildContext {
+    /// The rate in Hz of input `port`.
+    pub fn input_rate(&self, port: InPort) -> f64 {
+        self.input_rates[port.index()]
+    }
+
+    /// The rate in Hz of output `port`.
+    pub fn output_rate(&self, port: OutPort) -> f64 {
+        self.output_rates[port.index()]
+    }
+
     /// A path parameter resolved against the graph file's folder.
     pub fn path(&self, p: &str) -> PathBuf {
         let p = Path::new(p);
@@ -306,21 +318,21 @@ impl<'a> Io<'a> {
     }
     /// The samples of input `i` for this call.
     #[inline]
-    pub fn input(&self, i: impl Into<InPort>) -> &[f64] {
-        let i = i.into().index();
+    pub fn input(&self, i: InPort) -> &[f64] {
+        let i = i.index();
         &self.pool[self.in_slots[i]][..self.in_lens[i]]
     }
     /// The buffer of output `o` for this call, to be filled completely.
     #[inline]
-    pub fn output(&mut self, o: impl Into<OutPort>) -> &mut [f64] {
-        let o = o.into().index();
+    pub fn output(&mut self, o: OutPort) -> &mut [f64] {
+        let o = o.index();
         let n = self.out_lens[o];
         &mut self.outs[o][..n]
     }
     /// Input `i` and output `o` together.
     #[inline]
-    pub fn io(&mut self, i: impl Into<InPort>, o: impl Into<OutPort>) -> (&[f64], &mut [f64]) {
-        let (i, o) = (i.into().index(), o.into().index());
+    pub fn io(&mut self, i: InPort, o: OutPort) -> (&[f64], &mut [f64]) {
+        let (i, o) = (i.index(), o.index());
         let n = self.out_lens[o];
         (&self.pool[self.in_slots[i]][..self.in_lens[i]], &mut self.outs[o][..n])
     }
@@ -340,12 +352,12 @@ impl<'a> Io<'a> {
         self.len() == 0
     }
     /// Length of output `o` in this call.
-    pub fn output_len(&self, o: impl Into<OutPort>) -> usize {
-        self.out_lens[o.into().index()]
+    pub fn output_len(&self, o: OutPort) -> usize {
+        self.out_lens[o.index()]
     }
     /// Length of input `i` in this call.
-    pub fn input_len(&self, i: impl Into<InPort>) -> usize {
-        self.in_lens[i.into().index()]
+    pub fn input_len(&self, i: InPort) -> usize {
+        self.in_lens[i.index()]
     }
     /// Index, at the node's rate, of the first sample of this call since t = 0.
     pub fn start(&self) -> u64 {
@@ -442,7 +454,8 @@ mod tests {
             node: "sink".into(),
             base_rate: 1000.0,
             rate: 1000.0,
-            port_rates: Vec::new(),
+            input_rates: Vec::new(),
+            output_rates: Vec::new(),
             base_dir: out.to_path_buf(),
             out_dir: out.to_path_buf(),
             seed: 1,

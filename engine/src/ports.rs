@@ -190,18 +190,6 @@ const fn same(a: &str, b: &str) -> bool {
     true
 }
 
-// TRANSITION: bare indices still accepted while the nodes move to named ports.
-impl From<usize> for InPort {
-    fn from(k: usize) -> Self {
-        Self(k)
-    }
-}
-impl From<usize> for OutPort {
-    fn from(k: usize) -> Self {
-        Self(k)
-    }
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;

@@ -20,7 +20,7 @@ pub mod math;
 #[cfg(feature = "mesh")]
 pub mod mesh;
 pub mod metric;
-pub mod model_file;
+pub mod model_file_error;
 #[cfg(feature = "narx")]
 pub mod narx;
 pub mod output;

@@ -7,6 +7,7 @@ use crate::harness::{FEED, TAP};
 use crate::node::{BuildContext, Constant, Io, Node, NodeError, RunMode};
 use crate::params::Params;
 use crate::plan::{Folding, Plan, PlanOptions};
+use crate::ports::{InPort, OutPort};
 use crate::registry::Registry;
 use crate::spec::{FoldArgs, NodeSpec, ParamSpec, PortSpec, Role};
 use std::path::Path;
@@ -28,7 +29,7 @@ static FILE: NodeSpec = NodeSpec::new("t.file", "test", Role::Source, "reads a f
 struct Ramp(f64);
 impl Node for Ramp {
     fn process(&mut self, io: &mut Io<'_>) -> Result<(), NodeError> {
-        for y in io.output(0) {
+        for y in io.output(OutPort::at(0)) {
             self.0 += 0.25;
             *y = self.0;
         }
@@ -57,7 +58,7 @@ static SCALE: NodeSpec = NodeSpec::new("t.scale", "test", Role::Filter, "y = k x
 struct Scale(f64);
 impl Node for Scale {
     fn process(&mut self, io: &mut Io<'_>) -> Result<(), NodeError> {
-        let (x, y) = io.io(0, 0);
+        let (x, y) = io.io(InPort::at(0), OutPort::at(0));
         for (y, x) in y.iter_mut().zip(x) {
             *y = self.0 * x;
         }
@@ -91,7 +92,7 @@ struct Sum;
 impl Node for Sum {
     fn process(&mut self, io: &mut Io<'_>) -> Result<(), NodeError> {
         for k in 0..io.len() {
-            io.output(0)[k] = io.input(0)[k] + io.input(1)[k];
+            io.output(OutPort::at(0))[k] = io.input(InPort::at(0))[k] + io.input(InPort::at(1))[k];
         }
         Ok(())
     }
@@ -124,8 +125,8 @@ struct Probe {
 impl Node for Probe {
     fn process(&mut self, io: &mut Io<'_>) -> Result<(), NodeError> {
         for k in 0..io.len() {
-            io.output(0)[k] = if self.flat { 0.0 } else { io.input(0)[k] };
-            io.output(1)[k] = 180.0;
+            io.output(OutPort::at(0))[k] = if self.flat { 0.0 } else { io.input(InPort::at(0))[k] };
+            io.output(OutPort::at(1))[k] = 180.0;
         }
         Ok(())
     }

@@ -6,6 +6,7 @@ use crate::graph::parse_graph;
 use crate::harness::{FEED, TAP};
 use crate::node::{BuildContext, Io, Node, NodeError};
 use crate::plan::{Plan, PlanOptions};
+use crate::ports::{InPort, OutPort};
 use crate::spec::{ParamSpec, PortSpec, Role};
 use std::path::Path;
 use std::sync::atomic::{AtomicUsize, Ordering};
@@ -15,7 +16,7 @@ static BUILT: AtomicUsize = AtomicUsize::new(0);
 struct Pass;
 impl Node for Pass {
     fn process(&mut self, io: &mut Io<'_>) -> Result<(), NodeError> {
-        let (x, y) = io.io(0, 0);
+        let (x, y) = io.io(InPort::at(0), OutPort::at(0));
         y.copy_from_slice(x);
         Ok(())
     }

@@ -8,6 +8,7 @@ use crate::harness::TAP;
 use crate::node::{BuildContext, Change, Io, Node, NodeError, Refused};
 use crate::params::Params;
 use crate::plan::{Plan, PlanOptions};
+use crate::ports::{InPort, OutPort};
 use crate::registry::Registry;
 use crate::spec::{NodeSpec, ParamSpec, PortSpec, Role};
 use crate::typed_params::{Flag, Float};
@@ -45,7 +46,7 @@ fn build_counter(p: &Params, _: &BuildContext) -> Result<Box<dyn Node>, NodeErro
 
 impl Node for Counter {
     fn process(&mut self, io: &mut Io<'_>) -> Result<(), NodeError> {
-        for y in io.output(0) {
+        for y in io.output(OutPort::at(0)) {
             if !self.stall.is_zero() && self.n >= self.stall_from {
                 std::thread::sleep(self.stall);
             }
@@ -93,7 +94,7 @@ fn build_guard(_: &Params, _: &BuildContext) -> Result<Box<dyn Node>, NodeError>
 
 impl Node for Guard {
     fn process(&mut self, io: &mut Io<'_>) -> Result<(), NodeError> {
-        let (x, y) = io.io(0, 0);
+        let (x, y) = io.io(InPort::at(0), OutPort::at(0));
         for (y, x) in y.iter_mut().zip(x) {
             self.gate = if self.open { 1.0 } else { (self.gate - 1.0 / 3.0).max(0.0) };
             *y = x * self.gate;

@@ -1,7 +1,7 @@
 //! `error`: how far a stream is from a reference stream.
 
 use crate::sum::Sum;
-use evflow_engine::typed_ports::InPort;
+use evflow_engine::ports::InPort;
 use evflow_engine::{BuildContext, Io, Node, NodeError, NodeSpec, Params, PortSpec, Role, Summary};
 
 /// Declaration of `error`.

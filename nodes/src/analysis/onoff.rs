@@ -1,7 +1,7 @@
 //! `onoff`: the friction increase while an effect is on, against while it is off.
 
+use evflow_engine::ports::InPort;
 use evflow_engine::typed_params::Float;
-use evflow_engine::typed_ports::InPort;
 use evflow_engine::{BuildContext, Io, Node, NodeError, NodeSpec, Params, PortSpec, Role, Summary};
 
 /// Declaration of `onoff`.

@@ -1,7 +1,7 @@
 //! `peaks`: the mean of the largest peak-to-peak amplitudes of a vibration.
 
+use evflow_engine::ports::InPort;
 use evflow_engine::typed_params::Int;
-use evflow_engine::typed_ports::InPort;
 use evflow_engine::{BuildContext, Io, Node, NodeError, NodeSpec, Params, PortSpec, Role, Summary};
 use std::cmp::Reverse;
 use std::collections::BinaryHeap;

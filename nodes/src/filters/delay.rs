@@ -1,8 +1,8 @@
 //! `delay`: delays a stream by a whole number of samples; the node that
 //! lets a feedback cycle through.
 
+use evflow_engine::ports::{InPort, OutPort};
 use evflow_engine::typed_params::Int;
-use evflow_engine::typed_ports::{InPort, OutPort};
 use evflow_engine::{BuildContext, Io, Node, NodeError, NodeSpec, Params, PortSpec, Role};
 
 /// Largest delay in samples (80 MB of history).

@@ -1,8 +1,8 @@
 //! `normalize`: maps a stream from a given range to [−1, 1] (MATLAB
 //! `mapminmax` with fixed settings).
 
+use evflow_engine::ports::{InPort, OutPort};
 use evflow_engine::typed_params::{Flag, Float};
-use evflow_engine::typed_ports::{InPort, OutPort};
 use evflow_engine::{BuildContext, Io, Node, NodeError, NodeSpec, Params, PortSpec, Role};
 
 /// Declaration of `normalize`.

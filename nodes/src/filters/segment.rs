@@ -1,7 +1,7 @@
 //! `segment`: marks the constant-speed stretches of a scan (§5.1.1).
 
+use evflow_engine::ports::{InPort, OutPort};
 use evflow_engine::typed_params::{Choice, Float, Words};
-use evflow_engine::typed_ports::{InPort, OutPort};
 use evflow_engine::{BuildContext, Io, Node, NodeError, NodeSpec, Params, PortSpec, Role};
 
 /// Declaration of `segment`.

@@ -2,7 +2,7 @@
 
 use super::sensor_model::SensorModel;
 use super::{profile_of, seed_of, INTEGRATOR, NOISE, PROFILE, SEED, SUBSTEPS};
-use evflow_engine::typed_ports::{InPort, OutPort};
+use evflow_engine::ports::{InPort, OutPort};
 use evflow_engine::{BuildContext, Io, Node, NodeError, NodeSpec, Params, PortSpec, Role, Summary};
 
 /// Declaration of `sim.forcesensor`.

@@ -2,8 +2,8 @@
 
 use super::tribometer_model::TribometerModel;
 use super::{profile_of, INTEGRATOR, PROFILE, SUBSTEPS};
+use evflow_engine::ports::OutPort;
 use evflow_engine::typed_params::{Float, Int};
-use evflow_engine::typed_ports::OutPort;
 use evflow_engine::{BuildContext, Io, Node, NodeError, NodeSpec, Params, PortSpec, Role, Summary};
 
 /// Declaration of `sim.tribometer`.

@@ -1,7 +1,7 @@
 //! The node state shared by the two-input arithmetic nodes (`add`, `mul`):
 //! one operation applied sample by sample to inputs `a` and `b`.
 
-use evflow_engine::typed_ports::{InPort, OutPort};
+use evflow_engine::ports::{InPort, OutPort};
 use evflow_engine::{Io, Node, NodeError};
 
 /// `v` held within ±f64::MAX: a sum or product of finite samples that

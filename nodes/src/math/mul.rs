@@ -2,8 +2,8 @@
 
 use super::binary::Binary;
 use evflow_engine::node::Constant;
+use evflow_engine::ports::{InPort, OutPort};
 use evflow_engine::spec::FoldArgs;
-use evflow_engine::typed_ports::{InPort, OutPort};
 use evflow_engine::{BuildContext, Node, NodeError, NodeSpec, Params, PortSpec, Role};
 
 /// Declaration of `mul`.

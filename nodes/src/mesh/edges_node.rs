@@ -5,8 +5,8 @@ use super::edges::{census, EdgeCensus, EdgeTracker};
 use super::gradient_node::placement_note;
 use super::source::{self, Placed};
 use evflow_engine::node::Constant;
+use evflow_engine::ports::{InPort, OutPort};
 use evflow_engine::typed_params::Float;
-use evflow_engine::typed_ports::{InPort, OutPort};
 use evflow_engine::{BuildContext, Change, Io, Node, NodeError, NodeSpec, Params, PortSpec, Refused, Role, Summary};
 
 /// Declaration of `mesh.edges`.

@@ -5,8 +5,8 @@ use super::calibrate::{calibrate, CacheStatus, Range, ScanSettings};
 use super::gradient::{intensity, Gradient, GradientSettings, SlopeMode};
 use super::raycast::RayCaster;
 use super::source::{self, Fit, Placed};
+use evflow_engine::ports::{InPort, OutPort};
 use evflow_engine::typed_params::{Choice, Float, Floats, Int, Text};
-use evflow_engine::typed_ports::{InPort, OutPort};
 use evflow_engine::{BuildContext, Change, Io, Node, NodeError, NodeSpec, Params, PortSpec, Refused, Role, Summary};
 
 /// Declaration of `mesh.gradient`.

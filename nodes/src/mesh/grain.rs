@@ -3,9 +3,9 @@
 //! EDGE-TICK for sharp edges — scaled by their intensities.
 
 use evflow_engine::node::Constant;
+use evflow_engine::ports::{InPort, OutPort};
 use evflow_engine::spec::FoldArgs;
 use evflow_engine::typed_params::{Float, Words};
-use evflow_engine::typed_ports::{InPort, OutPort};
 use evflow_engine::{BuildContext, Io, Node, NodeError, NodeSpec, Params, PortSpec, Role};
 use std::f64::consts::TAU;
 

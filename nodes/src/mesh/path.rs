@@ -1,8 +1,8 @@
 //! `mesh.path`: a scripted finger — straight scan lines over a scene in
 //! given directions at a given speed — for end-to-end tests and reports.
 
+use evflow_engine::ports::OutPort;
 use evflow_engine::typed_params::{Float, Floats, Int};
-use evflow_engine::typed_ports::OutPort;
 use evflow_engine::{BuildContext, Io, Node, NodeError, NodeSpec, Params, PortSpec, Role};
 
 /// Declaration of `mesh.path`.

@@ -2,8 +2,8 @@
 //! (dissertation §3.2.1) — a 1-D Gaussian bump, hole or flat surface, its
 //! tangential force profile and the IP0.5 / IP0.7 intensity profiles.
 
+use evflow_engine::ports::{InPort, OutPort};
 use evflow_engine::typed_params::{Choice, Float};
-use evflow_engine::typed_ports::{InPort, OutPort};
 use evflow_engine::{BuildContext, Io, Node, NodeError, NodeSpec, Params, PortSpec, Role};
 
 /// Declaration of `profile1d`.

@@ -3,8 +3,8 @@
 use super::spectral_error::{spectral_rms_error, Band, SpectralError};
 use super::spectrum::{Spectrum, SpectrumAccumulator, SpectrumConfig, Window};
 use crate::filters::segment::{Gates, GATES};
+use evflow_engine::ports::InPort;
 use evflow_engine::typed_params::{Choice, Flag, Float, Int};
-use evflow_engine::typed_ports::InPort;
 use evflow_engine::{BuildContext, Io, Node, NodeError, NodeSpec, Params, PortSpec, Role, Summary};
 
 /// Largest FFT length (2²⁰ samples: 17 min at 1 kHz, 105 s at 10 kHz).

@@ -1,6 +1,6 @@
 //! Errors of the NARX family: model files, training data, training.
 
-use crate::model_file::{ModelFileError, ModelFormat};
+use crate::model_file_error::{ModelFileError, ModelFormat};
 use std::path::Path;
 
 /// The NARX model format, as its errors name it.

@@ -7,8 +7,8 @@ use super::closed_loop::ClosedLoop;
 use super::model::Model;
 use super::nearest::nearest;
 use super::node::TANH;
+use evflow_engine::ports::{InPort, OutPort};
 use evflow_engine::typed_params::{Float, Words};
-use evflow_engine::typed_ports::{InPort, OutPort};
 use evflow_engine::{BuildContext, Io, Node, NodeError, NodeSpec, Params, PortSpec, Role, Summary};
 
 /// Declaration of `narx.grid`.

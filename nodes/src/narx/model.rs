@@ -392,7 +392,7 @@ mod tests {
         let path = dir.path().join("taken");
         std::fs::create_dir(&path).unwrap();
         let e = small().save(&path).unwrap_err();
-        assert!(matches!(e, NarxError::File(crate::model_file::ModelFileError::Io { .. })), "{e}");
+        assert!(matches!(e, NarxError::File(crate::model_file_error::ModelFileError::Io { .. })), "{e}");
         assert!(e.to_string().contains("taken"), "{e}");
         assert!(!dir.path().join("taken.tmp").exists());
     }

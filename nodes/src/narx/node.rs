@@ -4,8 +4,8 @@
 use super::closed_loop::ClosedLoop;
 use super::model::Model;
 use super::packed::Tanh;
+use evflow_engine::ports::{InPort, OutPort};
 use evflow_engine::typed_params::{Choice, Text};
-use evflow_engine::typed_ports::{InPort, OutPort};
 use evflow_engine::{BuildContext, Io, Node, NodeError, NodeSpec, Params, PortSpec, Role, Summary};
 
 /// Declaration of `narx`.

@@ -3,7 +3,7 @@
 //! when the stream ends.
 
 use crate::filters::segment::Gates;
-use evflow_engine::typed_ports::InPort;
+use evflow_engine::ports::InPort;
 use evflow_engine::Io;
 
 /// The buffered pairs (the node's inputs force `x` and actuation `y`),

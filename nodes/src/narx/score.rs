@@ -7,8 +7,8 @@ use super::model::Model;
 use super::node::MODEL;
 use super::pairs::GatedPairs;
 use crate::filters::segment::{Gates, GATES};
+use evflow_engine::ports::InPort;
 use evflow_engine::typed_params::Int;
-use evflow_engine::typed_ports::InPort;
 use evflow_engine::{BuildContext, Io, Node, NodeError, NodeSpec, Params, PortSpec, PrepareContext, Role, Summary};
 use std::path::PathBuf;
 

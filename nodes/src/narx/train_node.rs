@@ -6,8 +6,8 @@ use super::model::Condition;
 use super::pairs::GatedPairs;
 use super::train::Options;
 use crate::filters::segment::{Gates, GATES};
+use evflow_engine::ports::InPort;
 use evflow_engine::typed_params::{Choice, Flag, Float, Floats, Int, Text};
-use evflow_engine::typed_ports::InPort;
 use evflow_engine::{BuildContext, Io, Node, NodeError, NodeSpec, Params, PortSpec, PrepareContext, Role, Summary};
 use std::path::PathBuf;
 
@@ -212,7 +212,7 @@ fn build(p: &Params, ctx: &BuildContext) -> Result<Box<dyn Node>, NodeError> {
     for (i, &h) in HIDDEN.get(p).iter().enumerate() {
         if h.fract() != 0.0 || h < 1.0 {
             return Err(NodeError::param(
-                HIDDEN.spec().name,
+                HIDDEN.name(),
                 format!("entry {i} is {h}: layer sizes are whole numbers ≥ 1"),
             ));
         }

@@ -1,9 +1,9 @@
 //! `gain`: multiplies a stream by a constant.
 
 use evflow_engine::node::Constant;
+use evflow_engine::ports::{InPort, OutPort};
 use evflow_engine::spec::FoldArgs;
 use evflow_engine::typed_params::Float;
-use evflow_engine::typed_ports::{InPort, OutPort};
 use evflow_engine::{BuildContext, Change, Io, Node, NodeError, NodeSpec, Params, PortSpec, Refused, Role};
 
 /// Declaration of `gain`.

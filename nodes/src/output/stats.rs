@@ -1,7 +1,7 @@
 //! `stats`: a sink that reports count, mean, RMS, min, max and peak-to-peak.
 
 use crate::sum::Sum;
-use evflow_engine::typed_ports::InPort;
+use evflow_engine::ports::InPort;
 use evflow_engine::{BuildContext, Io, Node, NodeError, NodeSpec, PortSpec, Role, Summary};
 
 /// Declaration of `stats`.

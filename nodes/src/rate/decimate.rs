@@ -2,8 +2,8 @@
 //! anti-aliasing filter built in.
 
 use super::decimator::{design, DecimateError, Decimator};
+use evflow_engine::ports::{InPort, OutPort};
 use evflow_engine::typed_params::Float;
-use evflow_engine::typed_ports::{InPort, OutPort};
 use evflow_engine::{BuildContext, Io, Node, NodeError, NodeSpec, Params, PortSpec, RateSpec, Role};
 
 /// Declaration of `decimate`.
@@ -106,7 +106,7 @@ fn factor(input: f64, output: f64) -> Result<usize, NodeError> {
 }
 
 fn build(p: &Params, ctx: &BuildContext) -> Result<Box<dyn Node>, NodeError> {
-    let m = factor(ctx.port_rates[0], ctx.rate)?;
+    let m = factor(ctx.input_rate(IN), ctx.rate)?;
     let d = design(m, PASSBAND.get(p), ATTENUATION.get(p)).map_err(|e| match e {
         DecimateError::Passband(_) => NodeError::param(PASSBAND.name(), e.to_string()),
         DecimateError::Attenuation(_) => NodeError::param(ATTENUATION.name(), e.to_string()),

@@ -1,8 +1,8 @@
 //! `hold`: a stream at any rate, held to the node's rate (zero-order hold).
 
 use super::clock::Clock;
+use evflow_engine::ports::{InPort, OutPort};
 use evflow_engine::typed_params::Float;
-use evflow_engine::typed_ports::{InPort, OutPort};
 use evflow_engine::{BuildContext, Io, Node, NodeError, NodeSpec, Params, PortSpec, RateSpec, Role};
 
 /// Declaration of `hold`.
@@ -51,7 +51,7 @@ struct Hold {
 }
 
 fn build(_p: &Params, ctx: &BuildContext) -> Result<Box<dyn Node>, NodeError> {
-    let input = Clock::new(ctx.port_rates[0], ctx.base_rate, "in")?;
+    let input = Clock::new(ctx.input_rate(IN), ctx.base_rate, "in")?;
     let output = Clock::new(ctx.rate, ctx.base_rate, "out")?;
     Ok(Box::new(Hold { input, output, value: 0.0, received: 0, sent: 0 }))
 }

@@ -2,8 +2,8 @@
 //! asynchronous resampler, streaming, with a fixed latency.
 
 use super::resampler::{Quality, ResampleError, Stream, QUALITY_NAMES};
+use evflow_engine::ports::{InPort, OutPort};
 use evflow_engine::typed_params::{Choice, Float};
-use evflow_engine::typed_ports::{InPort, OutPort};
 use evflow_engine::{BuildContext, Io, Node, NodeError, NodeSpec, Params, PortSpec, PrepareContext, RateSpec, Role};
 
 /// Declaration of `resample`.
@@ -86,7 +86,7 @@ struct Resample {
 
 fn build(p: &Params, ctx: &BuildContext) -> Result<Box<dyn Node>, NodeError> {
     let quality = QUALITY.get(p);
-    let ratio = ctx.rate / ctx.port_rates[0];
+    let ratio = ctx.rate / ctx.input_rate(IN);
     let stream = Stream::new(ratio, quality).map_err(|e| match e {
         ResampleError::StepTooLarge { .. } | ResampleError::Ratio(_) => NodeError::param(RATE.name(), e.to_string()),
         _ => NodeError::Other(e.to_string()),

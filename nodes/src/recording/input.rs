@@ -1,8 +1,8 @@
 //! `recording.in`: plays channels of a recording.
 
 use super::format::{Recording, RecordingError, Shortfall};
+use evflow_engine::ports::OutPort;
 use evflow_engine::typed_params::{Float, Text, Words};
-use evflow_engine::typed_ports::OutPort;
 use evflow_engine::{BuildContext, Io, Node, NodeError, NodeSpec, Params, PortSpec, Role, Summary};
 
 /// Declaration of `recording.in`.

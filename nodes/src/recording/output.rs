@@ -1,8 +1,8 @@
 //! `recording.out`: writes its inputs to a recording.
 
 use super::format::{Channel, Condition, RecordingMeta, RecordingPaths, RecordingWriter};
+use evflow_engine::ports::InPort;
 use evflow_engine::typed_params::{Float, Text, Words};
-use evflow_engine::typed_ports::InPort;
 use evflow_engine::{BuildContext, Io, Node, NodeError, NodeSpec, Params, PortSpec, PrepareContext, Role, Summary};
 use std::path::Path;
 

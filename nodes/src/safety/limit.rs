@@ -1,8 +1,8 @@
 //! `limit`: the safety limiter in front of every hardware output.
 
 use super::envelope::Envelope;
+use evflow_engine::ports::{InPort, OutPort};
 use evflow_engine::typed_params::{Flag, Float, Words};
-use evflow_engine::typed_ports::{InPort, OutPort};
 use evflow_engine::{BuildContext, Change, Io, Node, NodeError, NodeSpec, Params, PortSpec, Refused, Role, Summary};
 
 /// The longest fade the limiter may take: the live runner's stop sequence

@@ -4,7 +4,7 @@
 use super::link::{self, InEnd, Link, LinkConfig};
 use super::message::fault_names;
 use super::params::{self, PORT_PARAMS};
-use evflow_engine::typed_ports::OutPort;
+use evflow_engine::ports::OutPort;
 use evflow_engine::{
     BuildContext, Io, Node, NodeError, NodeSpec, Params, PortSpec, PrepareContext, Role, RunMode, Summary,
 };

@@ -2,7 +2,7 @@
 
 use super::link::{self, Link, LinkConfig};
 use super::params::{self, PORT_PARAMS};
-use evflow_engine::typed_ports::InPort;
+use evflow_engine::ports::InPort;
 use evflow_engine::{
     BuildContext, Io, Node, NodeError, NodeSpec, Params, PortSpec, PrepareContext, Role, RunMode, Summary,
 };

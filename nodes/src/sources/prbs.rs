@@ -2,8 +2,8 @@
 //! the one MATLAB `idinput` generates.
 
 use super::prbs_taps::{self, Taps};
+use evflow_engine::ports::OutPort;
 use evflow_engine::typed_params::{Float, Int};
-use evflow_engine::typed_ports::OutPort;
 use evflow_engine::{BuildContext, Io, Node, NodeError, NodeSpec, Params, PortSpec, Role};
 
 /// Declaration of `prbs`.

@@ -3,8 +3,8 @@
 
 use super::prms_field::{self, Recurrence};
 use crate::rng::Rng;
+use evflow_engine::ports::OutPort;
 use evflow_engine::typed_params::{Choice, Float, Int};
-use evflow_engine::typed_ports::OutPort;
 use evflow_engine::{BuildContext, Io, Node, NodeError, NodeSpec, Params, PortSpec, Role};
 
 /// Declaration of `prms`.

@@ -1,7 +1,7 @@
 //! `pulse`: a rectangular gate that switches between two levels.
 
+use evflow_engine::ports::OutPort;
 use evflow_engine::typed_params::Float;
-use evflow_engine::typed_ports::OutPort;
 use evflow_engine::{BuildContext, Io, Node, NodeError, NodeSpec, Params, PortSpec, Role};
 
 /// Declaration of `pulse`.

@@ -1,7 +1,7 @@
 //! `sine`: a sine wave whose phase is exact at any sample index.
 
+use evflow_engine::ports::OutPort;
 use evflow_engine::typed_params::Float;
-use evflow_engine::typed_ports::OutPort;
 use evflow_engine::{BuildContext, Io, Node, NodeError, NodeSpec, Params, PortSpec, Role};
 use std::f64::consts::TAU;
 
@@ -171,7 +171,8 @@ mod tests {
             node: "s".into(),
             base_rate: fs,
             rate: fs,
-            port_rates: vec![fs],
+            input_rates: Vec::new(),
+            output_rates: vec![fs],
             base_dir: PathBuf::from("."),
             out_dir: PathBuf::from("."),
             seed: 0,

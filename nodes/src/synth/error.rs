@@ -1,7 +1,7 @@
 //! Errors of the synthesis family: forward-model files, identification
 //! data, synthesis targets.
 
-use crate::model_file::{ModelFileError, ModelFormat};
+use crate::model_file_error::{ModelFileError, ModelFormat};
 use std::path::Path;
 
 /// The forward-model format, as its errors name it.

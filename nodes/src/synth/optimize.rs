@@ -11,8 +11,8 @@ use crate::metric::spectral_error::Band;
 use crate::metric::spectrum::{SpectrumConfig, Window};
 use crate::narx::model::Model;
 use crate::recording::format::Recording;
+use evflow_engine::ports::OutPort;
 use evflow_engine::typed_params::{Choice, Flag, Float, Int, Text};
-use evflow_engine::typed_ports::OutPort;
 use evflow_engine::{BuildContext, Io, Node, NodeError, NodeSpec, Params, PortSpec, Role, Summary};
 
 /// Declaration of `synth.optimize`.

@@ -6,8 +6,8 @@ use super::grid::{Grid, GridSource};
 use super::kernel::SincKernel;
 use super::scheme::{Geometry, Mix, Scheme};
 use crate::rate::clock::Clock;
+use evflow_engine::ports::{InPort, OutPort};
 use evflow_engine::typed_params::{Choice, Flag, Float, Floats, Int, Text, Words};
-use evflow_engine::typed_ports::{InPort, OutPort};
 use evflow_engine::{
     BuildContext, Change, Io, Node, NodeError, NodeSpec, Params, PortSpec, PrepareContext, RateSpec, Refused, Role,
     Summary,
@@ -112,9 +112,6 @@ const LOAD: InPort = InPort::named(PORTS, "load");
 const VELOCITY: InPort = InPort::named(PORTS, "velocity");
 /// `table`: the table frames.
 const TABLE: OutPort = OutPort::named(PORTS, "table");
-/// Where `table` sits among all the ports, as [`BuildContext::port_rates`]
-/// counts them (in declaration order): after the two inputs.
-const TABLE_RATE_AT: usize = VELOCITY.index() + 1 + TABLE.index();
 
 /// Outside the grid's loads (`load_beyond`).
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -272,7 +269,7 @@ pub fn grid_sources(p: &Params, ctx: &BuildContext) -> Result<Vec<(GridSource, S
             [] => Ok(None),
             [lo, hi] => Ok(Some((*lo, *hi))),
             other => Err(NodeError::param(
-                list.spec().name,
+                list.name(),
                 format!("give two numbers [lo, hi], not {} values", other.len()),
             )),
         }
@@ -310,7 +307,7 @@ fn build(p: &Params, ctx: &BuildContext) -> Result<Box<dyn Node>, NodeError> {
         ));
     }
     let update = UPDATE_RATE.get(p);
-    let stream = ctx.port_rates[TABLE_RATE_AT];
+    let stream = ctx.output_rate(TABLE);
     let frame_f = stream / update;
     let frame = frame_f.round() as usize;
     if (frame_f - frame as f64).abs() > 1e-9 * frame_f || frame < HEADER + 32 {
@@ -364,7 +361,7 @@ fn build(p: &Params, ctx: &BuildContext) -> Result<Box<dyn Node>, NodeError> {
     }
     let scheme = SCHEME.get(p);
     Ok(Box::new(Interp {
-        in_clock: Clock::new(ctx.port_rates[LOAD.index()], ctx.base_rate, "load")?,
+        in_clock: Clock::new(ctx.input_rate(LOAD), ctx.base_rate, "load")?,
         out_clock: Clock::new(stream, ctx.base_rate, "table")?,
         textures: loaded,
         current: initial,

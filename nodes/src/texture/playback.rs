@@ -3,8 +3,8 @@
 
 use super::frame::{Header, HEADER};
 use crate::rate::clock::Clock;
+use evflow_engine::ports::{InPort, OutPort};
 use evflow_engine::typed_params::{Choice, Float, Int};
-use evflow_engine::typed_ports::{InPort, OutPort};
 use evflow_engine::{
     BuildContext, Io, Node, NodeError, NodeSpec, Params, PortSpec, PrepareContext, RateSpec, Role, Summary,
 };
@@ -133,7 +133,7 @@ struct Playback {
 }
 
 fn build(p: &Params, ctx: &BuildContext) -> Result<Box<dyn Node>, NodeError> {
-    let table_rate = ctx.port_rates[TABLE.index()];
+    let table_rate = ctx.input_rate(TABLE);
     let update = UPDATE_RATE.get(p);
     let frame_f = table_rate / update;
     let frame = frame_f.round() as usize;

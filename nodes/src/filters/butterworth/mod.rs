@@ -4,8 +4,8 @@ pub mod design;
 pub mod sos;
 
 use design::{butterworth, DesignError, Kind, MIN_RELATIVE_CUTOFF};
+use evflow_engine::ports::{InPort, OutPort};
 use evflow_engine::typed_params::{Choice, Float, Int};
-use evflow_engine::typed_ports::{InPort, OutPort};
 use evflow_engine::{BuildContext, Io, Node, NodeError, NodeSpec, Params, PortSpec, Role};
 use sos::Cascade;
 
@@ -247,7 +247,8 @@ mod tests {
             node: "lp".into(),
             base_rate: 1000.0,
             rate: 1000.0,
-            port_rates: vec![1000.0, 1000.0],
+            input_rates: vec![1000.0],
+            output_rates: vec![1000.0],
             base_dir: ".".into(),
             out_dir: ".".into(),
             seed: 0,

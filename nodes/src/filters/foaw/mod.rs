@@ -6,8 +6,8 @@ pub mod compare;
 pub mod estimator;
 
 use estimator::{Fit, Foaw};
+use evflow_engine::ports::{InPort, OutPort};
 use evflow_engine::typed_params::{Choice, Float, Int};
-use evflow_engine::typed_ports::{InPort, OutPort};
 use evflow_engine::{BuildContext, Io, Node, NodeError, NodeSpec, Params, PortSpec, Role};
 
 /// Declaration of `foaw`.

@@ -12,8 +12,8 @@ mod chain_tests;
 #[cfg(test)]
 mod tests;
 
+use evflow_engine::ports::{InPort, OutPort};
 use evflow_engine::typed_params::{Float, Text};
-use evflow_engine::typed_ports::{InPort, OutPort};
 use evflow_engine::{BuildContext, Io, Node, NodeError, NodeSpec, Params, PortSpec, Role};
 use surface::Surface;
 

@@ -6,8 +6,8 @@ pub mod finger;
 
 use crate::rate::clock::Clock;
 use crate::rng::Rng;
+use evflow_engine::ports::OutPort;
 use evflow_engine::typed_params::{Float, Int};
-use evflow_engine::typed_ports::OutPort;
 use evflow_engine::{BuildContext, Io, Node, NodeError, NodeSpec, Params, PortSpec, RateSpec, Role, Summary};
 use finger::{Finger, FingerSettings};
 

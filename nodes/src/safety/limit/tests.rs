@@ -1,7 +1,7 @@
 use super::{State, SPEC, STATE_ARMED, STATE_CLAMPING, STATE_FADED, STATE_FADING, STATE_FAULTED};
 use evflow_engine::harness::{Single, TAP};
+use evflow_engine::ports::OutPort;
 use evflow_engine::typed_params::Floats;
-use evflow_engine::typed_ports::OutPort;
 use evflow_engine::{
     check, graph::parse_graph, BuildContext, Io, Node, NodeError, NodeSpec, Params, Plan, PlanOptions, PortSpec,
     Registry, Role, Summary,

@@ -6,8 +6,8 @@ use super::envelope::{EnvelopeModel, ModelGrid};
 use super::horizon::Horizon;
 use super::window_min::WindowMin;
 use crate::synth::model_file::ForwardModel;
+use evflow_engine::ports::{InPort, OutPort};
 use evflow_engine::typed_params::{Float, Int, Words};
-use evflow_engine::typed_ports::{InPort, OutPort};
 use evflow_engine::{BuildContext, Io, Node, NodeError, NodeSpec, Params, PortSpec, Role, Summary};
 use std::time::{Duration, Instant};
 

@@ -1,3 +1,0 @@
-//! TRANSITION: the named port constants' old path; they live in [`crate::ports`].
-
-pub use crate::ports::{InPort, OutPort};

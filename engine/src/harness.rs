@@ -11,18 +11,24 @@ use crate::params::{toml_float, Params};
 use crate::plan::{Folding, Plan, PlanOptions};
 use crate::ports::OutPort;
 use crate::registry::Registry;
-use crate::spec::{NodeSpec, ParamSpec, PortSpec, RateSpec, Role};
+use crate::spec::{NodeSpec, PortSpec, RateSpec, Role};
+use crate::typed_params::{Float, Floats};
 use std::path::Path;
 
 /// A source that plays the `values` list once, at `rate` Hz.
 pub static FEED: NodeSpec =
     NodeSpec::new("harness.feed", "harness", Role::Source, "Plays a list of values (test harness).", build_feed)
-        .ports(&[PortSpec::output("out", "1", "the values")])
-        .params(&[
-            ParamSpec::float_list("values", f64::NEG_INFINITY, f64::INFINITY, "1", "samples to play"),
-            ParamSpec::float("rate", 1e-3, 1e7, 1000.0, "Hz", "sample rate"),
-        ])
-        .rate_param("rate");
+        .ports(FEED_PORTS)
+        .params(&[VALUES.spec(), RATE.spec()])
+        .rate_param(RATE.name());
+
+/// `harness.feed`'s one output.
+const FEED_PORTS: &[PortSpec] = &[PortSpec::output("out", "1", "the values")];
+const FEED_OUT: OutPort = OutPort::named(FEED_PORTS, "out");
+/// `values`: the samples `harness.feed` plays.
+const VALUES: Floats = Floats::new("values", f64::NEG_INFINITY, f64::INFINITY, "1", "samples to play");
+/// `rate`: `harness.feed`'s sample rate.
+const RATE: Float = Float::new("rate", 1e-3, 1e7, 1000.0, "Hz", "sample rate");
 
 /// A sink that accepts any rate and discards its input (the harness reads
 /// the plan's buffers directly).
@@ -37,7 +43,7 @@ struct Feed {
 
 impl Node for Feed {
     fn process(&mut self, io: &mut Io<'_>) -> Result<(), NodeError> {
-        for y in io.output(OutPort::at(0)).iter_mut() {
+        for y in io.output(FEED_OUT).iter_mut() {
             *y = self.values.get(self.pos).copied().unwrap_or(0.0);
             self.pos += 1;
         }
@@ -61,7 +67,7 @@ impl Node for Tap {
 }
 
 fn build_feed(p: &Params, _: &BuildContext) -> Result<Box<dyn Node>, NodeError> {
-    Ok(Box::new(Feed { values: p.float_list("values").to_vec(), pos: 0 }))
+    Ok(Box::new(Feed { values: VALUES.get(p).to_vec(), pos: 0 }))
 }
 
 fn build_tap(_: &Params, _: &BuildContext) -> Result<Box<dyn Node>, NodeError> {

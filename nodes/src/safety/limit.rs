@@ -145,7 +145,7 @@ const OUT: OutPort = OutPort::named(PORTS, "out");
 const STATE: OutPort = OutPort::named(PORTS, "state");
 
 /// `amplitude`: the largest |out|.
-const AMPLITUDE: Float = Float::new("amplitude", 0.0, 10.0, 1.0, "1", "largest |out| (1.0 = 50 V peak, 100 Vpp)");
+pub const AMPLITUDE: Float = Float::new("amplitude", 0.0, 10.0, 1.0, "1", "largest |out| (1.0 = 50 V peak, 100 Vpp)");
 /// `slew`: the largest rate of change.
 const SLEW: Float = Float::new("slew", 1e-3, 1e12, 4000.0, "1/s", "largest rate of change of the clamped signal");
 /// `ramp`: the gate's fade time.
@@ -153,7 +153,7 @@ const RAMP: Float = Float::new("ramp", 0.0, MAX_RAMP_S, MAX_RAMP_S, "s", "fade t
 /// `faults`: the names of the fault-flag inputs.
 const FAULTS: Words = Words::new("faults", "names of fault-flag inputs (e.g. [\"link\"]); none by default");
 /// `enable`: the gate, changeable live.
-const ENABLE: Flag = Flag::new("enable", true, "gate open; false fades to zero, true re-arms after a fault").live();
+pub const ENABLE: Flag = Flag::new("enable", true, "gate open; false fades to zero, true re-arms after a fault").live();
 
 /// What closed the gate first.
 #[derive(Debug, Clone, Copy, PartialEq)]

@@ -268,10 +268,9 @@ pub fn grid_sources(p: &Params, ctx: &BuildContext) -> Result<Vec<(GridSource, S
         match list.get(p) {
             [] => Ok(None),
             [lo, hi] => Ok(Some((*lo, *hi))),
-            other => Err(NodeError::param(
-                list.name(),
-                format!("give two numbers [lo, hi], not {} values", other.len()),
-            )),
+            other => {
+                Err(NodeError::param(list.name(), format!("give two numbers [lo, hi], not {} values", other.len())))
+            }
         }
     };
     let base = GridSource {

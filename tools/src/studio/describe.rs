@@ -7,6 +7,7 @@ use evflow_engine::live::{LivePlan, LiveVar, Tap, TapInfo};
 use evflow_engine::params::Value as PValue;
 use evflow_engine::spec::{ParamKind, ParamSpec};
 use evflow_engine::{Checked, Direction};
+use evflow_nodes::safety::limit;
 use serde_json::{json, Value};
 
 /// A safety limiter (`limit`) whose state the studio shows: from its
@@ -125,7 +126,7 @@ pub(crate) fn limiter_specs(
     plan_index: &dyn Fn(&str) -> Option<usize>,
 ) -> Vec<LimiterSpec> {
     let mut limiters = Vec::new();
-    for (k, n) in checked.nodes.iter().enumerate().filter(|(_, n)| n.spec.name == "limit") {
+    for (k, n) in checked.nodes.iter().enumerate().filter(|(_, n)| n.spec.name == limit::SPEC.name) {
         let Some(index) = plan_index(&n.name) else { continue };
         let input = checked.edges.iter().find(|e| e.to.0 == k && n.ports[e.to.1].name == "in").and_then(|e| {
             let f = &checked.nodes[e.from.0];
@@ -134,11 +135,11 @@ pub(crate) fn limiter_specs(
         limiters.push(LimiterSpec {
             node: n.name.clone(),
             index: index as u32,
-            amplitude: n.params.f64("amplitude"),
+            amplitude: limit::AMPLITUDE.get(&n.params),
             input,
             output: tap_of(&n.name, "out"),
             state: tap_of(&n.name, "state"),
-            enabled: n.params.bool("enable"),
+            enabled: limit::ENABLE.get(&n.params),
         });
     }
     limiters

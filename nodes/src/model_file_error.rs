@@ -95,6 +95,33 @@ impl From<ModelFileError> for evflow_engine::NodeError {
     }
 }
 
+/// A family error that wraps [`ModelFileError`] for its format: the
+/// constructors every model-file format's errors need, written once.
+pub trait ModelFileErrors: From<ModelFileError> {
+    /// The family's model-file format.
+    const FORMAT: ModelFormat;
+
+    /// A file at `path` that cannot be read or written.
+    fn io(path: &Path, message: impl Into<String>) -> Self {
+        ModelFileError::Io { path: path.to_path_buf(), message: message.into() }.into()
+    }
+
+    /// A file at `path` that is not valid JSON or not a model of the format.
+    fn parse(path: &Path, message: impl Into<String>) -> Self {
+        ModelFileError::Parse { format: Self::FORMAT, path: path.to_path_buf(), message: message.into() }.into()
+    }
+
+    /// A model at `path` of format version `found`; this code reads `supported`.
+    fn version(path: &Path, found: u64, supported: u64) -> Self {
+        ModelFileError::Version { format: Self::FORMAT, path: path.to_path_buf(), found, supported }.into()
+    }
+
+    /// A field of the model at `path` with a value that cannot be right.
+    fn field(path: &Path, field: &str, message: impl Into<String>) -> Self {
+        ModelFileError::field(path, field, message).into()
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

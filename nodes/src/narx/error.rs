@@ -1,7 +1,6 @@
 //! Errors of the NARX family: model files, training data, training.
 
-use crate::model_file_error::{ModelFileError, ModelFormat};
-use std::path::Path;
+use crate::model_file_error::{ModelFileError, ModelFileErrors, ModelFormat};
 
 /// The NARX model format, as its errors name it.
 pub const MODEL_FORMAT: ModelFormat = ModelFormat { file: "NARX model", name: "model", redo: "retrain" };
@@ -20,26 +19,8 @@ pub enum NarxError {
     Config(String),
 }
 
-impl NarxError {
-    /// A model file at `path` that cannot be read or written.
-    pub fn io(path: &Path, message: impl Into<String>) -> Self {
-        ModelFileError::Io { path: path.to_path_buf(), message: message.into() }.into()
-    }
-
-    /// A file at `path` that is not valid JSON or not a NARX model.
-    pub fn parse(path: &Path, message: impl Into<String>) -> Self {
-        ModelFileError::Parse { format: MODEL_FORMAT, path: path.to_path_buf(), message: message.into() }.into()
-    }
-
-    /// A model at `path` of format version `found`; this code reads `supported`.
-    pub fn version(path: &Path, found: u64, supported: u64) -> Self {
-        ModelFileError::Version { format: MODEL_FORMAT, path: path.to_path_buf(), found, supported }.into()
-    }
-
-    /// A field error for `path`.
-    pub fn field(path: &Path, field: &str, message: impl Into<String>) -> Self {
-        ModelFileError::field(path, field, message).into()
-    }
+impl ModelFileErrors for NarxError {
+    const FORMAT: ModelFormat = MODEL_FORMAT;
 }
 
 impl From<NarxError> for evflow_engine::NodeError {
@@ -55,6 +36,7 @@ impl From<NarxError> for evflow_engine::NodeError {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use std::path::Path;
 
     #[test]
     fn model_file_messages_name_the_narx_format() {

@@ -31,6 +31,7 @@ use super::net::Mlp;
 use super::packed::Tanh;
 use super::taps::Taps;
 use super::train::StopReason;
+use crate::model_file_error::ModelFileErrors;
 use serde::{Deserialize, Serialize};
 use std::path::Path;
 

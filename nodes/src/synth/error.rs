@@ -1,8 +1,7 @@
 //! Errors of the synthesis family: forward-model files, identification
 //! data, synthesis targets.
 
-use crate::model_file_error::{ModelFileError, ModelFormat};
-use std::path::Path;
+use crate::model_file_error::{ModelFileError, ModelFileErrors, ModelFormat};
 
 /// The forward-model format, as its errors name it.
 pub const MODEL_FORMAT: ModelFormat = ModelFormat { file: "forward-model", name: "forward-model", redo: "re-identify" };
@@ -23,26 +22,8 @@ pub enum SynthError {
     Config(String),
 }
 
-impl SynthError {
-    /// A file at `path` that cannot be read or written.
-    pub fn io(path: &Path, message: impl Into<String>) -> Self {
-        ModelFileError::Io { path: path.to_path_buf(), message: message.into() }.into()
-    }
-
-    /// A file at `path` that is not valid JSON or not a forward model.
-    pub fn parse(path: &Path, message: impl Into<String>) -> Self {
-        ModelFileError::Parse { format: MODEL_FORMAT, path: path.to_path_buf(), message: message.into() }.into()
-    }
-
-    /// A model at `path` of format version `found`; this code reads `supported`.
-    pub fn version(path: &Path, found: u64, supported: u64) -> Self {
-        ModelFileError::Version { format: MODEL_FORMAT, path: path.to_path_buf(), found, supported }.into()
-    }
-
-    /// A field error for `path`.
-    pub fn field(path: &Path, field: &str, message: impl Into<String>) -> Self {
-        ModelFileError::field(path, field, message).into()
-    }
+impl ModelFileErrors for SynthError {
+    const FORMAT: ModelFormat = MODEL_FORMAT;
 }
 
 impl From<SynthError> for evflow_engine::NodeError {
@@ -58,6 +39,7 @@ impl From<SynthError> for evflow_engine::NodeError {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use std::path::Path;
 
     #[test]
     fn model_file_messages_name_the_forward_model_format() {

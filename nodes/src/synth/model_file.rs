@@ -30,6 +30,7 @@ use super::output_filter::OutputFilter;
 use super::spectral::NoiseSpectrum;
 use super::volterra::{Volterra, MAX_MEMORY};
 use super::volterra_fit::{FitScores, NoiseModel};
+use crate::model_file_error::ModelFileErrors;
 use crate::narx::model::Condition;
 use serde::{Deserialize, Serialize};
 use std::path::Path;

@@ -1,6 +1,6 @@
 //! `metric`: E_s, RMS and peak-to-peak of a virtual force against a real one.
 
-use super::spectral_error::{spectral_rms_error, Band, SpectralError};
+use super::spectral_error::{spectral_rms_error, Band, BandError, BandParam, SpectralError};
 use super::spectrum::{Spectrum, SpectrumAccumulator, SpectrumConfig, Window};
 use crate::filters::segment::{Gates, GATES};
 use evflow_engine::ports::InPort;
@@ -191,6 +191,16 @@ struct Metric {
 const WINDOW: Choice<Window> =
     Choice::new("window", &["rect", "hann"], &[Window::Rect, Window::Hann], "rect", "window applied to each segment");
 
+/// A band error, naming this node's parameter.
+fn band_error(e: BandError) -> NodeError {
+    let param = match e.param {
+        BandParam::Fmin => FMIN.name(),
+        BandParam::Fmax => FMAX.name(),
+        BandParam::Nfft => NFFT.name(),
+    };
+    NodeError::param(param, e.message)
+}
+
 fn build(p: &Params, ctx: &BuildContext) -> Result<Box<dyn Node>, NodeError> {
     let rate = ctx.rate;
     let gates = Gates::from_params(p, GATE)?;
@@ -210,8 +220,7 @@ fn build(p: &Params, ctx: &BuildContext) -> Result<Box<dyn Node>, NodeError> {
     };
     let window = WINDOW.get(p);
     let include_dc = INCLUDE_DC.get(p);
-    let band = Band::new(rate, nfft, FMIN.get(p), FMAX.get(p), include_dc)
-        .map_err(|e| NodeError::param(e.param, e.message))?;
+    let band = Band::new(rate, nfft, FMIN.get(p), FMAX.get(p), include_dc).map_err(band_error)?;
     let cfg = SpectrumConfig { rate, nfft, window, overlap: OVERLAP.get(p) };
     let channel = |name, port| -> Result<Channel, NodeError> {
         let spectrum = SpectrumAccumulator::new(cfg).map_err(|e| NodeError::param(NFFT.name(), e.to_string()))?;

@@ -18,12 +18,24 @@
 use super::spectrum::ROUNDING_LEVEL;
 use std::ops::RangeInclusive;
 
-/// A parameter that gives no usable band, named for the node's error.
+/// Which argument of [`Band::new`] gives no usable band; a node names its
+/// own parameter for it in its error.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum BandParam {
+    /// The lowest frequency.
+    Fmin,
+    /// The highest frequency.
+    Fmax,
+    /// The spectrum's length (or the rate it is at).
+    Nfft,
+}
+
+/// An argument that gives no usable band.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
 #[error("{message}")]
 pub struct BandError {
-    /// The parameter to change (`fmin`, `fmax` or `nfft`).
-    pub param: &'static str,
+    /// The argument to change.
+    pub param: BandParam,
     /// What is wrong and what would be right.
     pub message: String,
 }
@@ -44,18 +56,21 @@ impl Band {
     pub fn new(rate: f64, nfft: usize, fmin: f64, fmax: f64, include_dc: bool) -> Result<Band, BandError> {
         let err = |param, message: String| Err(BandError { param, message });
         if nfft == 0 || !(rate.is_finite() && rate > 0.0) {
-            return err("nfft", format!("no spectrum of {nfft} points at {rate} Hz"));
+            return err(BandParam::Nfft, format!("no spectrum of {nfft} points at {rate} Hz"));
         }
         let nyquist = rate / 2.0;
         let fmax = if fmax == 0.0 { nyquist } else { fmax };
         if !(fmin.is_finite() && fmin >= 0.0) {
-            return err("fmin", format!("must be a frequency ≥ 0 Hz, not {fmin}"));
+            return err(BandParam::Fmin, format!("must be a frequency ≥ 0 Hz, not {fmin}"));
         }
         if !fmax.is_finite() || fmax > nyquist * (1.0 + 1e-12) {
-            return err("fmax", format!("{fmax} Hz is above the Nyquist frequency {nyquist} Hz (use 0 for Nyquist)"));
+            return err(
+                BandParam::Fmax,
+                format!("{fmax} Hz is above the Nyquist frequency {nyquist} Hz (use 0 for Nyquist)"),
+            );
         }
         if fmin > fmax {
-            return err("fmin", format!("{fmin} Hz is above fmax = {fmax} Hz"));
+            return err(BandParam::Fmin, format!("{fmin} Hz is above fmax = {fmax} Hz"));
         }
         let bin_hz = rate / nfft as f64;
         // A bin exactly on an edge belongs to the band despite rounding.
@@ -67,7 +82,7 @@ impl Band {
         if first > last {
             let dc = if include_dc { "" } else { " (0 Hz excluded: include_dc = false)" };
             return err(
-                "fmin",
+                BandParam::Fmin,
                 format!(
                     "no FFT bin lies between {fmin} and {fmax} Hz{dc}: bins are {bin_hz} Hz apart \
                      (nfft = {nfft} at {rate} Hz); widen the band or raise nfft"
@@ -225,10 +240,10 @@ mod tests {
     #[test]
     fn bands_without_bins_or_past_nyquist_are_refused() {
         let e = Band::new(1000.0, 1000, 0.3, 0.6, false).unwrap_err();
-        assert_eq!(e.param, "fmin");
+        assert_eq!(e.param, BandParam::Fmin);
         assert!(e.message.contains("no FFT bin"), "{e}");
-        assert_eq!(Band::new(1000.0, 1000, 0.0, 501.0, false).unwrap_err().param, "fmax");
-        assert_eq!(Band::new(1000.0, 1000, 300.0, 200.0, false).unwrap_err().param, "fmin");
+        assert_eq!(Band::new(1000.0, 1000, 0.0, 501.0, false).unwrap_err().param, BandParam::Fmax);
+        assert_eq!(Band::new(1000.0, 1000, 300.0, 200.0, false).unwrap_err().param, BandParam::Fmin);
         // nfft = 1: only the 0 Hz bin, excluded by default.
         assert!(Band::new(1000.0, 1, 0.0, 0.0, false).is_err());
         assert_eq!(Band::new(1000.0, 1, 0.0, 0.0, true).unwrap().bins(), 0..=0);

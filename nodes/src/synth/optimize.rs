@@ -7,7 +7,7 @@ use super::model_file::ForwardModel;
 use super::start::carrier;
 use super::synthesize::{synthesize, NoiseWeight, ObjectiveKind, SynthConfig};
 use crate::filters::segment::SpeedRule;
-use crate::metric::spectral_error::Band;
+use crate::metric::spectral_error::{Band, BandError, BandParam};
 use crate::metric::spectrum::{SpectrumConfig, Window};
 use crate::narx::model::Model;
 use crate::recording::format::Recording;
@@ -209,6 +209,16 @@ const BOUND: Float = Float::new("bound", 1e-6, 2.0, 1.0, "1", "|u| ≤ bound");
 const RECORD_TIME: Flag =
     Flag::new("record_time", true, "report the synthesis time as the `seconds` value (off: identical reruns)");
 
+/// A band error, naming this node's parameter.
+fn band_error(e: BandError) -> NodeError {
+    let param = match e.param {
+        BandParam::Fmin => FMIN.name(),
+        BandParam::Fmax => FMAX.name(),
+        BandParam::Nfft => NFFT.name(),
+    };
+    NodeError::param(param, e.message)
+}
+
 fn build(p: &Params, ctx: &BuildContext) -> Result<Box<dyn Node>, NodeError> {
     let shown = TARGET.get(p);
     let channel = CHANNEL.get(p);
@@ -294,15 +304,13 @@ fn build(p: &Params, ctx: &BuildContext) -> Result<Box<dyn Node>, NodeError> {
             (ObjectiveKind::Time, "time (fewer counted samples than one spectral segment)")
         }
         Objective::Expected => {
-            let band = Band::new(ctx.rate, nfft, FMIN.get(p), FMAX.get(p), false)
-                .map_err(|e| NodeError::param(e.param, e.message))?;
+            let band = Band::new(ctx.rate, nfft, FMIN.get(p), FMAX.get(p), false).map_err(band_error)?;
             let cfg = SpectrumConfig { rate: ctx.rate, nfft, window: Window::Hann, overlap: 0.5 };
             (ObjectiveKind::Expected { cfg, band }, "expected")
         }
         Objective::Spectral => {
             let window = WINDOW.get(p);
-            let band = Band::new(ctx.rate, nfft, FMIN.get(p), FMAX.get(p), false)
-                .map_err(|e| NodeError::param(e.param, e.message))?;
+            let band = Band::new(ctx.rate, nfft, FMIN.get(p), FMAX.get(p), false).map_err(band_error)?;
             let cfg = SpectrumConfig { rate: ctx.rate, nfft, window, overlap: OVERLAP.get(p) };
             (ObjectiveKind::Spectral { cfg, band }, "spectral")
         }

@@ -32,7 +32,6 @@ pub mod cells;
 pub mod constant_speed;
 #[cfg(feature = "synth")]
 pub mod crossval;
-#[cfg(feature = "synth")]
 pub mod exact;
 #[cfg(feature = "synth")]
 pub mod floor;

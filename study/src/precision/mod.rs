@@ -105,6 +105,8 @@ pub fn names() -> Vec<&'static str> {
 /// of the shipped graphs.
 pub fn run(name: &str, graphs: &Path, size: Size) -> Result<Vec<Curve>, PrecisionError> {
     // Absolute: the graphs' own paths (recordings, models) are relative to their files.
+    // (Only the lab, synth and mesh families' computations run graphs.)
+    #[cfg_attr(not(any(feature = "lab", feature = "synth", feature = "mesh")), allow(unused_variables))]
     let graphs = &std::fs::canonicalize(graphs)
         .map_err(|e| PrecisionError::Study(format!("the graphs folder {}: {e}", graphs.display())))?;
     match name {

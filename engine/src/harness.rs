@@ -129,9 +129,15 @@ impl<'a> Single<'a> {
         self
     }
 
+    /// Feeds each of these input ports: `(port, samples, rate in Hz)`.
+    pub fn inputs(mut self, ports: impl IntoIterator<Item = (&'a str, Vec<f64>, f64)>) -> Self {
+        self.inputs.extend(ports);
+        self
+    }
+
     /// Collects these output ports, in this order.
-    pub fn outputs(mut self, ports: &[&'a str]) -> Self {
-        self.outputs.extend_from_slice(ports);
+    pub fn outputs(mut self, ports: impl IntoIterator<Item = &'a str>) -> Self {
+        self.outputs.extend(ports);
         self
     }
 

@@ -55,16 +55,12 @@ fn case(spec: &NodeSpec) -> Case {
 }
 
 fn single<'a>(spec: &'static NodeSpec, c: &'a Case, dir: &'a Path, block: usize) -> Single<'a> {
-    Single {
-        spec,
-        params: spec.example,
-        inputs: c.inputs.iter().map(|(n, v)| (n.as_str(), v.clone(), 1000.0)).collect(),
-        outputs: c.outputs.iter().map(String::as_str).collect(),
-        base_rate: 1000.0,
-        ticks: TICKS,
-        block,
-        base_dir: dir,
-    }
+    Single::new(spec, spec.example)
+        .inputs(c.inputs.iter().map(|(n, v)| (n.as_str(), v.clone(), 1000.0)))
+        .outputs(c.outputs.iter().map(String::as_str))
+        .ticks(TICKS)
+        .block(block)
+        .base_dir(dir)
 }
 
 /// Hardware outputs (`serial.out`) cannot run alone: the loader refuses

@@ -21,7 +21,7 @@ fn edges(dir: &Path, params: &str, x: &[f64], y: &[f64], tri: &[f64]) -> (Vec<Ve
         .input("x", x.to_vec(), 1000.0)
         .input("y", y.to_vec(), 1000.0)
         .input("tri", tri.to_vec(), 1000.0)
-        .outputs(&["intensity", "sharpness", "angle"])
+        .outputs(["intensity", "sharpness", "angle"])
         .ticks(x.len() as u64)
         .base_dir(dir);
     (s.run().unwrap(), s.summary().unwrap())

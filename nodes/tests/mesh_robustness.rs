@@ -35,7 +35,7 @@ fn gradient(dir: &Path, params: &str, x: Vec<f64>, y: Vec<f64>) -> Result<Run, S
     Single::new(&gradient_node::SPEC, params)
         .input("x", x, 1000.0)
         .input("y", y, 1000.0)
-        .outputs(&["intensity", "fsq", "slope", "z", "tri"])
+        .outputs(["intensity", "fsq", "slope", "z", "tri"])
         .ticks(n)
         .block(100)
         .base_dir(dir)
@@ -115,7 +115,7 @@ fn open_and_non_manifold_meshes() {
             .input("x", x, 1000.0)
             .input("y", y, 1000.0)
             .input("tri", r.out[4].clone(), 1000.0)
-            .outputs(&["intensity", "sharpness", "angle"])
+            .outputs(["intensity", "sharpness", "angle"])
             .ticks(r.out[4].len() as u64)
             .base_dir(dir.path());
         let s = edges.summary().unwrap();

@@ -40,7 +40,7 @@ fn grid(dir: &Path, f: Vec<f64>, load: Vec<f64>, vel: Vec<f64>, block: usize) ->
         .input("force", f, 1000.0)
         .input("load", load, 1000.0)
         .input("velocity", vel, 1000.0)
-        .outputs(&["u", "model"])
+        .outputs(["u", "model"])
         .ticks(n)
         .block(block)
         .base_dir(dir)

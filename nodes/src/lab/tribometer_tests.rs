@@ -161,7 +161,7 @@ mod node {
     fn single(params: &str, block: usize, ticks: u64) -> Vec<Vec<f64>> {
         let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("../graphs/lab");
         Single::new(&SPEC, params)
-            .outputs(&["position", "velocity", "load"])
+            .outputs(["position", "velocity", "load"])
             .ticks(ticks)
             .block(block)
             .base_dir(&dir)

@@ -224,7 +224,6 @@ mod tests {
     use super::*;
     use evflow_engine::harness::Single;
     use rustfft::{num_complex::Complex, FftPlanner};
-    use std::path::Path;
 
     fn run(params: &str, area: Vec<f64>, edge: Option<Vec<f64>>) -> Vec<f64> {
         let n = area.len() as u64;
@@ -232,19 +231,7 @@ mod tests {
         if let Some(e) = edge {
             inputs.push(("edge", e, 1000.0));
         }
-        Single {
-            spec: &SPEC,
-            params,
-            inputs,
-            outputs: vec!["out"],
-            base_rate: 1000.0,
-            ticks: n,
-            block: 64,
-            base_dir: Path::new("."),
-        }
-        .run()
-        .unwrap()
-        .remove(0)
+        Single::new(&SPEC, params).inputs(inputs).output("out").ticks(n).run().unwrap().remove(0)
     }
 
     fn magnitudes(x: &[f64], n: usize) -> Vec<f64> {

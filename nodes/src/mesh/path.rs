@@ -152,7 +152,7 @@ mod tests {
             &SPEC,
             "directions = [0.0, 90.0]\nspeed = 0.05\nlength = 0.1\nlines = 2\nspacing = 0.02\npause = 0.01",
         )
-        .outputs(&["x", "y", "speed"])
+        .outputs(["x", "y", "speed"])
         .ticks(4 * 2010)
         .block(333)
         .base_dir(FsPath::new("."))

@@ -335,7 +335,7 @@ mod tests {
         let x = vec![-0.005, 0.0, 0.005];
         let out = Single::new(&SPEC, "shape = \"bump\"\nprofile = \"ip0.5\"")
             .input("x", x, 1000.0)
-            .outputs(&["height", "force", "intensity"])
+            .outputs(["height", "force", "intensity"])
             .ticks(3)
             .block(2)
             .run()

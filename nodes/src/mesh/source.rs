@@ -394,7 +394,7 @@ mod tests {
         Single::new(&gradient_node::SPEC, &params)
             .input("x", x, 1000.0)
             .input("y", y, 1000.0)
-            .outputs(&["intensity", "fsq", "slope", "z", "tri"])
+            .outputs(["intensity", "fsq", "slope", "z", "tri"])
             .ticks(n)
             .base_dir(dir)
             .run()

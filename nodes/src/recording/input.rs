@@ -160,7 +160,12 @@ mod tests {
     }
 
     fn run(dir: &Path, params: &str, outputs: Vec<&str>, base: f64, ticks: u64, block: usize) -> Vec<Vec<f64>> {
-        Single { spec: &SPEC, params, inputs: vec![], outputs, base_rate: base, ticks, block, base_dir: dir }
+        Single::new(&SPEC, params)
+            .outputs(outputs)
+            .base_rate(base)
+            .ticks(ticks)
+            .block(block)
+            .base_dir(dir)
             .run()
             .unwrap()
     }

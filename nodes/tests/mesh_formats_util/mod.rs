@@ -218,7 +218,7 @@ pub fn gradient(dir: &Path, params: &str, x: &[f64], y: &[f64]) -> Result<Vec<Ve
     Single::new(&gradient_node::SPEC, &params)
         .input("x", x.to_vec(), 1000.0)
         .input("y", y.to_vec(), 1000.0)
-        .outputs(&["intensity", "fsq", "slope", "z", "tri"])
+        .outputs(["intensity", "fsq", "slope", "z", "tri"])
         .ticks(x.len() as u64)
         .base_dir(dir)
         .run()

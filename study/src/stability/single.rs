@@ -58,16 +58,13 @@ pub fn run(
             return o;
         }
     };
-    let single = Single {
-        spec,
-        params,
-        inputs: ins.iter().enumerate().map(|(k, n)| (n.as_str(), input(k), RATE)).collect(),
-        outputs: outs.iter().map(String::as_str).collect(),
-        base_rate: RATE,
-        ticks,
-        block,
-        base_dir: dir,
-    };
+    let single = Single::new(spec, params)
+        .inputs(ins.iter().enumerate().map(|(k, n)| (n.as_str(), input(k), RATE)))
+        .outputs(outs.iter().map(String::as_str))
+        .base_rate(RATE)
+        .ticks(ticks)
+        .block(block)
+        .base_dir(dir);
     let (mut plan, index) = match single.plan() {
         Ok(p) => p,
         Err(e) => {

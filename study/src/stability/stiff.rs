@@ -232,18 +232,15 @@ fn single_outputs(
     ticks: usize,
 ) -> Result<Vec<f64>, String> {
     let (ins, outs) = single::ports(spec, params)?;
-    evflow_engine::harness::Single {
-        spec,
-        params,
-        inputs: ins.iter().enumerate().map(|(k, n)| (n.as_str(), input(k), single::RATE)).collect(),
-        outputs: outs.iter().take(1).map(String::as_str).collect(),
-        base_rate: single::RATE,
-        ticks: ticks as u64,
-        block: 4096,
-        base_dir: &env.dir,
-    }
-    .run()
-    .map(|mut o| o.remove(0))
+    evflow_engine::harness::Single::new(spec, params)
+        .inputs(ins.iter().enumerate().map(|(k, n)| (n.as_str(), input(k), single::RATE)))
+        .outputs(outs.iter().take(1).map(String::as_str))
+        .base_rate(single::RATE)
+        .ticks(ticks as u64)
+        .block(4096)
+        .base_dir(&env.dir)
+        .run()
+        .map(|mut o| o.remove(0))
 }
 
 fn last_mean(

@@ -1,20 +1,8 @@
 use super::*;
 use evflow_engine::harness::Single;
-use std::path::Path;
 
 fn run(params: &str, seconds: f64, outputs: Vec<&'static str>) -> Vec<Vec<f64>> {
-    Single {
-        spec: &SPEC,
-        params,
-        inputs: vec![],
-        outputs,
-        base_rate: 1000.0,
-        ticks: (seconds * 1000.0) as u64,
-        block: 37,
-        base_dir: Path::new("."),
-    }
-    .run()
-    .unwrap()
+    Single::new(&SPEC, params).outputs(outputs).ticks((seconds * 1000.0) as u64).block(37).run().unwrap()
 }
 
 #[test]

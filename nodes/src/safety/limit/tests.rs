@@ -56,18 +56,14 @@ fn run(params: &str, inputs: Vec<(&str, Vec<f64>)>, rate: f64) -> Vec<f64> {
 /// `out` and `state`, processed in blocks of `block` samples.
 fn run_both(params: &str, inputs: Vec<(&str, Vec<f64>)>, rate: f64, block: usize) -> (Vec<f64>, Vec<f64>) {
     let ticks = inputs[0].1.len() as u64;
-    let out = Single {
-        spec: &SPEC,
-        params,
-        inputs: inputs.into_iter().map(|(n, v)| (n, v, rate)).collect(),
-        outputs: vec!["out", "state"],
-        base_rate: rate,
-        ticks,
-        block,
-        base_dir: Path::new("."),
-    }
-    .run()
-    .unwrap();
+    let out = Single::new(&SPEC, params)
+        .inputs(inputs.into_iter().map(|(n, v)| (n, v, rate)))
+        .outputs(["out", "state"])
+        .base_rate(rate)
+        .ticks(ticks)
+        .block(block)
+        .run()
+        .unwrap();
     let mut it = out.into_iter();
     (it.next().unwrap(), it.next().unwrap())
 }

@@ -104,51 +104,40 @@ pub struct InPort(usize);
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub struct OutPort(usize);
 
-impl InPort {
-    /// The input called `name` in `ports` (the node's declaration). Fails to
-    /// compile (in a `const`) when `ports` has no input of that name, or
-    /// when a repeated port comes before it.
-    pub const fn named(ports: &[PortSpec], name: &str) -> Self {
-        Self(find(ports, name, Direction::In))
-    }
+/// The two port constants differ only in the direction they look up.
+macro_rules! port_constant {
+    ($($port:ident: $dir:ident, $what:literal;)*) => {$(
+        impl $port {
+            #[doc = concat!("The ", $what, " called `name` in `ports` (the node's declaration). Fails to")]
+            /// compile (in a `const`) when `ports` has no such port of that
+            /// direction, or when a repeated port of that direction comes before it.
+            pub const fn named(ports: &[PortSpec], name: &str) -> Self {
+                Self(find(ports, name, Direction::$dir))
+            }
 
-    /// The `k`-th input counted from 0, for a node whose inputs are a list
-    /// (e.g. `add`'s operands) or the ports after the first of a repeated port.
-    pub const fn at(k: usize) -> Self {
-        Self(k)
-    }
+            #[doc = concat!("The `k`-th ", $what, " counted from 0, for a node whose ", $what, "s are")]
+            /// a list (e.g. `add`'s operands) or the ports after the first of
+            /// a repeated port.
+            pub const fn at(k: usize) -> Self {
+                Self(k)
+            }
 
-    /// The `k`-th of a repeated port that starts here.
-    pub const fn nth(self, k: usize) -> Self {
-        Self(self.0 + k)
-    }
+            /// The `k`-th of a repeated port that starts here.
+            pub const fn nth(self, k: usize) -> Self {
+                Self(self.0 + k)
+            }
 
-    /// Its index among the node's inputs.
-    pub const fn index(self) -> usize {
-        self.0
-    }
+            #[doc = concat!("Its index among the node's ", $what, "s.")]
+            pub const fn index(self) -> usize {
+                self.0
+            }
+        }
+    )*};
 }
 
-impl OutPort {
-    /// The output called `name` in `ports`; see [`InPort::named`].
-    pub const fn named(ports: &[PortSpec], name: &str) -> Self {
-        Self(find(ports, name, Direction::Out))
-    }
-
-    /// The `k`-th output counted from 0.
-    pub const fn at(k: usize) -> Self {
-        Self(k)
-    }
-
-    /// The `k`-th of a repeated port that starts here.
-    pub const fn nth(self, k: usize) -> Self {
-        Self(self.0 + k)
-    }
-
-    /// Its index among the node's outputs.
-    pub const fn index(self) -> usize {
-        self.0
-    }
+port_constant! {
+    InPort: In, "input";
+    OutPort: Out, "output";
 }
 
 /// Index of the port `name` among the ports of direction `dir`.

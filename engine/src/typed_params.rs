@@ -41,26 +41,6 @@ impl Float {
         Self(ParamSpec::float(name, min, max, default, unit, doc))
     }
 
-    /// The same parameter, changeable while the graph runs live.
-    pub const fn live(self) -> Self {
-        Self(self.0.live())
-    }
-
-    /// The same parameter without a default: the graph file must set it.
-    pub const fn required(self) -> Self {
-        Self(self.0.required())
-    }
-
-    /// Its declaration.
-    pub const fn spec(&self) -> ParamSpec {
-        self.0
-    }
-
-    /// Its name, as written in the node's table (and as a live change names it).
-    pub const fn name(&self) -> &'static str {
-        self.0.name
-    }
-
     /// Its validated value.
     pub fn get(&self, p: &Params) -> f64 {
         p.f64(self.0.name)
@@ -89,21 +69,6 @@ impl Int {
         Self(ParamSpec::int(name, min, max, default, unit, doc))
     }
 
-    /// The same parameter without a default: the graph file must set it.
-    pub const fn required(self) -> Self {
-        Self(self.0.required())
-    }
-
-    /// Its name, as written in the node's table.
-    pub const fn name(&self) -> &'static str {
-        self.0.name
-    }
-
-    /// Its declaration.
-    pub const fn spec(&self) -> ParamSpec {
-        self.0
-    }
-
     /// Its validated value.
     pub fn get(&self, p: &Params) -> i64 {
         p.i64(self.0.name)
@@ -112,11 +77,6 @@ impl Int {
     /// Its validated value as a count (the declaration's minimum is ≥ 0).
     pub fn count(&self, p: &Params) -> usize {
         p.usize(self.0.name)
-    }
-
-    /// The same parameter, changeable while the graph runs live.
-    pub const fn live(self) -> Self {
-        Self(self.0.live())
     }
 
     /// The new value when `c` changes this parameter (checked against the
@@ -136,24 +96,9 @@ impl Flag {
         Self(ParamSpec::flag(name, default, doc))
     }
 
-    /// Its declaration.
-    pub const fn spec(&self) -> ParamSpec {
-        self.0
-    }
-
     /// Its validated value.
     pub fn get(&self, p: &Params) -> bool {
         p.bool(self.0.name)
-    }
-
-    /// The same parameter, changeable while the graph runs live.
-    pub const fn live(self) -> Self {
-        Self(self.0.live())
-    }
-
-    /// Its name, as written in the node's table.
-    pub const fn name(&self) -> &'static str {
-        self.0.name
     }
 
     /// The new value when `c` changes this parameter.
@@ -172,21 +117,6 @@ impl Text {
         Self(ParamSpec::text(name, default, doc))
     }
 
-    /// The same parameter without a default: the graph file must set it.
-    pub const fn required(self) -> Self {
-        Self(self.0.required())
-    }
-
-    /// Its declaration.
-    pub const fn spec(&self) -> ParamSpec {
-        self.0
-    }
-
-    /// Its name, as written in the node's table (and in errors about it).
-    pub const fn name(&self) -> &'static str {
-        self.0.name
-    }
-
     /// Its validated value.
     pub fn get<'p>(&self, p: &'p Params) -> &'p str {
         p.str(self.0.name)
@@ -201,21 +131,6 @@ impl Words {
     /// Declares it: name, one-line description.
     pub const fn new(name: &'static str, doc: &'static str) -> Self {
         Self(ParamSpec::text_list(name, doc))
-    }
-
-    /// The same parameter without a default: the graph file must set it.
-    pub const fn required(self) -> Self {
-        Self(self.0.required())
-    }
-
-    /// Its declaration.
-    pub const fn spec(&self) -> ParamSpec {
-        self.0
-    }
-
-    /// Its name, as a repeated port's declaration ([`crate::PortSpec::per`]) names it.
-    pub const fn name(&self) -> &'static str {
-        self.0.name
     }
 
     /// Its validated value.
@@ -234,26 +149,41 @@ impl Floats {
         Self(ParamSpec::float_list(name, min, max, unit, doc))
     }
 
-    /// The same parameter without a default: the graph file must set it.
-    pub const fn required(self) -> Self {
-        Self(self.0.required())
-    }
-
-    /// Its declaration.
-    pub const fn spec(&self) -> ParamSpec {
-        self.0
-    }
-
-    /// Its name, as written in the node's table.
-    pub const fn name(&self) -> &'static str {
-        self.0.name
-    }
-
     /// Its validated value.
     pub fn get<'p>(&self, p: &'p Params) -> &'p [f64] {
         p.float_list(self.0.name)
     }
 }
+
+/// What every one-spec handle has: its declaration, its name, and the
+/// same parameter made live or required.
+macro_rules! handle_basics {
+    ($($handle:ident),*) => {$(
+        impl $handle {
+            /// Its declaration.
+            pub const fn spec(&self) -> ParamSpec {
+                self.0
+            }
+
+            /// Its name, as written in the node's table (and in errors about it).
+            pub const fn name(&self) -> &'static str {
+                self.0.name
+            }
+
+            /// The same parameter, changeable while the graph runs live.
+            pub const fn live(self) -> Self {
+                Self(self.0.live())
+            }
+
+            /// The same parameter without a default: the graph file must set it.
+            pub const fn required(self) -> Self {
+                Self(self.0.required())
+            }
+        }
+    )*};
+}
+
+handle_basics!(Float, Int, Flag, Text, Words, Floats);
 
 /// A choice among fixed words, read as the node's enum `E`: `values[i]`
 /// stands for `words[i]`.

@@ -1,5 +1,6 @@
 //! `evflow live FILE`: run a graph in real time, recording the session.
 
+mod disk;
 mod ending;
 pub mod integrity;
 mod recorder;
@@ -148,7 +149,15 @@ pub fn main(a: Args) -> Result<()> {
 
     // Recorder, metrics display and console: ordinary threads.
     let done = Arc::new(AtomicBool::new(false));
-    let recorder = Recorder::create(&dir, &[inputs, outputs].concat(), parts.taps, parts.events, names, "evflow live")?;
+    let recorder = Recorder::create(
+        &dir,
+        &[inputs, outputs].concat(),
+        parts.taps,
+        parts.events,
+        names,
+        "evflow live",
+        threads::FLUSH_EVERY,
+    )?;
     #[cfg(feature = "studio")]
     let recorder = match &studio {
         Some((_, ingest)) => recorder.tee(Box::new(ingest.clone())),

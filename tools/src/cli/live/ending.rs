@@ -141,7 +141,7 @@ impl End<'_> {
         println!("{}", self.summary);
         for (f, n, gap, err) in &self.rec.files {
             let gap = if *gap > 0 {
-                format!(", {gap} lost to a slow disk (zero-filled, see events.jsonl)")
+                format!(", {gap} lost to a full tap ring: the recorder fell behind (zero-filled, see events.jsonl)")
             } else {
                 String::new()
             };

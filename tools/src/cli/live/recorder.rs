@@ -1,26 +1,26 @@
 //! The session recorder: a non-real-time thread that drains the tap and
-//! event rings in chunks into the session's files and flushes them at a
-//! steady pace, so a killed process leaves readable files.
+//! event rings in chunks and hands them to the disk thread
+//! ([`super::disk`]), which writes the session's files and flushes them at
+//! a steady pace, so a killed process leaves readable files. The recorder
+//! itself never waits on the disk.
 
+use super::disk::{Disk, DiskQueue, Files, Op, QUEUE_SECONDS};
 use super::session::{event_json, FileSpec};
 use evflow_engine::live::{rtrb, Event, EventKind, TapInfo};
 use evflow_nodes::recording::format::{Channel, RecordingMeta, RecordingWriter};
 use std::fs::File;
-use std::io::Write;
 use std::path::Path;
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::Arc;
-use std::time::{Duration, Instant};
+use std::time::Duration;
 
 /// One recording being written.
 struct Sink {
     spec: FileSpec,
-    writer: Option<RecordingWriter>,
     /// Indices into the tap rings, one per channel.
     rings: Vec<usize>,
     /// Frames accepted (samples of each channel), including zero-filled gaps.
     frames: u64,
-    error: Option<String>,
     gap_frames: u64,
 }
 
@@ -47,21 +47,21 @@ pub trait Tee: Send {
     fn event(&mut self, e: &Event);
 }
 
-/// Owns the consumer ends of the rings and the session's files.
+/// Owns the consumer ends of the rings and the queue to the disk thread.
 pub struct Recorder {
     tee: Option<Box<dyn Tee>>,
     sinks: Vec<Sink>,
     rings: Vec<rtrb::Consumer<f64>>,
     events: rtrb::Consumer<Event>,
-    log: Option<std::io::BufWriter<File>>,
+    disk: DiskQueue,
     names: Vec<String>,
-    report: RecorderReport,
-    scratch: Vec<f64>,
+    events_logged: u64,
 }
 
 impl Recorder {
     /// Creates every file of the session (live writers: they never replace
-    /// an existing recording). `specs` lists inputs then outputs; `taps`
+    /// an existing recording) and starts the disk thread, which flushes
+    /// them every `flush_every`. `specs` lists inputs then outputs; `taps`
     /// are the ring ends in the same tap order.
     pub fn create(
         dir: &Path,
@@ -70,8 +70,9 @@ impl Recorder {
         events: rtrb::Consumer<Event>,
         names: Vec<String>,
         source: &str,
+        flush_every: Duration,
     ) -> anyhow::Result<Self> {
-        let mut sinks = Vec::new();
+        let (mut writers, mut sinks) = (Vec::new(), Vec::new());
         let infos: Vec<TapInfo> = taps.iter().map(|(i, _)| i.clone()).collect();
         let rings = taps.into_iter().map(|(_, r)| r).collect();
         let mut used = vec![false; infos.len()];
@@ -95,26 +96,27 @@ impl Recorder {
                 .map_err(|e| anyhow::anyhow!("cannot start the session recording: {e}"))?;
             writer.reserve_frames(8192);
             writer.flush().map_err(|e| anyhow::anyhow!("{e}"))?;
-            sinks.push(Sink {
-                spec: spec.clone(),
-                writer: Some(writer),
-                rings: idx,
-                frames: 0,
-                error: None,
-                gap_frames: 0,
-            });
+            writers.push(writer);
+            sinks.push(Sink { spec: spec.clone(), rings: idx, frames: 0, gap_frames: 0 });
         }
         let log = File::create(dir.join("events.jsonl"))?;
-        Ok(Self {
-            tee: None,
-            sinks,
-            rings,
-            events,
-            log: Some(std::io::BufWriter::new(log)),
-            names,
-            report: RecorderReport::default(),
-            scratch: Vec::new(),
-        })
+        Self::with_disk(Box::new(Files::new(writers, log)), sinks, rings, events, names, flush_every)
+    }
+
+    /// A recorder of `sinks` writing to `disk` through its own thread.
+    fn with_disk(
+        disk: Box<dyn Disk>,
+        sinks: Vec<Sink>,
+        rings: Vec<rtrb::Consumer<f64>>,
+        events: rtrb::Consumer<Event>,
+        names: Vec<String>,
+        flush_every: Duration,
+    ) -> anyhow::Result<Self> {
+        // The budget: QUEUE_SECONDS of every recording's samples.
+        let per_second: f64 = sinks.iter().map(|s| s.spec.rate * s.spec.ports.len() as f64).sum();
+        let budget = (QUEUE_SECONDS * per_second * std::mem::size_of::<f64>() as f64) as usize;
+        let disk = DiskQueue::start(disk, sinks.len(), budget.max(1 << 16), flush_every)?;
+        Ok(Self { tee: None, sinks, rings, events, disk, names, events_logged: 0 })
     }
 
     /// Hands every drained sample and event to `tee` as well.
@@ -134,8 +136,7 @@ impl Recorder {
             return;
         }
         let ch = sink.rings.len();
-        self.scratch.clear();
-        self.scratch.resize(n * ch, 0.0);
+        let mut frames = vec![0.0; n * ch];
         for (c, &r) in sink.rings.iter().enumerate() {
             if let Ok(chunk) = self.rings[r].read_chunk(n) {
                 let (a, b) = chunk.as_slices();
@@ -144,13 +145,13 @@ impl Recorder {
                     t.samples(r, b);
                 }
                 for (i, x) in a.iter().chain(b).enumerate() {
-                    self.scratch[i * ch + c] = *x;
+                    frames[i * ch + c] = *x;
                 }
                 chunk.commit_all();
             }
         }
         sink.frames += n as u64;
-        write(sink, &self.scratch);
+        self.disk.send(Op::Frames { file: s, data: frames });
     }
 
     /// Frames of a sink due for ticks [0, tick).
@@ -170,7 +171,7 @@ impl Recorder {
                 }
             }
             if let EventKind::Gap { ticks } = e.kind {
-                for sink in &mut self.sinks {
+                for (s, sink) in self.sinks.iter_mut().enumerate() {
                     let missing = Self::due(&sink.spec, e.tick + ticks) - Self::due(&sink.spec, e.tick);
                     let zeros = vec![0.0; (missing as usize) * sink.rings.len()];
                     if let Some(t) = self.tee.as_mut() {
@@ -180,7 +181,9 @@ impl Recorder {
                     }
                     sink.frames += missing;
                     sink.gap_frames += missing;
-                    write(sink, &zeros);
+                    if missing > 0 {
+                        self.disk.send(Op::Frames { file: s, data: zeros });
+                    }
                 }
             }
             if let Some(t) = self.tee.as_mut() {
@@ -194,69 +197,103 @@ impl Recorder {
     }
 
     fn log_event(&mut self, e: &Event) {
-        let line = event_json(e, &self.names).to_string();
-        if let Some(log) = self.log.as_mut() {
-            if let Err(err) = writeln!(log, "{line}") {
-                self.report.event_error.get_or_insert_with(|| format!("events.jsonl: {err}"));
-            }
-        }
-        self.report.events += 1;
-    }
-
-    /// Writes everything out: recordings (WAV header and sidecar updated)
-    /// and the event log.
-    pub fn flush(&mut self) {
-        if let Some(log) = self.log.as_mut() {
-            if let Err(err) = log.flush().and_then(|_| log.get_ref().sync_data()) {
-                self.report.event_error.get_or_insert_with(|| format!("events.jsonl: {err}"));
-            }
-        }
-        for sink in &mut self.sinks {
-            if let Some(w) = sink.writer.as_mut() {
-                if let Err(e) = w.flush() {
-                    sink.error.get_or_insert_with(|| e.to_string());
-                }
-            }
-        }
+        self.disk.send(Op::Event(event_json(e, &self.names).to_string()));
+        self.events_logged += 1;
     }
 
     /// Runs until `done` is set (after the real-time thread ended), pumping
-    /// every `pace` and flushing every `flush_every`; then drains what is
-    /// left, finishes every file and reports.
-    pub fn run(mut self, done: Arc<AtomicBool>, pace: Duration, flush_every: Duration) -> RecorderReport {
-        let mut flushed = Instant::now();
+    /// every `pace` — except while the disk thread is more than its budget
+    /// behind, when the rings are left to fill — then drains what is left,
+    /// waits for the disk thread to finish every file, and reports.
+    pub fn run(mut self, done: Arc<AtomicBool>, pace: Duration) -> RecorderReport {
         while !done.load(Ordering::Acquire) {
             std::thread::sleep(pace);
-            self.pump();
-            if flushed.elapsed() >= flush_every {
-                self.flush();
-                flushed = Instant::now();
+            if !self.disk.over_budget() {
+                self.pump();
             }
         }
         self.pump();
-        self.flush();
-        for sink in &mut self.sinks {
-            if let Some(w) = sink.writer.take() {
-                if let Err(e) = w.finish() {
-                    sink.error.get_or_insert_with(|| e.to_string());
-                }
-            }
-            self.report.files.push((sink.spec.file.clone(), sink.frames, sink.gap_frames, sink.error.clone()));
-        }
-        self.log = None;
-        self.report
+        self.finish()
+    }
+
+    /// Waits for the disk thread to finish every file; the report.
+    fn finish(self) -> RecorderReport {
+        let disk = self.disk.finish();
+        let files = self
+            .sinks
+            .iter()
+            .zip(disk.files.into_iter().chain(std::iter::repeat(None)))
+            .map(|(sink, err)| (sink.spec.file.clone(), sink.frames, sink.gap_frames, err))
+            .collect();
+        RecorderReport { files, events: self.events_logged, event_error: disk.event_error }
     }
 }
 
-/// Appends interleaved frames; after an error the file stops growing (the
-/// error is reported) but its ring keeps being drained.
-fn write(sink: &mut Sink, frames: &[f64]) {
-    if sink.error.is_some() || frames.is_empty() {
-        return;
+#[cfg(test)]
+mod tests {
+    use super::super::disk::DiskReport;
+    use super::*;
+    use evflow_engine::rate::Ratio;
+    use std::sync::mpsc;
+    use std::sync::Mutex;
+
+    /// A disk whose first write stalls until the test lets it go (an fsync
+    /// that takes seconds), keeping every frame it is given.
+    struct Stalled {
+        gate: Option<mpsc::Receiver<()>>,
+        frames: Arc<Mutex<Vec<f64>>>,
     }
-    if let Some(w) = sink.writer.as_mut() {
-        if let Err(e) = w.write_interleaved(frames) {
-            sink.error = Some(e.to_string());
+
+    impl Disk for Stalled {
+        fn write(&mut self, op: Op) {
+            if let Some(g) = self.gate.take() {
+                let _ = g.recv_timeout(Duration::from_secs(30));
+            }
+            if let Op::Frames { data, .. } = op {
+                self.frames.lock().unwrap().extend(data);
+            }
         }
+        fn flush(&mut self) {}
+        fn finish(self: Box<Self>) -> DiskReport {
+            DiskReport { files: vec![None], event_error: None }
+        }
+    }
+
+    #[test]
+    fn a_stalled_disk_does_not_stop_the_rings_being_drained() {
+        // Two taps of one recording, rings of 100 samples (0.1 s at 1 kHz).
+        let (mut producers, consumers): (Vec<_>, Vec<_>) = (0..2).map(|_| rtrb::RingBuffer::new(100)).unzip();
+        let (_ev_tx, ev_rx) = rtrb::RingBuffer::new(16);
+        let spec = FileSpec {
+            file: "outputs/x".into(),
+            node: "x".into(),
+            ports: vec!["a".into(), "b".into()],
+            ratio: Ratio::ONE,
+            rate: 1000.0,
+        };
+        let sink = Sink { spec, rings: vec![0, 1], frames: 0, gap_frames: 0 };
+        let (release, gate) = mpsc::channel();
+        let frames = Arc::new(Mutex::new(Vec::new()));
+        let disk = Box::new(Stalled { gate: Some(gate), frames: frames.clone() });
+        let mut rec =
+            Recorder::with_disk(disk, vec![sink], consumers, ev_rx, vec![], Duration::from_secs(3600)).unwrap();
+        // Ten seconds of samples, 50 at a time, while the disk is stalled:
+        // the rings never fill, since the recorder keeps draining them.
+        for k in 0..10_000 {
+            for (c, p) in producers.iter_mut().enumerate() {
+                p.push(k as f64 + 0.5 * c as f64).expect("a ring filled: the recorder stopped draining");
+            }
+            if k % 50 == 49 {
+                rec.pump();
+            }
+        }
+        assert!(!rec.disk.over_budget(), "ten seconds is within the queue's budget");
+        assert!(frames.lock().unwrap().len() <= 2 * 50, "the disk was still stalled");
+        release.send(()).unwrap();
+        let report = rec.finish();
+        assert_eq!(report.files, vec![("outputs/x".to_string(), 10_000, 0, None)]);
+        let got = frames.lock().unwrap();
+        let want: Vec<f64> = (0..10_000).flat_map(|k| [k as f64, k as f64 + 0.5]).collect();
+        assert!(*got == want, "every frame, in order, interleaved");
     }
 }

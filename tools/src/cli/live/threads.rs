@@ -34,13 +34,17 @@ pub(super) fn on_ctrl_c(shared: &Arc<Shared>) {
     });
 }
 
-/// Starts the recorder's thread, which writes the taps and events until
-/// `done`.
+/// How often the recorder drains the rings.
+const DRAIN_EVERY: Duration = Duration::from_millis(20);
+
+/// How often the disk thread flushes the session's files.
+pub(super) const FLUSH_EVERY: Duration = Duration::from_millis(200);
+
+/// Starts the recorder's thread, which drains the taps and events until
+/// `done` and hands them to its disk thread.
 pub(super) fn spawn_recorder(recorder: Recorder, done: &Arc<AtomicBool>) -> Result<JoinHandle<RecorderReport>> {
     let done = done.clone();
-    Ok(std::thread::Builder::new()
-        .name("evflow-recorder".into())
-        .spawn(move || recorder.run(done, Duration::from_millis(20), Duration::from_millis(200)))?)
+    Ok(std::thread::Builder::new().name("evflow-recorder".into()).spawn(move || recorder.run(done, DRAIN_EVERY))?)
 }
 
 /// The metrics display: drains the tick timings until `done` and, unless

@@ -133,6 +133,9 @@ pub fn main(a: Args) -> Result<()> {
         evflow_tools::studio::Description::live(&checked, &lp, &vars)
             .with_scene(evflow_tools::studio::scene_json(&checked, graph_dir))
     });
+    // The files first: creating them syncs each to disk, which must not
+    // happen while the real-time thread fills its rings.
+    let files = recorder::Files::create(&dir, &[inputs, outputs].concat(), "evflow live")?;
     let mut session = live::start(lp, &pacing.config).map_err(|e| anyhow!("{e}"))?;
     let vars_line = setup::vars_line(&vars);
     session.control.bind_vars(vars);
@@ -149,15 +152,7 @@ pub fn main(a: Args) -> Result<()> {
 
     // Recorder, metrics display and console: ordinary threads.
     let done = Arc::new(AtomicBool::new(false));
-    let recorder = Recorder::create(
-        &dir,
-        &[inputs, outputs].concat(),
-        parts.taps,
-        parts.events,
-        names,
-        "evflow live",
-        threads::FLUSH_EVERY,
-    )?;
+    let recorder = Recorder::create(files, parts.taps, parts.events, names, threads::FLUSH_EVERY)?;
     #[cfg(feature = "studio")]
     let recorder = match &studio {
         Some((_, ingest)) => recorder.tee(Box::new(ingest.clone())),

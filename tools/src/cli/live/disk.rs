@@ -6,9 +6,11 @@
 //! the real-time thread counts the lost ticks as a gap — the same outcome
 //! as before, only seconds later and with memory still bounded.
 
-use evflow_nodes::recording::format::RecordingWriter;
+use super::session::FileSpec;
+use evflow_nodes::recording::format::{Channel, RecordingMeta, RecordingWriter};
 use std::fs::File;
 use std::io::Write;
+use std::path::Path;
 use std::sync::atomic::{AtomicUsize, Ordering};
 use std::sync::mpsc::{self, RecvTimeoutError};
 use std::sync::Arc;
@@ -63,20 +65,51 @@ pub(super) trait Disk: Send + 'static {
 }
 
 /// The session's recordings and event log.
-pub(super) struct Files {
+pub struct Files {
+    specs: Vec<FileSpec>,
     writers: Vec<(Option<RecordingWriter>, Option<String>)>,
     log: Option<std::io::BufWriter<File>>,
     event_error: Option<String>,
 }
 
 impl Files {
-    /// The recordings (in the order [`Op::Frames`] names them) and the event log.
-    pub(super) fn new(writers: Vec<RecordingWriter>, log: File) -> Self {
-        Self {
-            writers: writers.into_iter().map(|w| (Some(w), None)).collect(),
-            log: Some(std::io::BufWriter::new(log)),
-            event_error: None,
+    /// Creates every recording of `specs` (inputs then outputs; live
+    /// writers, which never replace an existing recording) and the event
+    /// log in the session folder `dir`. Each file is synced to disk once
+    /// here, which can take seconds on a loaded machine: call it before the
+    /// real-time thread starts filling its rings.
+    pub fn create(dir: &Path, specs: &[FileSpec], source: &str) -> anyhow::Result<Self> {
+        let mut writers = Vec::new();
+        for spec in specs {
+            let path = dir.join(&spec.file);
+            if let Some(parent) = path.parent() {
+                std::fs::create_dir_all(parent)?;
+            }
+            let channels = spec.ports.iter().map(|p| Channel::new(p.clone(), "")).collect();
+            let mut meta = RecordingMeta::new(spec.rate, channels);
+            meta.source = format!("{source}: `{}` ({})", spec.node, spec.ports.join(", "));
+            let mut writer = RecordingWriter::create_live(&path, meta)
+                .map_err(|e| anyhow::anyhow!("cannot start the session recording: {e}"))?;
+            writer.reserve_frames(8192);
+            writer.flush().map_err(|e| anyhow::anyhow!("{e}"))?;
+            writers.push((Some(writer), None));
         }
+        let log = File::create(dir.join("events.jsonl"))?;
+        Ok(Self { specs: specs.to_vec(), writers, log: Some(std::io::BufWriter::new(log)), event_error: None })
+    }
+
+    /// Writes the event log out and syncs it.
+    fn flush_log(&mut self) {
+        if let Some(log) = self.log.as_mut() {
+            if let Err(e) = log.flush().and_then(|_| log.get_ref().sync_data()) {
+                self.event_error.get_or_insert_with(|| format!("events.jsonl: {e}"));
+            }
+        }
+    }
+
+    /// What each recording holds, in the order [`Op::Frames`] names them.
+    pub(super) fn specs(&self) -> &[FileSpec] {
+        &self.specs
     }
 }
 
@@ -103,11 +136,7 @@ impl Disk for Files {
     }
 
     fn flush(&mut self) {
-        if let Some(log) = self.log.as_mut() {
-            if let Err(e) = log.flush().and_then(|_| log.get_ref().sync_data()) {
-                self.event_error.get_or_insert_with(|| format!("events.jsonl: {e}"));
-            }
-        }
+        self.flush_log();
         for (w, err) in &mut self.writers {
             if let Some(w) = w.as_mut() {
                 if let Err(e) = w.flush() {
@@ -117,8 +146,10 @@ impl Disk for Files {
         }
     }
 
+    /// The event log is flushed and synced; each recording is finished
+    /// (written out, synced, its sidecar written), which is its flush.
     fn finish(mut self: Box<Self>) -> DiskReport {
-        self.flush();
+        self.flush_log();
         let files = self
             .writers
             .drain(..)
@@ -295,21 +326,35 @@ mod tests {
 
     #[test]
     fn files_write_frames_and_events_and_finish_them() {
-        use evflow_nodes::recording::format::{Channel, Recording, RecordingMeta};
+        use evflow_nodes::recording::format::Recording;
         let dir = tempfile::tempdir().unwrap();
-        let meta = RecordingMeta::new(1000.0, vec![Channel::new("a", ""), Channel::new("b", "")]);
-        let w = RecordingWriter::create_live(&dir.path().join("r"), meta).unwrap();
-        let log = File::create(dir.path().join("events.jsonl")).unwrap();
-        let q = DiskQueue::start(Box::new(Files::new(vec![w], log)), 1, 1 << 20, Duration::from_millis(1)).unwrap();
+        let spec = FileSpec { ports: vec!["a".into(), "b".into()], ..r_spec() };
+        let files = Files::create(dir.path(), &[spec], "test").unwrap();
+        assert!(dir.path().join("outputs/r.json").exists(), "created before any frame");
+        let q = DiskQueue::start(Box::new(files), 1, 1 << 20, Duration::from_millis(1)).unwrap();
         q.send(Op::Frames { file: 0, data: vec![1.0, 2.0, 3.0, 4.0] });
         q.send(Op::Event("{\"tick\":1}".into()));
         q.send(Op::Frames { file: 0, data: vec![5.0, 6.0] });
         let report = q.finish();
         assert_eq!(report.files, vec![None]);
         assert_eq!(report.event_error, None);
-        let r = Recording::open(&dir.path().join("r")).unwrap();
+        let r = Recording::open(&dir.path().join("outputs/r")).unwrap();
         assert_eq!(r.frames(), 3);
         assert_eq!(r.channel("b"), Some(&[2.0, 4.0, 6.0][..]));
         assert_eq!(std::fs::read_to_string(dir.path().join("events.jsonl")).unwrap(), "{\"tick\":1}\n");
+        // A second session into the same folder is refused, naming the file.
+        let again = Files::create(dir.path(), &[r_spec()], "test");
+        let e = again.err().expect("never overwrites a recording").to_string();
+        assert!(e.contains("outputs/r"), "{e}");
+    }
+
+    fn r_spec() -> FileSpec {
+        FileSpec {
+            file: "outputs/r".into(),
+            node: "r".into(),
+            ports: vec!["a".into()],
+            ratio: evflow_engine::rate::Ratio::ONE,
+            rate: 1000.0,
+        }
     }
 }

@@ -4,12 +4,10 @@
 //! a steady pace, so a killed process leaves readable files. The recorder
 //! itself never waits on the disk.
 
-use super::disk::{Disk, DiskQueue, Files, Op, QUEUE_SECONDS};
+pub use super::disk::Files;
+use super::disk::{Disk, DiskQueue, Op, QUEUE_SECONDS};
 use super::session::{event_json, FileSpec};
 use evflow_engine::live::{rtrb, Event, EventKind, TapInfo};
-use evflow_nodes::recording::format::{Channel, RecordingMeta, RecordingWriter};
-use std::fs::File;
-use std::path::Path;
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::Arc;
 use std::time::Duration;
@@ -59,24 +57,21 @@ pub struct Recorder {
 }
 
 impl Recorder {
-    /// Creates every file of the session (live writers: they never replace
-    /// an existing recording) and starts the disk thread, which flushes
-    /// them every `flush_every`. `specs` lists inputs then outputs; `taps`
-    /// are the ring ends in the same tap order.
+    /// A recorder of the session's `files` (created before the real-time
+    /// thread started) and its disk thread, which flushes them every
+    /// `flush_every`. `taps` are the ring ends in tap order.
     pub fn create(
-        dir: &Path,
-        specs: &[FileSpec],
+        files: Files,
         taps: Vec<(TapInfo, rtrb::Consumer<f64>)>,
         events: rtrb::Consumer<Event>,
         names: Vec<String>,
-        source: &str,
         flush_every: Duration,
     ) -> anyhow::Result<Self> {
-        let (mut writers, mut sinks) = (Vec::new(), Vec::new());
         let infos: Vec<TapInfo> = taps.iter().map(|(i, _)| i.clone()).collect();
         let rings = taps.into_iter().map(|(_, r)| r).collect();
         let mut used = vec![false; infos.len()];
-        for spec in specs {
+        let mut sinks = Vec::new();
+        for spec in files.specs() {
             let mut idx = Vec::new();
             for port in &spec.ports {
                 let i = (0..infos.len())
@@ -85,22 +80,9 @@ impl Recorder {
                 used[i] = true;
                 idx.push(i);
             }
-            let path = dir.join(&spec.file);
-            if let Some(parent) = path.parent() {
-                std::fs::create_dir_all(parent)?;
-            }
-            let channels = spec.ports.iter().map(|p| Channel::new(p.clone(), "")).collect();
-            let mut meta = RecordingMeta::new(spec.rate, channels);
-            meta.source = format!("{source}: `{}` ({})", spec.node, spec.ports.join(", "));
-            let mut writer = RecordingWriter::create_live(&path, meta)
-                .map_err(|e| anyhow::anyhow!("cannot start the session recording: {e}"))?;
-            writer.reserve_frames(8192);
-            writer.flush().map_err(|e| anyhow::anyhow!("{e}"))?;
-            writers.push(writer);
             sinks.push(Sink { spec: spec.clone(), rings: idx, frames: 0, gap_frames: 0 });
         }
-        let log = File::create(dir.join("events.jsonl"))?;
-        Self::with_disk(Box::new(Files::new(writers, log)), sinks, rings, events, names, flush_every)
+        Self::with_disk(Box::new(files), sinks, rings, events, names, flush_every)
     }
 
     /// A recorder of `sinks` writing to `disk` through its own thread.

@@ -1,6 +1,7 @@
 //! `serial.out`: actuation samples to a device on a serial port.
 
 use super::link::{self, Link, LinkConfig};
+use super::link_state::LinkReport;
 use super::params::{self, PORT_PARAMS};
 use evflow_engine::ports::InPort;
 use evflow_engine::{
@@ -125,13 +126,16 @@ impl Node for SerialOut {
         let Some(l) = &self.live else {
             return Ok(s.line(self.idle.clone().unwrap_or_default()));
         };
-        // Let the I/O thread send what is still queued before reporting.
-        let until = std::time::Instant::now() + std::time::Duration::from_millis(50);
-        while l.ring.slots() < l.ring.buffer().capacity() && std::time::Instant::now() < until {
+        // Let the I/O thread send, or count as dropped, every sample still
+        // queued before reporting (up to half a second: a loaded machine
+        // may not run it for a while).
+        let until = std::time::Instant::now() + std::time::Duration::from_millis(500);
+        let mut r = l.link.state.report();
+        let accounted = |r: &LinkReport| r.counters.sent + r.counters.dropped_down + r.stale_dropped + self.overruns;
+        while accounted(&r) < self.samples && std::time::Instant::now() < until {
             std::thread::sleep(std::time::Duration::from_millis(1));
+            r = l.link.state.report();
         }
-        std::thread::sleep(std::time::Duration::from_millis(3));
-        let r = l.link.state.report();
         let c = r.counters;
         s = s
             .value("sent", c.sent as f64, "samples")

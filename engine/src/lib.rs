@@ -3,7 +3,7 @@
 //! A block-based, multi-rate dataflow engine. It knows nothing about haptics:
 //! node types are declared as data ([`spec::NodeSpec`]), graphs are TOML
 //! files ([`graph`]), validated completely before anything is built
-//! ([`check`]), compiled into a flat [`plan::Plan`] that leaves out every node
+//! ([`check`](mod@check)), compiled into a flat [`plan::Plan`] that leaves out every node
 //! no sink needs, and driven either offline ([`run`]) or live, one tick at a
 //! time, through the same [`plan::Plan::step`].
 #![deny(missing_docs)]

@@ -39,7 +39,7 @@ impl Method {
     }
 
     /// Whether the method's actuation rides a Nyquist-rate carrier,
-    /// u[n] = (−1)ⁿ·a[n] with a slowly varying envelope a: the optimized
+    /// u\[n\] = (−1)ⁿ·a\[n\] with a slowly varying envelope a: the optimized
     /// synthesis starts from that form and keeps it (97–99.8 % of the
     /// envelope's power below 0.43·f_N on the shipped cells). Its grid cells
     /// say so (`condition.carrier`), so that `interp` interpolates the

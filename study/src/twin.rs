@@ -230,7 +230,7 @@ impl DisplayTwin {
         out
     }
 
-    /// Adds to `ubar` the gradient of Σ_n f̄[n]·F[n] with respect to the
+    /// Adds to `ubar` the gradient of Σ_n f̄\[n\]·F\[n\] with respect to the
     /// actuation, for the forward pass recorded in `tape`.
     pub fn backward(&self, tape: &Tape, fbar: &[f64], ubar: &mut [f64]) {
         let (mut bxe, mut bfl, mut bxm) = ([0.0; NE], 0.0, [0.0; 2]);
@@ -370,7 +370,7 @@ impl SensorTwin {
         out
     }
 
-    /// The gradient with respect to the surface force of Σ ȳ[n]·y[n]
+    /// The gradient with respect to the surface force of Σ ȳ\[n\]·y\[n\]
     /// (quantization passed straight through, clipped samples 0).
     pub fn backward(&self, pass: &[bool], ybar: &[f64]) -> Vec<f64> {
         let mut fbar = vec![0.0; ybar.len()];

@@ -2,7 +2,7 @@
 //! network's own estimates are fed back in place of the reference, one
 //! sample per call, without allocating.
 //!
-//! Each call takes the newest force sample x[t] and returns the estimate
+//! Each call takes the newest force sample x\[t\] and returns the estimate
 //! of u[t − L], L = max(d, 0) the look-ahead latency ([`super::taps`]).
 //! Before the histories have filled, missing force samples count as 0 N and
 //! missing past estimates as u = 0.
@@ -114,7 +114,7 @@ impl ClosedLoop {
         self.bad_inputs = 0;
     }
 
-    /// Takes the force sample x[t] (N) and returns the estimate of u[t − L].
+    /// Takes the force sample x\[t\] (N) and returns the estimate of u[t − L].
     #[inline]
     pub fn step(&mut self, x: f64) -> f64 {
         let y = self.estimate(x);
@@ -178,7 +178,7 @@ impl ClosedLoop {
     }
 
     /// Runs a whole force series and returns the estimates aligned with it:
-    /// element n is the estimate of u[n] (the last L samples, whose
+    /// element n is the estimate of u\[n\] (the last L samples, whose
     /// look-ahead lies past the end of `x`, are estimated with 0 N there).
     pub fn run(&mut self, x: &[f64]) -> Vec<f64> {
         let lat = self.taps.latency();

@@ -1,5 +1,5 @@
 //! NARX inverse models of the display (dissertation §5.2.1): a network
-//! learns the actuation u[n] from the measured lateral force, trained open
+//! learns the actuation u\[n\] from the measured lateral force, trained open
 //! loop and run closed loop.
 
 pub mod closed_loop;

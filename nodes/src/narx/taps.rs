@@ -11,9 +11,9 @@
 //! — `k_y` feedback taps (Eq. 5.1's y[n−1] … y[n−k_y]) and the external
 //! input from d samples ahead back to k_x samples behind (k_x + d + 1
 //! values). d = −1 gives Eq. 5.1 exactly (x[n−1] … x[n−k_x]). A look-ahead
-//! d > 0 is what an *inverse* model needs: the force that u[n] causes
+//! d > 0 is what an *inverse* model needs: the force that u\[n\] causes
 //! appears after it (the display's electrical, electroadhesive and
-//! mechanical lags), so u[n] is best read from force samples up to n + d.
+//! mechanical lags), so u\[n\] is best read from force samples up to n + d.
 //! Offline this is free; streaming, it delays the estimate by d samples
 //! (see the `narx` node).
 //!
@@ -24,11 +24,11 @@
 //! says nothing about timing. What the force does show is *change* in u: a
 //! transition of a binary excitation charges the gap and makes a force
 //! spike (docs/simulated-lab.md §1.4). [`choose_lookahead`] therefore
-//! correlates the squared increment z[n] = (u[n] − u[n−1])² (centred) with
+//! correlates the squared increment z\[n\] = (u\[n\] − u[n−1])² (centred) with
 //! the force x[n + k] for k = 0 … `max_lag`, takes the lag k* of the largest
 //! |correlation| and extends it while |correlation| stays above a quarter of
 //! that peak: d is the last lag of the response's main part, so the window
-//! x[n+d] … x[n−k_x] covers the force response to u[n]. (|·| because the
+//! x[n+d] … x[n−k_x] covers the force response to u\[n\]. (|·| because the
 //! response rings: on the nominal simulated lab the correlation alternates
 //! in sign, +0.33, −0.38, +0.14, −0.13, +0.06 at lags 0 … 4 — the pen tip's
 //! 712 Hz resonance seen at 1 kHz — and d = 3. Networks trained with d = 1,
@@ -46,7 +46,7 @@ pub struct Taps {
     /// Feedback taps k_y: y[n−1] … y[n−k_y] (0 = no feedback: a pure
     /// nonlinear FIR inverse).
     pub feedback: usize,
-    /// Input taps k_x behind the output sample: x[n] … x[n−k_x].
+    /// Input taps k_x behind the output sample: x\[n\] … x[n−k_x].
     pub input: usize,
     /// Look-ahead d: the newest input sample is x[n+d] (−k_x ≤ d).
     pub lookahead: i64,

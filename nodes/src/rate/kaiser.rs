@@ -10,9 +10,9 @@
 //! * shape β = 0.1102 (A − 8.7) for A > 50, 0.5842 (A − 21)^0.4 +
 //!   0.07886 (A − 21) for 21 ≤ A ≤ 50, and 0 below (Eq. 7.75);
 //! * order N = ⌈(A − 8) / (2.285 Δω)⌉ (Eq. 7.76);
-//! * taps h[n] = (ω_c/π) · sinc(ω_c (n − N/2) / π) · w[n], n = 0 … N, with
+//! * taps h\[n\] = (ω_c/π) · sinc(ω_c (n − N/2) / π) · w\[n\], n = 0 … N, with
 //!   the ideal cut-off ω_c = (ω_p + ω_s)/2 in the middle of the transition
-//!   band and the Kaiser window w[n] = I₀(β √(1 − (2n/N − 1)²)) / I₀(β).
+//!   band and the Kaiser window w\[n\] = I₀(β √(1 − (2n/N − 1)²)) / I₀(β).
 //!
 //! An even N gives a type I filter (odd length, symmetric): linear phase,
 //! a group delay of exactly N/2 samples at every frequency. The taps are

@@ -1,4 +1,4 @@
-//! Arithmetic in GF(q)[x] for the maximum-length q-level generator of
+//! Arithmetic in GF(q)\[x\] for the maximum-length q-level generator of
 //! [`super::prms`]: the search for a primitive polynomial of a degree and the
 //! linear recurrence it defines.
 //!

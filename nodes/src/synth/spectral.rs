@@ -12,7 +12,7 @@
 //! ```
 //!
 //! so the gradient of J = E_s² on segment p is
-//! w_n · Re(DFT(c)[n]) / P with c_k = 2(S_k − R_k)/‖R‖² · conj(X_{p,k})/|X_{p,k}|
+//! w_n · Re(DFT(c)\[n\]) / P with c_k = 2(S_k − R_k)/‖R‖² · conj(X_{p,k})/|X_{p,k}|
 //! on the band's bins (0 elsewhere): one more FFT per segment. |X| is not
 //! differentiable where X = 0; there the bin contributes no gradient.
 

@@ -4,7 +4,7 @@
 //! display turns an actuation a·(−1)ⁿ — a full swing every sample, held —
 //! into a nearly steady extra friction κ·a² (the gap voltage follows the
 //! swing through the circuit's capacitive division; its square hardly
-//! moves). A slowly varying envelope a[n] then renders κ·a[n]², at the
+//! moves). A slowly varying envelope a\[n\] then renders κ·a\[n\]², at the
 //! envelope's own frequencies, not doubled as a force-shaped actuation
 //! would be. To render the (zero-mean, high-passed) force f:
 //!

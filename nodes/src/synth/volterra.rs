@@ -5,7 +5,7 @@
 //! y[n] = c + Σ_i l_i·u[n−i] + Σ_i Σ_j H_ij·u[n−i]·u[n−j],   i, j = 0 … M−1
 //! ```
 //!
-//! with H symmetric and u[k] = 0 before the first sample. Why this class:
+//! with H symmetric and u\[k\] = 0 before the first sample. Why this class:
 //! an electrovibration display is a square law between linear dynamics —
 //! amplifier and circuit before it (u → gap voltage v_g), the
 //! electroadhesion lag, the contact mechanics and the force sensor after it
@@ -136,7 +136,7 @@ impl Volterra {
         self.memory * (self.memory + 1) / 2 + self.memory + 1
     }
 
-    /// The force added per a² by a Nyquist-rate carrier u[n] = (−1)ⁿ·a held
+    /// The force added per a² by a Nyquist-rate carrier u\[n\] = (−1)ⁿ·a held
     /// at amplitude a: κ = Σ_ij H_ij (−1)^(i+j). For a square-law display
     /// this is the friction raised by a full-swing carrier of unit
     /// amplitude (N) — the constant of the square-law start
@@ -210,8 +210,8 @@ impl Volterra {
         y
     }
 
-    /// The force for `u` into `y`, and the gradient of Σ_n ȳ[n]·y[n] with
-    /// respect to every u[k] *added* to `du` (reverse mode: each window's
+    /// The force for `u` into `y`, and the gradient of Σ_n ȳ\[n\]·y\[n\] with
+    /// respect to every u\[k\] *added* to `du` (reverse mode: each window's
     /// sensitivity 2·H·w + l scattered back onto the samples it read).
     pub fn eval_grad(&self, u: &[f64], ybar: &[f64], y: &mut [f64], du: &mut [f64]) {
         #[cfg(target_arch = "x86_64")]

@@ -17,7 +17,7 @@
 //! noise, unmodelled dynamics — is not the same at every actuation level: a
 //! display's friction noise grows with the normal force the actuation adds.
 //! The squared residual is regressed on the local actuation power
-//! p[n] = mean of u² over `noise_window` samples around n: r² ≈ σ₀² + β·p.
+//! p\[n\] = mean of u² over `noise_window` samples around n: r² ≈ σ₀² + β·p.
 //! The synthesis uses β to weigh matching the force against the noise a
 //! stronger actuation brings ([`super::objective`]).
 

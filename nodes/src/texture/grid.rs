@@ -15,7 +15,7 @@
 //! or velocity, a non-positive velocity, and cells at different rates.
 //!
 //! A cell may declare `condition.carrier = "nyquist"`: its actuation rides
-//! a Nyquist-rate carrier, u[n] = (−1)ⁿ·a[n] with a slowly varying
+//! a Nyquist-rate carrier, u\[n\] = (−1)ⁿ·a\[n\] with a slowly varying
 //! envelope a (the optimized synthesis' cells, docs/synthesis.md). The
 //! grid records it ([`Grid::carrier`]); every reachable cell must agree.
 
@@ -155,7 +155,7 @@ pub struct Grid {
     pub cells: Vec<Vec<f64>>,
     /// The recordings, in the order of `cells`.
     pub paths: Vec<PathBuf>,
-    /// Whether the cells ride a Nyquist-rate carrier, u[n] = (−1)ⁿ·a[n]
+    /// Whether the cells ride a Nyquist-rate carrier, u\[n\] = (−1)ⁿ·a\[n\]
     /// (their sidecars' `condition.carrier = "nyquist"`).
     pub carrier: bool,
 }

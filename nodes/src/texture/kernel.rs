@@ -12,7 +12,7 @@
 //! built, and its docs warn that lowering the ratio afterwards by more than a
 //! few percent aliases; the ratio here changes at every update.)
 //!
-//! y(p) = Σₙ y[n]·h(p − n) / Σₙ h(p − n), h(d) = sinc(c·d)·kaiser(c·d / W),
+//! y(p) = Σₙ y\[n\]·h(p − n) / Σₙ h(p − n), h(d) = sinc(c·d)·kaiser(c·d / W),
 //! summed over |p − n| < W/c. Dividing by the sum of the taps makes a
 //! constant come out exact whatever the position and the cutoff.
 

@@ -22,11 +22,11 @@
 //! without two versions of one file.
 //!
 //! **Failures.** One failing item does not lose the others: a failed
-//! (setting, seed) is left out of its setting's means ([`Scored::seeds`]
+//! (setting, seed) is left out of its setting's means ([`run::Scored::seeds`]
 //! says over how many seeds a row is), a setting whose every seed failed has
 //! no scores, and a texture whose recording or optimized synthesis failed is
 //! left out of every setting's scores; every failure is listed with its
-//! reason ([`NarxStudy::failures`]).
+//! reason ([`run::NarxStudy::failures`]).
 //!
 //! [`setting`] parses the network settings, [`scope`] says what a study
 //! covers (its config's, its shard record's and its merge's one

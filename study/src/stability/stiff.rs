@@ -49,7 +49,7 @@ const HARDEST: &[&str] = &[
     "sensor.resonance_hz",
 ];
 
-/// A lab profile (TOML) with every [`HARDEST`] key at its declared
+/// A lab profile (TOML) with every `HARDEST` key at its declared
 /// maximum — but below half the sample rate `rate` for a corner frequency
 /// the lab requires to be (the charge relaxation's).
 pub fn hardest_profile(rate: f64) -> String {

@@ -5,7 +5,7 @@
 //!
 //! Nothing here runs on the real-time thread. The recorder hands every
 //! tap sample and event it drains to an [`Ingest`] (the recorder's thread
-//! decimates them into a [`feed`]), the metrics thread hands it the tick
+//! decimates them into a feed), the metrics thread hands it the tick
 //! timings; a feeder thread turns what accumulated into one JSON frame
 //! every 50 ms and offers it to each browser's bounded queue, where a
 //! slow or vanished browser loses frames (counted and shown), never the

@@ -1,7 +1,7 @@
 //! The forward model seen through a Nyquist-rate carrier, and a grid of
 //! such models blended at the finger's condition.
 //!
-//! With u[k] = s_k·a[k], s_k = (−1)^k, the second-order Volterra model of
+//! With u\[k\] = s_k·a\[k\], s_k = (−1)^k, the second-order Volterra model of
 //! [`crate::synth::volterra`] becomes, since s_{k−i}·s_{k−j} = (−1)^{i+j}
 //! for every k,
 //!

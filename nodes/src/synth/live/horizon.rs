@@ -54,7 +54,7 @@ pub struct TickOutcome {
     pub budget_stop: bool,
     /// The carrier start or silence was played instead of an optimized point.
     pub fallback: bool,
-    /// The model's expected force change now, y[n] − c − b (N): what the
+    /// The model's expected force change now, y\[n\] − c − b (N): what the
     /// synthesis expects the display to render of the target.
     pub predicted: f64,
 }

@@ -23,8 +23,8 @@ pub(super) const QUEUE_SECONDS: f64 = 60.0;
 
 /// One thing to write.
 pub(super) enum Op {
-    /// Interleaved frames for recording `file` (in the order the recordings
-    /// were handed to [`Files::new`]).
+    /// Interleaved frames for recording `file` (in the order of the specs
+    /// given to [`Files::create`]).
     Frames {
         /// Index of the recording.
         file: usize,

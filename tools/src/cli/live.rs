@@ -135,7 +135,7 @@ pub fn main(a: Args) -> Result<()> {
     });
     // The files first: creating them syncs each to disk, which must not
     // happen while the real-time thread fills its rings.
-    let files = recorder::Files::create(&dir, &[inputs, outputs].concat(), "evflow live")?;
+    let files = disk::Files::create(&dir, &[inputs, outputs].concat(), "evflow live")?;
     let mut session = live::start(lp, &pacing.config).map_err(|e| anyhow!("{e}"))?;
     let vars_line = setup::vars_line(&vars);
     session.control.bind_vars(vars);

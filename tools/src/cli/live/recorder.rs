@@ -4,8 +4,7 @@
 //! a steady pace, so a killed process leaves readable files. The recorder
 //! itself never waits on the disk.
 
-pub use super::disk::Files;
-use super::disk::{Disk, DiskQueue, Op, QUEUE_SECONDS};
+use super::disk::{Disk, DiskQueue, Files, Op, QUEUE_SECONDS};
 use super::session::{event_json, FileSpec};
 use evflow_engine::live::{rtrb, Event, EventKind, TapInfo};
 use std::sync::atomic::{AtomicBool, Ordering};

@@ -217,9 +217,20 @@ impl DiskQueue {
     }
 
     /// Closes the queue, waits for the disk thread to write and finish
-    /// everything, and reports.
-    pub(super) fn finish(mut self) -> DiskReport {
+    /// everything, and reports. Should that take longer than `patience`
+    /// (a slow disk), `notice` is called once with the bytes still queued,
+    /// so the user knows why the session has not ended yet.
+    pub(super) fn finish(mut self, patience: Duration, mut notice: impl FnMut(usize)) -> DiskReport {
         self.tx = None;
+        let asked = Instant::now();
+        let mut told = false;
+        while self.thread.as_ref().is_some_and(|t| !t.is_finished()) {
+            if !told && asked.elapsed() >= patience {
+                notice(self.queued.load(Ordering::Acquire));
+                told = true;
+            }
+            std::thread::sleep(Duration::from_millis(5));
+        }
         match self.thread.take().map(JoinHandle::join) {
             Some(Ok(report)) => report,
             _ => {
@@ -298,10 +309,34 @@ mod tests {
         // The first write outlasts the flush period: a flush follows it.
         std::thread::sleep(Duration::from_millis(20));
         drop(held);
-        let report = q.finish();
+        let report = q.finish(Duration::from_secs(60), |_| panic!("no notice"));
         assert_eq!(written.load(Ordering::SeqCst), 10 * 160 + 2, "every op written");
         assert!(flushes.load(Ordering::SeqCst) >= 1, "flushed once the period passed");
         assert_eq!(report.files, vec![None, Some("full".to_string())]);
+    }
+
+    #[test]
+    fn a_slow_finish_is_noticed_once_with_what_is_still_queued() {
+        /// A disk that takes 200 ms per write.
+        struct Slow;
+        impl Disk for Slow {
+            fn write(&mut self, _: Op) {
+                std::thread::sleep(Duration::from_millis(200));
+            }
+            fn flush(&mut self) {}
+            fn finish(self: Box<Self>) -> DiskReport {
+                DiskReport { files: vec![None], event_error: None }
+            }
+        }
+        let q = DiskQueue::start(Box::new(Slow), 1, 1 << 20, Duration::from_secs(60)).unwrap();
+        for _ in 0..3 {
+            q.send(Op::Frames { file: 0, data: vec![0.0; 100] });
+        }
+        let mut notices = Vec::new();
+        let report = q.finish(Duration::from_millis(10), |bytes| notices.push(bytes));
+        assert_eq!(notices.len(), 1, "told once: {notices:?}");
+        assert!(notices[0] >= 800, "the bytes still queued: {notices:?}");
+        assert_eq!(report.files, vec![None]);
     }
 
     #[test]
@@ -318,7 +353,7 @@ mod tests {
         }
         let q = DiskQueue::start(Box::new(Panics), 3, 1 << 20, Duration::from_secs(1)).unwrap();
         q.send(Op::Event("x".into()));
-        let report = q.finish();
+        let report = q.finish(Duration::from_secs(60), |_| panic!("no notice"));
         assert_eq!(report.files.len(), 3);
         assert!(report.files.iter().all(|e| e.as_deref() == Some("the session's disk thread failed")));
         assert!(report.event_error.is_some());
@@ -335,7 +370,7 @@ mod tests {
         q.send(Op::Frames { file: 0, data: vec![1.0, 2.0, 3.0, 4.0] });
         q.send(Op::Event("{\"tick\":1}".into()));
         q.send(Op::Frames { file: 0, data: vec![5.0, 6.0] });
-        let report = q.finish();
+        let report = q.finish(Duration::from_secs(60), |_| panic!("no notice"));
         assert_eq!(report.files, vec![None]);
         assert_eq!(report.event_error, None);
         let r = Recording::open(&dir.path().join("outputs/r")).unwrap();

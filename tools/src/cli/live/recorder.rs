@@ -199,7 +199,13 @@ impl Recorder {
 
     /// Waits for the disk thread to finish every file; the report.
     fn finish(self) -> RecorderReport {
-        let disk = self.disk.finish();
+        let disk = self.disk.finish(Duration::from_secs(2), |bytes| {
+            let what = match bytes {
+                0 => "syncing".to_string(),
+                _ => format!("writing ({:.0} kB queued) and syncing", bytes as f64 / 1e3),
+            };
+            eprintln!("still {what} the session's files on a slow disk; the session ends once they are synced");
+        });
         let files = self
             .sinks
             .iter()

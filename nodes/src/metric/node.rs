@@ -1,6 +1,6 @@
 //! `metric`: E_s, RMS and peak-to-peak of a virtual force against a real one.
 
-use super::spectral_error::{spectral_rms_error, Band, BandError, BandParam, SpectralError};
+use super::spectral_error::{spectral_rms_error, Band, BandError, SpectralError};
 use super::spectrum::{Spectrum, SpectrumAccumulator, SpectrumConfig, Window};
 use crate::filters::segment::{Gates, GATES};
 use evflow_engine::ports::InPort;
@@ -193,12 +193,7 @@ const WINDOW: Choice<Window> =
 
 /// A band error, naming this node's parameter.
 fn band_error(e: BandError) -> NodeError {
-    let param = match e.param {
-        BandParam::Fmin => FMIN.name(),
-        BandParam::Fmax => FMAX.name(),
-        BandParam::Nfft => NFFT.name(),
-    };
-    NodeError::param(param, e.message)
+    e.naming([FMIN.name(), FMAX.name(), NFFT.name()])
 }
 
 fn build(p: &Params, ctx: &BuildContext) -> Result<Box<dyn Node>, NodeError> {

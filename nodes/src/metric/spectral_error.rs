@@ -16,6 +16,7 @@
 //! force's mean (the friction level) is not texture; see the `metric` node.
 
 use super::spectrum::ROUNDING_LEVEL;
+use evflow_engine::NodeError;
 use std::ops::RangeInclusive;
 
 /// Which argument of [`Band::new`] gives no usable band; a node names its
@@ -38,6 +39,19 @@ pub struct BandError {
     pub param: BandParam,
     /// What is wrong and what would be right.
     pub message: String,
+}
+
+impl BandError {
+    /// The node error naming the node's own parameter for the argument:
+    /// `[fmin, fmax, nfft]` are the names of its three handles.
+    pub fn naming(self, [fmin, fmax, nfft]: [&str; 3]) -> NodeError {
+        let param = match self.param {
+            BandParam::Fmin => fmin,
+            BandParam::Fmax => fmax,
+            BandParam::Nfft => nfft,
+        };
+        NodeError::param(param, self.message)
+    }
 }
 
 /// The one-sided FFT bins E_s is taken over: every bin k with
@@ -209,6 +223,20 @@ pub fn spectral_rms_error(virt: &[f64], real: &[f64], band: &Band) -> Result<f64
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn a_band_error_names_the_nodes_own_parameter() {
+        let names = ["lo_hz", "hi_hz", "len"];
+        let e = Band::new(1000.0, 1000, 300.0, 100.0, false).unwrap_err();
+        let (param, message) = (e.param, e.message.clone());
+        let NodeError::Param { param: named, message: m } = e.naming(names) else { panic!("a parameter error") };
+        let want = match param {
+            BandParam::Fmin => "lo_hz",
+            BandParam::Fmax => "hi_hz",
+            BandParam::Nfft => "len",
+        };
+        assert_eq!((named.as_str(), m), (want, message));
+    }
     use crate::metric::spectrum::tests::{gaussian, sine};
     use crate::metric::spectrum::{averaged_spectrum, SpectrumConfig, Window};
 

@@ -7,7 +7,7 @@ use super::model_file::ForwardModel;
 use super::start::carrier;
 use super::synthesize::{synthesize, NoiseWeight, ObjectiveKind, SynthConfig};
 use crate::filters::segment::SpeedRule;
-use crate::metric::spectral_error::{Band, BandError, BandParam};
+use crate::metric::spectral_error::{Band, BandError};
 use crate::metric::spectrum::{SpectrumConfig, Window};
 use crate::narx::model::Model;
 use crate::recording::format::Recording;
@@ -211,12 +211,7 @@ const RECORD_TIME: Flag =
 
 /// A band error, naming this node's parameter.
 fn band_error(e: BandError) -> NodeError {
-    let param = match e.param {
-        BandParam::Fmin => FMIN.name(),
-        BandParam::Fmax => FMAX.name(),
-        BandParam::Nfft => NFFT.name(),
-    };
-    NodeError::param(param, e.message)
+    e.naming([FMIN.name(), FMAX.name(), NFFT.name()])
 }
 
 fn build(p: &Params, ctx: &BuildContext) -> Result<Box<dyn Node>, NodeError> {

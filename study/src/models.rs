@@ -37,8 +37,7 @@ pub fn build(
     dir: &Path,
 ) -> Result<Models, StudyError> {
     let common = c.sets().and(profile.sets());
-    let narx_sets =
-        common.clone().int("epochs", epochs).flag("train.progress", false).flag("train.record_time", record_time);
+    let narx_sets = common.int("epochs", epochs).flag("train.progress", false).flag("train.record_time", record_time);
     let t = std::time::Instant::now();
     run_graph(&graphs.join("model-build.toml"), &narx_sets, dir)?;
     let narx_s = t.elapsed().as_secs_f64();
@@ -54,10 +53,22 @@ pub fn build(
         None
     };
     let t = std::time::Instant::now();
-    let forward_sets = common.flag("record_time", record_time);
-    run_graph(&graphs.join("forward-build.toml"), &forward_sets, dir)?;
-    let forward = found(dir.join(format!("forward-{}.json", c.tag())))?;
+    let forward = forward(graphs, profile, c, record_time, dir)?;
     Ok(Models { narx, narx_multilevel, forward, seconds: [narx_s, ml_s, t.elapsed().as_secs_f64()] })
+}
+
+/// Identifies the forward model of `c` on `profile` (graphs/forward-build.toml)
+/// into `dir`, and returns its file `forward-TAG.json`.
+pub fn forward(
+    graphs: &Path,
+    profile: &Profile,
+    c: &Cond,
+    record_time: bool,
+    dir: &Path,
+) -> Result<PathBuf, StudyError> {
+    let sets = c.sets().and(profile.sets()).flag("record_time", record_time);
+    run_graph(&graphs.join("forward-build.toml"), &sets, dir)?;
+    found(dir.join(format!("forward-{}.json", c.tag())))
 }
 
 /// Trains the inverse NARX model of `c` on `profile` alone

@@ -7,7 +7,8 @@
 //! actuation sample. The achievable floor ([`super::floor`]) optimizes
 //! through them — through the display itself, not a model of it.
 //!
-//! Forward, per substep (exact integrator): circuit with its charge
+//! Forward: the actuation delayed by the display's latency (whole
+//! samples), then per substep (exact integrator): circuit with its charge
 //! relaxation state q (electrical.rs) x_e ← Φ_e x_e + Γ_e V_cmd;
 //! F_e = k_e v_r², v_r = v_g − q (q ≡ 0 without relaxation); lag F_l ← a F_l + (1 − a) F_e; N = max(0, F_n + F_l); the
 //! tip's augmented exact map gives the free motion and the slip s; the
@@ -84,6 +85,8 @@ pub struct DisplayTwin {
     phi_m: Vec<f64>,
     gam_m: Vec<f64>,
     x0: [f64; NE],
+    /// The actuation path's latency, samples.
+    delay: usize,
 }
 
 #[inline]
@@ -143,6 +146,7 @@ impl DisplayTwin {
             phi_m,
             gam_m,
             x0,
+            delay: evflow_nodes::lab::display_model::delay_samples(amp.delay_ms, rate),
         })
     }
 
@@ -176,7 +180,8 @@ impl DisplayTwin {
         let mut out = Vec::with_capacity(u.len());
         let ds_df = self.gam_m[2 * 2 + 1];
         for n in 0..u.len() {
-            let uu = if u[n].is_finite() { u[n] } else { 0.0 };
+            let un = if n >= self.delay { u[n - self.delay] } else { 0.0 };
+            let uu = if un.is_finite() { un } else { 0.0 };
             let ld = if load[n].is_finite() { load[n].max(0.0) } else { 0.0 };
             let v = if velocity[n].is_finite() { velocity[n] } else { 0.0 };
             let raw = self.gain * uu + self.offset;
@@ -294,8 +299,8 @@ impl DisplayTwin {
                 bxe = b0;
                 let _ = s.xe0;
             }
-            if !clamped {
-                ubar[n] += bvcmd * self.gain;
+            if !clamped && n >= self.delay {
+                ubar[n - self.delay] += bvcmd * self.gain;
             }
         }
     }
@@ -397,16 +402,21 @@ mod tests {
     use evflow_nodes::lab::sensor_model::SensorModel;
     use evflow_nodes::lab::tribometer_model::TribometerModel;
 
-    /// Every profile shipped in graphs/lab (new ones included as they come).
+    /// Every profile shipped in graphs/lab (new ones included as they
+    /// come), and the nominal one with a 2 ms latency.
     fn shipped() -> Vec<(String, LabProfile)> {
         let dir = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../graphs/lab");
         let mut files: Vec<_> = std::fs::read_dir(&dir).unwrap().filter_map(|e| e.ok().map(|e| e.path())).collect();
         files.sort();
-        files
+        let mut v: Vec<(String, LabProfile)> = files
             .into_iter()
             .filter(|p| p.extension().is_some_and(|e| e == "toml"))
             .map(|p| (p.file_stem().unwrap().to_string_lossy().into_owned(), LabProfile::load(&p).unwrap()))
-            .collect()
+            .collect();
+        let mut late = LabProfile::default();
+        late.display.amplifier.delay_ms = 2.0;
+        v.push(("nominal, 2 ms late".into(), late));
+        v
     }
 
     fn pass(profile: &LabProfile, mass_g: f64, speed: f64) -> (Vec<f64>, Vec<f64>) {

@@ -105,6 +105,15 @@ enum Command {
     ///
     /// Example: cargo run --release -p evflow -- bench mesh
     Bench(cli::bench::BenchArgs),
+    /// Write the display family: lab profiles drawn from seeded, documented
+    /// ranges of every constant of the virtual display, split into a tuning
+    /// set and a held-out set (docs/simulated-lab.md §6.2). The shipped
+    /// family is graphs/lab/family, which `report live --displays` and
+    /// `report textures --displays` run on.
+    ///
+    /// Example: evflow family --out graphs/lab/family
+    #[cfg(feature = "lab")]
+    Family(cli::family::Args),
     /// Print a graph in Graphviz dot syntax (pruned nodes dashed).
     ///
     /// Example: evflow dot graphs/excitation.toml | dot -Tpng > graph.png
@@ -151,6 +160,8 @@ fn main() -> ExitCode {
         Command::Check(a) => cli::check::main(a),
         Command::Nodes(a) => cli::nodes::main(a),
         Command::Dot(a) => cli::dot::main(a),
+        #[cfg(feature = "lab")]
+        Command::Family(a) => cli::family::main(a),
         #[cfg(feature = "studio")]
         Command::Studio(a) => cli::studio::main(a),
         Command::Import(a) => cli::import::main(a),

@@ -69,10 +69,11 @@ fn the_live_report_holds_every_chain_and_its_shards_merge_into_one_run() {
         assert!(md.contains(chain), "{chain}: {md}");
     }
     assert!(md.contains("| plastic-sheet |") && md.contains("## Targets"), "{md}");
-    // rows.csv: per user, nothing, five chains, the floor, its sliding only, the display floor.
+    // rows.csv: per user, nothing, five chains, the floor, the target's floor, the floor's sliding only, the display floor.
     let csv = std::fs::read_to_string(one.join("rows.csv")).unwrap();
     let lines: Vec<&str> = csv.lines().skip(1).collect();
-    assert_eq!(lines.len(), 2 * 9, "{csv}");
+    assert_eq!(lines.len(), 2 * 10, "{csv}");
+    assert!(md.contains("target's floor") && md.contains("issue 33's targets"), "{md}");
     for user in ["person", "short-strokes"] {
         let best = |chain: &str| -> f64 {
             let l =
@@ -84,6 +85,10 @@ fn the_live_report_holds_every_chain_and_its_shards_merge_into_one_run() {
         for chain in ["playback", "narx", "optimized", "ff", "live"] {
             assert!(floor <= best(chain), "{user}: the floor {floor} above {chain}'s best {}", best(chain));
         }
+        // The target's floor is never above the live synthesis, and never below the stroke's floor by much
+        // (both are optimized alike; the stroke's floor knows the real force).
+        let target = best("target_floor");
+        assert!(target.is_finite() && target <= best("live"), "{user}: {csv}");
     }
 
     // Shards, merged out of order: the same tables.
@@ -113,4 +118,47 @@ fn the_live_report_holds_every_chain_and_its_shards_merge_into_one_run() {
             "{f}"
         );
     }
+}
+
+#[test]
+fn two_members_of_the_display_family_play_the_live_synthesis_from_its_own_library() {
+    let base = tempfile::tempdir().unwrap();
+    let out = base.path().join("family");
+    let (ok, stdout, err) = evflow(&[
+        "report",
+        "live",
+        "--out",
+        out.to_str().unwrap(),
+        "--profiles",
+        "family/tuning-04,family/held-out-01",
+        "--chains",
+        "live",
+        "--samples",
+        "plastic-sheet",
+        "--users",
+        "person",
+        "--gains",
+        "1.0",
+        "--seconds",
+        "2",
+        "--floor-iterations",
+        "3",
+        "--no-plots",
+    ]);
+    assert!(ok, "{stdout}{err}");
+    let md = std::fs::read_to_string(out.join("live.md")).unwrap();
+    assert!(md.contains("| tuning-04 |") && md.contains("| held-out-01 |"), "{md}");
+    assert!(!md.contains("NARX cells"), "only the live synthesis plays: {md}");
+    assert!(md.contains("issue 33's targets"), "{md}");
+    // The live synthesis' own library: forward models and forces, no inverse models or cells.
+    let lib = out.join("work/tuning-04/live-library");
+    assert!(lib.join("models/forward-60g-3cms.json").is_file() && lib.join("forces-plastic-sheet").is_dir());
+    assert!(!lib.join("models/narx-60g-3cms.json").exists() && !lib.join("narx-plastic-sheet").exists());
+    let csv = std::fs::read_to_string(out.join("rows.csv")).unwrap();
+    for chain in ["nothing", "live", "stroke_floor", "target_floor", "display_floor"] {
+        assert_eq!(csv.lines().filter(|l| l.contains(&format!(",{chain},"))).count(), 2, "{chain}: {csv}");
+    }
+    // A typo in --chains is refused by name.
+    let (ok, _, err) = evflow(&["report", "live", "--chains", "liev", "--out", out.to_str().unwrap()]);
+    assert!(!ok && err.contains("no chain named `liev`"), "{err}");
 }

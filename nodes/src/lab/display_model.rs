@@ -2,6 +2,7 @@
 //! and sliding velocity in, lateral force out, one sample at a time. The
 //! `sim.display` node (display.rs) wraps it; docs/simulated-lab.md derives it.
 //!
+//! The actuation first passes the latency line (`delay_ms`, whole samples).
 //! Chain per substep (every method; `exact` uses the exact maps, `rk4` and
 //! `euler` their one-step maps of the same linear parts, integrator.rs):
 //! 1. amplifier + circuit + charge relaxation (electrical.rs) advance by
@@ -38,6 +39,16 @@ use crate::rng::Rng;
 pub const GUARD_N: f64 = 1e3;
 /// Gap voltage beyond which the model counts as diverged, V.
 const GUARD_V: f64 = 1e5;
+
+/// The actuation path's latency `delay_ms` in whole samples at `rate` Hz.
+pub fn delay_samples(delay_ms: f64, rate: f64) -> usize {
+    let d = (delay_ms * 1e-3 * rate).round();
+    if d.is_finite() && d > 0.0 {
+        d as usize
+    } else {
+        0
+    }
+}
 
 /// The friction law's constants.
 #[derive(Debug, Clone, Copy)]
@@ -91,6 +102,9 @@ pub struct DisplayModel {
     /// Input samples that were NaN or infinite (read as 0).
     pub bad_inputs: u64,
     last_n: f64,
+    /// The actuation's latency line: the last `delay` samples of u, oldest at `head`.
+    line: Vec<f64>,
+    head: usize,
 }
 
 impl DisplayModel {
@@ -166,6 +180,8 @@ impl DisplayModel {
             diverged: 0,
             bad_inputs: 0,
             last_n: 0.0,
+            line: vec![0.0; delay_samples(a.delay_ms, rate)],
+            head: 0,
         };
         model.reset();
         Ok(model)
@@ -188,6 +204,20 @@ impl DisplayModel {
         self.xm = [0.0; 2];
         self.stuck = true;
         self.last_n = 0.0;
+        self.line.iter_mut().for_each(|x| *x = 0.0);
+        self.head = 0;
+    }
+
+    /// u as it reaches the amplifier: `u` delayed by the latency line.
+    fn delayed(&mut self, u: f64) -> f64 {
+        match self.line.len() {
+            0 => u,
+            d => {
+                let out = std::mem::replace(&mut self.line[self.head], u);
+                self.head = (self.head + 1) % d;
+                out
+            }
+        }
     }
 
     fn clean(&mut self, x: f64) -> f64 {
@@ -204,6 +234,7 @@ impl DisplayModel {
     /// returns the lateral force at the end of the sample, N.
     pub fn step(&mut self, u: f64, load: f64, v: f64) -> f64 {
         let u = self.clean(u);
+        let u = self.delayed(u);
         let load = self.clean(load).max(0.0);
         let v = self.clean(v);
         let noise = if self.noise_v > 0.0 { self.noise_v * self.rng.gaussian() } else { 0.0 };

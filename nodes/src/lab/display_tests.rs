@@ -265,3 +265,21 @@ fn seeded_noise_reproduces_and_reset_replays() {
     a.reset();
     assert_eq!(fa, run(&mut a, &u, LOAD_85G, 0.05));
 }
+
+#[test]
+fn the_latency_delays_the_actuation_by_whole_samples() {
+    let mut p = LabProfile::default();
+    let u: Vec<f64> = (0..400).map(|k| if k % 2 == 0 { 0.7 } else { -0.7 } * (1.0 + (k as f64 * 0.05).sin())).collect();
+    let mut now = DisplayModel::new(&p, 1000.0, Method::Exact, 4, 0.0, 1).unwrap();
+    p.display.amplifier.delay_ms = 2.6; // rounds to 3 samples at 1 kHz
+    let mut late = DisplayModel::new(&p, 1000.0, Method::Exact, 4, 0.0, 1).unwrap();
+    let shifted: Vec<f64> = [0.0; 3].iter().chain(&u[..u.len() - 3]).copied().collect();
+    let a = run(&mut now, &shifted, 0.85, 0.05);
+    let b = run(&mut late, &u, 0.85, 0.05);
+    assert_eq!(a, b);
+    // Reset empties the line.
+    late.reset();
+    assert_eq!(run(&mut late, &u, 0.85, 0.05), b);
+    assert_eq!(super::display_model::delay_samples(2.6, 10_000.0), 26);
+    assert_eq!(super::display_model::delay_samples(0.4, 1000.0), 0);
+}

@@ -8,6 +8,7 @@ pub mod display;
 pub mod display_model;
 pub mod electrical;
 pub mod expm;
+pub mod family;
 pub mod forcesensor;
 pub mod integrator;
 pub mod noise;

@@ -16,6 +16,9 @@ pub struct Amplifier {
     pub offset_v: f64,
     /// White output noise, V rms (per sample).
     pub noise_v: f64,
+    /// Latency of the actuation path (DAQ output buffer, link, driver) in
+    /// ms, rounded to whole samples of the node's rate.
+    pub delay_ms: f64,
 }
 
 /// The series circuit amplifier → insulator → air gap → pen tip/skin → return.
@@ -165,7 +168,14 @@ impl Default for LabProfile {
             name: "nominal".into(),
             description: "3M-like surface-capacitive panel driven at 100 Vpp, touch-pen stylus on the linear tribometer of §5.1.1".into(),
             display: Display {
-                amplifier: Amplifier { gain_v: 50.0, max_v: 100.0, bandwidth_hz: 20_000.0, offset_v: 2.0, noise_v: 0.05 },
+                amplifier: Amplifier {
+                    gain_v: 50.0,
+                    max_v: 100.0,
+                    bandwidth_hz: 20_000.0,
+                    offset_v: 2.0,
+                    noise_v: 0.05,
+                    delay_ms: 0.0,
+                },
                 electrical: Electrical {
                     contact_area_mm2: 50.0,
                     insulator_thickness_um: 1.0,
@@ -272,6 +282,15 @@ pub static KEYS: &[Key] = &[
     key!("display.amplifier", bandwidth_hz, display.amplifier, "Hz", 10.0, 1e7, "first-order bandwidth"),
     key!("display.amplifier", offset_v, display.amplifier, "V", -100.0, 100.0, "DC offset at the output"),
     key!("display.amplifier", noise_v, display.amplifier, "V", 0.0, 100.0, "white output noise, rms"),
+    key!(
+        "display.amplifier",
+        delay_ms,
+        display.amplifier,
+        "ms",
+        0.0,
+        100.0,
+        "latency of the actuation path, rounded to whole samples"
+    ),
     key!("display.electrical", contact_area_mm2, display.electrical, "mm²", 0.1, 1e4, "apparent contact area"),
     key!("display.electrical", insulator_thickness_um, display.electrical, "µm", 0.01, 1e4, "coating thickness"),
     key!(

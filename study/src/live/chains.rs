@@ -25,6 +25,9 @@ pub struct ChainsRun {
     /// Every chain's actuation as played at gain 1 (or at the sweep's
     /// first gain when 1 is not in it), by chain.
     pub actuations: Vec<(Chain, Vec<f64>)>,
+    /// The force the live synthesis aimed at, tick by tick, at that gain
+    /// (N; empty when the live synthesis was left out).
+    pub live_target: Vec<f64>,
 }
 
 /// Runs the chains on `at`, the grids and models read from `library`.
@@ -34,7 +37,10 @@ pub fn run(at: &Stage<'_>, library: &Path) -> Result<ChainsRun, StudyError> {
     let record_gain = if scope.gains.contains(&1.0) { 1.0 } else { scope.gains[0] };
     let mut runs = Vec::new();
     for &gain in &scope.gains {
-        let sets = Sets::new()
+        // A chain left out plays nothing: its gain is 0, and what fed only it is pruned (never built).
+        let out = Chain::ALL.iter().filter(|c| !scope.chains.contains(c));
+        let sets = out
+            .fold(Sets::new(), |s, c| s.num(&format!("{}_gain.gain", c.prefix()), 0.0))
             .path("library", library)
             .text("sample", sample)
             .and(profile.sets())
@@ -52,7 +58,7 @@ pub fn run(at: &Stage<'_>, library: &Path) -> Result<ChainsRun, StudyError> {
         welch: value(first, &graph, "nothing_welch", "E_s")?,
     };
     let mut chains = Vec::new();
-    for c in Chain::ALL {
+    for c in Chain::ALL.into_iter().filter(|c| scope.chains.contains(c)) {
         let p = c.prefix();
         let mut sweep = Vec::new();
         for (gain, r) in &runs {
@@ -71,12 +77,16 @@ pub fn run(at: &Stage<'_>, library: &Path) -> Result<ChainsRun, StudyError> {
     }
     // The actuations as played at the recorded gain; the other gains' recordings are not kept.
     let mut actuations = Vec::new();
+    let mut live_target = Vec::new();
     for &gain in &scope.gains {
         let file = dir.join(format!("actuations-g{gain:?}"));
         if gain == record_gain {
             let rec = Recording::open(&file).map_err(|e| StudyError::Recording(e.to_string()))?;
-            for c in Chain::ALL {
+            for c in Chain::ALL.into_iter().filter(|c| scope.chains.contains(c)) {
                 actuations.push((c, rec.channel(c.prefix()).unwrap_or_default().to_vec()));
+            }
+            if scope.chains.contains(&Chain::Live) {
+                live_target = rec.channel("live_target").unwrap_or_default().to_vec();
             }
         } else {
             for ext in ["wav", "json"] {
@@ -84,5 +94,5 @@ pub fn run(at: &Stage<'_>, library: &Path) -> Result<ChainsRun, StudyError> {
             }
         }
     }
-    Ok(ChainsRun { nothing, chains, actuations })
+    Ok(ChainsRun { nothing, chains, actuations, live_target })
 }

@@ -121,37 +121,90 @@ impl Chain<'_> {
     }
 }
 
+/// What a floor optimizes towards: the force the display should give
+/// along the stroke (high-passed like every force the study scores), and
+/// its magnitude variation, whose square-law envelope is the carrier start.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Goal {
+    /// The force to match, high-passed at 10 Hz, N.
+    pub highpassed: Vec<f64>,
+    /// The force's variation in the direction of motion, N (for the carrier starts).
+    pub magnitude: Vec<f64>,
+}
+
+impl Goal {
+    /// The stroke's floor: the real force under the finger.
+    pub fn real(stroke: &Stroke) -> Result<Self, StudyError> {
+        let real = stroke.real_highpassed()?;
+        // The real force's magnitude variation: its sign taken off with the motion's.
+        let magnitude = real.iter().zip(&stroke.velocity).map(|(f, v)| if *v < 0.0 { -f } else { *f }).collect();
+        Ok(Self { highpassed: real, magnitude })
+    }
+
+    /// The target's floor: the live synthesis' own target `target` (N,
+    /// tick by tick, a friction magnitude: what the chain computed from
+    /// the IR frame and the load cell) in the direction the finger truly
+    /// moves (friction opposes the motion), high-passed — the stroke's
+    /// floor with the real force replaced by the force the chain aims at.
+    pub fn chain_target(stroke: &Stroke, target: &[f64]) -> Result<Self, StudyError> {
+        let n = stroke.len();
+        let mut t: Vec<f64> = target.iter().take(n).map(|v| if v.is_finite() { *v } else { 0.0 }).collect();
+        t.resize(n, 0.0);
+        let mut want: Vec<f64> = t.iter().zip(&stroke.velocity).map(|(f, v)| f * sign_of_motion(*v)).collect();
+        OutputFilter::highpass(4, 10.0, stroke.rate)?.apply_in_place(&mut want);
+        Ok(Self { highpassed: want, magnitude: t })
+    }
+}
+
+/// The direction friction opposes: +1 moving forward or at rest, −1 backwards.
+fn sign_of_motion(v: f64) -> f64 {
+    if v < 0.0 {
+        -1.0
+    } else {
+        1.0
+    }
+}
+
 /// Optimizes the stroke's actuation through the display of `profile` from
 /// the carrier starts and every seed (`(name, actuation)`, each clipped to
-/// |u| ≤ 1 and cut or padded with 0 to the stroke), `iterations` each.
+/// |u| ≤ 1 and cut or padded with 0 to the stroke), `iterations` each,
+/// towards the real force (the stroke's floor).
 pub fn optimize(
     stroke: &Stroke,
     profile: &LabProfile,
     seeds: &[(String, Vec<f64>)],
     iterations: usize,
 ) -> Result<Vec<Candidate>, StudyError> {
+    optimize_towards(stroke, profile, &Goal::real(stroke)?, seeds, iterations)
+}
+
+/// [`optimize`] towards any [`Goal`].
+pub fn optimize_towards(
+    stroke: &Stroke,
+    profile: &LabProfile,
+    goal: &Goal,
+    seeds: &[(String, Vec<f64>)],
+    iterations: usize,
+) -> Result<Vec<Candidate>, StudyError> {
     let rate = stroke.rate;
     let nfft = rate.round() as usize;
-    let real = stroke.real_highpassed()?;
     let cfg = SpectrumConfig { rate, nfft, window: Window::Hann, overlap: 0.5 };
     let band = Band::new(rate, nfft, 2.0, 200.0, false).map_err(|e| StudyError::Config(e.message))?;
     let mut chain = Chain {
         twin: DisplayTwin::new(profile, rate, 4).map_err(StudyError::Config)?,
         filter: OutputFilter::highpass(4, 10.0, rate)?,
         stroke,
-        target: SpectralTarget::new(&real, cfg, band)?,
+        target: SpectralTarget::new(&goal.highpassed, cfg, band)?,
         tape: Tape::default(),
         y: Vec::new(),
     };
     let n = stroke.len();
     let kappa = chain.carrier_gain();
-    // The real force's magnitude variation: its sign taken off with the motion's.
-    let magnitude: Vec<f64> = real.iter().zip(&stroke.velocity).map(|(f, v)| if *v < 0.0 { -f } else { *f }).collect();
     let keep = vec![true; n];
     let mut starts: Vec<(String, Vec<f64>)> = Vec::new();
     if kappa.is_finite() && kappa > 0.0 {
         for scale in START_OFFSETS {
-            starts.push((format!("carrier ×{scale}"), carrier_scaled(&magnitude, &keep, kappa, 1.0, scale)?));
+            starts.push((format!("carrier ×{scale}"), carrier_scaled(&goal.magnitude, &keep, kappa, 1.0, scale)?));
         }
     }
     for (name, u) in seeds {
@@ -200,6 +253,28 @@ mod tests {
                 assert!(near, "sample {k} cleared at full speed far from a reversal");
             }
         }
+    }
+
+    #[test]
+    fn the_target_goal_is_the_target_along_the_motion_high_passed() {
+        let user = User { name: "t".into(), seed: 5, speed: [3.0, 7.0], mass: [60.0, 110.0], travel_cm: 3.0 };
+        let stroke = Stroke::of(&user, "plastic-sheet", 3.0, 1000.0).unwrap();
+        let zero = Goal::chain_target(&stroke, &[]).unwrap();
+        assert_eq!(zero.magnitude.len(), stroke.len());
+        assert!(zero.magnitude.iter().chain(&zero.highpassed).all(|m| *m == 0.0));
+        // A constant target: a step the high-pass removes, except where the motion reverses.
+        let c = Goal::chain_target(&stroke, &vec![0.05; stroke.len()]).unwrap();
+        let mut want: Vec<f64> = stroke.velocity.iter().map(|v| 0.05 * sign_of_motion(*v)).collect();
+        OutputFilter::highpass(4, 10.0, 1000.0).unwrap().apply_in_place(&mut want);
+        assert_eq!(c.highpassed, want);
+        assert!(want.iter().any(|w| w.abs() > 0.03), "the reversals show");
+        // Non-finite target samples count as 0.
+        let mut bad = vec![0.05; stroke.len()];
+        bad[10] = f64::NAN;
+        assert!(Goal::chain_target(&stroke, &bad).unwrap().highpassed.iter().all(|x| x.is_finite()));
+        // The real goal is the high-passed real force.
+        let real = Goal::real(&stroke).unwrap();
+        assert_eq!(real.highpassed, stroke.real_highpassed().unwrap());
     }
 
     #[test]

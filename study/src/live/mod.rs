@@ -10,13 +10,15 @@
 //! * [`scope`] — what a study covers (one serializable scope);
 //! * [`stroke`] — a user's true strokes and the real force;
 //! * [`chains`] — every chain over the gain sweep;
-//! * [`floor`] — the stroke's achievable floor, through the display's twin;
+//! * [`floor`] — the stroke's achievable floor and the target's floor, through the display's twin;
+//! * [`library`] — the live synthesis' own library (forward models and forces);
 //! * [`play`] — actuations played and scored like every chain;
 //! * [`row`] — one row's results; [`run`] — the driver;
 //! * [`saved`] — a shard's record, read back by `evflow merge`.
 
 pub mod chains;
 pub mod floor;
+pub mod library;
 pub mod play;
 pub mod row;
 pub mod run;

@@ -88,6 +88,30 @@ pub struct StrokeFloor {
     pub seconds: f64,
 }
 
+/// The target's floor as played: the whole stroke's actuation optimized
+/// through the display's twin towards the live synthesis' own target (the
+/// force the chain computed, tick by tick, from the IR frame and the load
+/// cell, in the direction of motion, high-passed — in the stroke's floor's
+/// objective, in place of the real force), played like every chain and
+/// scored against the real force. It splits the live synthesis' distance
+/// from the stroke's floor into what its target lacks (target's floor /
+/// stroke's floor) and what the synthesis loses (live / target's floor).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct TargetFloor {
+    /// The best start's scores over the gain sweep.
+    pub sweep: Vec<AtGain>,
+    /// The best of each reading over the sweep, over every start.
+    pub reached: Reading,
+    /// The start whose optimum played best (Welch, best gain).
+    pub start: String,
+    /// Its objective through the twin towards the target, noise off (E_s²).
+    #[serde(with = "exact")]
+    pub objective: f64,
+    /// Seconds the optimizations took.
+    #[serde(with = "exact")]
+    pub seconds: f64,
+}
+
 /// One row.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct LiveRow {
@@ -107,6 +131,9 @@ pub struct LiveRow {
     pub chains: Vec<ChainResult>,
     /// The stroke's achievable floor (None: not computed).
     pub achievable: Option<StrokeFloor>,
+    /// The target's floor (None: not computed, or the live synthesis not played).
+    #[serde(default)]
+    pub target_floor: Option<TargetFloor>,
     /// The folder of the row's runs.
     pub dir: PathBuf,
 }
@@ -123,6 +150,18 @@ impl LiveRow {
     pub fn floor(&self) -> Option<Reading> {
         let mut f = self.achievable.as_ref()?.reached;
         for c in &self.chains {
+            f = f.min(Reading { rect: c.chosen.best_rect.rect, welch: c.chosen.best_welch.welch });
+        }
+        Some(f)
+    }
+
+    /// The target's floor as defined: the best that optimizing towards the
+    /// live synthesis' target reached, or the live synthesis' own best-gain
+    /// value where it did better (the optimization then was not optimal
+    /// there), per reading.
+    pub fn target_floor(&self) -> Option<Reading> {
+        let mut f = self.target_floor.as_ref()?.reached;
+        if let Some(c) = self.chain(Chain::Live) {
             f = f.min(Reading { rect: c.chosen.best_rect.rect, welch: c.chosen.best_welch.welch });
         }
         Some(f)

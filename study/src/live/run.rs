@@ -7,8 +7,10 @@
 
 use super::chains;
 use super::floor;
+use super::floor::{Candidate, Goal};
+use super::library::{self as live_library, LivePlan};
 use super::play::{self, Stage};
-use super::row::{LiveRow, StrokeFloor};
+use super::row::{Chain, LiveRow, StrokeFloor, TargetFloor};
 use super::scope::{LiveScope, User};
 use super::stroke::Stroke;
 use crate::gains::choose;
@@ -69,9 +71,10 @@ impl LiveConfig {
         all[self.shard.range(all.len())].to_vec()
     }
 
-    /// A profile's library folder.
+    /// A profile's library folder (the live synthesis' own library when
+    /// only the live synthesis plays).
     pub fn library(&self, profile: &Profile) -> PathBuf {
-        self.work.join(&profile.name).join("library")
+        self.work.join(&profile.name).join(if self.scope.live_only() { "live-library" } else { "library" })
     }
 }
 
@@ -120,6 +123,26 @@ pub fn run(cfg: &LiveConfig, progress: &mut dyn FnMut(Progress<'_>)) -> Result<L
     let conds: Vec<Cond> =
         s.masses.iter().flat_map(|&mass| s.speeds.iter().map(move |&speed| Cond { mass, speed })).collect();
     for p in needed {
+        if s.live_only() {
+            let plan = LivePlan {
+                dir: cfg.library(&profiles[p]),
+                graphs: cfg.graphs.clone(),
+                profile: profiles[p].clone(),
+                samples: s.samples.clone(),
+                conds: conds.clone(),
+                jobs: cfg.jobs,
+            };
+            match live_library::build(&plan) {
+                Ok(out) if out.failures.is_empty() => ready[p] = true,
+                Ok(out) => failures.push((
+                    format!("{}: library", profiles[p].name),
+                    out.failures.iter().map(|(w, e)| format!("{w}: {e}")).collect::<Vec<_>>().join("; "),
+                )),
+                Err(e) => failures.push((format!("{}: library", profiles[p].name), e.to_string())),
+            }
+            progress(Progress::Library(&profiles[p].name));
+            continue;
+        }
         let plan = Plan {
             dir: cfg.library(&profiles[p]),
             graphs: cfg.graphs.clone(),
@@ -174,7 +197,16 @@ fn one(cfg: &LiveConfig, profile: &Profile, sample: &str, user: &User) -> Result
     let ran = chains::run(&at, &cfg.library(profile))?;
     let stroke = Stroke::of(user, sample, s.seconds, 1000.0)?;
     let display_floor = play::display_floor(&at, &stroke)?;
-    let achievable = if s.floor { Some(stroke_floor(&at, &stroke, &ran)?) } else { None };
+    let (achievable, target_floor) = if s.floor {
+        let lab = match &profile.path {
+            Some(p) => LabProfile::load(p).map_err(|e| StudyError::Config(e.issues_text()))?,
+            None => LabProfile::default(),
+        };
+        let target = if s.chains.contains(&Chain::Live) { Some(target_floor(&at, &stroke, &lab, &ran)?) } else { None };
+        (Some(stroke_floor(&at, &stroke, &lab, &ran)?), target)
+    } else {
+        (None, None)
+    };
     Ok(LiveRow {
         profile: profile.name.clone(),
         sample: sample.into(),
@@ -183,72 +215,114 @@ fn one(cfg: &LiveConfig, profile: &Profile, sample: &str, user: &User) -> Result
         display_floor,
         chains: ran.chains,
         achievable,
+        target_floor,
         dir,
     })
 }
 
-/// The stroke's floor: every start optimized through the twin, each
-/// optimum played over the gain sweep, the best kept.
-fn stroke_floor(at: &Stage<'_>, stroke: &Stroke, ran: &chains::ChainsRun) -> Result<StrokeFloor, StudyError> {
-    let (s, dir) = (at.scope, at.dir);
-    let lab = match &at.profile.path {
-        Some(p) => LabProfile::load(p).map_err(|e| StudyError::Config(e.issues_text()))?,
-        None => LabProfile::default(),
-    };
-    let seeds: Vec<(String, Vec<f64>)> =
-        ran.actuations.iter().map(|(c, u)| (c.label().to_string(), u.clone())).collect();
-    let t = Instant::now();
-    let candidates = floor::optimize(stroke, &lab, &seeds, s.floor_iterations)?;
-    let seconds = t.elapsed().as_secs_f64();
+/// The best of `candidates` as played over the gain sweep (each written
+/// as `dir/NAME-uK`): its sweep, the best of each reading over every
+/// candidate, and its index.
+struct Played {
+    sweep: Vec<crate::gains::AtGain>,
+    reached: Reading,
+    best: usize,
+}
+
+fn play_best(
+    at: &Stage<'_>,
+    stroke: &Stroke,
+    candidates: &[Candidate],
+    name: &str,
+    what: &str,
+) -> Result<Played, StudyError> {
     let zeros = vec![0.0; stroke.len()];
-    let mut best: Option<(StrokeFloor, usize)> = None;
-    let unplayed = Reading { rect: f64::NAN, welch: f64::NAN };
+    let mut best: Option<Played> = None;
     for (k, c) in candidates.iter().enumerate() {
         let file = play::write(
-            &dir.join(format!("floor-u{k}")),
+            &at.dir.join(format!("{name}-u{k}")),
             stroke.rate,
             &c.u,
             &zeros,
-            &format!("evflow live study: the stroke's floor from {} (optimized through the display's twin)", c.start),
+            &format!("evflow live study: {what} from {} (optimized through the display's twin)", c.start),
         )?;
-        let sweep = play::sweep(at, &file, &s.gains)?;
+        let sweep = play::sweep(at, &file, &at.scope.gains)?;
         let chosen = choose(&sweep).ok_or_else(|| StudyError::Config("an empty gain sweep".into()))?;
         let reached = Reading { rect: chosen.best_rect.rect, welch: chosen.best_welch.welch };
-        let better = best.as_ref().is_none_or(|(b, _)| reached.welch < b.reached.welch);
-        let merged = best.as_ref().map_or(reached, |(b, _)| b.reached.min(reached));
-        if better {
-            let f = StrokeFloor {
-                sweep,
-                reached: merged,
-                start: c.start.clone(),
-                objective: c.objective,
-                sliding_only: unplayed,
-                seconds,
-            };
-            best = Some((f, k));
-        } else if let Some((b, _)) = best.as_mut() {
-            b.reached = merged;
+        match best.as_mut() {
+            Some(b) if reached.welch >= b.reached.welch => b.reached = b.reached.min(reached),
+            Some(b) => *b = Played { sweep, reached: b.reached.min(reached), best: k },
+            None => best = Some(Played { sweep, reached, best: k }),
         }
     }
-    let (mut f, k) = best.ok_or_else(|| StudyError::Config("the stroke's floor had no start".into()))?;
+    let p = best.ok_or_else(|| StudyError::Config(format!("{what} had no start")))?;
     play::write(
-        &dir.join("floor-best"),
+        &at.dir.join(format!("{name}-best")),
         stroke.rate,
-        &candidates[k].u,
+        &candidates[p.best].u,
         &zeros,
-        &format!("evflow live study: the stroke's floor (optimized through the display's twin from {})", f.start),
+        &format!("evflow live study: {what} (optimized through the display's twin from {})", candidates[p.best].start),
     )?;
+    Ok(p)
+}
+
+/// The stroke's floor: every start optimized through the twin, each
+/// optimum played over the gain sweep, the best kept.
+fn stroke_floor(
+    at: &Stage<'_>,
+    stroke: &Stroke,
+    lab: &LabProfile,
+    ran: &chains::ChainsRun,
+) -> Result<StrokeFloor, StudyError> {
+    let s = at.scope;
+    let seeds: Vec<(String, Vec<f64>)> =
+        ran.actuations.iter().map(|(c, u)| (c.label().to_string(), u.clone())).collect();
+    let t = Instant::now();
+    let candidates = floor::optimize(stroke, lab, &seeds, s.floor_iterations)?;
+    let seconds = t.elapsed().as_secs_f64();
+    let p = play_best(at, stroke, &candidates, "floor", "the stroke's floor")?;
+    let c = &candidates[p.best];
     // The best optimum without its reversals, played alike.
-    let u = floor::sliding_only(&candidates[k].u, stroke);
+    let u = floor::sliding_only(&c.u, stroke);
     let file = play::write(
-        &dir.join("floor-sliding"),
+        &at.dir.join("floor-sliding"),
         stroke.rate,
         &u,
-        &zeros,
+        &vec![0.0; stroke.len()],
         "evflow live study: the stroke's floor with nothing played around the reversals",
     )?;
     let sweep = play::sweep(at, &file, &s.gains)?;
     let chosen = choose(&sweep).ok_or_else(|| StudyError::Config("an empty gain sweep".into()))?;
-    f.sliding_only = Reading { rect: chosen.best_rect.rect, welch: chosen.best_welch.welch };
-    Ok(f)
+    Ok(StrokeFloor {
+        sweep: p.sweep,
+        reached: p.reached,
+        start: c.start.clone(),
+        objective: c.objective,
+        sliding_only: Reading { rect: chosen.best_rect.rect, welch: chosen.best_welch.welch },
+        seconds,
+    })
+}
+
+/// The target's floor: the carrier starts for the live synthesis' target
+/// and its own actuation, optimized through the twin towards that target,
+/// each optimum played over the gain sweep, the best kept.
+fn target_floor(
+    at: &Stage<'_>,
+    stroke: &Stroke,
+    lab: &LabProfile,
+    ran: &chains::ChainsRun,
+) -> Result<TargetFloor, StudyError> {
+    let seeds: Vec<(String, Vec<f64>)> = ran
+        .actuations
+        .iter()
+        .filter(|(c, _)| *c == Chain::Live)
+        .map(|(c, u)| (c.label().to_string(), u.clone()))
+        .collect();
+    let t = Instant::now();
+    let goal = Goal::chain_target(stroke, &ran.live_target)?;
+    let candidates = floor::optimize_towards(stroke, lab, &goal, &seeds, at.scope.floor_iterations)?;
+    let seconds = t.elapsed().as_secs_f64();
+    let p = play_best(at, stroke, &candidates, "target-floor", "the target's floor")?;
+    let c = &candidates[p.best];
+    Ok(TargetFloor { sweep: p.sweep, reached: p.reached, start: c.start.clone(), objective: c.objective, seconds })
 }

@@ -95,7 +95,7 @@ impl LiveRecord {
 
 #[cfg(test)]
 mod tests {
-    use super::super::row::{Chain, ChainResult, StrokeFloor};
+    use super::super::row::{Chain, ChainResult, StrokeFloor, TargetFloor};
     use super::*;
     use crate::gains::{AtGain, Chosen};
     use crate::row::Reading;
@@ -122,6 +122,13 @@ mod tests {
                 objective: 0.01,
                 sliding_only: Reading { rect: 0.4, welch: 0.5 },
                 seconds: 2.5,
+            }),
+            target_floor: (k != 1).then(|| TargetFloor {
+                sweep: vec![at],
+                reached: Reading { rect: 0.25, welch: f64::NAN },
+                start: "live synthesis".into(),
+                objective: 0.02,
+                seconds: 1.25,
             }),
             dir: PathBuf::from(format!("/out/work/nominal/live/felt-fabric-u{k}")),
         }

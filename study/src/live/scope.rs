@@ -3,6 +3,7 @@
 //! settings of the live synthesis — one serializable scope, used by the
 //! study's config, its shard record and its merge.
 
+use super::row::Chain;
 use crate::exact;
 use serde::{Deserialize, Serialize};
 
@@ -113,6 +114,16 @@ pub struct LiveScope {
     pub floor_iterations: usize,
     /// The live synthesis' settings.
     pub live: LiveSettings,
+    /// The chains played, beside nothing (which always is). With the live
+    /// synthesis alone, each profile's library is the live synthesis' own
+    /// ([`super::library`]: forward models and forces, no inverse models
+    /// or cells).
+    #[serde(default = "every_chain")]
+    pub chains: Vec<Chain>,
+}
+
+fn every_chain() -> Vec<Chain> {
+    Chain::ALL.to_vec()
 }
 
 impl LiveScope {
@@ -141,7 +152,13 @@ impl LiveScope {
             floor: true,
             floor_iterations: 100,
             live: LiveSettings::default(),
+            chains: every_chain(),
         }
+    }
+
+    /// Whether only the live synthesis is played (its own library is enough).
+    pub fn live_only(&self) -> bool {
+        self.chains == [Chain::Live]
     }
 
     /// Checks what a run needs: something to run, positive gains, valid users.
@@ -157,6 +174,9 @@ impl LiveScope {
         }
         if !(self.seconds.is_finite() && (2.0..=600.0).contains(&self.seconds)) {
             return Err(format!("{} s per user: choose 2–600 s (E_s needs whole one-second segments)", self.seconds));
+        }
+        if self.chains.is_empty() {
+            return Err("name at least one chain to play beside nothing".into());
         }
         if self.live.lookahead > 63 {
             return Err(format!("a look-ahead of {} samples: at most 63", self.live.lookahead));

@@ -48,21 +48,24 @@ struct Cell {
     nothing: f64,
     chains: Vec<(f64, f64)>,
     floor: f64,
+    /// The target's floor.
+    target: f64,
     /// The floor's actuation with nothing played around the reversals.
     sliding: f64,
     display_floor: f64,
     users: usize,
 }
 
-fn cell(study: &LiveStudy, profile: &str, sample: &str) -> Cell {
+fn cell(study: &LiveStudy, chains: &[Chain], profile: &str, sample: &str) -> Cell {
     let rows: Vec<&LiveRow> = rows_of(study, profile, sample).collect();
     Cell {
         nothing: mean(rows.iter().map(|r| r.nothing.welch)),
-        chains: Chain::ALL
+        chains: chains
             .iter()
             .map(|c| (mean(rows.iter().map(|r| welch(r, *c).0)), mean(rows.iter().map(|r| welch(r, *c).1))))
             .collect(),
         floor: mean(rows.iter().filter_map(|r| r.floor()).map(|f| f.welch)),
+        target: mean(rows.iter().filter_map(|r| r.target_floor()).map(|f| f.welch)),
         sliding: mean(rows.iter().filter_map(|r| r.achievable.as_ref()).map(|a| a.sliding_only.welch)),
         display_floor: mean(rows.iter().map(|r| r.display_floor.welch)),
         users: rows.len(),
@@ -70,7 +73,7 @@ fn cell(study: &LiveStudy, profile: &str, sample: &str) -> Cell {
 }
 
 impl Cell {
-    /// The best chain at its best gain (index into [`Chain::ALL`]) and its E_s.
+    /// The best chain at its best gain (index into the played chains) and its E_s.
     fn best(&self) -> Option<(usize, f64)> {
         self.chains
             .iter()
@@ -81,8 +84,91 @@ impl Cell {
     }
 }
 
+/// The chains a study played, in report order.
+fn played(scope: &LiveScope) -> Vec<Chain> {
+    Chain::ALL.into_iter().filter(|c| scope.chains.contains(c)).collect()
+}
+
+/// A profile's name in the rows: the file stem of a profile given as a path
+/// or as `family/NAME`, as [`crate::setup::Profile::resolve`] names it.
+fn profile_name(p: &str) -> &str {
+    let stem = p.rsplit('/').next().unwrap_or(p);
+    stem.strip_suffix(".toml").unwrap_or(stem)
+}
+
+/// Issue 33's targets over every (profile, sample) cell of the study — and
+/// over the cells with room, where the stroke's floor lies ≥ 10 % below
+/// nothing — for the live synthesis at its best gain against nothing, the
+/// stroke's floor and the target's floor.
+fn held_out_targets(md: &mut String, cells: &[&Cell], k: usize) {
+    let live = |c: &Cell| c.chains[k].1;
+    let room: Vec<&Cell> = cells.iter().copied().filter(|c| c.floor <= 0.9 * c.nothing).collect();
+    let below = room.iter().filter(|c| live(c) < c.nothing).count();
+    let ratios = |cs: &[&Cell], f: &dyn Fn(&Cell) -> f64| -> Vec<f64> {
+        cs.iter().map(|c| f(c)).filter(|r| r.is_finite()).collect()
+    };
+    let within = |r: &[f64]| {
+        let n = r.iter().filter(|x| **x <= WITHIN).count();
+        format!("{n} of {} ({:.0} %)", r.len(), 100.0 * n as f64 / r.len().max(1) as f64)
+    };
+    let m = |r: Vec<f64>| f2x(mean(r.into_iter()));
+    let to_floor = |c: &Cell| live(c) / c.floor;
+    let to_target = |c: &Cell| live(c) / c.target;
+    let lacks = |c: &Cell| c.target / c.floor;
+    let _ = writeln!(md, "## The live synthesis over every profile × sample (issue 33's targets)\n");
+    let _ = writeln!(
+        md,
+        "Means over the users; the live synthesis at its best gain. \"With room\": the {} of {} profile × \
+         sample cells whose stroke's floor lies ≥ 10 % below nothing.\n",
+        room.len(),
+        cells.len()
+    );
+    let _ = writeln!(md, "| target | every cell | cells with room | goal |\n|---|---:|---:|---:|");
+    let _ = writeln!(
+        md,
+        "| below nothing where the stroke's floor is ≥ 10 % below nothing | – | {below} of {} | all |",
+        room.len()
+    );
+    let _ = writeln!(
+        md,
+        "| mean live / stroke's floor | {} | {} | ≤ 1.5× |",
+        m(ratios(cells, &to_floor)),
+        m(ratios(&room, &to_floor))
+    );
+    let _ = writeln!(
+        md,
+        "| live ≤ {WITHIN}× the stroke's floor | {} | {} | ≥ 70 % |",
+        within(&ratios(cells, &to_floor)),
+        within(&ratios(&room, &to_floor))
+    );
+    let _ = writeln!(
+        md,
+        "| mean live / target's floor | {} | {} | ≤ 1.2× |",
+        m(ratios(cells, &to_target)),
+        m(ratios(&room, &to_target))
+    );
+    let _ = writeln!(
+        md,
+        "| mean target's floor / stroke's floor (what the target lacks) | {} | {} | – |",
+        m(ratios(cells, &lacks)),
+        m(ratios(&room, &lacks))
+    );
+    let _ = writeln!(md);
+}
+
+fn f2x(x: f64) -> String {
+    if x.is_finite() {
+        format!("{x:.2}×")
+    } else {
+        "–".into()
+    }
+}
+
 /// The report's Markdown.
 pub fn markdown(study: &LiveStudy, scope: &LiveScope) -> String {
+    let chains = played(scope);
+    let chains = chains.as_slice();
+    let live_k = chains.iter().position(|c| *c == Chain::Live);
     let mut md = String::new();
     let _ = writeln!(md, "# Live texture rendering under virtual users\n");
     let _ = writeln!(
@@ -98,7 +184,10 @@ pub fn markdown(study: &LiveStudy, scope: &LiveScope) -> String {
          stroke optimized through the display's twin knowing the finger's path, load and the real force, \
          within |u| ≤ 1, played with noise on like every chain; where a chain scores lower, the chain's value), \
          and that floor's actuation with nothing played within 150 ms of a reversal (how much of the floor \
-         lies in the sliding alone). Definitions: docs/texture.md §9.\n",
+         lies in the sliding alone); with the live synthesis, the **target's floor** (the same optimization \
+         towards the live synthesis' own target — the force the chain computed from the IR frame and the load \
+         cell, in place of the real force — played alike: live / target's floor is what the synthesis \
+         loses, target's floor / stroke floor what its target lacks). Definitions: docs/texture.md §9.\n",
         scope.seconds,
         scope.gains.iter().map(|g| format!("{g}")).collect::<Vec<_>>().join(", "),
     );
@@ -111,15 +200,18 @@ pub fn markdown(study: &LiveStudy, scope: &LiveScope) -> String {
     let _ = writeln!(md, "Users: {}.\n", users.collect::<Vec<_>>().join("; "));
     let header = |md: &mut String, first: &str| {
         let _ = write!(md, "| {first} | nothing |");
-        for c in Chain::ALL {
+        for c in chains {
             let _ = write!(md, " {} |", c.label());
         }
-        let _ = writeln!(md, " stroke floor | its sliding only | display floor | best chain / floor |");
+        let _ = writeln!(
+            md,
+            " target's floor | stroke floor | its sliding only | display floor | best chain / floor | live / target's floor |"
+        );
         let _ = write!(md, "|---|---:|");
-        for _ in Chain::ALL {
+        for _ in chains {
             let _ = write!(md, "---|");
         }
-        let _ = writeln!(md, "---:|---:|---:|---:|");
+        let _ = writeln!(md, "---:|---:|---:|---:|---:|---:|");
     };
     let line = |md: &mut String, first: &str, c: &Cell| {
         let best = c.best();
@@ -130,13 +222,17 @@ pub fn markdown(study: &LiveStudy, scope: &LiveScope) -> String {
             let _ = write!(md, " {} / {o}{}{e} |", f3(*rule), f3(*b));
         }
         let ratio = best.map_or(f64::NAN, |(_, b)| b / c.floor);
+        let live = live_k.map_or(f64::NAN, |k| c.chains[k].1 / c.target);
+        let times = |r: f64| if r.is_finite() { format!("{r:.2}×") } else { "–".into() };
         let _ = writeln!(
             md,
-            " {} | {} | {} | {} |",
+            " {} | {} | {} | {} | {} | {} |",
+            f3(c.target),
             f3(c.floor),
             f3(c.sliding),
             f3(c.display_floor),
-            if ratio.is_finite() { format!("{ratio:.2}×") } else { "–".into() }
+            times(ratio),
+            times(live)
         );
     };
     // Summary per profile: means over samples and users.
@@ -144,22 +240,25 @@ pub fn markdown(study: &LiveStudy, scope: &LiveScope) -> String {
     header(&mut md, "profile");
     let mut per_profile = Vec::new();
     for p in &scope.profiles {
-        let cells: Vec<Cell> = scope.samples.iter().map(|s| cell(study, p, s)).filter(|c| c.users > 0).collect();
+        let name = profile_name(p);
+        let cells: Vec<Cell> =
+            scope.samples.iter().map(|s| cell(study, chains, name, s)).filter(|c| c.users > 0).collect();
         if cells.is_empty() {
             continue;
         }
         let m = Cell {
             nothing: mean(cells.iter().map(|c| c.nothing)),
-            chains: (0..Chain::ALL.len())
+            chains: (0..chains.len())
                 .map(|k| (mean(cells.iter().map(|c| c.chains[k].0)), mean(cells.iter().map(|c| c.chains[k].1))))
                 .collect(),
             floor: mean(cells.iter().map(|c| c.floor)),
+            target: mean(cells.iter().map(|c| c.target)),
             sliding: mean(cells.iter().map(|c| c.sliding)),
             display_floor: mean(cells.iter().map(|c| c.display_floor)),
             users: cells.iter().map(|c| c.users).sum(),
         };
-        line(&mut md, p, &m);
-        per_profile.push((p.clone(), cells));
+        line(&mut md, name, &m);
+        per_profile.push((name.to_string(), cells));
     }
     let _ = writeln!(md);
     // Per profile, per sample.
@@ -167,7 +266,7 @@ pub fn markdown(study: &LiveStudy, scope: &LiveScope) -> String {
         let _ = writeln!(md, "## {p}\n");
         header(&mut md, "sample");
         for s in &scope.samples {
-            let c = cell(study, p, s);
+            let c = cell(study, chains, p, s);
             if c.users > 0 {
                 line(&mut md, s, &c);
             }
@@ -178,23 +277,32 @@ pub fn markdown(study: &LiveStudy, scope: &LiveScope) -> String {
     let _ = writeln!(md, "## Targets (issue 24, point 5)\n");
     for (p, cells) in &per_profile {
         let within = cells.iter().filter(|c| c.best().is_some_and(|(_, b)| b <= WITHIN * c.floor)).count();
-        let live_k = Chain::ALL.iter().position(|c| *c == Chain::Live).unwrap_or(0);
-        let live_within = cells.iter().filter(|c| c.chains[live_k].1 <= WITHIN * c.floor).count();
         let room: Vec<&Cell> = cells.iter().filter(|c| c.floor <= 0.9 * c.nothing).collect();
         let beats = room.iter().filter(|c| c.best().is_some_and(|(_, b)| b < c.nothing)).count();
-        let live_beats = room.iter().filter(|c| c.chains[live_k].1 < c.nothing).count();
-        let live_rule_beats = room.iter().filter(|c| c.chains[live_k].0 < c.nothing).count();
-        let _ = writeln!(
+        let _ = write!(
             md,
-            "* {p}: the best chain within {WITHIN}× of the stroke's floor on {within} of {} samples (the live \
-             synthesis on {live_within}); where the floor is ≥ 10 % below nothing ({} samples), the best chain \
-             beats nothing on {beats}, the live synthesis on {live_beats} at its best gain and {live_rule_beats} \
-             at Table 5.1's rule.",
+            "* {p}: the best chain within {WITHIN}× of the stroke's floor on {within} of {} samples; where the \
+             floor is ≥ 10 % below nothing ({} samples), the best chain beats nothing on {beats}",
             cells.len(),
             room.len()
         );
+        if let Some(k) = live_k {
+            let live_within = cells.iter().filter(|c| c.chains[k].1 <= WITHIN * c.floor).count();
+            let live_beats = room.iter().filter(|c| c.chains[k].1 < c.nothing).count();
+            let live_rule_beats = room.iter().filter(|c| c.chains[k].0 < c.nothing).count();
+            let _ = write!(
+                md,
+                "; the live synthesis is within {WITHIN}× on {live_within} and beats nothing on {live_beats} at its \
+                 best gain and {live_rule_beats} at Table 5.1's rule"
+            );
+        }
+        let _ = writeln!(md, ".");
     }
     let _ = writeln!(md);
+    if let Some(k) = live_k {
+        let all: Vec<&Cell> = per_profile.iter().flat_map(|(_, c)| c.iter()).collect();
+        held_out_targets(&mut md, &all, k);
+    }
     if !study.failures.is_empty() {
         let _ = writeln!(md, "## Steps that failed\n");
         for (what, why) in &study.failures {
@@ -233,6 +341,9 @@ pub fn csv(study: &LiveStudy) -> String {
         if let Some(f) = r.floor() {
             put("stroke_floor", (f64::NAN, f.welch, f.rect), (f64::NAN, f.welch), (f64::NAN, f.rect));
         }
+        if let Some(f) = r.target_floor() {
+            put("target_floor", (f64::NAN, f.welch, f.rect), (f64::NAN, f.welch), (f64::NAN, f.rect));
+        }
         if let Some(a) = &r.achievable {
             let f = a.sliding_only;
             put("floor_sliding_only", (f64::NAN, f.welch, f.rect), (f64::NAN, f.welch), (f64::NAN, f.rect));
@@ -248,13 +359,14 @@ pub fn csv(study: &LiveStudy) -> String {
 /// (x = the sample's number in the scope, 1 …).
 pub fn figures(study: &LiveStudy, scope: &LiveScope) -> Vec<(String, crate::figure::Plot)> {
     use crate::figure::{Plot, Series};
+    let chains = played(scope);
     let mut out = Vec::new();
-    for p in &scope.profiles {
+    for p in scope.profiles.iter().map(|p| profile_name(p)) {
         let cells: Vec<(f64, Cell)> = scope
             .samples
             .iter()
             .enumerate()
-            .map(|(k, s)| ((k + 1) as f64, cell(study, p, s)))
+            .map(|(k, s)| ((k + 1) as f64, cell(study, &chains, p, s)))
             .filter(|(_, c)| c.users > 0)
             .collect();
         if cells.is_empty() {
@@ -263,8 +375,11 @@ pub fn figures(study: &LiveStudy, scope: &LiveScope) -> Vec<(String, crate::figu
         let pts =
             |f: &dyn Fn(&Cell) -> f64| cells.iter().map(|(x, c)| (*x, f(c))).filter(|p| p.1.is_finite()).collect();
         let mut series = vec![Series::line_points("nothing", pts(&|c| c.nothing))];
-        for (k, ch) in Chain::ALL.iter().enumerate() {
+        for (k, ch) in chains.iter().enumerate() {
             series.push(Series::line_points(format!("{} (best gain)", ch.label()), pts(&|c| c.chains[k].1)));
+        }
+        if chains.contains(&Chain::Live) {
+            series.push(Series::line_points("target's floor", pts(&|c| c.target)));
         }
         series.push(Series::line_points("stroke floor", pts(&|c| c.floor)));
         let names: Vec<String> = scope.samples.iter().enumerate().map(|(k, s)| format!("{} {s}", k + 1)).collect();
@@ -281,4 +396,92 @@ pub fn figures(study: &LiveStudy, scope: &LiveScope) -> Vec<(String, crate::figu
         ));
     }
     out
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::gains::Chosen;
+    use crate::live::row::{ChainResult, StrokeFloor, TargetFloor};
+    use crate::row::Reading;
+
+    fn at(welch: f64) -> AtGain {
+        AtGain { gain: 1.0, rect: welch, welch, peak_ratio: 1.0 }
+    }
+
+    /// A row of `profile` × `sample`: nothing, the live synthesis, the target's and the stroke's floor.
+    fn row(profile: &str, sample: &str, nothing: f64, live: f64, target: f64, floor: f64) -> LiveRow {
+        let r = |w: f64| Reading { rect: w, welch: w };
+        LiveRow {
+            profile: profile.into(),
+            sample: sample.into(),
+            user: "person".into(),
+            nothing: r(nothing),
+            display_floor: r(nothing),
+            chains: vec![ChainResult {
+                chain: Chain::Live,
+                sweep: vec![at(live)],
+                chosen: Chosen { table51: at(live), best_rect: at(live), best_welch: at(live) },
+                iterations_per_tick: 4.0,
+            }],
+            achievable: Some(StrokeFloor {
+                sweep: vec![at(floor)],
+                reached: r(floor),
+                start: "carrier ×1".into(),
+                objective: 0.0,
+                sliding_only: r(floor),
+                seconds: 0.0,
+            }),
+            target_floor: Some(TargetFloor {
+                sweep: vec![at(target)],
+                reached: r(target),
+                start: "live synthesis".into(),
+                objective: 0.0,
+                seconds: 0.0,
+            }),
+            dir: "/w".into(),
+        }
+    }
+
+    #[test]
+    fn a_family_study_tables_the_played_chains_the_targets_floor_and_issue_33s_targets() {
+        let mut scope = LiveScope::defaults();
+        scope.profiles = vec!["family/tuning-01".into(), "family/tuning-02".into()];
+        scope.samples = vec!["felt-fabric".into(), "plastic-sheet".into()];
+        scope.chains = vec![Chain::Live];
+        let study = LiveStudy {
+            rows: vec![
+                // Room: the floor is 50 % below nothing; live 1.2× the floor, 1.1× the target's floor.
+                row("tuning-01", "felt-fabric", 0.8, 0.48, 0.48 / 1.1, 0.4),
+                // Room; live 2× the floor and not below nothing.
+                row("tuning-01", "plastic-sheet", 0.6, 0.6, 0.5, 0.3),
+                // No room: the floor is nothing's.
+                row("tuning-02", "felt-fabric", 1.0, 1.0, 1.0, 0.99),
+                row("tuning-02", "plastic-sheet", 1.0, 1.0, 1.0, 0.95),
+            ],
+            failures: vec![],
+            seconds: 0.0,
+        };
+        let md = markdown(&study, &scope);
+        assert!(!md.contains("NARX cells"), "only the played chains are tabled");
+        assert!(md.contains("| tuning-01 | 0.700 | 0.540 / **0.540** |"), "{md}");
+        assert!(md.contains("## tuning-02"), "profiles named by their file stem");
+        // Issue 33's targets: below nothing on 1 of the 2 cells with room; live within 1.3× on 3 of 4 cells, 1 of 2 with room.
+        assert!(
+            md.contains("| below nothing where the stroke's floor is ≥ 10 % below nothing | – | 1 of 2 | all |"),
+            "{md}"
+        );
+        assert!(md.contains("| live ≤ 1.3× the stroke's floor | 3 of 4 (75 %) | 1 of 2 (50 %) | ≥ 70 % |"), "{md}");
+        let mean_room = (1.2 + 2.0) / 2.0;
+        assert!(
+            md.contains(&format!(
+                "| mean live / stroke's floor | {:.2}× | {mean_room:.2}× |",
+                (1.2 + 2.0 + 1.0 / 0.99 + 1.0 / 0.95) / 4.0
+            )),
+            "{md}"
+        );
+        let csv = csv(&study);
+        assert_eq!(csv.lines().filter(|l| l.contains(",target_floor,")).count(), 4);
+        assert_eq!(figures(&study, &scope).len(), 2);
+    }
 }

@@ -5,6 +5,7 @@
 
 use anyhow::{Context, Result};
 use evflow_nodes::lab::texture::samples;
+use evflow_study::live::row::Chain;
 use evflow_study::live::run::{run, LiveConfig, Progress};
 use evflow_study::live::saved::{LiveRecord, RECORD};
 use evflow_study::live::scope::{LiveScope, LiveSettings, User};
@@ -22,6 +23,17 @@ pub struct Args {
     /// Lab profiles: `nominal`, names of graphs/lab/*.toml, or profile files.
     #[arg(long, value_delimiter = ',', default_value = "nominal,stiff,display-b,relaxing,resonant")]
     profiles: Vec<String>,
+    /// Run on the display family instead of --profiles (docs/simulated-lab.md §6.2):
+    /// `tuning` (where the defaults are chosen), `held-out` (where figures are
+    /// quoted) or `all`. With it, the chains default to the live synthesis alone.
+    #[arg(long, conflicts_with = "profiles")]
+    displays: Option<super::Displays>,
+    /// The chains played beside nothing: any of playback, narx, optimized, ff,
+    /// live (default: all of them, or live alone with --displays). With live
+    /// alone, each profile's library is the live synthesis' own (forward models
+    /// and forces), built in a fraction of the time.
+    #[arg(long, value_delimiter = ',')]
+    chains: Vec<String>,
     /// Texture samples (default: the six of §5.3).
     #[arg(long, value_delimiter = ',')]
     samples: Vec<String>,
@@ -81,6 +93,25 @@ pub struct Args {
 pub fn main(a: Args) -> Result<()> {
     let mut scope = LiveScope::defaults();
     scope.profiles = a.profiles.clone();
+    if let Some(set) = a.displays {
+        scope.profiles = set.profiles();
+        scope.chains = vec![Chain::Live];
+    }
+    if !a.chains.is_empty() {
+        scope.chains = a
+            .chains
+            .iter()
+            .map(|n| {
+                Chain::ALL
+                    .into_iter()
+                    .find(|c| c.prefix() == n || (n == "forces-first" && *c == Chain::ForcesFirst))
+                    .ok_or_else(|| {
+                        let names: Vec<&str> = Chain::ALL.iter().map(|c| c.prefix()).collect();
+                        anyhow::anyhow!("--chains: no chain named `{n}` (the chains are {})", names.join(", "))
+                    })
+            })
+            .collect::<Result<_>>()?;
+    }
     if !a.samples.is_empty() {
         for s in &a.samples {
             samples::lookup(s).map_err(|e| anyhow::anyhow!("--samples: {e}"))?;

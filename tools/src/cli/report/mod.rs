@@ -131,6 +131,32 @@ enum Which {
     Stability(stability::Args),
 }
 
+/// `--displays`: a set of the display family (docs/simulated-lab.md §6.2).
+#[derive(clap::ValueEnum, Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Displays {
+    /// The tuning displays, where the defaults are chosen.
+    Tuning,
+    /// The held-out displays, where the figures the docs quote are measured.
+    HeldOut,
+    /// Both.
+    All,
+}
+
+#[cfg(feature = "synth")]
+impl Displays {
+    /// The set's profiles as `--profiles` names them (`family/NAME`, the
+    /// files of graphs/lab/family/).
+    fn profiles(self) -> Vec<String> {
+        use evflow_nodes::lab::family::{names, Split};
+        let split = match self {
+            Displays::Tuning => Some(Split::Tuning),
+            Displays::HeldOut => Some(Split::HeldOut),
+            Displays::All => None,
+        };
+        names(split).into_iter().map(|n| format!("family/{n}")).collect()
+    }
+}
+
 /// Writes `plot` to `path` and says so (unlabelled without a font); a plot
 /// that cannot be drawn is a warning, not a failed report.
 fn save_png(plot: &evflow_tools::plot::Plot, path: &std::path::Path) {

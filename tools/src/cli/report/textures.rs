@@ -36,6 +36,11 @@ pub struct Args {
     /// Lab profiles: `nominal`, names of graphs/lab/*.toml, or profile files.
     #[arg(long, value_delimiter = ',', default_value = "nominal,display-b,stiff")]
     profiles: Vec<String>,
+    /// Run on the display family instead of --profiles (docs/simulated-lab.md
+    /// §6.2): `tuning` (where defaults are chosen), `held-out` (where figures
+    /// are quoted) or `all`.
+    #[arg(long, conflicts_with = "profiles")]
+    displays: Option<super::Displays>,
     /// Gains of the sweep (§5.3.2), applied to every method alike.
     #[arg(long, value_delimiter = ',', default_value = "0.6,0.8,1.0,1.2,1.4")]
     gains: Vec<f64>,
@@ -107,7 +112,7 @@ pub fn main(a: Args) -> Result<()> {
     let base = std::fs::canonicalize(&a.out)?;
     let work = base.join("work");
     let scope = Scope {
-        profiles: a.profiles.clone(),
+        profiles: a.displays.map_or_else(|| a.profiles.clone(), |d| d.profiles()),
         samples,
         conds,
         gains: a.gains.clone(),

@@ -53,7 +53,14 @@ struct Cell {
     /// The floor's actuation with nothing played around the reversals.
     sliding: f64,
     display_floor: f64,
+    /// The live synthesis at the shipped gain, 1 (NaN when not played or not in the sweep).
+    live_at_one: f64,
     users: usize,
+}
+
+/// The live synthesis' Welch E_s at gain 1 in `r` (NaN when not played or not in the sweep).
+fn live_at_one(r: &LiveRow) -> f64 {
+    r.chain(Chain::Live).and_then(|c| c.sweep.iter().find(|a| a.gain == 1.0)).map_or(f64::NAN, |a| a.welch)
 }
 
 fn cell(study: &LiveStudy, chains: &[Chain], profile: &str, sample: &str) -> Cell {
@@ -68,6 +75,7 @@ fn cell(study: &LiveStudy, chains: &[Chain], profile: &str, sample: &str) -> Cel
         target: mean(rows.iter().filter_map(|r| r.target_floor()).map(|f| f.welch)),
         sliding: mean(rows.iter().filter_map(|r| r.achievable.as_ref()).map(|a| a.sliding_only.welch)),
         display_floor: mean(rows.iter().map(|r| r.display_floor.welch)),
+        live_at_one: mean(rows.iter().map(|r| live_at_one(r))),
         users: rows.len(),
     }
 }
@@ -101,9 +109,23 @@ fn profile_name(p: &str) -> &str {
 /// nothing — for the live synthesis at its best gain against nothing, the
 /// stroke's floor and the target's floor.
 fn held_out_targets(md: &mut String, cells: &[&Cell], k: usize) {
-    let live = |c: &Cell| c.chains[k].1;
     let room: Vec<&Cell> = cells.iter().copied().filter(|c| c.floor <= 0.9 * c.nothing).collect();
-    let below = room.iter().filter(|c| live(c) < c.nothing).count();
+    let _ = writeln!(md, "## The live synthesis over every profile × sample (issue 33's targets)\n");
+    let _ = writeln!(
+        md,
+        "Means over the users. \"With room\": the {} of {} profile × sample cells whose stroke's floor lies \
+         ≥ 10 % below nothing. The live synthesis at the shipped gain (1) and at its best gain over the sweep.\n",
+        room.len(),
+        cells.len()
+    );
+    let _ = writeln!(
+        md,
+        "| target | gain 1: every cell | gain 1: with room | best gain: every cell | best gain: with room | goal |\n\
+         |---|---:|---:|---:|---:|---:|"
+    );
+    let at_one = |c: &Cell| c.live_at_one;
+    let best = |c: &Cell| c.chains[k].1;
+    let readings: [&dyn Fn(&Cell) -> f64; 2] = [&at_one, &best];
     let ratios = |cs: &[&Cell], f: &dyn Fn(&Cell) -> f64| -> Vec<f64> {
         cs.iter().map(|c| f(c)).filter(|r| r.is_finite()).collect()
     };
@@ -112,47 +134,24 @@ fn held_out_targets(md: &mut String, cells: &[&Cell], k: usize) {
         format!("{n} of {} ({:.0} %)", r.len(), 100.0 * n as f64 / r.len().max(1) as f64)
     };
     let m = |r: Vec<f64>| f2x(mean(r.into_iter()));
-    let to_floor = |c: &Cell| live(c) / c.floor;
-    let to_target = |c: &Cell| live(c) / c.target;
+    let mut below = String::from("| below nothing where the stroke's floor is ≥ 10 % below nothing |");
+    let mut to_floor = String::from("| mean live / stroke's floor |");
+    let mut share = format!("| live ≤ {WITHIN}× the stroke's floor |");
+    let mut to_target = String::from("| mean live / target's floor |");
+    for live in readings {
+        let n = room.iter().filter(|c| live(c) < c.nothing).count();
+        let _ = write!(below, " – | {n} of {} |", room.len());
+        for cs in [cells, room.as_slice()] {
+            let _ = write!(to_floor, " {} |", m(ratios(cs, &|c| live(c) / c.floor)));
+            let _ = write!(share, " {} |", within(&ratios(cs, &|c| live(c) / c.floor)));
+            let _ = write!(to_target, " {} |", m(ratios(cs, &|c| live(c) / c.target)));
+        }
+    }
+    let _ = writeln!(md, "{below} all |\n{to_floor} ≤ 1.5× |\n{share} ≥ 70 % |\n{to_target} ≤ 1.2× |");
     let lacks = |c: &Cell| c.target / c.floor;
-    let _ = writeln!(md, "## The live synthesis over every profile × sample (issue 33's targets)\n");
-    let _ = writeln!(
-        md,
-        "Means over the users; the live synthesis at its best gain. \"With room\": the {} of {} profile × \
-         sample cells whose stroke's floor lies ≥ 10 % below nothing.\n",
-        room.len(),
-        cells.len()
-    );
-    let _ = writeln!(md, "| target | every cell | cells with room | goal |\n|---|---:|---:|---:|");
-    let _ = writeln!(
-        md,
-        "| below nothing where the stroke's floor is ≥ 10 % below nothing | – | {below} of {} | all |",
-        room.len()
-    );
-    let _ = writeln!(
-        md,
-        "| mean live / stroke's floor | {} | {} | ≤ 1.5× |",
-        m(ratios(cells, &to_floor)),
-        m(ratios(&room, &to_floor))
-    );
-    let _ = writeln!(
-        md,
-        "| live ≤ {WITHIN}× the stroke's floor | {} | {} | ≥ 70 % |",
-        within(&ratios(cells, &to_floor)),
-        within(&ratios(&room, &to_floor))
-    );
-    let _ = writeln!(
-        md,
-        "| mean live / target's floor | {} | {} | ≤ 1.2× |",
-        m(ratios(cells, &to_target)),
-        m(ratios(&room, &to_target))
-    );
-    let _ = writeln!(
-        md,
-        "| mean target's floor / stroke's floor (what the target lacks) | {} | {} | – |",
-        m(ratios(cells, &lacks)),
-        m(ratios(&room, &lacks))
-    );
+    let (a, b) = (m(ratios(cells, &lacks)), m(ratios(&room, &lacks)));
+    let _ =
+        writeln!(md, "| mean target's floor / stroke's floor (what the target lacks) | {a} | {b} | {a} | {b} | – |");
     let _ = writeln!(md);
 }
 
@@ -255,6 +254,7 @@ pub fn markdown(study: &LiveStudy, scope: &LiveScope) -> String {
             target: mean(cells.iter().map(|c| c.target)),
             sliding: mean(cells.iter().map(|c| c.sliding)),
             display_floor: mean(cells.iter().map(|c| c.display_floor)),
+            live_at_one: mean(cells.iter().map(|c| c.live_at_one)),
             users: cells.iter().map(|c| c.users).sum(),
         };
         line(&mut md, name, &m);
@@ -314,42 +314,48 @@ pub fn markdown(study: &LiveStudy, scope: &LiveScope) -> String {
 }
 
 /// Every row and chain: profile, sample, user, chain, then Welch and rect
-/// E_s and the gain at Table 5.1's rule and at the best gain.
+/// E_s and the gain at Table 5.1's rule and at the best gain, and the Welch
+/// E_s at gain 1 (the shipped gain; NaN for the floors, or when 1 is not in
+/// the sweep).
 pub fn csv(study: &LiveStudy) -> String {
     let mut out = String::from(
-        "profile,sample,user,chain,rule_gain,rule_welch,rule_rect,best_welch_gain,best_welch,best_rect_gain,best_rect\n",
+        "profile,sample,user,chain,rule_gain,rule_welch,rule_rect,best_welch_gain,best_welch,best_rect_gain,best_rect,gain1_welch\n",
     );
     let at = |a: &AtGain| (a.gain, a.welch, a.rect);
     for r in &study.rows {
-        let mut put = |name: &str, rule: (f64, f64, f64), bw: (f64, f64), br: (f64, f64)| {
+        let mut put = |name: &str, rule: (f64, f64, f64), bw: (f64, f64), br: (f64, f64), one: f64| {
             let _ = writeln!(
                 out,
-                "{},{},{},{name},{},{},{},{},{},{},{}",
+                "{},{},{},{name},{},{},{},{},{},{},{},{one}",
                 r.profile, r.sample, r.user, rule.0, rule.1, rule.2, bw.0, bw.1, br.0, br.1
             );
         };
-        put("nothing", (0.0, r.nothing.welch, r.nothing.rect), (0.0, r.nothing.welch), (0.0, r.nothing.rect));
+        let n = r.nothing;
+        put("nothing", (0.0, n.welch, n.rect), (0.0, n.welch), (0.0, n.rect), n.welch);
         for c in &r.chains {
             let (g, w, re) = at(&c.chosen.table51);
+            let one = c.sweep.iter().find(|a| a.gain == 1.0).map_or(f64::NAN, |a| a.welch);
             put(
                 c.chain.prefix(),
                 (g, w, re),
                 (c.chosen.best_welch.gain, c.chosen.best_welch.welch),
                 (c.chosen.best_rect.gain, c.chosen.best_rect.rect),
+                one,
             );
         }
+        let nan = f64::NAN;
         if let Some(f) = r.floor() {
-            put("stroke_floor", (f64::NAN, f.welch, f.rect), (f64::NAN, f.welch), (f64::NAN, f.rect));
+            put("stroke_floor", (nan, f.welch, f.rect), (nan, f.welch), (nan, f.rect), nan);
         }
         if let Some(f) = r.target_floor() {
-            put("target_floor", (f64::NAN, f.welch, f.rect), (f64::NAN, f.welch), (f64::NAN, f.rect));
+            put("target_floor", (nan, f.welch, f.rect), (nan, f.welch), (nan, f.rect), nan);
         }
         if let Some(a) = &r.achievable {
             let f = a.sliding_only;
-            put("floor_sliding_only", (f64::NAN, f.welch, f.rect), (f64::NAN, f.welch), (f64::NAN, f.rect));
+            put("floor_sliding_only", (nan, f.welch, f.rect), (nan, f.welch), (nan, f.rect), nan);
         }
         let d = r.display_floor;
-        put("display_floor", (0.0, d.welch, d.rect), (0.0, d.welch), (0.0, d.rect));
+        put("display_floor", (0.0, d.welch, d.rect), (0.0, d.welch), (0.0, d.rect), d.welch);
     }
     out
 }
@@ -466,22 +472,22 @@ mod tests {
         assert!(!md.contains("NARX cells"), "only the played chains are tabled");
         assert!(md.contains("| tuning-01 | 0.700 | 0.540 / **0.540** |"), "{md}");
         assert!(md.contains("## tuning-02"), "profiles named by their file stem");
-        // Issue 33's targets: below nothing on 1 of the 2 cells with room; live within 1.3× on 3 of 4 cells, 1 of 2 with room.
+        // Issue 33's targets (the sweep is gain 1 alone: both readings agree): below nothing on 1 of the 2 cells
+        // with room; live within 1.3× on 3 of 4 cells, 1 of 2 with room.
+        let below =
+            "| below nothing where the stroke's floor is ≥ 10 % below nothing | – | 1 of 2 | – | 1 of 2 | all |";
+        assert!(md.contains(below), "{md}");
+        let within =
+            "| live ≤ 1.3× the stroke's floor | 3 of 4 (75 %) | 1 of 2 (50 %) | 3 of 4 (75 %) | 1 of 2 (50 %) |";
+        assert!(md.contains(within), "{md}");
+        let (every, room) = ((1.2 + 2.0 + 1.0 / 0.99 + 1.0 / 0.95) / 4.0, (1.2 + 2.0) / 2.0);
         assert!(
-            md.contains("| below nothing where the stroke's floor is ≥ 10 % below nothing | – | 1 of 2 | all |"),
-            "{md}"
-        );
-        assert!(md.contains("| live ≤ 1.3× the stroke's floor | 3 of 4 (75 %) | 1 of 2 (50 %) | ≥ 70 % |"), "{md}");
-        let mean_room = (1.2 + 2.0) / 2.0;
-        assert!(
-            md.contains(&format!(
-                "| mean live / stroke's floor | {:.2}× | {mean_room:.2}× |",
-                (1.2 + 2.0 + 1.0 / 0.99 + 1.0 / 0.95) / 4.0
-            )),
+            md.contains(&format!("| mean live / stroke's floor | {every:.2}× | {room:.2}× | {every:.2}× |")),
             "{md}"
         );
         let csv = csv(&study);
         assert_eq!(csv.lines().filter(|l| l.contains(",target_floor,")).count(), 4);
+        assert!(csv.contains("tuning-01,felt-fabric,person,live,1,0.48,0.48,1,0.48,1,0.48,0.48\n"), "{csv}");
         assert_eq!(figures(&study, &scope).len(), 2);
     }
 }

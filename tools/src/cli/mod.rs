@@ -5,6 +5,8 @@ pub mod check;
 #[cfg(all(feature = "serial", feature = "lab"))]
 pub mod devsim;
 pub mod dot;
+#[cfg(feature = "synth")]
+pub mod from_recordings;
 pub mod graph_args;
 pub mod import;
 #[cfg(feature = "synth")]

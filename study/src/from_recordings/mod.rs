@@ -9,7 +9,8 @@
 //!   forward constant-speed stretch ([`forces`]; unit `N`, gain 1, the
 //!   condition in the sidecar — the layout `evflow library build` writes);
 //! - `models/forward-TAG.json`: per excitation, the forward model
-//!   (graphs/forward-build-recordings.toml);
+//!   (graphs/forward-build-recordings.toml, run on the 1 kHz recording
+//!   [`excitation`] makes, whose `u` keeps its band up to 500 Hz);
 //! - `models/narx-TAG.json`: per excitation, the inverse NARX model
 //!   (graphs/model-build-recordings.toml), for the cells chains
 //!   (graphs/synthesize-recordings.toml `--set models=LIB/models`);

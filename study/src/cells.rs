@@ -56,6 +56,23 @@ pub fn write_force(from: &Path, grid: &Path, sample: &str, c: &Cond) -> Result<P
     write(&kept, rate, "N", grid, sample, c, 1.0, false, source, from)
 }
 
+/// Writes `kept`, a force in newtons at `rate` Hz already cut to its
+/// constant-speed stretch, as the cell of `sample` at `c` into `grid`,
+/// gain 1, with `source` (what [`write_force`] writes for a lab recording
+/// it cuts itself; `evflow library from-recordings`). `from` names the
+/// recording in errors.
+pub fn write_force_samples(
+    kept: &[f64],
+    rate: f64,
+    grid: &Path,
+    sample: &str,
+    c: &Cond,
+    source: String,
+    from: &Path,
+) -> Result<PathBuf, StudyError> {
+    write(kept, rate, "N", grid, sample, c, 1.0, false, source, from)
+}
+
 #[allow(clippy::too_many_arguments)]
 fn write(
     kept: &[f64],

@@ -38,6 +38,8 @@ pub mod floor;
 #[cfg(feature = "synth")]
 pub mod forces_first;
 #[cfg(feature = "synth")]
+pub mod from_recordings;
+#[cfg(feature = "synth")]
 pub mod gains;
 #[cfg(feature = "synth")]
 pub mod grid_plan;

@@ -45,10 +45,14 @@ enum Command {
     ///   for k in 1 2 3; do evflow run graphs/excitation.toml --shard $k/3 --out part$k --csv part$k/grid.csv; done
     ///   evflow merge grid part1 part2 part3
     Merge(cli::merge::Args),
-    /// The model library: inverse models and actuation cells for every
-    /// texture sample × the 3×3 grid, with an index; resumable.
+    /// The model library: on the simulated lab (`build`), models, recorded
+    /// forces and actuation cells for every texture sample × the 3×3 grid,
+    /// with an index, resumable; from a lab's own recordings
+    /// (`from-recordings`), the forces and models the live chains play.
     ///
-    /// Example: cargo run --release -p evflow -- library build --out library --jobs 2
+    /// Examples:
+    ///   cargo run --release -p evflow -- library build --out library --jobs 2
+    ///   evflow library from-recordings --excitation /lab/excitation --textures /lab/textures --out /lab/library
     #[cfg(feature = "synth")]
     Library(cli::library::Args),
     /// Validate a graph and print its plan: execution order, rates, buffer

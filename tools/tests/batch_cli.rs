@@ -243,8 +243,8 @@ fn a_model_library_resumes_and_redoes_a_half_written_item() {
             assert!(lib.join(e["cells"][m].as_str().unwrap()).is_file());
         }
     }
-    // The texture-live grid plays the library's cells.
-    let grid = format!("textures=[\"{}\"]", lib.join("narx-felt-fabric").display());
+    // The live synthesis (texture-live.toml) plays the library's recorded forces.
+    let grid = format!("textures=[\"{}\"]", lib.join("forces-felt-fabric").display());
     let o = evflow(&["run", "graphs/texture-live.toml", "--set", &grid, "--duration", "0.5", "-q", "--out", l]);
     assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
 
@@ -374,7 +374,7 @@ fn a_library_takes_generated_samples_and_refuses_malformed_names() {
     // Two generated textures are two different textures: their cells differ.
     let cell = |s: &str| std::fs::read(lib.join(format!("narx-{s}/u-{s}-85g-5cms.wav"))).unwrap();
     assert_ne!(cell("generated-1"), cell("generated-2"));
-    let grid = format!("textures=[\"{}\"]", lib.join("narx-generated-2").display());
+    let grid = format!("textures=[\"{}\"]", lib.join("forces-generated-2").display());
     let o = evflow(&["run", "graphs/texture-live.toml", "--set", &grid, "--duration", "0.5", "-q", "--out", l]);
     assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
 

@@ -18,6 +18,15 @@
 //! a Nyquist-rate carrier, u\[n\] = (−1)ⁿ·a\[n\] with a slowly varying
 //! envelope a (the optimized synthesis' cells, docs/synthesis.md). The
 //! grid records it ([`Grid::carrier`]); every reachable cell must agree.
+//!
+//! A grid may be declared a grid of **forces** ([`Expect::Force`]: what a
+//! chain that renders the texture's force through `synth.live` reads).
+//! Each reachable cell must then hold newtons (its channel's unit `N`) and
+//! no offset that the 10 Hz high-pass of §5.1.1 would have removed
+//! ([`offset_ratio`] at most [`OFFSET_RATIO_MAX`]): the force as the sensor
+//! measured it (friction and bias, 0.1–0.45 N) or an actuation grid
+//! (`narx-SAMPLE`, unit `1`) is refused with the command that makes a
+//! proper one.
 
 use crate::recording::format::{Recording, RecordingPaths};
 use std::path::{Path, PathBuf};
@@ -102,6 +111,103 @@ pub enum GridError {
     /// The recording itself is unreadable.
     #[error("{0}")]
     Recording(String),
+    /// A cell of a grid of forces that holds no proper force ([`Expect::Force`]).
+    #[error("{}: {message}; {}", path.display(), FORCES_FIX)]
+    NotForce {
+        /// The sidecar.
+        path: PathBuf,
+        /// What is wrong.
+        message: String,
+    },
+}
+
+/// How a refused grid of forces is made properly (the end of every
+/// [`GridError::NotForce`] message).
+pub const FORCES_FIX: &str =
+    "a force-rendering chain (synth.live) needs a forces-SAMPLE folder: the force in newtons, \
+     high-passed at 10 Hz, over constant-speed stretches — `evflow library from-recordings --excitation DIR \
+     --textures DIR --out LIB` makes LIB/forces-SAMPLE from a lab's recordings as the sensor measured them \
+     (docs/rig.md), `evflow library build` on the simulated lab";
+
+/// What the cells of a grid must be.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum Expect {
+    /// Anything (actuation or force; no check).
+    #[default]
+    Any,
+    /// Forces: unit `N`, no offset ([`offset_ratio`] ≤ [`OFFSET_RATIO_MAX`]).
+    Force,
+}
+
+/// Window of [`offset_ratio`]'s slow part, s.
+pub const OFFSET_WINDOW_S: f64 = 0.25;
+
+/// The largest [`offset_ratio`] of a cell in a grid of forces. On the
+/// simulated lab's five profiles × ten samples (the seven of §5.3 and
+/// generated-1…3) × the 3×3 grid, the forces high-passed at 10 Hz over
+/// their constant-speed stretch (what `evflow library build` writes) reach
+/// at most 0.079, and the same stretches of the raw force (friction and
+/// sensor bias, as measured) at least 2.30: 0.4 is about 5× from both.
+pub const OFFSET_RATIO_MAX: f64 = 0.4;
+
+/// How much of `x` (sampled at `rate` Hz) is an offset: the rms of its
+/// means over consecutive windows of [`OFFSET_WINDOW_S`] (the last window
+/// takes the remainder; a signal shorter than one window is one window)
+/// over the rms of its variation around them. A force high-passed at
+/// 10 Hz has almost nothing below 4 Hz, so its window means are small
+/// beside its variation; a raw force's offset — one sign per stroke
+/// direction, so stretches of both directions are caught too — is many
+/// times its variation. 0 for a signal with no slow part; infinite for a
+/// constant non-zero one (or all but rounding).
+pub fn offset_ratio(x: &[f64], rate: f64) -> f64 {
+    let n = x.len();
+    if n == 0 {
+        return 0.0;
+    }
+    let w = ((OFFSET_WINDOW_S * rate).round() as usize).clamp(1, n);
+    let windows = n / w;
+    let (mut slow, mut fast) = (0.0, 0.0);
+    for k in 0..windows {
+        let end = if k + 1 == windows { n } else { (k + 1) * w };
+        let seg = &x[k * w..end];
+        let m = seg.iter().sum::<f64>() / seg.len() as f64;
+        slow += seg.len() as f64 * m * m;
+        fast += seg.iter().map(|v| (v - m) * (v - m)).sum::<f64>();
+    }
+    if slow == 0.0 {
+        0.0
+    } else {
+        (slow / fast).sqrt()
+    }
+}
+
+/// Checks a cell of a grid of forces: `unit` is its channel's, `samples` its samples.
+fn check_force(path: &Path, channel: &str, unit: &str, samples: &[f64], rate: f64) -> Result<(), GridError> {
+    let json = RecordingPaths::new(path).json;
+    if unit != "N" {
+        let shown = if unit.is_empty() { "no unit".to_string() } else { format!("unit `{unit}`") };
+        return Err(GridError::NotForce {
+            path: json,
+            message: format!(
+                "channel `{channel}` has {shown}, not `N`: not a force (an actuation grid such as narx-SAMPLE \
+                 holds unit `1`)"
+            ),
+        });
+    }
+    let ratio = offset_ratio(samples, rate);
+    if ratio > OFFSET_RATIO_MAX {
+        let mean = samples.iter().sum::<f64>() / samples.len().max(1) as f64;
+        return Err(GridError::NotForce {
+            path: json,
+            message: format!(
+                "the force carries an offset (mean {mean:.3} N): its {OFFSET_WINDOW_S} s means are {ratio:.2} \
+                 times its variation around them, where a force high-passed at 10 Hz stays below \
+                 {OFFSET_RATIO_MAX} — the force as the sensor measured it (friction, bias), which would play a \
+                 saturated carrier"
+            ),
+        });
+    }
+    Ok(())
 }
 
 /// One candidate cell: its condition and files, samples not yet loaded.
@@ -117,6 +223,8 @@ pub struct CellInfo {
     pub rate: f64,
     /// Channel names.
     pub channels: Vec<String>,
+    /// Channel units, in the order of `channels` (empty when unknown).
+    pub units: Vec<String>,
     /// Display gain of the condition (1 when absent).
     pub gain: f64,
     /// Whether the cell rides a Nyquist-rate carrier (`condition.carrier`).
@@ -140,6 +248,8 @@ pub struct GridSource {
     pub velocity_range: Option<(f64, f64)>,
     /// Multiply each cell by its condition's display gain.
     pub apply_gain: bool,
+    /// What the cells must be (a grid of forces is checked).
+    pub expect: Expect,
 }
 
 /// The loaded grid: axes ascending, cells row-major (load, then velocity).
@@ -270,6 +380,10 @@ impl Grid {
                     .map_err(|e| GridError::Recording(e.to_string()))?;
                 rec.require_complete().map_err(|e| GridError::Recording(e.to_string()))?;
                 let mut samples = rec.into_channels().remove(0);
+                if src.expect == Expect::Force {
+                    let unit = c.channels.iter().position(|n| *n == channel).map_or("", |k| c.units[k].as_str());
+                    check_force(&c.path, &channel, unit, &samples, c.rate)?;
+                }
                 if src.apply_gain {
                     samples.iter_mut().for_each(|x| *x *= c.gain);
                 }
@@ -358,11 +472,19 @@ fn read_cell(path: &Path, lenient: bool) -> Result<Option<Candidate>, GridError>
         return Err(bad(format!("condition load {load} g, velocity {velocity} cm/s: a grid cell needs a finite load and a positive velocity")));
     }
     let rate = v.get("rate").and_then(|r| r.as_f64()).unwrap_or(0.0);
-    let channels = v
+    let listed: Vec<(String, String)> = v
         .get("channels")
         .and_then(|c| c.as_array())
-        .map(|a| a.iter().filter_map(|c| c.get("name").and_then(|n| n.as_str()).map(String::from)).collect())
+        .map(|a| {
+            a.iter()
+                .filter_map(|c| {
+                    let name = c.get("name").and_then(|n| n.as_str())?;
+                    Some((name.to_string(), c.get("unit").and_then(|u| u.as_str()).unwrap_or("").to_string()))
+                })
+                .collect()
+        })
         .unwrap_or_default();
+    let (channels, units) = listed.into_iter().unzip();
     let gain = num("gain").unwrap_or(1.0);
     let material = cond.and_then(|c| c.get("material")).and_then(|m| m.as_str()).map(String::from);
     let carrier = match cond.and_then(|c| c.get("carrier")) {
@@ -378,7 +500,10 @@ fn read_cell(path: &Path, lenient: bool) -> Result<Option<Candidate>, GridError>
             }
         },
     };
-    Ok(Some(Candidate { info: CellInfo { path: paths.wav, load, velocity, rate, channels, gain, carrier }, material }))
+    Ok(Some(Candidate {
+        info: CellInfo { path: paths.wav, load, velocity, rate, channels, units, gain, carrier },
+        material,
+    }))
 }
 
 fn pick_channel(c: &CellInfo, wanted: &str) -> Result<String, GridError> {
@@ -411,5 +536,94 @@ mod tests {
         assert_eq!(reachable(&v, Some((0.0, 1.0))), (0, 0));
         assert_eq!(reachable(&v, Some((9.0, 20.0))), (4, 4));
         assert_eq!(reachable(&[85.0], Some((60.0, 110.0))), (0, 0));
+    }
+
+    /// `n` samples at 1 kHz of a texture-like variation (20 and 37 Hz, 0.03 N
+    /// rms in all) plus `offset(t)`.
+    fn force(n: usize, offset: impl Fn(f64) -> f64) -> Vec<f64> {
+        (0..n)
+            .map(|k| {
+                let t = k as f64 / 1000.0;
+                let tau = std::f64::consts::TAU;
+                0.03 * ((tau * 20.0 * t).sin() + (tau * 37.0 * t + 1.0).sin()) + offset(t)
+            })
+            .collect()
+    }
+
+    #[test]
+    fn the_offset_ratio_is_the_slow_part_over_the_variation() {
+        // No offset: the 250 ms means of 20 and 37 Hz sines are small.
+        let r = offset_ratio(&force(2500, |_| 0.0), 1000.0);
+        assert!(r < 0.05, "{r}");
+        // A constant offset of 0.3 N over 0.03 N rms of variation: 10.
+        let r = offset_ratio(&force(2500, |_| 0.3), 1000.0);
+        assert!((r - 10.0).abs() < 0.5, "{r}");
+        // Friction of each stroke direction: ±0.3 N per 1 s stretch, mean 0 over the cell.
+        let both = force(2000, |t| if t < 1.0 { 0.3 } else { -0.3 });
+        let r = offset_ratio(&both, 1000.0);
+        assert!((r - 10.0).abs() < 0.5, "{r}");
+        // Edge cases: nothing, silence, a constant, a cell shorter than one window.
+        assert_eq!(offset_ratio(&[], 1000.0), 0.0);
+        assert_eq!(offset_ratio(&[0.0; 100], 1000.0), 0.0);
+        assert!(offset_ratio(&[0.2; 100], 1000.0) > 1e6);
+        assert!(offset_ratio(&force(100, |_| 0.3), 1000.0) > 5.0);
+    }
+
+    /// Writes a one-channel cell `u-TAG` with `unit` into `dir`.
+    fn cell(dir: &Path, tag: &str, load: f64, velocity: f64, unit: &str, samples: &[f64]) {
+        use crate::recording::format::{Channel, RecordingMeta, RecordingWriter};
+        let mut meta = RecordingMeta::new(1000.0, vec![Channel::new("u", unit)]);
+        meta.condition.load_g = Some(load);
+        meta.condition.velocity_cm_s = Some(velocity);
+        let mut w = RecordingWriter::create(&dir.join(format!("u-{tag}")), meta).unwrap();
+        w.write_interleaved(samples).unwrap();
+        w.finish().unwrap();
+    }
+
+    fn forces(dir: &Path) -> GridSource {
+        GridSource {
+            folder: Some(dir.to_path_buf()),
+            channel: "u".into(),
+            expect: Expect::Force,
+            ..GridSource::default()
+        }
+    }
+
+    #[test]
+    fn a_grid_of_forces_takes_high_passed_newtons_and_refuses_the_rest_naming_the_fix() {
+        let dir = tempfile::tempdir().unwrap();
+        let good = force(2000, |_| 0.0);
+        cell(dir.path(), "60g-3cms", 60.0, 3.0, "N", &good);
+        cell(dir.path(), "60g-7cms", 60.0, 7.0, "N", &good);
+        let g = Grid::load(&forces(dir.path())).unwrap();
+        assert_eq!(g.cells.len(), 2);
+
+        // The raw force (0.25 N of friction) in one cell.
+        cell(dir.path(), "60g-7cms", 60.0, 7.0, "N", &force(2000, |_| 0.25));
+        let e = Grid::load(&forces(dir.path())).unwrap_err().to_string();
+        assert!(e.contains("u-60g-7cms.json") && e.contains("carries an offset (mean 0.250 N)"), "{e}");
+        assert!(e.contains("evflow library from-recordings") && e.contains("forces-SAMPLE"), "{e}");
+        // Unchecked, the same grid loads (an actuation chain's choice).
+        assert!(Grid::load(&GridSource { expect: Expect::Any, ..forces(dir.path()) }).is_ok());
+
+        // An actuation (narx-SAMPLE's unit `1`), and a force with no unit.
+        for (unit, says) in [("1", "unit `1`, not `N`"), ("", "no unit, not `N`")] {
+            cell(dir.path(), "60g-7cms", 60.0, 7.0, unit, &good);
+            let e = Grid::load(&forces(dir.path())).unwrap_err().to_string();
+            assert!(e.contains("u-60g-7cms.json") && e.contains(says) && e.contains("narx-SAMPLE"), "{e}");
+            assert!(e.contains("evflow library from-recordings"), "{e}");
+        }
+        // A cell the session cannot reach is not opened, so not checked.
+        let narrow = GridSource { velocity_range: Some((3.0, 3.0)), ..forces(dir.path()) };
+        assert!(Grid::load(&narrow).is_ok());
+    }
+
+    #[test]
+    fn the_interp_doc_states_the_threshold() {
+        let doc = crate::texture::interp::SPEC.doc;
+        assert!(
+            doc.contains(&format!("at most {OFFSET_RATIO_MAX} times")),
+            "interp's doc and OFFSET_RATIO_MAX disagree"
+        );
     }
 }

@@ -2,7 +2,7 @@
 //! velocity, recomputed at the update rate and sent to `playback` as frames.
 
 use super::frame::{at, CARRIER, HEADER, IMPROVED, MAGIC};
-use super::grid::{Grid, GridSource};
+use super::grid::{Expect, Grid, GridSource};
 use super::kernel::SincKernel;
 use super::scheme::{Geometry, Mix, Scheme};
 use crate::rate::clock::Clock;
@@ -71,6 +71,13 @@ envelope a. Re-sampling removes everything near the Nyquist rate, so such cells 
 and their envelopes interpolated; the frame says so (flag 2) and `playback` multiplies the envelope by \
 (−1)ᵐ at its own output sample m. `carrier = \"nyquist\"` or `\"none\"` overrides the sidecars; the cells of \
 one grid must agree.\n\n\
+**Forces.** A chain that renders the texture's *force* (`synth.live`: graphs/texture-live.toml) sets \
+`expect = \"force\"`: every reachable cell must then hold newtons (its channel's unit `N`) with no offset \
+the 10 Hz high-pass of §5.1.1 removes — the rms of its 250 ms means at most 0.4 times the rms of \
+its variation around them (the lab's high-passed forces: ≤ 0.08; the raw force with its friction and \
+sensor bias: ≥ 2.3). An actuation grid (`narx-SAMPLE`, unit `1`) or the force as the sensor measured it \
+is refused at load, naming the cell and the command that makes a proper `forces-SAMPLE` folder \
+(`evflow library from-recordings`, docs/rig.md), instead of playing a saturated carrier.\n\n\
 **Checked against:** the sine examples of §6.1–6.2 (10 and 20 Hz → 15 Hz: one full-power peak; basic: \
 two half-amplitude peaks; 19 Hz with weights 0.1/0.9 and 12 Hz with 0.8/0.2), clamping, single-row and \
 single-column grids, a velocity ratio of 10, missing and duplicate cells, envelopes on a carrier \
@@ -96,6 +103,7 @@ single-column grids, a velocity ratio of 10, missing and duplicate cells, envelo
     APPLY_GAIN.spec(),
     LOAD_BEYOND.spec(),
     CARRIER_MODE.spec(),
+    EXPECT.spec(),
 ])
 .example("folder = \"recordings/grid\"\nscheme = \"improved\"\nupdate_rate = 10.0\nstream_rate = 20000.0");
 
@@ -212,6 +220,15 @@ const CARRIER_MODE: Choice<CarrierMode> = Choice::new(
     "cells riding a Nyquist-rate carrier are interpolated as envelopes (auto: as their condition.carrier says)",
 );
 
+/// `expect`: what the cells must be.
+const EXPECT: Choice<Expect> = Choice::new(
+    "expect",
+    &["any", "force"],
+    &[Expect::Any, Expect::Force],
+    "any",
+    "what the cells hold: any (unchecked) | force (a chain rendering forces: each cell in N and with no offset the 10 Hz high-pass removes, else refused naming the fix)",
+);
+
 /// One texture's grid and the geometry of its tables.
 struct Texture {
     /// The cells; a carrier's cells hold their envelopes (demodulated at load).
@@ -281,6 +298,7 @@ pub fn grid_sources(p: &Params, ctx: &BuildContext) -> Result<Vec<(GridSource, S
         load_range: range(LOAD_RANGE)?,
         velocity_range: range(VELOCITY_RANGE)?,
         apply_gain: APPLY_GAIN.get(p),
+        expect: EXPECT.get(p),
     };
     Ok(if !textures.is_empty() {
         textures.iter().map(|t| (GridSource { folder: Some(ctx.path(t)), ..base.clone() }, t.to_string())).collect()

@@ -1,5 +1,7 @@
 //! `evflow library build --out DIR`: the model library (issue 17, point 3)
 //! — parse, call `evflow_study::library`, print. docs/scale.md describes it.
+//! `evflow library from-recordings`: the same layout from a lab's own
+//! recordings (`super::from_recordings`, docs/rig.md).
 
 use anyhow::{ensure, Context, Result};
 use evflow_nodes::lab::texture::{generated, samples};
@@ -19,14 +21,24 @@ pub struct Args {
 enum Which {
     /// Build (or complete) a library: for every texture sample × every
     /// condition of the grid, the inverse NARX model of the condition and
-    /// each method's actuation cell at its Table 5.1 gain, with index.json
-    /// (texture, condition, model file, training scores, E_s). A rerun
-    /// skips what is done and redoes what an interruption left half
-    /// written. Point graphs/texture-live.toml at `DIR/narx-SAMPLE` (or
-    /// `optimized-`, `playback-`).
+    /// each method's actuation cell at its Table 5.1 gain, the recorded
+    /// force itself (`forces-SAMPLE`) and the forward models, with
+    /// index.json (texture, condition, model file, training scores, E_s).
+    /// A rerun skips what is done and redoes what an interruption left
+    /// half written. The live synthesis (graphs/texture-live.toml,
+    /// texture-serial.toml, texture-live-recorded.toml) renders the forces:
+    /// point its `textures` at `DIR/forces-SAMPLE` (or `--set library=DIR`);
+    /// the actuation cells `narx-`, `optimized-`, `playback-SAMPLE` are for
+    /// the chains that play cells (graphs/texture-live-quality.toml).
     ///
     /// Example: cargo run --release -p evflow -- library build --out library
     Build(BuildArgs),
+    /// A library from a lab's own recordings, as the sensor measured them
+    /// (docs/rig.md): forces-SAMPLE, forward and inverse models per
+    /// condition, index.json — what the live chains play.
+    ///
+    /// Example: evflow library from-recordings --excitation /lab/excitation --textures /lab/textures --out /lab/library
+    FromRecordings(super::from_recordings::Args),
 }
 
 /// Arguments of `evflow library build`.
@@ -70,7 +82,10 @@ struct BuildArgs {
 
 /// Runs `evflow library`.
 pub fn main(a: Args) -> Result<()> {
-    let Which::Build(b) = a.which;
+    let b = match a.which {
+        Which::Build(b) => b,
+        Which::FromRecordings(f) => return super::from_recordings::main(f),
+    };
     let mut samples: Vec<String> =
         if b.samples.is_empty() { samples::NAMES.iter().map(|s| s.to_string()).collect() } else { b.samples.clone() };
     for s in &samples {

@@ -7,6 +7,8 @@ pub mod devsim;
 pub mod dot;
 #[cfg(feature = "lab")]
 pub mod family;
+#[cfg(feature = "synth")]
+pub mod from_recordings;
 pub mod graph_args;
 pub mod import;
 #[cfg(feature = "synth")]

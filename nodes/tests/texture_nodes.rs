@@ -3,7 +3,7 @@
 
 mod texture_util;
 
-use texture_util::{amplitudes, peak, run_chain, write_sine_grid};
+use texture_util::{amplitudes, peak, run_chain, write_cell, write_sine_grid};
 
 /// A loop of 6 cm: six periods of the one-cycle-per-cm texture, so the
 /// loop itself has no seam and the spectra are those of pure sines.
@@ -142,4 +142,33 @@ fn a_loop_of_whole_texture_periods_keeps_the_main_component_in_phase() {
     assert!(cut < 0.85, "a seam 0.8 of a period out of phase left the 10 Hz component at {cut}");
     let e = run_chain(dir.path(), "folder = \"grid\"\nperiod = 25.0", TIME, &[85.0], &[10.0], 1, 1).unwrap_err();
     assert!(e.contains("period") && e.contains("longer than the loop"), "{e}");
+}
+
+#[test]
+fn cells_recorded_from_different_places_cancel_unless_aligned_in_position() {
+    // Two loads at one velocity, the same 1 cycle/cm texture recorded half a
+    // period apart: averaged at the middle load they cancel; aligned first,
+    // they add up to the texture's full amplitude.
+    let dir = tempfile::tempdir().unwrap();
+    let grid = dir.path().join("grid");
+    std::fs::create_dir_all(&grid).unwrap();
+    let (v, n) = (10.0, 8000);
+    let wave = |x0: f64| -> Vec<f64> {
+        (0..n).map(|i| (std::f64::consts::TAU * (x0 + i as f64 * v / 1000.0)).sin()).collect()
+    };
+    write_cell(&grid, "light", 60.0, v, &wave(0.0));
+    write_cell(&grid, "heavy", 110.0, v, &wave(0.5));
+    let ticks = 3000;
+    let (m, vel) = (vec![85.0; ticks], vec![v; ticks]);
+    let played = |align: f64| {
+        let interp = format!(
+            "{INTERP}
+align = {align}"
+        );
+        let out = run_chain(dir.path(), &interp, TIME, &m, &vel, ticks as u64, 512).unwrap();
+        amplitudes(&out[200..])[10]
+    };
+    let (misaligned, aligned) = (played(0.0), played(1.0));
+    assert!(misaligned < 0.02, "{misaligned}");
+    assert!((aligned - 1.0).abs() < 0.03, "{aligned}");
 }

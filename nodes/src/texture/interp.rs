@@ -1,6 +1,7 @@
 //! `interp`: the interpolated actuation signal for the user's load and
 //! velocity, recomputed at the update rate and sent to `playback` as frames.
 
+use super::align::{self, Shift};
 use super::frame::{at, CARRIER, HEADER, IMPROVED, MAGIC};
 use super::grid::{Expect, Grid, GridSource};
 use super::kernel::SincKernel;
@@ -58,6 +59,14 @@ bound to it, `docs/live.md`).\n\n\
 (default: the recording's only one). Only the cells that `load_range` × `velocity_range` can reach are \
 loaded (the rest are never opened). A reachable cell without a recording, two recordings for one cell, \
 a cell without a condition, or cells at different rates is an error at load naming the file or cell.\n\n\
+**Alignment.** The schemes take every recording to start at the same place on the texture, as \
+tribometer passes do. Cells cut to their constant-speed stretch, or recorded by a lab from where it \
+started, do not: averaged, misaligned cells cancel part of a periodic texture's harmonics and smear a \
+random one's, so the table holds less texture than any cell. `align` = S > 0 compares each cell with the \
+first (lowest load and velocity) in position and trims its start so that every cell begins at the same \
+place: the normalized cross-correlation of the two, read at the first cell's spatial step, is maximized \
+over shifts up to S cm (`nodes/src/texture/align.rs`; the summary lists each cell's shift). The chains \
+that render recorded forces set 1 cm.\n\n\
 **Loop.** Every table covers the same stretch of texture, from a margin x₀ to x₀ + L: L = `loop` cm, or \
 by default the longest the recordings allow (at most `stream_rate/update_rate − 10 − overlap` samples at \
 v_min); a loop of a whole number of texture periods has no seam at all: `period` (the texture's main \
@@ -104,6 +113,7 @@ single-column grids, a velocity ratio of 10, missing and duplicate cells, envelo
     LOAD_BEYOND.spec(),
     CARRIER_MODE.spec(),
     EXPECT.spec(),
+    ALIGN.spec(),
 ])
 .example("folder = \"recordings/grid\"\nscheme = \"improved\"\nupdate_rate = 10.0\nstream_rate = 20000.0");
 
@@ -188,6 +198,15 @@ const LOOP: Float = Float::new(
     "cm",
     "length of texture each table covers (0: the longest the recordings allow)",
 );
+/// `align`: the largest shift searched when aligning the cells in position.
+const ALIGN: Float = Float::new(
+    "align",
+    0.0,
+    100.0,
+    0.0,
+    "cm",
+    "align the cells in position by cross-correlation, searching shifts up to this far (0: take every recording to start at the same place)",
+);
 /// `period`: the spatial period the loop is a whole number of.
 const PERIOD: Float = Float::new(
     "period",
@@ -237,6 +256,8 @@ struct Texture {
     shown: String,
     /// Whether the cells ride a Nyquist-rate carrier.
     carrier: bool,
+    /// What aligning the cells in position did (`align`), cell by cell.
+    shifts: Vec<Shift>,
 }
 
 /// The state of `interp`.
@@ -350,6 +371,9 @@ fn build(p: &Params, ctx: &BuildContext) -> Result<Box<dyn Node>, NodeError> {
                 cell.iter_mut().skip(1).step_by(2).for_each(|x| *x = -*x);
             }
         }
+        let nv = grid.velocities.len();
+        let speeds: Vec<f64> = (0..grid.cells.len()).map(|k| grid.velocities[k % nv]).collect();
+        let shifts = align::align(&mut grid.cells, &speeds, grid.rate, ALIGN.get(p));
         if let Some(first) = loaded.first() {
             if grid.rate != first.grid.rate {
                 return Err(NodeError::Data(format!(
@@ -374,7 +398,7 @@ fn build(p: &Params, ctx: &BuildContext) -> Result<Box<dyn Node>, NodeError> {
             }
             geo = geometry(whole * period)?;
         }
-        loaded.push(Texture { grid, geo, shown, carrier });
+        loaded.push(Texture { grid, geo, shown, carrier, shifts });
     }
     let scheme = SCHEME.get(p);
     Ok(Box::new(Interp {
@@ -498,6 +522,14 @@ impl Node for Interp {
                 g.rate,
                 t.geo.loop_cm,
             ));
+            if t.shifts.iter().any(|x| x.trimmed > 0 || x.correlation.is_nan()) {
+                let cells: Vec<String> = t
+                    .shifts
+                    .iter()
+                    .map(|x| format!("{:+.3} cm (r {:.2}, {} trimmed)", x.delta_cm, x.correlation, x.trimmed))
+                    .collect();
+                s = s.line(format!("{which}aligned in position against the first cell: {}", cells.join(", ")));
+            }
         }
         Ok(s.line(format!("{} frames sent", self.sent / self.frame as u64)))
     }

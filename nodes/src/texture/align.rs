@@ -38,7 +38,7 @@ pub struct Shift {
 /// interpolation; `None` past its ends).
 fn at(x: &[f64], v: f64, fs: f64, p: f64) -> Option<f64> {
     let t = p * fs / v;
-    if !(t >= 0.0) || t > (x.len() - 1) as f64 {
+    if t.is_nan() || t < 0.0 || t > (x.len() - 1) as f64 {
         return None;
     }
     let k = t.floor() as usize;
@@ -79,7 +79,7 @@ fn best_lag(a: &[f64], b: &[f64], max: usize) -> Option<(isize, f64)> {
             eb += y * y;
         }
         let den = (ea * eb).sqrt();
-        if !(den > 0.0) {
+        if den.is_nan() || den <= 0.0 {
             continue;
         }
         let r = ab / den;
@@ -101,7 +101,7 @@ fn best_lag(a: &[f64], b: &[f64], max: usize) -> Option<(isize, f64)> {
 /// short, or flat) keeps its start (δ = 0, correlation NaN).
 pub fn align(cells: &mut [Vec<f64>], velocities: &[f64], fs: f64, max_shift: f64) -> Vec<Shift> {
     let none = Shift { delta_cm: 0.0, correlation: f64::NAN, trimmed: 0 };
-    if cells.is_empty() || !(max_shift > 0.0) {
+    if cells.is_empty() || max_shift.is_nan() || max_shift <= 0.0 {
         return vec![none; cells.len()];
     }
     let dx = velocities[0] / fs;

@@ -108,9 +108,14 @@ enum Command {
     /// its rows; score.md, score.json and a PNG of the spectra
     /// (docs/score.md).
     ///
-    /// Example, on the shipped stroke (graphs/data/strokes/person):
+    /// Example, on the shipped stroke (graphs/data/strokes/person, the
+    /// `person` user of `report live`): its truth and the plastic sheet's
+    /// force along it, the live chain's actuation for it, its score:
+    ///
     ///   evflow run graphs/record-stroke.toml --out s
+    ///
     ///   evflow run graphs/texture-live-recorded.toml --out s
+    ///
     ///   evflow score graphs/data/strokes/person --real s/stroke-truth --actuation s/actuation-plastic-sheet
     #[cfg(feature = "synth")]
     Score(cli::score::Args),

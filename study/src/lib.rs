@@ -62,6 +62,8 @@ pub mod saved;
 #[cfg(feature = "synth")]
 pub mod scope;
 #[cfg(feature = "synth")]
+pub mod score;
+#[cfg(feature = "synth")]
 pub mod setup;
 #[cfg(feature = "synth")]
 pub mod shard_file;

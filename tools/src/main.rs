@@ -104,6 +104,25 @@ enum Command {
     ///
     /// Example: evflow report mesh --out report
     Report(cli::report::ReportArgs),
+    /// Score the live chain's actuation for a recorded stroke: played on a
+    /// display (a lab profile, or the display made of a library's forward
+    /// models) under the finger's true path, E_s (Welch, 2–200 Hz) against
+    /// the real force along that path, beside nothing, the display floor,
+    /// the target's floor and the stroke's floor, as `report live` scores
+    /// its rows; score.md, score.json and a PNG of the spectra
+    /// (docs/score.md).
+    ///
+    /// Example, on the shipped stroke (graphs/data/strokes/person, the
+    /// `person` user of `report live`): its truth and the plastic sheet's
+    /// force along it, the live chain's actuation for it, its score:
+    ///
+    ///   evflow run graphs/record-stroke.toml --out s
+    ///
+    ///   evflow run graphs/texture-live-recorded.toml --out s
+    ///
+    ///   evflow score graphs/data/strokes/person --real s/stroke-truth --actuation s/actuation-plastic-sheet
+    #[cfg(feature = "synth")]
+    Score(cli::score::Args),
     /// Benchmarks with distributions and baselines (the figures of
     /// docs/benchmarks.md). Build with --release.
     ///
@@ -175,6 +194,8 @@ fn main() -> ExitCode {
         #[cfg(feature = "synth")]
         Command::Library(a) => cli::library::main(a),
         Command::Report(a) => cli::report::main(a),
+        #[cfg(feature = "synth")]
+        Command::Score(a) => cli::score::main(a),
         Command::Bench(a) => cli::bench::main(a),
         #[cfg(all(feature = "serial", feature = "lab"))]
         Command::Devsim(a) => cli::devsim::main(a),

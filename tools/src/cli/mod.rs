@@ -20,5 +20,7 @@ pub mod replay;
 pub mod report;
 pub mod run;
 pub mod run_report;
+#[cfg(feature = "synth")]
+pub mod score;
 #[cfg(feature = "studio")]
 pub mod studio;

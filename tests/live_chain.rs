@@ -80,3 +80,32 @@ fn on_the_plastic_sheet_the_live_synthesis_renders_closer_than_nothing_and_every
         assert!(live < 0.9 * sum[k], "live {live:.3} against {c} {:.3}", sum[k]);
     }
 }
+
+#[test]
+fn the_live_synthesis_aims_at_its_target_high_passed_by_the_reference_butterworth() {
+    // synth.live's `highpass` (20 Hz by default) filters the force in before
+    // the synthesis aims at it: the `target` it reports with the default is
+    // the second-order Butterworth high-pass (the design module, checked
+    // against its analytic response) of the target it reports with
+    // `highpass = 0`, sample for sample; and the filtered target has lost
+    // its slow part (its mean over the stroke) while keeping the texture.
+    let dir = tempfile::tempdir().unwrap();
+    let target = |sets: &[String], name: &str| {
+        let out = dir.path().join(name);
+        std::fs::create_dir_all(&out).unwrap();
+        run("graphs/texture-live-quality.toml", sets, &out).unwrap();
+        channel(&out.join("actuations"), "live_target")
+    };
+    let whole = target(&["live_synth.highpass=0".into()], "whole");
+    let filtered = target(&[], "filtered");
+    assert_eq!(whole.len(), 8000);
+    use evflow_nodes::filters::butterworth::design::{butterworth, Kind};
+    let sections = butterworth(Kind::Highpass, 2, 20.0, 1000.0).unwrap();
+    let mut cascade = evflow_nodes::filters::butterworth::sos::Cascade::new(&sections);
+    let worst = whole.iter().zip(&filtered).map(|(w, f)| (cascade.tick(*w) - f).abs()).fold(0.0, f64::max);
+    assert!(worst < 1e-12, "the target differs from its reference high-pass by {worst:e} N");
+    let mean = |x: &[f64]| x.iter().sum::<f64>() / x.len() as f64;
+    let rms = |x: &[f64]| (x.iter().map(|v| v * v).sum::<f64>() / x.len() as f64).sqrt();
+    assert!(mean(&whole).abs() > 10.0 * mean(&filtered).abs(), "{} {}", mean(&whole), mean(&filtered));
+    assert!(rms(&filtered) > 0.3 * rms(&whole), "{} {}", rms(&filtered), rms(&whole));
+}

@@ -5,6 +5,8 @@
 use super::envelope::{EnvelopeModel, ModelGrid};
 use super::horizon::Horizon;
 use super::window_min::WindowMin;
+use crate::filters::butterworth::design::{butterworth, Kind};
+use crate::filters::butterworth::sos::Cascade;
 use crate::synth::model_file::ForwardModel;
 use evflow_engine::ports::{InPort, OutPort};
 use evflow_engine::typed_params::{Float, Int, Words};
@@ -27,6 +29,11 @@ pub static SPEC: NodeSpec = NodeSpec::new(
      (improved scheme, Eq. 6.4) played position-locked by `playback` with the same `lookahead` L, so \
      that at tick n this node receives the force of sample n + L along the finger's predicted path; \
      the horizon H is L + 1 samples.\n\n\
+     **Target.** The force in is high-passed at `highpass` Hz (second-order Butterworth; 0 passes it \
+     whole) before the synthesis aims at it: below about 20 Hz the display's own response to the \
+     stroke's reversals already exceeds what the real surface gives, and aiming at the target's slow \
+     part there only adds to it (chosen on the tuning displays of the display family, docs/texture.md \
+     §9.6). `target` is the force aimed at, after the high-pass.\n\n\
      **Model.** The forward models of `models` (written by `forward.train`, one per trained condition, \
      covering every combination of their loads and speeds) are blended bilinearly at the finger's \
      (`load`, |`velocity`|), clamped to the grid, `update_rate` times a second, and seen through a \
@@ -58,6 +65,7 @@ pub static SPEC: NodeSpec = NodeSpec::new(
     ITERATIONS.spec(),
     OFFSET.spec(),
     WINDOW.spec(),
+    HIGHPASS.spec(),
     BOUND.spec(),
     NOISE.spec(),
     REST_SPEED.spec(),
@@ -115,6 +123,17 @@ const OFFSET: Float =
 /// `window`: how far back the troughs count.
 const WINDOW: Float =
     Float::new("window", 1.0, 10_000.0, 200.0, "ms", "how far back the target's troughs count for the offset");
+/// `highpass`: the cut-off of the target's high-pass.
+const HIGHPASS: Float = Float::new(
+    "highpass",
+    0.0,
+    200.0,
+    20.0,
+    "Hz",
+    "the target is high-passed here before the synthesis aims at it (second order; 0: not filtered)",
+);
+/// Order of the target's high-pass.
+const HIGHPASS_ORDER: usize = 2;
 /// `bound`: the largest envelope.
 const BOUND: Float = Float::new("bound", 1e-6, 2.0, 1.0, "1", "largest envelope |u| (1 = 50 V)");
 /// `noise`: the scale on the learned noise slope.
@@ -136,6 +155,8 @@ struct Live {
     model: EnvelopeModel,
     horizon: Horizon,
     troughs: WindowMin,
+    /// The target's high-pass, when `highpass` > 0.
+    highpass: Option<Cascade>,
     /// The targets of samples n … n+H−1.
     ahead: Vec<f64>,
     offset: f64,
@@ -193,7 +214,16 @@ fn build(p: &Params, ctx: &BuildContext) -> Result<Box<dyn Node>, NodeError> {
     let m = grid.memory();
     let window = ((WINDOW.get(p) * 1e-3 * ctx.rate).round() as usize).max(1);
     let budget = BUDGET.get(p);
+    let cutoff = HIGHPASS.get(p);
+    let highpass = if cutoff > 0.0 {
+        let sections = butterworth(Kind::Highpass, HIGHPASS_ORDER, cutoff, ctx.rate)
+            .map_err(|e| NodeError::param(HIGHPASS.name(), e.to_string()))?;
+        Some(Cascade::new(&sections))
+    } else {
+        None
+    };
     Ok(Box::new(Live {
+        highpass,
         model: EnvelopeModel::zeros(m),
         horizon: Horizon::new(m, h),
         troughs: WindowMin::new(window),
@@ -247,6 +277,10 @@ impl Node for Live {
         let h = self.ahead.len();
         for k in 0..io.len() {
             let f = self.finite(io.input(FORCE)[k]);
+            let f = match &mut self.highpass {
+                Some(hp) => hp.tick(f),
+                None => f,
+            };
             let load = self.finite(io.input(LOAD)[k]);
             let v = self.finite(io.input(VELOCITY)[k]);
             if self.n == 0 {
@@ -286,6 +320,9 @@ impl Node for Live {
     fn reset(&mut self) {
         self.horizon.reset();
         self.troughs.reset();
+        if let Some(hp) = &mut self.highpass {
+            hp.reset();
+        }
         self.ahead.fill(0.0);
         self.n = 0;
         self.total_iterations = 0;

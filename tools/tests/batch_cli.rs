@@ -544,6 +544,52 @@ fn report_textures_shards_merged_equal_one_report() {
     assert_eq!(std::fs::read(m4.join("rows.csv")).unwrap(), std::fs::read(one.join("rows.csv")).unwrap());
 }
 
+/// `report textures --displays tuning` runs on the display family's tuning
+/// displays, sharded like any report: of the ten (display, condition)
+/// cells at one condition, shard 1/10 runs the first display's alone and
+/// its record names it (docs/simulated-lab.md §6.2).
+#[cfg(feature = "synth")]
+#[test]
+fn report_textures_runs_on_the_display_family_in_shards() {
+    let base = tempfile::tempdir().unwrap();
+    let out = base.path().join("s1");
+    let o = evflow(&[
+        "report",
+        "textures",
+        "--displays",
+        "tuning",
+        "--out",
+        out.to_str().unwrap(),
+        "--samples",
+        "plastic-sheet",
+        "--conditions",
+        "60:3",
+        "--epochs",
+        "3",
+        "--iterations",
+        "3",
+        "--gains",
+        "1.0",
+        "--no-floor",
+        "--no-multilevel",
+        "--no-times",
+        "--shard",
+        "1/10",
+    ]);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let record: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(out.join("textures-shard.json")).unwrap()).unwrap();
+    assert_eq!(record["cells"], 10, "{record}");
+    assert_eq!(record["scope"]["profiles"][9], "family/tuning-10", "{record}");
+    let rows: Vec<&str> = record["rows"].as_array().unwrap().iter().map(|r| r["profile"].as_str().unwrap()).collect();
+    assert_eq!(rows, ["tuning-01"]);
+    assert!(out.join("work/tuning-01/models/forward-60g-3cms.json").is_file());
+    // The family's names are the choices; a wrong one lists them.
+    let o = evflow(&["report", "textures", "--displays", "held", "--out", out.to_str().unwrap()]);
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert!(!o.status.success() && err.contains("held-out") && err.contains("tuning"), "{err}");
+}
+
 /// The README's main job in shards (issue 27, point 8): a shard draws no
 /// plot of the sweep (it holds part of it), and `evflow merge` draws them
 /// from every run, so the merge is one run's output, PNGs included, byte

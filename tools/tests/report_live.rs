@@ -73,7 +73,7 @@ fn the_live_report_holds_every_chain_and_its_shards_merge_into_one_run() {
     let csv = std::fs::read_to_string(one.join("rows.csv")).unwrap();
     let lines: Vec<&str> = csv.lines().skip(1).collect();
     assert_eq!(lines.len(), 2 * 10, "{csv}");
-    assert!(md.contains("target's floor") && md.contains("issue 33's targets"), "{md}");
+    assert!(md.contains("target's floor") && md.contains("against its goals"), "{md}");
     for user in ["person", "short-strokes"] {
         let best = |chain: &str| -> f64 {
             let l =
@@ -149,7 +149,7 @@ fn two_members_of_the_display_family_play_the_live_synthesis_from_its_own_librar
     let md = std::fs::read_to_string(out.join("live.md")).unwrap();
     assert!(md.contains("| tuning-04 |") && md.contains("| held-out-01 |"), "{md}");
     assert!(!md.contains("NARX cells"), "only the live synthesis plays: {md}");
-    assert!(md.contains("issue 33's targets"), "{md}");
+    assert!(md.contains("against its goals"), "{md}");
     // The live synthesis' own library: forward models and forces, no inverse models or cells.
     let lib = out.join("work/tuning-04/live-library");
     assert!(lib.join("models/forward-60g-3cms.json").is_file() && lib.join("forces-plastic-sheet").is_dir());

@@ -104,13 +104,14 @@ fn profile_name(p: &str) -> &str {
     stem.strip_suffix(".toml").unwrap_or(stem)
 }
 
-/// Issue 33's targets over every (profile, sample) cell of the study — and
-/// over the cells with room, where the stroke's floor lies ≥ 10 % below
-/// nothing — for the live synthesis at its best gain against nothing, the
-/// stroke's floor and the target's floor.
+/// The goals of the display family (docs/texture.md §9.6) over every
+/// (profile, sample) cell of the study — and over the cells with room,
+/// where the stroke's floor lies ≥ 10 % below nothing — for the live
+/// synthesis at gain 1 and at its best gain, against nothing, the stroke's
+/// floor and the target's floor.
 fn held_out_targets(md: &mut String, cells: &[&Cell], k: usize) {
     let room: Vec<&Cell> = cells.iter().copied().filter(|c| c.floor <= 0.9 * c.nothing).collect();
-    let _ = writeln!(md, "## The live synthesis over every profile × sample (issue 33's targets)\n");
+    let _ = writeln!(md, "## The live synthesis over every profile × sample, against its goals\n");
     let _ = writeln!(
         md,
         "Means over the users. \"With room\": the {} of {} profile × sample cells whose stroke's floor lies \

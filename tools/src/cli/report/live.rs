@@ -25,7 +25,8 @@ pub struct Args {
     profiles: Vec<String>,
     /// Run on the display family instead of --profiles (docs/simulated-lab.md §6.2):
     /// `tuning` (where the defaults are chosen), `held-out` (where figures are
-    /// quoted) or `all`. With it, the chains default to the live synthesis alone.
+    /// quoted) or `all`. With it, the chains default to the live synthesis alone
+    /// and the users to `person` (the family's targets are the person's).
     #[arg(long, conflicts_with = "profiles")]
     displays: Option<super::Displays>,
     /// The chains played beside nothing: any of playback, narx, optimized, ff,
@@ -38,7 +39,8 @@ pub struct Args {
     #[arg(long, value_delimiter = ',')]
     samples: Vec<String>,
     /// Virtual users by name (default: all of person, slow-heavy,
-    /// fast-light, short-strokes — docs/texture.md §9 gives their ranges).
+    /// fast-light, short-strokes — docs/texture.md §9 gives their ranges;
+    /// `person` alone with --displays).
     #[arg(long, value_delimiter = ',')]
     users: Vec<String>,
     /// Overall gains of the sweep, applied to every chain alike (each
@@ -96,6 +98,7 @@ pub fn main(a: Args) -> Result<()> {
     if let Some(set) = a.displays {
         scope.profiles = set.profiles();
         scope.chains = vec![Chain::Live];
+        scope.users.retain(|u| u.name == "person");
     }
     if !a.chains.is_empty() {
         scope.chains = a

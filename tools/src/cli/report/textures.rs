@@ -67,7 +67,8 @@ pub struct Args {
     /// Also write each texture's grid of actuation signals U_ij (the trained
     /// cells at their Table 5.1 gains) here, one folder per method and
     /// texture — `optimized-SAMPLE`, `narx-SAMPLE`, `playback-SAMPLE` — for
-    /// `interp` (graphs/texture-live.toml's `textures`). Nominal profile
+    /// an `interp` that plays cells (graphs/texture-render-quality.toml's
+    /// `grid`; the live synthesis renders forces, not cells). Nominal profile
     /// only. (`report interp --cells optimized` writes the same cells
     /// together with the cross-validation; the shipped grids come from it.)
     #[arg(long)]

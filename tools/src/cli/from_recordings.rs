@@ -1,5 +1,5 @@
 //! `evflow library from-recordings`: a model library from a lab's own
-//! recordings (issue 33, point 4) — parse, call
+//! recordings — parse, call
 //! `evflow_study::from_recordings`, print. docs/rig.md describes it.
 
 use anyhow::{Context, Result};

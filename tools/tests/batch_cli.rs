@@ -114,6 +114,38 @@ fn one_bad_run_does_not_lose_the_others_and_fails_the_batch() {
     assert!(wavs.iter().any(|p| p.to_string_lossy().starts_with("excitation-110g")), "{wavs:?}");
 }
 
+/// A shard beyond the batch's runs is empty, not a failure (a job array
+/// of N tasks over a graph without a sweep): it runs nothing, exits 0,
+/// writes a record saying so, and `merge` of it with the shard that ran is
+/// the one run's output, byte for byte.
+#[test]
+fn an_empty_shard_writes_its_record_and_merges() {
+    let base = tempfile::tempdir().unwrap();
+    let dir = |n: &str| base.path().join(n).to_str().unwrap().to_string();
+    let one = evflow(&["run", "graphs/excitation.toml", "-q", "--no-times", "--out", &dir("one")]);
+    assert!(one.status.success(), "{}", String::from_utf8_lossy(&one.stderr));
+    for (k, n) in [(1, 3), (2, 3), (3, 3)] {
+        let o = evflow(&[
+            "run",
+            "graphs/excitation.toml",
+            "-q",
+            "--no-times",
+            "--shard",
+            &format!("{k}/{n}"),
+            "--out",
+            &dir(&format!("s{k}")),
+        ]);
+        assert!(o.status.success(), "shard {k}/{n}: {}", String::from_utf8_lossy(&o.stderr));
+    }
+    let empty = std::fs::read_to_string(base.path().join("s3/shard.json")).unwrap();
+    assert!(empty.contains("\"runs\": []") || empty.contains("\"runs\":[]"), "{empty}");
+    let o = evflow(&["merge", &dir("merged"), &dir("s2"), &dir("s1"), &dir("s3")]);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let (a, b) = (tree(&base.path().join("one")), tree(&base.path().join("merged")));
+    assert_eq!(a.iter().map(|t| &t.0).collect::<Vec<_>>(), b.iter().map(|t| &t.0).collect::<Vec<_>>());
+    assert!(a == b, "the merged empty shards differ from one run");
+}
+
 #[test]
 fn shards_merged_equal_one_run_byte_for_byte() {
     let base = tempfile::tempdir().unwrap();

@@ -356,3 +356,19 @@ fn check_refuses_a_recording_folder_whose_recordings_lack_a_channel_the_graph_re
     assert_eq!(o.status.code(), Some(1), "{stderr}");
     assert!(stderr.contains("prbs-85g-5cms") && stderr.contains("no channel `velocity`"), "{stderr}");
 }
+
+/// `evflow check` writes nothing: checking a graph whose sink writes into
+/// a folder, from another working folder, leaves that folder empty.
+#[test]
+fn check_creates_no_file_and_no_folder() {
+    let dir = tempfile::tempdir().unwrap();
+    let graph = root().join("graphs/synthesize-recordings.toml");
+    let o = Command::new(env!("CARGO_BIN_EXE_evflow"))
+        .args(["check", graph.to_str().unwrap()])
+        .current_dir(dir.path())
+        .output()
+        .unwrap();
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let left: Vec<_> = std::fs::read_dir(dir.path()).unwrap().map(|e| e.unwrap().file_name()).collect();
+    assert!(left.is_empty(), "check left {left:?}");
+}

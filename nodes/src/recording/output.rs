@@ -124,15 +124,11 @@ fn build(p: &Params, ctx: &BuildContext) -> Result<Box<dyn Node>, NodeError> {
         .collect();
     let meta = RecordingMeta { rate: ctx.rate, channels, condition, source };
     let path = PATH.get(p);
-    let writer = RecordingWriter::create(&ctx.output_path(PATH.name(), path)?, meta)?;
+    let target = ctx.output_path(PATH.name(), path)?;
+    // `evflow check` builds to validate and writes nothing: no folder, no file.
+    let writer = if ctx.check_only { None } else { Some(RecordingWriter::create(&target, meta)?) };
     let shown = RecordingPaths::new(Path::new(path)).wav.display().to_string();
-    Ok(Box::new(RecordingOut {
-        writer: Some(writer),
-        shown,
-        channels: names.len(),
-        interleave: Vec::new(),
-        pending: None,
-    }))
+    Ok(Box::new(RecordingOut { writer, shown, channels: names.len(), interleave: Vec::new(), pending: None }))
 }
 
 impl Node for RecordingOut {

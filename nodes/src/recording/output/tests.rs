@@ -37,6 +37,10 @@ fn graph(rate: f64, chans: &[(&str, &[f64])], sink: &str) -> String {
 }
 
 fn plan(dir: &Path, doc: &str, block: usize) -> Result<Plan, String> {
+    plan_for(dir, doc, block, false)
+}
+
+fn plan_for(dir: &Path, doc: &str, block: usize, check_only: bool) -> Result<Plan, String> {
     let mut reg = Registry::new();
     reg.add(&SPEC).add(&FEED);
     let g = parse_graph(&dir.join("g.toml"), doc).map_err(|d| d.to_string())?;
@@ -48,7 +52,7 @@ fn plan(dir: &Path, doc: &str, block: usize) -> Result<Plan, String> {
         out_dir: Some(dir.to_path_buf()),
         timing: false,
         mode: evflow_engine::RunMode::Offline,
-        check_only: false,
+        check_only,
     };
     Plan::build(&checked, &opts).map_err(|e| e.to_string())
 }
@@ -241,4 +245,17 @@ fn a_missing_folder_is_created() {
     run(dir.path(), &doc, 8).unwrap();
     let rec = Recording::open(&dir.path().join("no/such/folder/o.wav")).unwrap();
     assert_eq!(rec.channel("a").unwrap(), &[1.0, 2.0][..]);
+}
+
+#[test]
+fn a_check_writes_nothing() {
+    // `evflow check` builds every node with check_only: the sink validates
+    // its path but creates neither the folder nor a file.
+    let dir = tempfile::tempdir().unwrap();
+    let doc = graph(1000.0, &[("a", &[1.0, 2.0])], "path = \"no/such/folder/o.wav\"");
+    plan_for(dir.path(), &doc, 8, true).unwrap();
+    assert!(files(dir.path()).is_empty(), "{:?}", files(dir.path()));
+    // A path leaving the output folder is still refused.
+    let doc = graph(1000.0, &[("a", &[1.0])], "path = \"../o.wav\"");
+    assert!(plan_for(dir.path(), &doc, 8, true).is_err());
 }

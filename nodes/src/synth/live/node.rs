@@ -54,8 +54,8 @@ pub static SPEC: NodeSpec = NodeSpec::new(
      ahead), `load` (g), `velocity` (cm/s, signed); out `u` (1 = 50 V), `target` (N, the target at \
      this tick), `predicted` (N, the force change the model expects now, to set beside `target`), \
      `iterations` and `fallbacks` (running counts since the start: their rates are the synthesis' \
-     iterations and fallbacks per second, which the studio shows). Non-finite inputs are read as 0 and \
-     counted. Summary: mean iterations, \
+     iterations and fallbacks per second, which the studio shows). Non-finite inputs (and a force so \
+     large that the high-pass overflows) are read as 0 and counted. Summary: mean iterations, \
      fallbacks, budget stops, the objective's mean reduction.",
 )
 .ports(PORTS)
@@ -278,7 +278,18 @@ impl Node for Live {
         for k in 0..io.len() {
             let f = self.finite(io.input(FORCE)[k]);
             let f = match &mut self.highpass {
-                Some(hp) => hp.tick(f),
+                Some(hp) => {
+                    // A force near ±f64::MAX overflows the filter's state:
+                    // it starts again from rest, the sample read as 0.
+                    let g = hp.tick(f);
+                    if g.is_finite() {
+                        g
+                    } else {
+                        hp.reset();
+                        self.bad_inputs += 1;
+                        0.0
+                    }
+                }
                 None => f,
             };
             let load = self.finite(io.input(LOAD)[k]);
@@ -354,7 +365,7 @@ impl Node for Live {
         if self.bad_inputs > 0 {
             s = s
                 .value("bad_inputs", self.bad_inputs as f64, "samples")
-                .line(format!("{} non-finite input sample(s) were read as 0", self.bad_inputs));
+                .line(format!("{} non-finite (or overflowing) input sample(s) were read as 0", self.bad_inputs));
         }
         Ok(s)
     }

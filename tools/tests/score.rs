@@ -147,7 +147,7 @@ fn the_command_writes_its_score_and_refuses_bad_input_by_name() {
         "--models",
         "graphs/data",
         "--gains",
-        "1",
+        "0.8",
         "--floor-iterations",
         "2",
         "--out",
@@ -155,7 +155,16 @@ fn the_command_writes_its_score_and_refuses_bad_input_by_name() {
     ]);
     assert!(ok, "{stderr}");
     assert!(stderr.contains("forward-85g-5cms.json: off the grid"), "{stderr}");
-    for want in ["nothing (no actuation)", "display floor", "as recorded", "target's floor", "stroke's floor"] {
+    // Gain 1, the actuation as recorded, is played even where --gains leaves it out.
+    for want in [
+        "nothing (no actuation)",
+        "display floor",
+        "as recorded",
+        "target's floor",
+        "stroke's floor",
+        "floors know the display exactly",
+        "the chain (gain 1) / nothing",
+    ] {
         assert!(stdout.contains(want), "{want} missing from:\n{stdout}");
     }
     for f in ["score.md", "score.json", "spectra.png"] {

@@ -53,7 +53,8 @@ pub struct Args {
     #[arg(long, value_name = "SAMPLE")]
     sample: Option<String>,
     /// The gain sweep every actuation is played over (× gain, then |u| ≤ 1):
-    /// the chain's, each floor's. `report live`'s by default.
+    /// the chain's, each floor's. `report live`'s by default; gain 1 (the
+    /// actuation as recorded) is always added.
     #[arg(long, value_delimiter = ',', default_value = "0.4,0.6,0.8,1.0,1.2")]
     gains: Vec<f64>,
     /// Optimizer iterations per start of each floor (`report live`'s by default).
@@ -72,6 +73,13 @@ pub struct Args {
     #[arg(long)]
     no_plot: bool,
 }
+
+/// What the floors mean on the display made of forward models.
+const MODELS_FLOORS: &str =
+    "\nOn a display made of forward models the floors know the display exactly: it has no friction \
+     and no noise of its own, so a floor can render the real force almost perfectly. Ratios to them are not \
+     comparable with a lab profile's or a rig's: this display compares actuations with each other \
+     (docs/score.md).\n";
 
 /// `STROKE-truth` beside `stroke`.
 fn truth_of(stroke: &Path) -> PathBuf {
@@ -106,10 +114,16 @@ pub fn main(a: Args) -> Result<()> {
         }
     }
     std::fs::create_dir_all(&a.out).with_context(|| format!("{}: cannot create", a.out.display()))?;
+    let models = matches!(display, Display::Models(_));
+    let mut gains = a.gains.clone();
+    if !gains.contains(&1.0) {
+        gains.push(1.0);
+        gains.sort_by(f64::total_cmp);
+    }
     let cfg = ScoreConfig {
         display,
         work: a.out.join("work"),
-        gains: a.gains.clone(),
+        gains,
         floors: !a.no_floors,
         floor_iterations: a.floor_iterations,
     };
@@ -128,7 +142,10 @@ pub fn main(a: Args) -> Result<()> {
         }
         Step::Optimized(what, secs) => eprintln!("  optimized {what} in {secs:.1} s"),
     })?;
-    let md = report::markdown(&s);
+    let mut md = report::markdown(&s);
+    if models && cfg.floors {
+        md.push_str(MODELS_FLOORS);
+    }
     print!("\n{md}\n");
     save(&a.out.join("score.md"), &md)?;
     save(&a.out.join("score.json"), &serde_json::to_string_pretty(&s)?)?;

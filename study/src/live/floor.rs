@@ -198,13 +198,46 @@ pub fn optimize_towards(
         tape: Tape::default(),
         y: Vec::new(),
     };
-    let n = stroke.len();
     let kappa = chain.carrier_gain();
+    from_starts(&mut chain, &goal.magnitude, kappa, stroke.len(), seeds, iterations)
+}
+
+/// An objective over a whole stroke's actuation that the floors minimize:
+/// its value, and its value with the gradient written into `g`.
+pub(crate) trait Objective {
+    /// The objective at `u`.
+    fn value(&mut self, u: &[f64]) -> f64;
+    /// The objective at `u`, its gradient into `g`.
+    fn value_grad(&mut self, u: &[f64], g: &mut [f64]) -> f64;
+}
+
+impl Objective for Chain<'_> {
+    fn value(&mut self, u: &[f64]) -> f64 {
+        Chain::value(self, u)
+    }
+    fn value_grad(&mut self, u: &[f64], g: &mut [f64]) -> f64 {
+        Chain::value_grad(self, u, g)
+    }
+}
+
+/// The floors' optimization of `objective` over `n` samples: the carrier
+/// starts at [`START_OFFSETS`] for the goal's `magnitude` (when the carrier
+/// gain `kappa` is positive) and every seed (cut or padded with 0 to `n`,
+/// within |u| ≤ 1), each followed by `iterations` of L-BFGS-B within
+/// |u| ≤ 1.
+pub(crate) fn from_starts(
+    objective: &mut impl Objective,
+    magnitude: &[f64],
+    kappa: f64,
+    n: usize,
+    seeds: &[(String, Vec<f64>)],
+    iterations: usize,
+) -> Result<Vec<Candidate>, StudyError> {
     let keep = vec![true; n];
     let mut starts: Vec<(String, Vec<f64>)> = Vec::new();
     if kappa.is_finite() && kappa > 0.0 {
         for scale in START_OFFSETS {
-            starts.push((format!("carrier ×{scale}"), carrier_scaled(&goal.magnitude, &keep, kappa, 1.0, scale)?));
+            starts.push((format!("carrier ×{scale}"), carrier_scaled(magnitude, &keep, kappa, 1.0, scale)?));
         }
     }
     for (name, u) in seeds {
@@ -215,8 +248,8 @@ pub fn optimize_towards(
     let opts = Options { max_iter: iterations, ..Options::default() };
     let mut out = Vec::with_capacity(starts.len());
     for (start, u0) in starts {
-        let start_objective = chain.value(&u0);
-        let mut f = |u: &[f64], g: &mut [f64]| chain.value_grad(u, g);
+        let start_objective = objective.value(&u0);
+        let mut f = |u: &[f64], g: &mut [f64]| objective.value_grad(u, g);
         let r = minimize(&mut f, &u0, -1.0, 1.0, &opts);
         out.push(Candidate { start, start_objective, objective: r.f, u: r.x });
     }

@@ -27,17 +27,15 @@
 //! ([`crate::live::floor`]): E_s² in the Welch reading of the high-passed
 //! force against the goal, L-BFGS-B within |u| ≤ 1.
 
-use crate::live::floor::{Candidate, Goal, START_OFFSETS};
+use crate::live::floor::{from_starts, Candidate, Goal, Objective};
 use crate::live::stroke::Stroke;
 use crate::StudyError;
 use evflow_nodes::metric::spectral_error::Band;
 use evflow_nodes::metric::spectrum::{SpectrumConfig, Window};
-use evflow_nodes::synth::lbfgsb::{minimize, Options};
 use evflow_nodes::synth::live::envelope::{EnvelopeModel, ModelGrid};
 use evflow_nodes::synth::model_file::ForwardModel;
 use evflow_nodes::synth::output_filter::OutputFilter;
 use evflow_nodes::synth::spectral::SpectralTarget;
-use evflow_nodes::synth::start::carrier_scaled;
 use evflow_nodes::synth::volterra::Volterra;
 use std::path::{Path, PathBuf};
 
@@ -230,30 +228,8 @@ impl ForwardDisplay {
             target: SpectralTarget::new(&goal.highpassed, cfg, band)?,
             y: Vec::new(),
         };
-        let n = path.len();
         let kappa = chain.carrier_gain(path);
-        let keep = vec![true; n];
-        let mut starts: Vec<(String, Vec<f64>)> = Vec::new();
-        if kappa.is_finite() && kappa > 0.0 {
-            for scale in START_OFFSETS {
-                starts.push((format!("carrier ×{scale}"), carrier_scaled(&goal.magnitude, &keep, kappa, 1.0, scale)?));
-            }
-        }
-        for (name, u) in seeds {
-            let mut u: Vec<f64> =
-                u.iter().take(n).map(|v| if v.is_finite() { v.clamp(-1.0, 1.0) } else { 0.0 }).collect();
-            u.resize(n, 0.0);
-            starts.push((name.clone(), u));
-        }
-        let opts = Options { max_iter: iterations, ..Options::default() };
-        let mut out = Vec::with_capacity(starts.len());
-        for (start, u0) in starts {
-            let start_objective = chain.value(&u0);
-            let mut f = |u: &[f64], g: &mut [f64]| chain.value_grad(u, g);
-            let r = minimize(&mut f, &u0, -1.0, 1.0, &opts);
-            out.push(Candidate { start, start_objective, objective: r.f, u: r.x });
-        }
-        Ok(out)
+        from_starts(&mut chain, &goal.magnitude, kappa, path.len(), seeds, iterations)
     }
 }
 
@@ -267,6 +243,15 @@ struct Chain<'a> {
     filter: OutputFilter,
     target: SpectralTarget,
     y: Vec<f64>,
+}
+
+impl Objective for Chain<'_> {
+    fn value(&mut self, u: &[f64]) -> f64 {
+        Chain::value(self, u)
+    }
+    fn value_grad(&mut self, u: &[f64], g: &mut [f64]) -> f64 {
+        Chain::value_grad(self, u, g)
+    }
 }
 
 impl Chain<'_> {

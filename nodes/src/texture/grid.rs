@@ -422,10 +422,40 @@ pub fn reachable(axis: &[f64], range: Option<(f64, f64)>) -> (usize, usize) {
     (i0.min(i1), i1.max(i0))
 }
 
+/// The system's message for a grid folder that cannot be listed, and,
+/// when it does not exist, the folders beside it of the same kind (the
+/// name's part before its first `-`, e.g. `forces-`) with the nearest
+/// named: `sample=felt` finds `forces-felt-fabric`.
+fn missing_folder(folder: &Path, e: &std::io::Error) -> String {
+    let message = e.to_string();
+    if e.kind() != std::io::ErrorKind::NotFound {
+        return message;
+    }
+    let (Some(parent), Some(name)) = (folder.parent(), folder.file_name().and_then(|n| n.to_str())) else {
+        return message;
+    };
+    let kind = name.split_once('-').map_or(name, |(k, _)| k);
+    let Ok(rd) = std::fs::read_dir(if parent.as_os_str().is_empty() { Path::new(".") } else { parent }) else {
+        return message;
+    };
+    let mut beside: Vec<String> = rd
+        .filter_map(|e| e.ok())
+        .filter(|e| e.path().is_dir())
+        .filter_map(|e| e.file_name().to_str().map(str::to_string))
+        .filter(|n| n.split_once('-').is_some_and(|(k, _)| k == kind))
+        .collect();
+    if beside.is_empty() {
+        return message;
+    }
+    beside.sort();
+    let help = evflow_engine::suggest::help(name, beside.iter().map(String::as_str));
+    format!("{message}; the {kind}-* folders beside it are {}: {help}", beside.join(", "))
+}
+
 fn list_candidates(src: &GridSource) -> Result<(String, Vec<PathBuf>), GridError> {
     if let Some(folder) = &src.folder {
         let rd = std::fs::read_dir(folder)
-            .map_err(|e| GridError::Folder { path: folder.clone(), message: e.to_string() })?;
+            .map_err(|e| GridError::Folder { path: folder.clone(), message: missing_folder(folder, &e) })?;
         let mut v: Vec<PathBuf> = rd
             .filter_map(|e| e.ok().map(|e| e.path()))
             .filter(|p| p.extension().and_then(|e| e.to_str()) == Some("json"))
@@ -526,6 +556,23 @@ fn pick_channel(c: &CellInfo, wanted: &str) -> Result<String, GridError> {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn a_missing_grid_folder_names_the_folders_of_its_kind_and_the_nearest() {
+        let dir = tempfile::tempdir().unwrap();
+        for f in ["forces-felt-fabric", "forces-plastic-sheet", "narx-felt-fabric"] {
+            std::fs::create_dir(dir.path().join(f)).unwrap();
+        }
+        let missing = dir.path().join("forces-felt");
+        let e = std::fs::read_dir(&missing).unwrap_err();
+        let m = missing_folder(&missing, &e);
+        assert!(m.contains("forces-felt-fabric, forces-plastic-sheet") && !m.contains("narx"), "{m}");
+        assert!(m.ends_with("did you mean `forces-felt-fabric`?"), "{m}");
+        // Nothing of its kind beside it: the system's message alone.
+        let other = dir.path().join("cells-x");
+        let e = std::fs::read_dir(&other).unwrap_err();
+        assert_eq!(missing_folder(&other, &e), e.to_string());
+    }
 
     #[test]
     fn reachable_cells_bracket_the_clamped_range() {

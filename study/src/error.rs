@@ -47,3 +47,8 @@ impl StudyError {
         StudyError::At { what, error: Box::new(self) }
     }
 }
+
+/// An [`StudyError::Io`] about the file or folder `path`.
+pub(crate) fn io(path: &std::path::Path, message: impl std::fmt::Display) -> StudyError {
+    StudyError::Io { path: path.to_path_buf(), message: message.to_string() }
+}

@@ -34,10 +34,7 @@ use std::sync::atomic::AtomicBool;
 
 type Result<T> = std::result::Result<T, StudyError>;
 
-/// An error about the file or folder `path`.
-fn io(path: &Path, message: impl std::fmt::Display) -> StudyError {
-    StudyError::Io { path: path.to_path_buf(), message: message.to_string() }
-}
+use crate::error::io;
 
 /// What a library covers.
 #[derive(Debug, Clone)]

@@ -42,9 +42,7 @@ use survey::Survey;
 
 type Result<T> = std::result::Result<T, StudyError>;
 
-fn io(path: &Path, message: impl std::fmt::Display) -> StudyError {
-    StudyError::Io { path: path.to_path_buf(), message: message.to_string() }
-}
+use crate::error::io;
 
 /// What to build from what.
 #[derive(Debug, Clone)]

@@ -22,9 +22,7 @@ use evflow_engine::batch::for_each_ordered;
 use std::path::{Path, PathBuf};
 use std::sync::atomic::AtomicBool;
 
-fn io(path: &Path, message: impl std::fmt::Display) -> StudyError {
-    StudyError::Io { path: path.to_path_buf(), message: message.to_string() }
-}
+use crate::error::io;
 
 /// What a live library covers.
 #[derive(Debug, Clone)]

@@ -32,7 +32,7 @@ use crate::live::stroke::Stroke;
 use crate::StudyError;
 use evflow_nodes::metric::spectral_error::Band;
 use evflow_nodes::metric::spectrum::{SpectrumConfig, Window};
-use evflow_nodes::synth::live::envelope::{EnvelopeModel, ModelGrid};
+use evflow_nodes::synth::live::envelope::{bracket, EnvelopeModel, ModelGrid};
 use evflow_nodes::synth::model_file::ForwardModel;
 use evflow_nodes::synth::output_filter::OutputFilter;
 use evflow_nodes::synth::spectral::SpectralTarget;
@@ -55,21 +55,6 @@ pub struct ForwardDisplay {
     models: Vec<Volterra>,
     /// The models' rate, Hz.
     pub rate: f64,
-}
-
-/// The bracketing indices and the weight of the upper one for `x` on the
-/// ascending `axis`, clamped to its ends — as `synth.live`'s grid brackets.
-fn bracket(axis: &[f64], x: f64) -> (usize, usize, f64) {
-    let n = axis.len();
-    if n == 1 || !x.is_finite() || x <= axis[0] {
-        return (0, 0, 0.0);
-    }
-    if x >= axis[n - 1] {
-        return (n - 1, n - 1, 0.0);
-    }
-    let hi = axis.iter().position(|&a| a > x).unwrap_or(n - 1);
-    let lo = hi - 1;
-    (lo, hi, (x - axis[lo]) / (axis[hi] - axis[lo]))
 }
 
 /// +1 moving forwards or at rest, −1 backwards (as the target's floor's goal).

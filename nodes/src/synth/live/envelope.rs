@@ -92,8 +92,9 @@ pub struct ModelGrid {
 }
 
 /// The bracketing indices and the weight of the upper one for `x` on the
-/// ascending axis `axis`, clamped to its ends.
-fn bracket(axis: &[f64], x: f64) -> (usize, usize, f64) {
+/// ascending axis `axis`, clamped to its ends (a non-finite `x` takes the
+/// first point).
+pub fn bracket(axis: &[f64], x: f64) -> (usize, usize, f64) {
     let n = axis.len();
     if n == 1 || !x.is_finite() || x <= axis[0] {
         return (0, 0, 0.0);

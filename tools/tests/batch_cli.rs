@@ -73,6 +73,13 @@ fn a_sweep_on_two_jobs_prints_and_writes_what_one_job_does() {
     assert_eq!(heads.len(), 9, "{out}");
     assert!(heads[0].contains("1/9: mass=60 speed=3") && heads[8].contains("9/9: mass=110 speed=5"), "{out}");
     assert_eq!(a.stdout, b.stdout, "stdout differs between --jobs 1 and 2");
+    // stderr is a pipe here, not a terminal: the progress comes as plain
+    // lines (issue 37, point 8): one at the start, one at the end.
+    let err = String::from_utf8_lossy(&a.stderr);
+    let progress: Vec<&str> = err.lines().filter(|l| l.contains(" runs, ") && l.contains("elapsed")).collect();
+    assert!(progress.len() >= 2, "no progress lines in a log:\n{err}");
+    assert!(progress.first().is_some_and(|l| l.starts_with("0/9 runs")), "{err}");
+    assert!(progress.last().is_some_and(|l| l.starts_with("9/9 runs")), "{err}");
     let (ta, tb) = (tree(one.path()), tree(two.path()));
     assert_eq!(ta.len(), 9 * 2 + 2, "{:?}", ta.iter().map(|t| &t.0).collect::<Vec<_>>());
     assert_eq!(ta, tb, "files differ between --jobs 1 and 2");

@@ -5,6 +5,7 @@
 //! record, and the merge of shards. The pool itself is engine code
 //! (`evflow_engine::batch`).
 
+pub mod log_lines;
 pub mod merge;
 pub mod record_json;
 pub mod shard_record;
@@ -14,6 +15,7 @@ pub mod tables;
 
 use evflow_engine::batch::{default_jobs, Shard};
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
+use std::io::IsTerminal;
 
 /// `--jobs`, for batches that cannot be sharded.
 #[derive(clap::Args, Debug, Clone)]
@@ -59,12 +61,37 @@ impl BatchArgs {
     }
 }
 
-/// One progress bar for a whole batch of `total` items, on stderr (hidden
-/// when `quiet`, and by indicatif when stderr is not a terminal).
+/// One progress bar for a whole batch of `total` items, on stderr: a
+/// redrawn bar on a terminal, plain lines at least once a minute in a log
+/// ([`log_lines`]), nothing when `quiet`.
 pub fn progress_bar(total: usize, what: &str, quiet: bool) -> ProgressBar {
-    let target = if quiet { ProgressDrawTarget::hidden() } else { ProgressDrawTarget::stderr() };
+    let terminal = std::io::stderr().is_terminal();
+    let target = if quiet {
+        ProgressDrawTarget::hidden()
+    } else if terminal {
+        ProgressDrawTarget::stderr()
+    } else {
+        ProgressDrawTarget::term_like_with_hz(Box::new(log_lines::LogLines::new(std::io::stderr())), 4)
+    };
     let bar = ProgressBar::with_draw_target(Some(total as u64), target);
-    let template = format!("{{bar:30}} {{pos}}/{{len}} {what}, {{elapsed}} (eta {{eta}}) {{msg}}");
+    let template = if terminal {
+        format!("{{bar:30}} {{pos}}/{{len}} {what}, {{elapsed}} (eta {{eta}}) {{msg}}")
+    } else {
+        log_lines::TEMPLATE.replace("{what}", what)
+    };
     bar.set_style(ProgressStyle::with_template(&template).unwrap_or_else(|_| ProgressStyle::default_bar()));
+    if !quiet && !terminal {
+        bar.enable_steady_tick(log_lines::REDRAW);
+    }
     bar
+}
+
+/// Ends a batch's [`progress_bar`]: the bar is cleared from a terminal; a
+/// log gets the line of the last item.
+pub fn finish(bar: &ProgressBar) {
+    if !bar.is_hidden() && !std::io::stderr().is_terminal() {
+        bar.abandon();
+    } else {
+        bar.finish_and_clear();
+    }
 }

@@ -95,7 +95,7 @@ pub fn main(a: Args) -> Result<()> {
         bar.inc(1);
         bar.set_message(label.to_string());
     });
-    bar.finish_and_clear();
+    evflow_tools::batch::finish(&bar);
     let o = outcome?;
     let conds: Vec<String> = o.conditions.iter().map(|c| c.label()).collect();
     println!(

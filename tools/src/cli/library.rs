@@ -132,7 +132,7 @@ pub fn main(a: Args) -> Result<()> {
         bar.inc(1);
         bar.set_message(label.to_string());
     })?;
-    bar.finish_and_clear();
+    evflow_tools::batch::finish(&bar);
     println!(
         "library {}: {} items built, {} already there, {} failed, of {}; index {}",
         b.out.display(),

@@ -120,7 +120,7 @@ pub fn main(a: Args) -> Result<()> {
         }
         println!();
     });
-    bar.finish_and_clear();
+    evflow_tools::batch::finish(&bar);
     if !failures.is_empty() {
         bail!("{}", failures.summary(n, "sessions").trim_end());
     }

@@ -138,7 +138,7 @@ pub fn main(a: Args) -> Result<()> {
                 println!();
             }
         });
-        bar.finish_and_clear();
+        evflow_tools::batch::finish(&bar);
         received
     } else if let Some((_, point, c)) = items.pop() {
         let report = run_one(&c.map_err(|e| anyhow!(e))?, &a, &stop, true)?;

@@ -105,7 +105,7 @@ pub fn main(a: Args) -> Result<()> {
             }
         }
     });
-    bar.finish_and_clear();
+    evflow_tools::batch::finish(&bar);
     let plot = Plot {
         title: format!("Main component frequency against scanning speed ({} g; cf. Fig. 6.6)", a.mass),
         x_label: "scanning speed (cm/s)".into(),

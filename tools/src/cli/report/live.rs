@@ -159,7 +159,7 @@ pub fn main(a: Args) -> Result<()> {
             Progress::Row(profile, sample, user) => bar.set_message(format!("{profile}: {sample} under {user}")),
         }
     })?;
-    bar.finish_and_clear();
+    evflow_tools::batch::finish(&bar);
     if a.batch.shard.is_some() {
         LiveRecord::of(&study, &cfg, &base).write(&base)?;
         println!(

@@ -113,7 +113,7 @@ pub fn main(a: Args) -> Result<()> {
         bar.inc(1);
         bar.set_message(narx_study::item_label(&cfg.scope.settings, item));
     })?;
-    bar.finish_and_clear();
+    evflow_tools::batch::finish(&bar);
     if a.batch.shard.is_some() {
         NarxRecord::of(&study, &cfg).write(&out)?;
         println!(

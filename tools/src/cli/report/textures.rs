@@ -134,7 +134,7 @@ pub fn main(a: Args) -> Result<()> {
             Progress::Row(profile, s, c, _, _) => bar.set_message(format!("{}: {s} at {}", profile.name, c.label())),
         }
     })?;
-    bar.finish_and_clear();
+    evflow_tools::batch::finish(&bar);
     if a.batch.shard.is_some() {
         SavedStudy::of(&study, &cfg, &base).write(&base)?;
         println!(

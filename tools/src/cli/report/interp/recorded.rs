@@ -132,7 +132,7 @@ pub fn main(a: Args) -> Result<()> {
             Err(e) => failures.push(samples[k].clone(), format!("{e:#}")),
         }
     });
-    bar.finish_and_clear();
+    evflow_tools::batch::finish(&bar);
     println!(
         "E_s (Eq. 5.2, {}–{} Hz) against the recording at each untrained condition; cells: recorded forces.\n",
         a.band[0], a.band[1]

@@ -372,3 +372,15 @@ fn check_creates_no_file_and_no_folder() {
     let left: Vec<_> = std::fs::read_dir(dir.path()).unwrap().map(|e| e.unwrap().file_name()).collect();
     assert!(left.is_empty(), "check left {left:?}");
 }
+
+/// docs/rig.md's slip (issue 37, point 9): `sample=felt` names a grid folder
+/// that is not there; the error names it once and the folders there are.
+#[test]
+fn a_misnamed_sample_names_its_grid_folder_once_and_suggests_the_nearest() {
+    let o = evflow(&["check", "graphs/texture-live-recorded.toml", "--set", "sample=felt"]);
+    let (_, stderr) = text(&o);
+    assert!(!o.status.success(), "{stderr}");
+    assert_eq!(stderr.matches("forces-felt:").count(), 1, "{stderr}");
+    assert!(stderr.contains("cannot list the grid folder"), "{stderr}");
+    assert!(stderr.contains("did you mean `forces-felt-fabric`?"), "{stderr}");
+}

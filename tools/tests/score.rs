@@ -40,6 +40,9 @@ fn stroke(dir: &Path) -> (PathBuf, PathBuf, PathBuf) {
     let ours = Recording::open(&stroke).unwrap();
     let shipped = Recording::open(&graphs.join("data/strokes/person")).unwrap();
     assert_eq!(ours.frames(), 120);
+    // The sidecar says which virtual user it holds (issue 37, point 9).
+    assert!(ours.meta().source.ends_with("virtual user of seed 1"), "{}", ours.meta().source);
+    assert_eq!(ours.meta().source, shipped.meta().source);
     for c in ["ir_x", "load_cell"] {
         let (a, b) = (ours.channel(c).unwrap(), shipped.channel(c).unwrap());
         assert!(a.iter().zip(b).all(|(x, y)| x.to_bits() == y.to_bits()), "{c} differs from the shipped stroke");

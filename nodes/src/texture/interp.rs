@@ -3,7 +3,7 @@
 
 use super::align::{self, Shift};
 use super::frame::{at, CARRIER, HEADER, IMPROVED, MAGIC};
-use super::grid::{Expect, Grid, GridSource};
+use super::grid::{Expect, Grid, GridError, GridSource};
 use super::kernel::SincKernel;
 use super::scheme::{Geometry, Mix, Scheme};
 use crate::rate::clock::Clock;
@@ -358,7 +358,11 @@ fn build(p: &Params, ctx: &BuildContext) -> Result<Box<dyn Node>, NodeError> {
     let period = PERIOD.get(p);
     let mut loaded: Vec<Texture> = Vec::with_capacity(sources.len());
     for (src, shown) in sources {
-        let mut grid = Grid::load(&src).map_err(|e| NodeError::Data(format!("grid {shown}: {e}")))?;
+        let mut grid = Grid::load(&src).map_err(|e| match e {
+            // The message starts with the folder already.
+            GridError::Folder { .. } => NodeError::Data(e.to_string()),
+            _ => NodeError::Data(format!("grid {shown}: {e}")),
+        })?;
         let carrier = match CARRIER_MODE.get(p) {
             CarrierMode::Nyquist => true,
             CarrierMode::None => false,

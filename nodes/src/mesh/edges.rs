@@ -63,6 +63,9 @@ pub struct EdgeCensus {
     pub non_manifold: usize,
     /// Convex edges (or face pairs) sharper than `max_angle`.
     pub convex: usize,
+    /// Of [`Self::convex`], the open mesh's boundary edges read as cliffs
+    /// (standing above the floor, see the module's doc).
+    pub cliffs: usize,
     /// The sharpest convex angle θ_min, degrees (180 when none).
     pub theta_min: f64,
 }
@@ -175,7 +178,9 @@ pub fn census(m: &Mesh, floor: f64, max_angle: f64) -> EdgeCensus {
                     let turn = (180.0 - max_angle).clamp(0.0, 89.0).to_radians().tan();
                     let tall = o.is_some_and(|o| drop > turn * across(p0, p1, o));
                     if let Some(th) = o.filter(|_| tall).and_then(|o| wall_angle(n, p0, p1, o)) {
+                        let before = c.convex;
                         take(th, &mut c);
+                        c.cliffs += c.convex - before;
                     }
                 }
             }
@@ -458,7 +463,7 @@ mod tests {
         // A square floating at z = 1 over a floor at 0: its border is a 90° cliff.
         let sq = grid(1, 1, [0.0, 1.0], [0.0, 1.0], |_, _| 1.0);
         let c = census(&sq, 0.0, 160.0);
-        assert_eq!((c.boundary, c.convex), (4, 4));
+        assert_eq!((c.boundary, c.convex, c.cliffs), (4, 4, 4));
         assert!((c.theta_min - 90.0).abs() < 1e-9);
         // The same square lying on the floor: no edge.
         assert_eq!(census(&sq, 1.0, 160.0).theta_min, 180.0);
@@ -472,7 +477,7 @@ mod tests {
         // vertical and goes up (not convex); the roof's open borders reach
         // down to the floor (not cliffs).
         assert!((c.theta_min - 90.0).abs() < 1e-9, "{c:?}");
-        assert_eq!((c.convex, c.boundary), (1, 6));
+        assert_eq!((c.convex, c.boundary, c.cliffs), (1, 6, 0));
     }
 
     #[test]

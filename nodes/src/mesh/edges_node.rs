@@ -115,15 +115,28 @@ fn build(p: &Params, ctx: &BuildContext) -> Result<Box<dyn Node>, NodeError> {
         .flat_map(|s| {
             let c = &s.census;
             let note = format!(
-                "{}; {} convex edges sharper than {max_angle}° (θ_min {:.1}°)",
+                "{}; {} convex edges sharper than {max_angle}° (θ_min {:.1}°){}",
                 placement_note(&s.placed, p),
                 c.convex,
-                c.theta_min
+                c.theta_min,
+                cliffs_note(c)
             );
             std::iter::once(note).chain(s.placed.warnings.iter().cloned())
         })
         .collect();
     Ok(Box::new(EdgesNode { scenes, current: initial, initial, max_angle, notes }))
+}
+
+/// What part of the convex edges is the open boundary, when any: an open
+/// mesh standing above the floor ends in cliffs, which count as edges.
+fn cliffs_note(c: &EdgeCensus) -> String {
+    match c.cliffs {
+        0 => String::new(),
+        n => format!(
+            ", {n} of them on the open mesh's boundary, read as cliffs down to the floor (close the mesh or lower it \
+             to the floor if its border is not a cliff)"
+        ),
+    }
 }
 
 impl Node for EdgesNode {
@@ -212,8 +225,15 @@ impl MeshEdges {
     fn summary(&self, s: Summary, values: bool) -> Summary {
         let c = &self.census;
         let line = format!(
-            "{}: {} edges, {} boundary, {} non-manifold, {} convex edges (θ_min {:.1}°), {} crossings",
-            self.placed.name, c.edges, c.boundary, c.non_manifold, c.convex, c.theta_min, self.crossings
+            "{}: {} edges, {} boundary, {} non-manifold, {} convex edges (θ_min {:.1}°){}, {} crossings",
+            self.placed.name,
+            c.edges,
+            c.boundary,
+            c.non_manifold,
+            c.convex,
+            c.theta_min,
+            cliffs_note(c),
+            self.crossings
         );
         if values {
             s.value("theta_min", c.theta_min, "deg")
@@ -274,6 +294,15 @@ mod tests {
             }
         }
         (out, folded)
+    }
+
+    #[test]
+    fn the_open_boundarys_cliffs_are_said_to_be_such() {
+        use super::{cliffs_note, EdgeCensus};
+        let open = EdgeCensus { edges: 5, boundary: 4, convex: 4, cliffs: 4, theta_min: 90.0, ..Default::default() };
+        let note = cliffs_note(&open);
+        assert!(note.contains("4 of them on the open mesh's boundary, read as cliffs"), "{note}");
+        assert_eq!(cliffs_note(&EdgeCensus { cliffs: 0, ..open }), "");
     }
 
     #[test]

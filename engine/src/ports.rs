@@ -56,6 +56,16 @@ pub enum RateSpec {
     Param(&'static str),
 }
 
+/// The unit of an output that carries its input's unit (a filter, a rate
+/// change, a gain): `check` shows the unit of what feeds the node's first
+/// input in its place — or the node's text parameter [`UNIT_PARAM`], when
+/// it has one and it is set (a gain that converts, N → g).
+pub const SAME_AS_INPUT: &str = "as its input";
+
+/// The text parameter that names the unit of a [`SAME_AS_INPUT`] output
+/// where the node changes it.
+pub const UNIT_PARAM: &str = "unit";
+
 /// One port of a node type.
 #[derive(Debug, Clone, Copy)]
 pub struct PortSpec {

@@ -384,3 +384,16 @@ fn a_misnamed_sample_names_its_grid_folder_once_and_suggests_the_nearest() {
     assert!(stderr.contains("cannot list the grid folder"), "{stderr}");
     assert!(stderr.contains("did you mean `forces-felt-fabric`?"), "{stderr}");
 }
+
+/// `check` shows what a gain, a hold or a filter carries, not `[1]`
+/// (issue 37, point 13): the load cell's N made g, the velocity in cm/s.
+#[test]
+fn check_shows_the_units_a_chain_carries() {
+    let o = evflow(&["check", "graphs/texture-live-recorded.toml"]);
+    let (out, err) = text(&o);
+    assert!(o.status.success(), "{err}");
+    let line = |name: &str| out.lines().find(|l| l.trim_start().starts_with(name)).unwrap_or_default().to_string();
+    assert!(line("load_g ").ends_with("out: out [g]"), "{out}");
+    assert!(line("load_1khz ").ends_with("out: out [g]"), "{out}");
+    assert!(line("velocity_1khz ").ends_with("out: out [cm/s]"), "{out}");
+}

@@ -9,6 +9,7 @@ mod params;
 pub mod prune;
 mod rate_hint;
 mod topology;
+pub mod units;
 
 use crate::diag::{Diagnostic, Diagnostics, Loc};
 use crate::graph::Graph;

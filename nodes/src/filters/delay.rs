@@ -1,7 +1,7 @@
 //! `delay`: delays a stream by a whole number of samples; the node that
 //! lets a feedback cycle through.
 
-use evflow_engine::ports::{InPort, OutPort};
+use evflow_engine::ports::{InPort, OutPort, SAME_AS_INPUT};
 use evflow_engine::typed_params::Int;
 use evflow_engine::{BuildContext, Io, Node, NodeError, NodeSpec, Params, PortSpec, Role};
 
@@ -32,7 +32,7 @@ pub static SPEC: NodeSpec =
 
 /// The ports: one signal in, the same signal d samples later out.
 const PORTS: &[PortSpec] =
-    &[PortSpec::input("in", "1", "signal"), PortSpec::output("out", "1", "signal, d samples later")];
+    &[PortSpec::input("in", "1", "signal"), PortSpec::output("out", SAME_AS_INPUT, "signal, d samples later")];
 /// The signal.
 const IN: InPort = InPort::named(PORTS, "in");
 /// The delayed signal.

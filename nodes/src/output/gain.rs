@@ -1,9 +1,9 @@
 //! `gain`: multiplies a stream by a constant.
 
 use evflow_engine::node::Constant;
-use evflow_engine::ports::{InPort, OutPort};
+use evflow_engine::ports::{InPort, OutPort, SAME_AS_INPUT, UNIT_PARAM};
 use evflow_engine::spec::FoldArgs;
-use evflow_engine::typed_params::Float;
+use evflow_engine::typed_params::{Float, Text};
 use evflow_engine::{BuildContext, Change, Io, Node, NodeError, NodeSpec, Params, PortSpec, Refused, Role};
 
 /// Declaration of `gain`.
@@ -12,7 +12,8 @@ pub static SPEC: NodeSpec =
         .doc(
             "y[n] = g · x[n]. Used to scale synthesized actuation signals before the display \
          (the gain sweep 0.6–1.4 of dissertation §5.3.1, Table 5.1; 1.0 corresponds to 100 Vpp \
-         through the amplifier). Runs at the rate of its input. A product beyond the range of \
+         through the amplifier). Runs at the rate of its input; its output has its input's unit, or \
+         `unit` where the gain converts one into another (the load cell's N into g). A product beyond the range of \
          f64 saturates at ±f64::MAX instead of becoming infinite.\n\n\
          `gain` changes live (a session's parameter queue): the multiplier then moves linearly \
          from its current value to the new one over `ramp` seconds (round(ramp·rate) samples, at \
@@ -24,12 +25,13 @@ pub static SPEC: NodeSpec =
          only this node. A live plan never folds on `gain`, which may change while it runs.",
         )
         .ports(PORTS)
-        .params(&[GAIN.spec(), RAMP.spec()])
+        .params(&[GAIN.spec(), RAMP.spec(), UNIT.spec()])
         .example("gain = 1.2")
         .fold(fold);
 
 /// The ports: one signal in, the scaled signal out.
-const PORTS: &[PortSpec] = &[PortSpec::input("in", "1", "signal"), PortSpec::output("out", "1", "signal × gain")];
+const PORTS: &[PortSpec] =
+    &[PortSpec::input("in", "1", "signal"), PortSpec::output("out", SAME_AS_INPUT, "signal × gain")];
 const IN: InPort = InPort::named(PORTS, "in");
 const OUT: OutPort = OutPort::named(PORTS, "out");
 
@@ -37,6 +39,13 @@ const OUT: OutPort = OutPort::named(PORTS, "out");
 const GAIN: Float = Float::new("gain", -1e6, 1e6, 1.0, "1", "multiplier").live();
 /// `ramp`: how long a live change takes.
 const RAMP: Float = Float::new("ramp", 0.0, 10.0, 0.01, "s", "time a live change of `gain` takes");
+
+/// `unit`: the output's unit where the gain converts.
+const UNIT: Text = Text::new(
+    UNIT_PARAM,
+    "",
+    "unit of the output where the gain converts (e.g. `g` for N → g; shown by `check`); empty: its input's",
+);
 
 /// Constant when the gain is 0 (inputs are finite), or of a constant input.
 fn fold(f: &FoldArgs<'_>) -> Option<Constant> {

@@ -2,7 +2,7 @@
 //! anti-aliasing filter built in.
 
 use super::decimator::{design, DecimateError, Decimator};
-use evflow_engine::ports::{InPort, OutPort};
+use evflow_engine::ports::{InPort, OutPort, SAME_AS_INPUT};
 use evflow_engine::typed_params::Float;
 use evflow_engine::{BuildContext, Io, Node, NodeError, NodeSpec, Params, PortSpec, RateSpec, Role};
 
@@ -56,7 +56,7 @@ stated ripple, phase = the stated delay) and above it (attenuated by the stated 
 /// The ports: the stream at M × `rate` in, at `rate` out.
 const PORTS: &[PortSpec] = &[
     PortSpec::input("in", "1", "the stream, at M × `rate`").at(RateSpec::Any),
-    PortSpec::output("out", "1", "the stream low-passed and decimated to `rate`"),
+    PortSpec::output("out", SAME_AS_INPUT, "the stream low-passed and decimated to `rate`"),
 ];
 /// The stream.
 const IN: InPort = InPort::named(PORTS, "in");

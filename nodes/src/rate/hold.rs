@@ -1,7 +1,7 @@
 //! `hold`: a stream at any rate, held to the node's rate (zero-order hold).
 
 use super::clock::Clock;
-use evflow_engine::ports::{InPort, OutPort};
+use evflow_engine::ports::{InPort, OutPort, SAME_AS_INPUT};
 use evflow_engine::typed_params::Float;
 use evflow_engine::{BuildContext, Io, Node, NodeError, NodeSpec, Params, PortSpec, RateSpec, Role};
 
@@ -32,7 +32,7 @@ per-sample processing.\n\n\
 /// The ports: the stream at any rate in, held at `rate` out.
 const PORTS: &[PortSpec] = &[
     PortSpec::input("in", "1", "the stream").at(RateSpec::Any),
-    PortSpec::output("out", "1", "the stream held at `rate`"),
+    PortSpec::output("out", SAME_AS_INPUT, "the stream held at `rate`"),
 ];
 /// The stream.
 const IN: InPort = InPort::named(PORTS, "in");

@@ -2,7 +2,7 @@
 //! asynchronous resampler, streaming, with a fixed latency.
 
 use super::resampler::{Quality, ResampleError, Stream, QUALITY_NAMES};
-use evflow_engine::ports::{InPort, OutPort};
+use evflow_engine::ports::{InPort, OutPort, SAME_AS_INPUT};
 use evflow_engine::typed_params::{Choice, Float};
 use evflow_engine::{BuildContext, Io, Node, NodeError, NodeSpec, Params, PortSpec, PrepareContext, RateSpec, Role};
 
@@ -60,7 +60,7 @@ with `fast`, 1.1e-6 with `balanced`; every 1 ms step moves on), linearity, block
 /// The ports: the stream at any rate in, resampled to `rate` out.
 const PORTS: &[PortSpec] = &[
     PortSpec::input("in", "1", "the stream").at(RateSpec::Any),
-    PortSpec::output("out", "1", "the stream resampled to `rate`, late by the stated latency"),
+    PortSpec::output("out", SAME_AS_INPUT, "the stream resampled to `rate`, late by the stated latency"),
 ];
 /// The stream.
 const IN: InPort = InPort::named(PORTS, "in");

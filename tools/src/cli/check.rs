@@ -82,8 +82,10 @@ pub fn main(a: Args) -> Result<()> {
                 )
             })
             .collect();
-        let outs: Vec<String> =
-            n.ports.iter().filter(|p| p.dir == Direction::Out).map(|p| format!("{} [{}]", p.name, p.unit)).collect();
+        let outs: Vec<String> = (n.ports.iter().enumerate())
+            .filter(|(_, p)| p.dir == Direction::Out)
+            .map(|(k, p)| format!("{} [{}]", p.name, evflow_engine::check::units::output_unit(c, i, k)))
+            .collect();
         println!(
             "  {:<16} {:<16} {:>9} Hz ({})  in: {}  out: {}",
             n.name,

@@ -4,7 +4,7 @@ pub mod design;
 pub mod sos;
 
 use design::{butterworth, DesignError, Kind, MIN_RELATIVE_CUTOFF};
-use evflow_engine::ports::{InPort, OutPort};
+use evflow_engine::ports::{InPort, OutPort, SAME_AS_INPUT};
 use evflow_engine::typed_params::{Choice, Float, Int};
 use evflow_engine::{BuildContext, Io, Node, NodeError, NodeSpec, Params, PortSpec, Role};
 use sos::Cascade;
@@ -47,7 +47,8 @@ pub static SPEC: NodeSpec = NodeSpec::new(
 .example("kind = \"highpass\"\norder = 4\ncutoff = 10.0");
 
 /// The ports: one signal in, the filtered signal out.
-const PORTS: &[PortSpec] = &[PortSpec::input("in", "1", "signal"), PortSpec::output("out", "1", "filtered signal")];
+const PORTS: &[PortSpec] =
+    &[PortSpec::input("in", "1", "signal"), PortSpec::output("out", SAME_AS_INPUT, "filtered signal")];
 /// The signal.
 const IN: InPort = InPort::named(PORTS, "in");
 /// The filtered signal.

@@ -140,3 +140,48 @@ mod tests {
         assert_eq!(hz_word(44_100.0), "44100");
     }
 }
+
+/// The rates nearest `hz` that fit a base rate (base ÷ k or base × k),
+/// one below and one above (the same when `hz` is beyond the last).
+pub(crate) fn nearest_fitting(hz: f64, base: f64) -> (f64, f64) {
+    if !(hz.is_finite() && hz > 0.0 && base > 0.0) {
+        return (base, base);
+    }
+    if hz >= base {
+        let m = hz / base;
+        (base * m.floor().max(1.0), base * m.ceil().max(1.0))
+    } else {
+        let k = base / hz;
+        (base / k.ceil(), base / k.floor().max(1.0))
+    }
+}
+
+/// The help of a rate that does not fit the base: the nearest that do.
+pub(crate) fn fitting_help(hz: f64, base: f64) -> String {
+    let (lo, hi) = nearest_fitting(hz, base);
+    let show = |r: f64| {
+        let ratio = Ratio::of(r, base).unwrap_or(Ratio::ONE);
+        let how =
+            if ratio.div > 1 { format!("{base} Hz ÷ {}", ratio.div) } else { format!("{base} Hz × {}", ratio.mul) };
+        format!("{r} Hz ({how})")
+    };
+    if lo == hi {
+        format!("the nearest rate that fits the base rate {base} Hz is {}", show(lo))
+    } else {
+        format!("the nearest rates that fit the base rate {base} Hz are {} and {}", show(lo), show(hi))
+    }
+}
+
+#[cfg(test)]
+mod nearest_tests {
+    use super::*;
+
+    #[test]
+    fn the_nearest_fitting_rates_bracket_the_asked_one() {
+        assert_eq!(nearest_fitting(300.0, 1000.0), (250.0, 1000.0 / 3.0));
+        assert_eq!(nearest_fitting(1500.0, 1000.0), (1000.0, 2000.0));
+        assert_eq!(nearest_fitting(600.0, 1000.0), (500.0, 1000.0));
+        let h = fitting_help(300.0, 1000.0);
+        assert!(h.contains("250 Hz (1000 Hz ÷ 4)") && h.contains("(1000 Hz ÷ 3)"), "{h}");
+    }
+}

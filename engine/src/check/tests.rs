@@ -233,6 +233,11 @@ type = "harness.tap"
 "#;
     let e = errors(text);
     assert!(e.iter().any(|d| d.message.contains("333 Hz") && d.message.contains("not an integer")), "{e:#?}");
+    // At the line of `rate = 333` (line 8), with the nearest rates that fit.
+    let d = e.iter().find(|d| d.message.contains("333 Hz")).unwrap();
+    assert_eq!(d.loc.line, 8, "{d}");
+    let help = d.help.as_deref().unwrap_or_default();
+    assert!(help.contains("250 Hz (1000 Hz ÷ 4)") && help.contains("(1000 Hz ÷ 3)"), "{help}");
     let text = r#"[graph]
 format = 1
 name = "rates"

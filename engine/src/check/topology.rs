@@ -79,11 +79,23 @@ pub(super) fn analyse(graph: &Graph, nodes: &mut [CheckedNode], edges: &[Edge], 
 fn resolve_rates(graph: &Graph, nodes: &mut [CheckedNode], edges: &[Edge], topo: &[usize], sink: &mut Sink) {
     let base = graph.rate;
     let mut resolved = vec![false; nodes.len()];
-    let ratio_of = |hz: f64, node: &CheckedNode, what: &str, sink: &mut Sink| -> Ratio {
+    // A rate that does not fit is reported at the line of the parameter
+    // that sets it, with the nearest rates that fit.
+    let ratio_of = |hz: f64, node: &CheckedNode, what: &str, param: &str, sink: &mut Sink| -> Ratio {
         match Ratio::of(hz, base) {
             Some(r) => r,
             None => {
-                sink.err(node.loc, Some(&node.name), format!("{what} runs at {hz} Hz, which is not an integer multiple or divisor of the base rate {base} Hz"), Some("choose rates that divide or multiply the base rate exactly, e.g. 40 Hz or 10 kHz at a 1 kHz base".into()));
+                let loc = (graph.nodes.iter().find(|d| d.name == node.name))
+                    .and_then(|d| d.params.iter().find(|p| p.name == param))
+                    .map_or(node.loc, |p| p.loc);
+                sink.err(
+                    loc,
+                    Some(&node.name),
+                    format!(
+                        "{what} runs at {hz} Hz (`{param}`), which is not an integer multiple or divisor of the base rate {base} Hz"
+                    ),
+                    Some(rate_hint::fitting_help(hz, base)),
+                );
                 Ratio::ONE
             }
         }
@@ -114,7 +126,7 @@ fn resolve_rates(graph: &Graph, nodes: &mut [CheckedNode], edges: &[Edge], topo:
             r
         } else if let Some(p) = node.spec.rate_param {
             let hz = node.params.f64(p);
-            ratio_of(hz, node, "the node", sink)
+            ratio_of(hz, node, "the node", p, sink)
         } else if let Some(r) = from_any_inputs() {
             r
         } else {
@@ -124,7 +136,9 @@ fn resolve_rates(graph: &Graph, nodes: &mut [CheckedNode], edges: &[Edge], topo:
         for (k, p) in node.ports.iter().enumerate() {
             let r = match p.rate {
                 RateSpec::Node => ratio,
-                RateSpec::Param(name) => ratio_of(node.params.f64(name), node, &format!("port `{}`", p.name), sink),
+                RateSpec::Param(name) => {
+                    ratio_of(node.params.f64(name), node, &format!("port `{}`", p.name), name, sink)
+                }
                 RateSpec::Any => producer_ratio(k, nodes, &resolved).unwrap_or(ratio),
             };
             port_ratios.push(r);

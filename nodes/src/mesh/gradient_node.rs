@@ -430,6 +430,9 @@ impl Node for GradientNode {
     }
 }
 
+/// The unit of `on_mesh` and `off_mesh`, printed after them.
+const SHARE_OF_TICKS: &str = "of the ticks (a share)";
+
 /// The fractions of the session's ticks the finger was on and off the mesh
 /// felt (whichever scene that was), as the values `on_mesh` and
 /// `off_mesh`, and a warning line when it was off for most of them (more
@@ -440,7 +443,8 @@ fn off_mesh_warning(s: Summary, on: u64, off: u64) -> Summary {
         return s;
     }
     let fraction = off as f64 / total as f64;
-    let s = s.value("on_mesh", on as f64 / total as f64, "1").value("off_mesh", fraction, "1");
+    // Shares, not counts: say of what.
+    let s = s.value("on_mesh", on as f64 / total as f64, SHARE_OF_TICKS).value("off_mesh", fraction, SHARE_OF_TICKS);
     if 2 * off <= total {
         return s;
     }
@@ -525,6 +529,7 @@ mod tests {
         for mesh in ["file = \"plate.obj\"", "scenes = [\"plate.obj\", \"plate.obj\"]"] {
             let s = summary_with(dir.path(), 3, 7, mesh);
             assert_eq!((s.get("on_mesh"), s.get("off_mesh")), (Some(0.3), Some(0.7)), "{mesh}");
+            assert!(s.values.iter().all(|(k, _, u)| !k.ends_with("_mesh") || u == super::SHARE_OF_TICKS), "{mesh}");
         }
     }
 }

@@ -102,6 +102,12 @@ fn run_writes_its_recording_into_the_output_folder() {
     assert!(o.status.success(), "{stderr}");
     assert!(stdout.contains("wrote excitation-60g-5cms.wav (3066 frames"), "{stdout}");
     assert!(stdout.contains("ticks/s"), "{stdout}");
+    // The total and the nodes' times say what each counts (issue 37, point 13).
+    assert!(stdout.contains("the nodes' set-up and finish, writing files included, took"), "{stdout}");
+    assert!(
+        stdout.lines().any(|l| l.split_whitespace().eq(["node", "type", "set-up", "run", "finish", "share"])),
+        "{stdout}"
+    );
     assert_eq!(files_in(dir.path()), ["excitation-60g-5cms.json", "excitation-60g-5cms.wav"]);
 }
 

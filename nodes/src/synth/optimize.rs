@@ -177,8 +177,8 @@ const OBJECTIVE: Choice<Objective> = Choice::new(
     "objective",
     &["time", "spectral", "expected"],
     &[Objective::Time, Objective::Spectral, Objective::Expected],
-    "time",
-    "what to match",
+    "expected",
+    "what to match (`expected`: chosen by measurement, docs/synthesis.md)",
 );
 /// `nfft`: the spectral objective's segment length.
 const NFFT: Int = Int::new("nfft", 0, 1 << 20, 0, "samples", "spectral objective: segment length (0 = the rate)");
@@ -420,6 +420,17 @@ impl Node for Optimize {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// One default per parameter (issue 37, point 7): the node's objective
+    /// is the one the shipped graph and docs/synthesis.md call the default.
+    #[test]
+    fn the_default_objective_is_the_measured_one_the_shipped_graph_sets() {
+        use evflow_engine::spec::ParamDefault;
+        assert!(matches!(OBJECTIVE.spec().default, ParamDefault::Text("expected")));
+        let graph = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../graphs/synthesize-optimized.toml");
+        let text = std::fs::read_to_string(graph).unwrap();
+        assert!(text.lines().any(|l| l.starts_with("objective = \"expected\"")), "{text}");
+    }
     use crate::recording::format::{Channel, RecordingMeta, RecordingWriter};
     use crate::synth::model_file::Training;
     use crate::synth::volterra_fit::{fit, FitConfig};

@@ -109,3 +109,39 @@ fn the_live_synthesis_aims_at_its_target_high_passed_by_the_reference_butterwort
     assert!(mean(&whole).abs() > 10.0 * mean(&filtered).abs(), "{} {}", mean(&whole), mean(&filtered));
     assert!(rms(&filtered) > 0.3 * rms(&whole), "{} {}", rms(&filtered), rms(&whole));
 }
+
+#[test]
+fn a_speed_following_highpass_takes_its_cutoff_from_the_finger_speed() {
+    // With `highpass_spatial` = k the target's high-pass cut-off is
+    // k·|velocity| Hz, held between 1 Hz and `highpass` (20 Hz): the target
+    // reported equals the tracking filter run over the unfiltered target with
+    // the chain's own velocity (recorded beside it), and differs from the
+    // fixed 20 Hz filter's where the finger is slow.
+    let dir = tempfile::tempdir().unwrap();
+    let actuation = |sets: &[String], name: &str| {
+        let out = dir.path().join(name);
+        std::fs::create_dir_all(&out).unwrap();
+        run("graphs/texture-live-recorded.toml", sets, &out).unwrap();
+        let file = out.join("actuation-plastic-sheet");
+        (channel(&file, "target"), channel(&file, "velocity"))
+    };
+    let (whole, v) = actuation(&["synth.highpass=0".into()], "whole");
+    let (fixed, _) = actuation(&[], "fixed");
+    let (tracking, v2) = actuation(&["synth.highpass_spatial=5".into()], "tracking");
+    assert_eq!(v, v2, "the velocity does not depend on the target's filter");
+    use evflow_nodes::synth::live::tracking_highpass::TrackingHighpass;
+    // `target` at tick n is the force that came in `lookahead` (15) ticks
+    // before, filtered then, with the velocity of that tick.
+    const LOOKAHEAD: usize = 15;
+    let mut reference = TrackingHighpass::new(1000.0, 1.0, 20.0);
+    let scale = whole.iter().fold(0.0f64, |m, x| m.max(x.abs()));
+    let worst = (whole[LOOKAHEAD..].iter().zip(&v).zip(&tracking[LOOKAHEAD..]))
+        .map(|((w, v), t)| {
+            reference.set_cutoff(5.0 * v.abs());
+            (reference.tick(*w) - t).abs()
+        })
+        .fold(0.0, f64::max);
+    assert!(worst < 1e-6 * scale, "the target differs from its reference by {worst:e} N (scale {scale:e} N)");
+    let apart = fixed.iter().zip(&tracking).filter(|(a, b)| (*a - *b).abs() > 1e-3 * scale).count();
+    assert!(apart > 100, "the tracking filter gave the fixed one's target ({apart} samples apart)");
+}

@@ -4,6 +4,7 @@
 
 use super::envelope::{EnvelopeModel, ModelGrid};
 use super::horizon::Horizon;
+use super::tracking_highpass::TrackingHighpass;
 use super::window_min::WindowMin;
 use crate::filters::butterworth::design::{butterworth, Kind};
 use crate::filters::butterworth::sos::Cascade;
@@ -33,7 +34,11 @@ pub static SPEC: NodeSpec = NodeSpec::new(
      whole) before the synthesis aims at it: below about 20 Hz the display's own response to the \
      stroke's reversals already exceeds what the real surface gives, and aiming at the target's slow \
      part there only adds to it (chosen on the tuning displays of the display family, docs/texture.md \
-     §9.6). `target` is the force aimed at, after the high-pass.\n\n\
+     §9.6). With `highpass_spatial` = k > 0 the cut-off follows the finger instead: k·|`velocity`| Hz, \
+     from 1 Hz up to `highpass` (a state-variable filter whose cut-off may move every sample, \
+     `nodes/src/synth/live/tracking_highpass.rs`) — better for slow fingers, not the default (measured \
+     over every user on the tuning displays, docs/texture.md §9.6). `target` is the force aimed at, \
+     after the high-pass.\n\n\
      **Model.** The forward models of `models` (written by `forward.train`, one per trained condition, \
      covering every combination of their loads and speeds) are blended bilinearly at the finger's \
      (`load`, |`velocity`|), clamped to the grid, `update_rate` times a second, and seen through a \
@@ -66,6 +71,7 @@ pub static SPEC: NodeSpec = NodeSpec::new(
     OFFSET.spec(),
     WINDOW.spec(),
     HIGHPASS.spec(),
+    HIGHPASS_SPATIAL.spec(),
     BOUND.spec(),
     NOISE.spec(),
     REST_SPEED.spec(),
@@ -132,8 +138,59 @@ const HIGHPASS: Float = Float::new(
     "Hz",
     "the target is high-passed here before the synthesis aims at it (second order; 0: not filtered)",
 );
+/// `highpass_spatial`: the cut-off against travelled distance, when it follows the speed.
+const HIGHPASS_SPATIAL: Float = Float::new(
+    "highpass_spatial",
+    0.0,
+    100.0,
+    0.0,
+    "1/cm",
+    "when > 0, the high-pass follows the finger: cut-off = this × |velocity| Hz, from 1 Hz up to `highpass` (200 Hz if 0)",
+);
 /// Order of the target's high-pass.
 const HIGHPASS_ORDER: usize = 2;
+/// The range a speed-following cut-off is held in (Hz), its top lowered
+/// to `highpass` when set.
+const TRACKING_RANGE: (f64, f64) = (1.0, 200.0);
+
+/// The target's high-pass.
+enum Highpass {
+    /// The target is aimed at whole.
+    Off,
+    /// At a fixed cut-off.
+    Fixed(Cascade),
+    /// At a cut-off of `per_cm` × |velocity|.
+    Tracking { filter: TrackingHighpass, per_cm: f64 },
+}
+
+impl Highpass {
+    /// The target sample `f` filtered, the finger at speed `v`; `None` when
+    /// the filter overflowed (it then starts again from rest).
+    fn tick(&mut self, f: f64, v: f64) -> Option<f64> {
+        let g = match self {
+            Highpass::Off => return Some(f),
+            Highpass::Fixed(c) => c.tick(f),
+            Highpass::Tracking { filter, per_cm } => {
+                filter.set_cutoff(*per_cm * v.abs());
+                filter.tick(f)
+            }
+        };
+        if g.is_finite() {
+            Some(g)
+        } else {
+            self.reset();
+            None
+        }
+    }
+
+    fn reset(&mut self) {
+        match self {
+            Highpass::Off => {}
+            Highpass::Fixed(c) => c.reset(),
+            Highpass::Tracking { filter, .. } => filter.reset(),
+        }
+    }
+}
 /// `bound`: the largest envelope.
 const BOUND: Float = Float::new("bound", 1e-6, 2.0, 1.0, "1", "largest envelope |u| (1 = 50 V)");
 /// `noise`: the scale on the learned noise slope.
@@ -155,8 +212,8 @@ struct Live {
     model: EnvelopeModel,
     horizon: Horizon,
     troughs: WindowMin,
-    /// The target's high-pass, when `highpass` > 0.
-    highpass: Option<Cascade>,
+    /// The target's high-pass.
+    highpass: Highpass,
     /// The targets of samples n … n+H−1.
     ahead: Vec<f64>,
     offset: f64,
@@ -215,12 +272,17 @@ fn build(p: &Params, ctx: &BuildContext) -> Result<Box<dyn Node>, NodeError> {
     let window = ((WINDOW.get(p) * 1e-3 * ctx.rate).round() as usize).max(1);
     let budget = BUDGET.get(p);
     let cutoff = HIGHPASS.get(p);
-    let highpass = if cutoff > 0.0 {
+    let per_cm = HIGHPASS_SPATIAL.get(p);
+    let highpass = if per_cm > 0.0 {
+        let (lo, hi) = TRACKING_RANGE;
+        let ceiling = if cutoff > 0.0 { cutoff } else { hi };
+        Highpass::Tracking { filter: TrackingHighpass::new(ctx.rate, lo, ceiling), per_cm }
+    } else if cutoff > 0.0 {
         let sections = butterworth(Kind::Highpass, HIGHPASS_ORDER, cutoff, ctx.rate)
             .map_err(|e| NodeError::param(HIGHPASS.name(), e.to_string()))?;
-        Some(Cascade::new(&sections))
+        Highpass::Fixed(Cascade::new(&sections))
     } else {
-        None
+        Highpass::Off
     };
     Ok(Box::new(Live {
         highpass,
@@ -277,23 +339,14 @@ impl Node for Live {
         let h = self.ahead.len();
         for k in 0..io.len() {
             let f = self.finite(io.input(FORCE)[k]);
-            let f = match &mut self.highpass {
-                Some(hp) => {
-                    // A force near ±f64::MAX overflows the filter's state:
-                    // it starts again from rest, the sample read as 0.
-                    let g = hp.tick(f);
-                    if g.is_finite() {
-                        g
-                    } else {
-                        hp.reset();
-                        self.bad_inputs += 1;
-                        0.0
-                    }
-                }
-                None => f,
-            };
             let load = self.finite(io.input(LOAD)[k]);
             let v = self.finite(io.input(VELOCITY)[k]);
+            // A force near ±f64::MAX overflows the filter's state: it starts
+            // again from rest, the sample read as 0.
+            let f = self.highpass.tick(f, v).unwrap_or_else(|| {
+                self.bad_inputs += 1;
+                0.0
+            });
             if self.n == 0 {
                 self.ahead.fill(f);
             } else {
@@ -331,9 +384,7 @@ impl Node for Live {
     fn reset(&mut self) {
         self.horizon.reset();
         self.troughs.reset();
-        if let Some(hp) = &mut self.highpass {
-            hp.reset();
-        }
+        self.highpass.reset();
         self.ahead.fill(0.0);
         self.n = 0;
         self.total_iterations = 0;

@@ -1,0 +1,48 @@
+//! contrib/slurm's array scripts, run by bash as Slurm would run one task
+//! (its environment set by hand): rerunning one task of an array alone
+//! (`sbatch --array=6`, so Slurm counts one task) works when the array's
+//! size is given, and says how when it is not (issue 37, point 16).
+
+use std::path::{Path, PathBuf};
+use std::process::{Command, Output};
+
+fn root() -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR")).parent().expect("workspace root").to_path_buf()
+}
+
+/// model-grid.sbatch as array task `task` of a rerun that Slurm sees as
+/// `count` tasks, in `dir` (graphs linked there), cut short by `--set`s.
+fn task(dir: &Path, task: &str, count: &str, shards: Option<&str>) -> Output {
+    let mut c = Command::new("bash");
+    c.arg(root().join("contrib/slurm/model-grid.sbatch"))
+        .args(["--set", "epochs=1", "--set", "samples=600", "--set", "passes=2"])
+        .current_dir(dir)
+        .env("EVFLOW_BIN", env!("CARGO_BIN_EXE_evflow"))
+        .env("SLURM_ARRAY_TASK_ID", task)
+        .env("SLURM_ARRAY_TASK_COUNT", count)
+        .env_remove("EVFLOW_SHARDS");
+    if let Some(n) = shards {
+        c.env("EVFLOW_SHARDS", n);
+    }
+    c.output().expect("bash runs")
+}
+
+#[test]
+fn one_task_of_an_array_reruns_alone_given_the_arrays_size() {
+    let dir = tempfile::tempdir().unwrap();
+    std::os::unix::fs::symlink(root().join("graphs"), dir.path().join("graphs")).unwrap();
+    // Slurm counts one task in `sbatch --array=6`: without the array's
+    // size the task stops and says how to give it.
+    let o = task(dir.path(), "6", "1", None);
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert_eq!(o.status.code(), Some(2), "{err}");
+    assert!(err.contains("EVFLOW_SHARDS=9 sbatch --array=6 contrib/slurm/model-grid.sbatch"), "{err}");
+    assert!(!dir.path().join("parts/grid/6").exists());
+    // With it, task 6 runs the sixth of the nine runs and writes its record.
+    let o = task(dir.path(), "6", "1", Some("9"));
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let record = std::fs::read_to_string(dir.path().join("parts/grid/6/shard.json")).unwrap();
+    let record: serde_json::Value = serde_json::from_str(&record).unwrap();
+    assert_eq!(record["range"], serde_json::json!([5, 6]), "{record}");
+    assert!(dir.path().join("parts/grid/6/narx-85g-5cms.json").exists(), "the sixth run is mass=85 speed=5");
+}

@@ -158,7 +158,7 @@ impl End<'_> {
                 println!("{node}: {l}");
             }
             for (k, v, unit) in &s.values {
-                println!("{node}: {k} = {v}{}", unit_suffix(unit));
+                println!("{node}: {k} = {}{}", evflow_tools::batch::tables::number(*v), unit_suffix(unit));
             }
         }
     }

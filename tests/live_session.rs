@@ -37,9 +37,15 @@ fn live(session: &Path, args: &[&str]) -> Command {
 }
 
 fn replay(session: &Path, args: &[&str]) -> (bool, String) {
-    let out = Command::new(evflow()).arg("replay").arg(session).args(args).output().expect("evflow replay");
-    let text = String::from_utf8_lossy(&out.stdout).into_owned() + &String::from_utf8_lossy(&out.stderr);
-    (out.status.success(), text)
+    let (code, out, err) = replay_apart(&[session.as_os_str()], args);
+    (code == Some(0), out + &err)
+}
+
+/// `evflow replay SESSIONS ARGS`: the exit code, stdout and stderr.
+fn replay_apart(sessions: &[&std::ffi::OsStr], args: &[&str]) -> (Option<i32>, String, String) {
+    let out = Command::new(evflow()).arg("replay").args(sessions).args(args).output().expect("evflow replay");
+    let text = |b: &[u8]| String::from_utf8_lossy(b).into_owned();
+    (out.status.code(), text(&out.stdout), text(&out.stderr))
 }
 
 /// Frames the sidecar of a live recording claims (0 when not yet readable).
@@ -74,11 +80,34 @@ fn a_session_killed_with_sigkill_leaves_readable_recordings_that_replay_exactly(
     }
     let out = Recording::open(&s.join("outputs/limit.out")).unwrap();
     assert!(out.channel("out").unwrap().iter().all(|x| x.is_finite() && x.abs() <= 1.0));
-    let (ok, text) = replay(&s, &["--check", "-q"]);
+    let (ok, text) = replay(&s, &["-q"]);
     assert!(ok, "{text}");
     assert!(text.contains("limit.out: identical to the live session, bit for bit"), "{text}");
     // What a killed session cannot prove is said.
     assert!(text.contains("could not check that the recordings are whole: the session did not end"), "{text}");
+
+    // Issue 37, point 4: `--check` cannot prove a killed session — nor one
+    // of its outputs cut to half, which a killed session cannot tell from
+    // a short one: exit status 3 (not 0, not 1), and why on stderr, with -q.
+    let halved = tmp.path().join("halved");
+    copy_session(&s, &halved);
+    let p = halved.join("outputs/limit.out.wav");
+    let len = std::fs::metadata(&p).unwrap().len();
+    std::fs::OpenOptions::new().write(true).open(&p).unwrap().set_len(44 + (len - 44) / 2).unwrap();
+    let why = "the replay could not prove the live session: could not check that the recordings are whole: \
+               the session did not end (status `running`: killed?)";
+    for session in [&s, &halved] {
+        let (code, out, err) = replay_apart(&[session.as_os_str()], &["--check", "-q"]);
+        assert_eq!(code, Some(3), "{}: {out}{err}", session.display());
+        assert!(err.contains(why), "{err}");
+        assert!(out.contains("limit.out: identical to the live session, bit for bit"), "{out}");
+    }
+    // Several sessions: the same status when none failed otherwise.
+    let out_dir = tmp.path().join("replays");
+    let (code, out, err) =
+        replay_apart(&[s.as_os_str(), halved.as_os_str()], &["--check", "-q", "--out", out_dir.to_str().unwrap()]);
+    assert_eq!(code, Some(3), "{out}{err}");
+    assert!(err.contains("2 of 2 sessions failed") && err.contains("could not prove it"), "{err}");
 }
 
 #[test]

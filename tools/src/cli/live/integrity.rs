@@ -7,9 +7,10 @@
 //! count and a fingerprint of its samples (`end.files[].hash`). `evflow
 //! replay --check` holds the folder to them: a file cut short, a changed
 //! input (whether or not it feeds a recorded output), another seed or
-//! graph is a failure, named; what cannot be checked (a session killed
-//! before it ended has no end) is said. Fingerprints are FNV-1a, 64 bits —
-//! they catch accidents and careless edits, not a forger.
+//! graph is a failure, named ([`Verdict::Fails`]); what
+//! cannot be checked (a session killed before it ended has no end) is said
+//! and leaves the session unproven ([`Verdict::Unproven`]). Fingerprints are
+//! FNV-1a, 64 bits — they catch accidents and careless edits, not a forger.
 
 use super::session::{FileSpec, Manifest};
 use serde_json::Value;
@@ -61,17 +62,30 @@ pub fn identity(
     format!("fnv1a64:{:016x}", fnv(FNV_START, text.as_bytes()))
 }
 
+/// What a finding means for the check.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Verdict {
+    /// Something is not as the session recorded it: the check fails.
+    Fails,
+    /// Something could not be checked: the check cannot prove the session.
+    Unproven,
+}
+
 /// One thing the check found.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Finding {
-    /// Whether it holds (false: the check fails).
-    pub ok: bool,
+    /// Whether it fails the check or leaves it unproven.
+    pub verdict: Verdict,
     /// What, for people.
     pub what: String,
 }
 
 fn bad(what: String) -> Finding {
-    Finding { ok: false, what }
+    Finding { verdict: Verdict::Fails, what }
+}
+
+fn unproven(what: String) -> Finding {
+    Finding { verdict: Verdict::Unproven, what }
 }
 
 /// Holds the session folder `dir` (its manifest `m`, read as `raw`) to what
@@ -93,20 +107,16 @@ pub fn check(dir: &Path, m: &Manifest, raw: &Value) -> Vec<Finding> {
                 ));
             }
         }
-        _ => out.push(Finding {
-            ok: true,
-            what: "could not check the graph and the seed: the session was recorded without fingerprints".into(),
-        }),
+        _ => out.push(unproven(
+            "could not check the graph and the seed: the session was recorded without fingerprints".into(),
+        )),
     }
     let status = raw["status"].as_str().unwrap_or("");
     let Some(files) = raw["end"]["files"].as_array() else {
-        out.push(Finding {
-            ok: true,
-            what: format!(
-                "could not check that the recordings are whole: the session did not end (status `{status}`: \
-                 killed?), so it recorded neither their lengths nor their fingerprints; what they hold was compared"
-            ),
-        });
+        out.push(unproven(format!(
+            "could not check that the recordings are whole: the session did not end (status `{status}`: \
+             killed?), so it recorded neither their lengths nor their fingerprints; what they hold was compared"
+        )));
         return out;
     };
     let ticks = raw["end"]["ticks"].as_u64();
@@ -131,10 +141,10 @@ pub fn check(dir: &Path, m: &Manifest, raw: &Value) -> Vec<Finding> {
             (Some(want), Ok(now)) if want != now => {
                 out.push(bad(format!("{}: its samples changed since the session wrote them", f.file)))
             }
-            (None, _) => out.push(Finding {
-                ok: true,
-                what: format!("could not check the samples of {}: the session recorded no fingerprint", f.file),
-            }),
+            (None, _) => out.push(unproven(format!(
+                "could not check the samples of {}: the session recorded no fingerprint",
+                f.file
+            ))),
             _ => {}
         }
         // The session's length: every stream as long as its ticks say, bar the gaps it logged.

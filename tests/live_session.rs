@@ -181,6 +181,11 @@ fn replay_check_proves_the_whole_session_and_names_every_tampering() {
     let (ok, text) = replay(&s, &["--check", "-q"]);
     assert!(ok && !text.contains("could not check"), "{text}");
     type Tamper = Box<dyn Fn(&Path)>;
+    let edit_json = |p: &Path, f: &dyn Fn(&mut serde_json::Value)| {
+        let mut v: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(p).unwrap()).unwrap();
+        f(&mut v);
+        std::fs::write(p, v.to_string()).unwrap();
+    };
     let wav_len = |p: &Path| std::fs::metadata(p).unwrap().len();
     let cases: Vec<(&str, Tamper, &str)> = vec![
         (
@@ -231,15 +236,52 @@ fn replay_check_proves_the_whole_session_and_names_every_tampering() {
             }),
             "graph.toml: changed since the session ran it",
         ),
+        // Issue 37, point 5.
+        (
+            "an output sidecar's frames minus one",
+            Box::new(move |d: &Path| {
+                edit_json(&d.join("outputs/limit.out.json"), &|v| {
+                    v["frames"] = serde_json::json!(v["frames"].as_u64().unwrap() - 1)
+                })
+            }),
+            "outputs/limit.out.json: says 1010 frames, the session wrote 1011",
+        ),
+        (
+            "an extra file in inputs",
+            Box::new(|d: &Path| {
+                std::fs::copy(d.join("inputs/tribometer.wav"), d.join("inputs/extra.wav")).unwrap();
+            }),
+            "inputs/extra.wav: not a file the session wrote",
+        ),
+        (
+            "session.json padded with an unknown key",
+            Box::new(move |d: &Path| edit_json(&d.join("session.json"), &|v| v["padding"] = serde_json::json!("x"))),
+            "session.json: `padding` is not a key a session writes",
+        ),
+        (
+            "an unknown key in a file's entry",
+            Box::new(move |d: &Path| {
+                edit_json(&d.join("session.json"), &|v| v["outputs"][0]["note"] = serde_json::json!(1))
+            }),
+            "session.json: `outputs[0].note` is not a key a session writes",
+        ),
     ];
     for (what, tamper, said) in cases {
         let t = tmp.path().join(what.replace(' ', "-"));
         copy_session(&s, &t);
         tamper(&t);
-        let (ok, text) = replay(&t, &["--check", "-q"]);
-        assert!(!ok, "{what}: the check passed:\n{text}");
-        assert!(text.contains(said), "{what}: {text}");
+        let (code, out, err) = replay_apart(&[t.as_os_str()], &["--check", "-q"]);
+        assert_eq!(code, Some(1), "{what}: the check did not fail:\n{out}{err}");
+        let named = out.lines().any(|l| l.starts_with("not the session's: ") && l.contains(said));
+        assert!(named, "{what}: {out}");
     }
+    // Accepted by design (docs/security.md): `graph_source` says where the
+    // graph file was when the session started; the replay never reads it.
+    let t = tmp.path().join("graph-source");
+    copy_session(&s, &t);
+    edit_json(&t.join("session.json"), &|v| v["graph_source"] = serde_json::json!("/elsewhere/other.toml"));
+    let (ok, text) = replay(&t, &["--check", "-q"]);
+    assert!(ok && !text.contains("not the session's"), "{text}");
 }
 
 #[test]

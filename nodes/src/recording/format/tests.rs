@@ -276,6 +276,12 @@ fn truncated_file_is_read_up_to_its_last_whole_frame() {
     let json = dir.path().join("cut.json");
     fs::write(&json, fs::read_to_string(&json).unwrap().replace("\"frames\": 1000", "\"frames\": 1200")).unwrap();
     assert_eq!(Recording::open(&p).unwrap().shortfall(), Some(Shortfall { claimed: 1200, present: 1000 }));
+    assert_eq!(Recording::open(&p).unwrap().sidecar_frames(), 1200);
+    // Claiming fewer is no shortfall (a live writer killed before it rewrote
+    // its sidecar), but what the sidecar says is there to see.
+    fs::write(&json, fs::read_to_string(&json).unwrap().replace("\"frames\": 1200", "\"frames\": 999")).unwrap();
+    let r = Recording::open(&p).unwrap();
+    assert_eq!((r.frames(), r.shortfall(), r.sidecar_frames()), (1000, None, 999));
 
     // Cut inside the header: not a WAV any more.
     fs::write(&p, &bytes[..30]).unwrap();

@@ -37,9 +37,15 @@ fn live(session: &Path, args: &[&str]) -> Command {
 }
 
 fn replay(session: &Path, args: &[&str]) -> (bool, String) {
-    let out = Command::new(evflow()).arg("replay").arg(session).args(args).output().expect("evflow replay");
-    let text = String::from_utf8_lossy(&out.stdout).into_owned() + &String::from_utf8_lossy(&out.stderr);
-    (out.status.success(), text)
+    let (code, out, err) = replay_apart(&[session.as_os_str()], args);
+    (code == Some(0), out + &err)
+}
+
+/// `evflow replay SESSIONS ARGS`: the exit code, stdout and stderr.
+fn replay_apart(sessions: &[&std::ffi::OsStr], args: &[&str]) -> (Option<i32>, String, String) {
+    let out = Command::new(evflow()).arg("replay").args(sessions).args(args).output().expect("evflow replay");
+    let text = |b: &[u8]| String::from_utf8_lossy(b).into_owned();
+    (out.status.code(), text(&out.stdout), text(&out.stderr))
 }
 
 /// Frames the sidecar of a live recording claims (0 when not yet readable).
@@ -74,11 +80,34 @@ fn a_session_killed_with_sigkill_leaves_readable_recordings_that_replay_exactly(
     }
     let out = Recording::open(&s.join("outputs/limit.out")).unwrap();
     assert!(out.channel("out").unwrap().iter().all(|x| x.is_finite() && x.abs() <= 1.0));
-    let (ok, text) = replay(&s, &["--check", "-q"]);
+    let (ok, text) = replay(&s, &["-q"]);
     assert!(ok, "{text}");
     assert!(text.contains("limit.out: identical to the live session, bit for bit"), "{text}");
     // What a killed session cannot prove is said.
     assert!(text.contains("could not check that the recordings are whole: the session did not end"), "{text}");
+
+    // Issue 37, point 4: `--check` cannot prove a killed session — nor one
+    // of its outputs cut to half, which a killed session cannot tell from
+    // a short one: exit status 3 (not 0, not 1), and why on stderr, with -q.
+    let halved = tmp.path().join("halved");
+    copy_session(&s, &halved);
+    let p = halved.join("outputs/limit.out.wav");
+    let len = std::fs::metadata(&p).unwrap().len();
+    std::fs::OpenOptions::new().write(true).open(&p).unwrap().set_len(44 + (len - 44) / 2).unwrap();
+    let why = "the replay could not prove the live session: could not check that the recordings are whole: \
+               the session did not end (status `running`: killed?)";
+    for session in [&s, &halved] {
+        let (code, out, err) = replay_apart(&[session.as_os_str()], &["--check", "-q"]);
+        assert_eq!(code, Some(3), "{}: {out}{err}", session.display());
+        assert!(err.contains(why), "{err}");
+        assert!(out.contains("limit.out: identical to the live session, bit for bit"), "{out}");
+    }
+    // Several sessions: the same status when none failed otherwise.
+    let out_dir = tmp.path().join("replays");
+    let (code, out, err) =
+        replay_apart(&[s.as_os_str(), halved.as_os_str()], &["--check", "-q", "--out", out_dir.to_str().unwrap()]);
+    assert_eq!(code, Some(3), "{out}{err}");
+    assert!(err.contains("2 of 2 sessions failed") && err.contains("could not prove it"), "{err}");
 }
 
 #[test]
@@ -152,6 +181,11 @@ fn replay_check_proves_the_whole_session_and_names_every_tampering() {
     let (ok, text) = replay(&s, &["--check", "-q"]);
     assert!(ok && !text.contains("could not check"), "{text}");
     type Tamper = Box<dyn Fn(&Path)>;
+    let edit_json = |p: &Path, f: &dyn Fn(&mut serde_json::Value)| {
+        let mut v: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(p).unwrap()).unwrap();
+        f(&mut v);
+        std::fs::write(p, v.to_string()).unwrap();
+    };
     let wav_len = |p: &Path| std::fs::metadata(p).unwrap().len();
     let cases: Vec<(&str, Tamper, &str)> = vec![
         (
@@ -202,15 +236,52 @@ fn replay_check_proves_the_whole_session_and_names_every_tampering() {
             }),
             "graph.toml: changed since the session ran it",
         ),
+        // Issue 37, point 5.
+        (
+            "an output sidecar's frames minus one",
+            Box::new(move |d: &Path| {
+                edit_json(&d.join("outputs/limit.out.json"), &|v| {
+                    v["frames"] = serde_json::json!(v["frames"].as_u64().unwrap() - 1)
+                })
+            }),
+            "outputs/limit.out.json: says 1010 frames, the session wrote 1011",
+        ),
+        (
+            "an extra file in inputs",
+            Box::new(|d: &Path| {
+                std::fs::copy(d.join("inputs/tribometer.wav"), d.join("inputs/extra.wav")).unwrap();
+            }),
+            "inputs/extra.wav: not a file the session wrote",
+        ),
+        (
+            "session.json padded with an unknown key",
+            Box::new(move |d: &Path| edit_json(&d.join("session.json"), &|v| v["padding"] = serde_json::json!("x"))),
+            "session.json: `padding` is not a key a session writes",
+        ),
+        (
+            "an unknown key in a file's entry",
+            Box::new(move |d: &Path| {
+                edit_json(&d.join("session.json"), &|v| v["outputs"][0]["note"] = serde_json::json!(1))
+            }),
+            "session.json: `outputs[0].note` is not a key a session writes",
+        ),
     ];
     for (what, tamper, said) in cases {
         let t = tmp.path().join(what.replace(' ', "-"));
         copy_session(&s, &t);
         tamper(&t);
-        let (ok, text) = replay(&t, &["--check", "-q"]);
-        assert!(!ok, "{what}: the check passed:\n{text}");
-        assert!(text.contains(said), "{what}: {text}");
+        let (code, out, err) = replay_apart(&[t.as_os_str()], &["--check", "-q"]);
+        assert_eq!(code, Some(1), "{what}: the check did not fail:\n{out}{err}");
+        let named = out.lines().any(|l| l.starts_with("not the session's: ") && l.contains(said));
+        assert!(named, "{what}: {out}");
     }
+    // Accepted by design (docs/security.md): `graph_source` says where the
+    // graph file was when the session started; the replay never reads it.
+    let t = tmp.path().join("graph-source");
+    copy_session(&s, &t);
+    edit_json(&t.join("session.json"), &|v| v["graph_source"] = serde_json::json!("/elsewhere/other.toml"));
+    let (ok, text) = replay(&t, &["--check", "-q"]);
+    assert!(ok && !text.contains("not the session's"), "{text}");
 }
 
 #[test]

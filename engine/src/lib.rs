@@ -8,6 +8,7 @@
 //! time, through the same [`plan::Plan::step`].
 #![deny(missing_docs)]
 
+pub mod atomic_file;
 pub mod batch;
 pub mod check;
 pub mod diag;

@@ -182,10 +182,7 @@ fn read_index(dir: &Path) -> Result<Vec<Entry>> {
 
 /// Writes `text` to `path` through a temporary file beside it.
 fn write_atomic(path: &Path, text: &str) -> Result<()> {
-    let tmp = path.with_extension("json.tmp");
-    std::fs::write(&tmp, text)
-        .and_then(|_| std::fs::rename(&tmp, path))
-        .map_err(|e| io(path, format!("cannot write: {e}")))
+    evflow_engine::atomic_file::write_atomically(path, text).map_err(|e| io(path, format!("cannot write: {e}")))
 }
 
 /// The index's format name.

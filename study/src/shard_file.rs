@@ -36,13 +36,13 @@ pub fn under(base: &Path, dir: &Path) -> PathBuf {
     }
 }
 
-/// Writes `value` to `dir/name` as JSON, through `dir/.name.tmp`.
+/// Writes `value` to `dir/name` as JSON, through `dir/name.tmp`
+/// (`evflow_engine::atomic_file`).
 pub fn write<T: Serialize>(dir: &Path, name: &str, value: &T) -> Result<(), StudyError> {
     let path = dir.join(name);
-    let tmp = dir.join(format!(".{name}.tmp"));
     let io = |e: std::io::Error| StudyError::Io { path: path.clone(), message: e.to_string() };
     let text = serde_json::to_string_pretty(value).map_err(|e| io(e.into()))?;
-    std::fs::write(&tmp, text).and_then(|_| std::fs::rename(&tmp, &path)).map_err(io)
+    evflow_engine::atomic_file::write_atomically(&path, text).map_err(io)
 }
 
 /// Reads `dir/name`: `command` is what writes it (named when the file is

@@ -97,6 +97,10 @@ enum Command {
     /// Run a graph offline over a recorded session and compare its outputs
     /// with the live ones (bit for bit with the session's own graph).
     ///
+    /// Exit status with --check: 0 proven, 1 something differs (or the
+    /// replay failed), 3 nothing differs but something could not be checked
+    /// (a session killed before it ended).
+    ///
     /// Example: evflow replay sessions/display-live-20250101-120000 --check
     Replay(cli::replay::Args),
     /// Measure how well a method renders against ground truth, next to its
@@ -205,7 +209,11 @@ fn main() -> ExitCode {
         Err(e) => {
             // Whatever value reached the message, a person reads it cut.
             eprintln!("{}", evflow_engine::diag::cut_words(&format!("{e:#}"), evflow_engine::diag::MAX_WORD));
-            ExitCode::FAILURE
+            if e.downcast_ref::<cli::replay::Unproven>().is_some() {
+                ExitCode::from(cli::replay::UNPROVEN_EXIT)
+            } else {
+                ExitCode::FAILURE
+            }
         }
     }
 }

@@ -159,8 +159,10 @@ fn colour(i: usize) -> RGBColor {
     RGBColor(r, g, b)
 }
 
-/// Draws `plot` into `path` (PNG, 960×640). Written to a temporary file and
-/// renamed, so a failure leaves no half-written image.
+/// Draws `plot` into `path` (PNG, 960×640). Drawn in memory, then written
+/// to a new temporary file and renamed (`evflow_engine::atomic_file`), so a
+/// failure leaves no half-written image and nothing is written through a
+/// link.
 pub fn write_png(plot: &Plot, path: &Path) -> Result<Written, PlotError> {
     let shown = path.display().to_string();
     let series: Vec<Drawable<'_>> =
@@ -172,26 +174,41 @@ pub fn write_png(plot: &Plot, path: &Path) -> Result<Written, PlotError> {
     let xr = range(all().map(|p| p.0), plot.log_x);
     let yr = range(all().map(|p| p.1), plot.log_y);
     let labelled = font();
-    let tmp = path.with_extension("tmp.png");
     if let Some(dir) = path.parent().filter(|d| !d.as_os_str().is_empty()) {
         std::fs::create_dir_all(dir)
             .map_err(|e| PlotError::Draw { path: shown.clone(), message: format!("cannot create its folder: {e}") })?;
     }
-    let drawn = draw(plot, &series, xr, yr, labelled, &tmp);
-    let result = drawn.and_then(|()| std::fs::rename(&tmp, path).map_err(|e| e.to_string()));
-    if let Err(message) = result {
-        let _ = std::fs::remove_file(&tmp);
-        return Err(PlotError::Draw { path: shown, message });
-    }
+    let mut pixels = vec![0u8; SIZE.0 as usize * SIZE.1 as usize * 3];
+    let result = draw(plot, &series, xr, yr, labelled, &mut pixels).and_then(|()| {
+        evflow_engine::atomic_file::write_with(path, |f| encode_png(&pixels, f)).map_err(|e| e.to_string())
+    });
+    result.map_err(|message| PlotError::Draw { path: shown, message })?;
     Ok(Written { path: path.to_path_buf(), labelled })
+}
+
+/// Writes `pixels` (RGB, [`SIZE`]) to `out` as PNG with the encoder and
+/// settings plotters' own file output uses: the same bytes.
+fn encode_png(pixels: &[u8], out: &mut impl std::io::Write) -> std::io::Result<()> {
+    let mut w = std::io::BufWriter::new(out);
+    let png = image::codecs::png::PngEncoder::new(&mut w);
+    image::ImageEncoder::write_image(png, pixels, SIZE.0, SIZE.1, image::ColorType::Rgb8)
+        .map_err(std::io::Error::other)?;
+    std::io::Write::flush(&mut w)
 }
 
 /// A series with its index (for its colour) and its drawable points.
 type Drawable<'a> = (usize, &'a Series, Vec<(f64, f64)>);
 type Pts<'a> = [Drawable<'a>];
 
-fn draw(plot: &Plot, series: &Pts<'_>, xr: (f64, f64), yr: (f64, f64), text: bool, tmp: &Path) -> Result<(), String> {
-    let root = BitMapBackend::new(tmp, SIZE).into_drawing_area();
+fn draw(
+    plot: &Plot,
+    series: &Pts<'_>,
+    xr: (f64, f64),
+    yr: (f64, f64),
+    text: bool,
+    pixels: &mut [u8],
+) -> Result<(), String> {
+    let root = BitMapBackend::with_buffer(pixels, SIZE).into_drawing_area();
     root.fill(&WHITE).map_err(|e| e.to_string())?;
     let lx = || (xr.0..xr.1).log_scale().with_key_points(log_keys(xr));
     let ly = || (yr.0..yr.1).log_scale().with_key_points(log_keys(yr));
@@ -307,6 +324,26 @@ mod tests {
         assert_eq!(&bytes[..8], b"\x89PNG\r\n\x1a\n");
         let names: Vec<_> = std::fs::read_dir(dir.path()).unwrap().map(|e| e.unwrap().file_name()).collect();
         assert_eq!(names, vec![std::ffi::OsString::from("wp.png")]);
+    }
+
+    #[test]
+    fn the_png_is_byte_for_byte_what_plotters_writes_to_a_file() {
+        // Plots are drawn in memory and written through a new temporary
+        // (issue 37, point 2); the bytes are those plotters' file output wrote.
+        let dir = tempfile::tempdir().unwrap();
+        let scene = |root: DrawingArea<BitMapBackend<'_>, plotters::coord::Shift>| {
+            root.fill(&WHITE).unwrap();
+            let pts = (0..900).map(|x| (x + 30, 320 + ((x as f64 / 40.0).sin() * 250.0) as i32));
+            root.draw(&PathElement::new(pts.collect::<Vec<_>>(), colour(1).stroke_width(2))).unwrap();
+            root.present().unwrap();
+        };
+        let by_plotters = dir.path().join("plotters.png");
+        scene(BitMapBackend::new(&by_plotters, SIZE).into_drawing_area());
+        let mut pixels = vec![0u8; SIZE.0 as usize * SIZE.1 as usize * 3];
+        scene(BitMapBackend::with_buffer(&mut pixels, SIZE).into_drawing_area());
+        let mut ours = Vec::new();
+        encode_png(&pixels, &mut ours).unwrap();
+        assert_eq!(ours, std::fs::read(&by_plotters).unwrap());
     }
 
     #[test]

@@ -419,3 +419,57 @@ fn live_prints_values_as_run_does() {
     let significant = mantissa.chars().filter(char::is_ascii_digit).skip_while(|c| *c == '0').count();
     assert!(significant <= 6, "{rms}");
 }
+
+#[cfg(unix)]
+#[test]
+fn links_planted_at_the_temporary_names_are_never_written_through() {
+    // Issue 37, point 2: `ln -s /elsewhere/X.wav out/excitation-85g-5cms.wav.tmp`
+    // before `evflow run graphs/excitation.toml --out out` wrote the
+    // recording through the link (overwriting the file it points to) and
+    // renamed the link to the final name; the same for `.json.tmp` and the
+    // tables' temporaries.
+    let dir = tempfile::tempdir().unwrap();
+    let (out, elsewhere) = (dir.path().join("out"), dir.path().join("elsewhere"));
+    std::fs::create_dir_all(&out).unwrap();
+    std::fs::create_dir_all(&elsewhere).unwrap();
+    let planted = [
+        "excitation-85g-5cms.wav.tmp",
+        "excitation-85g-5cms.json.tmp",
+        "grid.csv.tmp",
+        ".grid.csv.tmp",
+        "results.json.tmp",
+        ".results.json.tmp",
+    ];
+    for (k, name) in planted.iter().enumerate() {
+        let target = elsewhere.join(format!("X{k}"));
+        std::fs::write(&target, "precious").unwrap();
+        std::os::unix::fs::symlink(&target, out.join(name)).unwrap();
+    }
+    let (csv, json) = (out.join("grid.csv"), out.join("results.json"));
+    let o = evflow(&[
+        "run",
+        "graphs/excitation.toml",
+        "--out",
+        out.to_str().unwrap(),
+        "--csv",
+        csv.to_str().unwrap(),
+        "--json",
+        json.to_str().unwrap(),
+    ]);
+    let (stdout, stderr) = text(&o);
+    assert!(o.status.success(), "{stdout}{stderr}");
+    for (k, name) in planted.iter().enumerate() {
+        let t = std::fs::read_to_string(elsewhere.join(format!("X{k}"))).unwrap();
+        assert_eq!(t, "precious", "written through the link {name}");
+    }
+    for name in ["excitation-85g-5cms.wav", "excitation-85g-5cms.json", "grid.csv", "results.json"] {
+        let m = std::fs::symlink_metadata(out.join(name)).unwrap();
+        assert!(m.file_type().is_file(), "{name} is not a regular file");
+    }
+    let r = evflow_nodes::recording::format::Recording::open(&out.join("excitation-85g-5cms")).unwrap();
+    assert_eq!(r.frames(), 3066);
+    // The planted links are left where they were, untouched.
+    for name in planted {
+        assert!(std::fs::symlink_metadata(out.join(name)).unwrap().file_type().is_symlink(), "{name}");
+    }
+}

@@ -192,12 +192,8 @@ fn write_cache(path: &Path, key: u64, r: &Range, triangles: usize) -> Result<(),
             "std": format!("{:016x}", r.std.to_bits()),
         },
     });
-    let tmp = path.with_extension(format!("tmp{}", std::process::id()));
-    std::fs::write(&tmp, serde_json::to_string_pretty(&body).unwrap_or_default()).map_err(err)?;
-    std::fs::rename(&tmp, path).map_err(|e| {
-        let _ = std::fs::remove_file(&tmp);
-        err(e)
-    })
+    evflow_engine::atomic_file::write_atomically(path, serde_json::to_string_pretty(&body).unwrap_or_default())
+        .map_err(err)
 }
 
 #[cfg(test)]

@@ -1,30 +1,17 @@
-//! Writing a whole file so that a reader never sees half of it: through
-//! `PATH.tmp`, synced, then renamed over `PATH` (the temporary file is
-//! removed when anything fails). Model files (`narx.train`,
+//! Writing a whole text file so that a reader never sees half of it, with
+//! its folder: through `PATH.tmp`, synced, then renamed over `PATH`, the
+//! temporary a new file and never a link planted at its name
+//! ([`evflow_engine::atomic_file`]). Model files (`narx.train`,
 //! `forward.train`) are written this way.
 
-use std::io::Write;
-use std::path::{Path, PathBuf};
+use std::path::Path;
 
 /// Writes `text` and a final newline to `path`, creating its folder.
 pub fn write_atomically(path: &Path, text: &str) -> std::io::Result<()> {
     if let Some(dir) = path.parent().filter(|d| !d.as_os_str().is_empty()) {
         std::fs::create_dir_all(dir)?;
     }
-    let mut tmp = path.as_os_str().to_owned();
-    tmp.push(".tmp");
-    let tmp = PathBuf::from(tmp);
-    let result = (|| {
-        let mut f = std::fs::File::create(&tmp)?;
-        f.write_all(text.as_bytes())?;
-        f.write_all(b"\n")?;
-        f.sync_all()?;
-        std::fs::rename(&tmp, path)
-    })();
-    if result.is_err() {
-        let _ = std::fs::remove_file(&tmp);
-    }
-    result
+    evflow_engine::atomic_file::write_atomically(path, format!("{text}\n"))
 }
 
 #[cfg(test)]

@@ -222,11 +222,7 @@ impl RecordingPaths {
     /// The temporary files an atomically committed writer fills:
     /// `NAME.wav.tmp` and `NAME.json.tmp`, in the same folder.
     pub fn temporary(&self) -> Self {
-        let tmp = |p: &Path| {
-            let mut s = p.as_os_str().to_owned();
-            s.push(".tmp");
-            PathBuf::from(s)
-        };
-        Self { wav: tmp(&self.wav), json: tmp(&self.json) }
+        use evflow_engine::atomic_file::temporary_name;
+        Self { wav: temporary_name(&self.wav), json: temporary_name(&self.json) }
     }
 }

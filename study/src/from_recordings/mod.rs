@@ -321,10 +321,7 @@ fn build_in(inputs: &Inputs, s: &Survey, partial: &Path, progress: &(dyn Fn(&str
     }
     let text = serde_json::to_string_pretty(&index).map_err(|e| io(&inputs.out, e))?;
     let path = inputs.out.join("index.json");
-    let tmp = path.with_extension("json.tmp");
-    std::fs::write(&tmp, text)
-        .and_then(|_| std::fs::rename(&tmp, &path))
-        .map_err(|e| io(&path, format!("cannot write: {e}")))?;
+    evflow_engine::atomic_file::write_atomically(&path, text).map_err(|e| io(&path, format!("cannot write: {e}")))?;
     Ok(Outcome {
         dir: inputs.out.clone(),
         conditions: s.excitation.iter().map(|e| e.cond).collect(),

@@ -188,7 +188,7 @@ mod tests {
         let dir = tempfile::tempdir().unwrap();
         let rec = record(Shard::ALL);
         rec.write(dir.path()).unwrap();
-        assert!(!dir.path().join(format!(".{NARX_RECORD}.tmp")).exists());
+        assert!(!dir.path().join(format!("{NARX_RECORD}.tmp")).exists());
         let back = NarxRecord::read(dir.path()).unwrap();
         // NaN is not equal to itself: compare the bits.
         let bits = |r: &NarxRecord| -> Vec<[u64; 4]> {

@@ -51,11 +51,9 @@ pub enum RecordError {
 /// record is whole or absent.
 pub fn write_doc<T: Serialize>(dir: &Path, name: &str, doc: &T) -> Result<(), RecordError> {
     let path = dir.join(name);
-    let tmp = dir.join(format!(".{name}.tmp"));
     serde_json::to_string_pretty(doc)
         .map_err(std::io::Error::from)
-        .and_then(|text| std::fs::write(&tmp, text))
-        .and_then(|_| std::fs::rename(&tmp, &path))
+        .and_then(|text| evflow_engine::atomic_file::write_atomically(&path, text))
         .map_err(|source| RecordError::Write { path, source })
 }
 

@@ -347,7 +347,7 @@ pub(crate) mod tests {
         let dir = tempfile::tempdir().unwrap();
         let rec = record(Shard { k: 2, n: 3 }, 7, vec![run(1.0 / 7.0, 123_456_789), run(1e300, 0)]);
         rec.write(dir.path()).unwrap();
-        assert!(!dir.path().join(format!(".{RECORD}.tmp")).exists());
+        assert!(!dir.path().join(format!("{RECORD}.tmp")).exists());
         let back = ShardRecord::read(dir.path()).unwrap();
         assert_eq!(
             (back.graph.as_str(), back.shard, back.total, back.range.clone()),

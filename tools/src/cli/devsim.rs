@@ -315,10 +315,9 @@ impl Log {
             "bad_frames_received": d.stream.bad_crc + d.stream.truncated + d.stream.bad_length,
             "injected": { "bad_crc": i.bad_crc, "truncated": i.truncated, "garbage_bursts": i.garbage_bursts, "garbage_bytes": i.garbage_bytes },
         });
-        let tmp = self.dir.join("stats.json.tmp");
-        std::fs::write(&tmp, serde_json::to_string_pretty(&v)?)?;
-        std::fs::rename(&tmp, self.dir.join("stats.json"))?;
-        Ok(())
+        let path = self.dir.join("stats.json");
+        evflow_engine::atomic_file::write_atomically(&path, serde_json::to_string_pretty(&v)?)
+            .with_context(|| format!("{}: cannot write", path.display()))
     }
 
     fn finish(self, dev: &DeviceSession, c: &Corrupter, connects: u64) -> Result<()> {

@@ -3,7 +3,6 @@
 
 use anyhow::{Context, Result};
 use evflow_nodes::lab::family;
-use std::io::Write;
 use std::path::{Path, PathBuf};
 
 /// Arguments of `evflow family`.
@@ -18,16 +17,7 @@ pub struct Args {
 /// Writes `text` to `path` through a new temporary file beside it (never
 /// following a link planted at the temporary name), then renames it.
 fn write(path: &Path, text: &str) -> Result<()> {
-    let tmp = path.with_extension("tmp");
-    let _ = std::fs::remove_file(&tmp);
-    let mut f = std::fs::OpenOptions::new()
-        .write(true)
-        .create_new(true)
-        .open(&tmp)
-        .with_context(|| format!("{}: cannot create", tmp.display()))?;
-    f.write_all(text.as_bytes())
-        .and_then(|_| f.sync_all())
-        .and_then(|_| std::fs::rename(&tmp, path))
+    evflow_engine::atomic_file::write_atomically(path, text)
         .with_context(|| format!("{}: cannot write", path.display()))
 }
 

@@ -9,12 +9,14 @@
 //! offline step are the same code. With the session's own graph the folder
 //! is also held to what the session recorded of itself (`live::integrity`):
 //! its graph file, seed and files, each as long and as written as when it
-//! ended — or the replay says what it could not check.
+//! ended — or the replay says what it could not check, and `--check`
+//! ends with exit status [`UNPROVEN_EXIT`] ([`Unproven`]).
 //!
 //! Several sessions (`evflow replay S1 S2 … [GRAPH]`) replay on `--jobs`
 //! threads, each into its own folder under `--out`, printed in the order
 //! given; one that fails does not stop the others.
 
+use super::live::integrity::Verdict;
 use super::live::session::{read_events, FileSpec, LoggedEvent, Manifest};
 use anyhow::{anyhow, bail, Context, Result};
 use evflow_engine::batch::{for_each_ordered, Failures};
@@ -46,7 +48,14 @@ pub struct Args {
     /// per session in it, named as the session's folder).
     #[arg(long, value_name = "DIR", default_value = ".")]
     out: PathBuf,
-    /// Fail unless every recorded output is reproduced bit for bit.
+    /// Fail unless the replay proves the session: every recorded output
+    /// reproduced bit for bit and, with the session's own graph, the folder
+    /// as the session recorded it (graph, seed, files and their lengths and
+    /// fingerprints; docs/live.md). Exit status 1 when something differs or
+    /// is not the session's; 3 when nothing differs but something could not
+    /// be checked — a session killed before it ended, one recorded without
+    /// fingerprints, outputs compared only up to samples the session lost.
+    /// Why is printed on stderr, also with -q.
     #[arg(long)]
     check: bool,
     /// Print only the comparison.
@@ -54,6 +63,41 @@ pub struct Args {
     quiet: bool,
     #[command(flatten)]
     jobs: JobsArg,
+}
+
+/// The exit status of `replay --check` when nothing differs but something
+/// could not be checked (1: something differs, or the replay failed).
+pub const UNPROVEN_EXIT: u8 = 3;
+
+/// The error `replay --check` ends with when it could not prove a session
+/// it found no fault in; the program then exits with [`UNPROVEN_EXIT`].
+#[derive(Debug, thiserror::Error)]
+#[error("{0}")]
+pub struct Unproven(String);
+
+/// What a replay proved of its session.
+#[derive(Debug, Clone, PartialEq)]
+enum Proof {
+    /// Every recorded output reproduced bit for bit and, with the
+    /// session's own graph, the folder as the session recorded it.
+    Proven,
+    /// Something differs or is not the session's (said in the text).
+    Differs,
+    /// Nothing differs, but these could not be checked.
+    Unproven(Vec<String>),
+}
+
+impl Proof {
+    /// The error `--check` ends with, if any.
+    fn check(self) -> Result<()> {
+        match self {
+            Proof::Proven => Ok(()),
+            Proof::Differs => Err(anyhow!("the replay does not prove the live session (above: what differs)")),
+            Proof::Unproven(why) => {
+                Err(Unproven(format!("the replay could not prove the live session: {}", why.join("; "))).into())
+            }
+        }
+    }
 }
 
 /// How one recorded output compares with its replay.
@@ -77,13 +121,9 @@ pub fn main(a: Args) -> Result<()> {
         _ => None,
     };
     if let [session] = sessions.as_slice() {
-        let (text, ok) = replay_one(session, graph.as_deref(), &a.out, &a)?;
+        let (text, proof) = replay_one(session, graph.as_deref(), &a.out, &a)?;
         print!("{text}");
-        return if ok || !a.check {
-            Ok(())
-        } else {
-            Err(anyhow!("the replay does not prove the live session (above: what differs)"))
-        };
+        return if a.check { proof.check() } else { Ok(()) };
     }
     let mut outs: Vec<PathBuf> = Vec::with_capacity(sessions.len());
     for s in &sessions {
@@ -103,34 +143,47 @@ pub fn main(a: Args) -> Result<()> {
         r
     };
     let mut failures = Failures::new();
+    // Failures that are not merely unproven sessions.
+    let mut faults = 0;
     let items: Vec<&PathBuf> = sessions.iter().collect();
     for_each_ordered(items, a.jobs.jobs(), &AtomicBool::new(false), work, |k, outcome| {
         println!("── session {}/{n}: {} ──", k + 1, sessions[k].display());
+        let name = sessions[k].display().to_string();
         match outcome.map_err(|p| anyhow!(p)).and_then(|r| r) {
-            Ok((text, ok)) => {
+            Ok((text, proof)) => {
                 print!("{text}");
-                if a.check && !ok {
-                    failures.push(sessions[k].display().to_string(), "the replay does not prove the live session");
+                match proof {
+                    _ if !a.check => {}
+                    Proof::Proven => {}
+                    Proof::Differs => {
+                        failures.push(name, "the replay does not prove the live session");
+                        faults += 1;
+                    }
+                    Proof::Unproven(why) => failures.push(name, format!("could not prove it: {}", why.join("; "))),
                 }
             }
             Err(e) => {
                 println!("replay failed: {e:#}");
-                failures.push(sessions[k].display().to_string(), format!("{e:#}"));
+                failures.push(name, format!("{e:#}"));
+                faults += 1;
             }
         }
         println!();
     });
     evflow_tools::batch::finish(&bar);
-    if !failures.is_empty() {
-        bail!("{}", failures.summary(n, "sessions").trim_end());
+    if failures.is_empty() {
+        return Ok(());
     }
-    Ok(())
+    let summary = failures.summary(n, "sessions").trim_end().to_string();
+    if faults == 0 {
+        return Err(Unproven(summary).into());
+    }
+    bail!("{summary}")
 }
 
 /// Replays one session with `graph` (else its own), the graph's files
-/// written under `out`; returns what to print and whether every recorded
-/// output was reproduced bit for bit.
-fn replay_one(session: &Path, graph: Option<&Path>, out: &Path, a: &Args) -> Result<(String, bool)> {
+/// written under `out`; returns what to print and what it proved.
+fn replay_one(session: &Path, graph: Option<&Path>, out: &Path, a: &Args) -> Result<(String, Proof)> {
     let mut shown = String::new();
     let (m, raw) = Manifest::read_raw(session)?;
     let own = graph.is_none();
@@ -194,19 +247,36 @@ fn replay_one(session: &Path, graph: Option<&Path>, out: &Path, a: &Args) -> Res
         }
     }
     let mut all_same = compare_outputs(&mut shown, &recorded, &replayed, exact_until);
+    let mut unproven = Vec::new();
     if exact_until < ticks {
-        let _ =
-            writeln!(shown, "compared up to tick {exact_until} (the session lost samples or replaced its plan there)");
+        let why = format!(
+            "compared up to tick {exact_until} of {ticks} (the session lost samples or replaced its plan there)"
+        );
+        let _ = writeln!(shown, "{why}");
+        unproven.push(why);
     }
     // The folder held to what the session recorded of itself: its graph,
     // seed and files, every file as long and as written as it ended.
     if own {
         for f in super::live::integrity::check(&session_dir, &m, &raw) {
-            let _ = writeln!(shown, "{}{}", if f.ok { "" } else { "not the session's: " }, f.what);
-            all_same &= f.ok;
+            match f.verdict {
+                Verdict::Fails => {
+                    let _ = writeln!(shown, "not the session's: {}", f.what);
+                    all_same = false;
+                }
+                Verdict::Unproven => {
+                    let _ = writeln!(shown, "{}", f.what);
+                    unproven.push(f.what);
+                }
+            }
         }
     }
-    Ok((shown, all_same))
+    let proof = match (all_same, unproven.is_empty()) {
+        (false, _) => Proof::Differs,
+        (true, false) => Proof::Unproven(unproven),
+        (true, true) => Proof::Proven,
+    };
+    Ok((shown, proof))
 }
 
 /// Recorded inputs replace the sources of the same names in `graph`;

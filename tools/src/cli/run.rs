@@ -202,12 +202,9 @@ pub fn main(a: Args) -> Result<()> {
 }
 
 /// Writes `text` to `path` through a temporary file beside it (an
-/// interrupted write leaves no half file).
+/// interrupted write leaves no half file; `evflow_engine::atomic_file`).
 fn write(path: &std::path::Path, text: &str, what: &str) -> Result<()> {
-    let name = path.file_name().map(|n| n.to_string_lossy().into_owned()).unwrap_or_default();
-    let tmp = path.with_file_name(format!(".{name}.tmp"));
-    std::fs::write(&tmp, text)
-        .and_then(|_| std::fs::rename(&tmp, path))
+    evflow_engine::atomic_file::write_atomically(path, text)
         .map_err(|e| anyhow!("{}: cannot write {what}: {e}", path.display()))
 }
 

@@ -90,9 +90,7 @@ fn truth_of(stroke: &Path) -> PathBuf {
 
 /// Writes `text` to `path` through a temporary file beside it.
 fn save(path: &Path, text: &str) -> Result<()> {
-    let tmp = path.with_extension("tmp");
-    std::fs::write(&tmp, text)
-        .and_then(|_| std::fs::rename(&tmp, path))
+    evflow_engine::atomic_file::write_atomically(path, text)
         .with_context(|| format!("{}: cannot write", path.display()))?;
     println!("wrote {}", path.display());
     Ok(())

@@ -43,6 +43,7 @@ pub struct Recording {
     data: Vec<(usize, Vec<f64>)>,
     frames: usize,
     shortfall: Option<Shortfall>,
+    sidecar_frames: u64,
 }
 
 impl Recording {
@@ -177,7 +178,7 @@ impl Recording {
         if !keep {
             data.clear();
         }
-        Ok(Recording { paths, meta, data, frames, shortfall })
+        Ok(Recording { paths, meta, data, frames, shortfall, sidecar_frames })
     }
 
     /// The files it was read from.
@@ -208,6 +209,13 @@ impl Recording {
     /// The loaded channels' samples, in load order, taken out of the recording.
     pub fn into_channels(self) -> Vec<Vec<f64>> {
         self.data.into_iter().map(|(_, v)| v).collect()
+    }
+    /// The frames the sidecar says the recording holds: the writer's count
+    /// when it last wrote the sidecar. Equal to [`Recording::frames`] in a
+    /// finished recording; a live one killed between writing frames and
+    /// rewriting its sidecar says fewer (more is a [`Recording::shortfall`]).
+    pub fn sidecar_frames(&self) -> u64 {
+        self.sidecar_frames
     }
     /// Frames missing if the file was cut short, else `None`.
     pub fn shortfall(&self) -> Option<Shortfall> {

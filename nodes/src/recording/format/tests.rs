@@ -130,6 +130,39 @@ fn committed_writer_uses_temporary_files_until_finish() {
     assert_eq!(Recording::open(&p).unwrap().channel("pos").unwrap(), &[2.0]);
 }
 
+#[cfg(unix)]
+#[test]
+fn links_planted_at_the_temporary_names_are_never_written_through() {
+    // Issue 37, point 2: `ln -s /elsewhere/X.wav out/c.wav.tmp` before a run
+    // wrote the recording through the link and renamed the link into place.
+    let dir = tempfile::tempdir().unwrap();
+    let (out, elsewhere) = (dir.path().join("out"), dir.path().join("elsewhere"));
+    fs::create_dir_all(&out).unwrap();
+    fs::create_dir_all(&elsewhere).unwrap();
+    for ext in ["wav", "json"] {
+        fs::write(elsewhere.join(ext), "precious").unwrap();
+        std::os::unix::fs::symlink(elsewhere.join(ext), out.join(format!("c.{ext}.tmp"))).unwrap();
+        // The live writer's sidecar goes through `NAME.json.tmp` too.
+        std::os::unix::fs::symlink(elsewhere.join(ext), out.join(format!("l.{ext}.tmp"))).unwrap();
+    }
+    let mut w = RecordingWriter::create(&out.join("c.wav"), meta2()).unwrap();
+    w.write_frame(&[1.0, 2.0]).unwrap();
+    w.finish().unwrap();
+    let mut l = RecordingWriter::create_live(&out.join("l"), meta2()).unwrap();
+    l.write_frame(&[3.0, 4.0]).unwrap();
+    l.flush().unwrap();
+    l.finish().unwrap();
+    for ext in ["wav", "json"] {
+        assert_eq!(fs::read_to_string(elsewhere.join(ext)).unwrap(), "precious", "written through the .{ext}.tmp link");
+        for name in ["c", "l"] {
+            let m = fs::symlink_metadata(out.join(format!("{name}.{ext}"))).unwrap();
+            assert!(m.file_type().is_file(), "{name}.{ext} is not a regular file");
+        }
+    }
+    assert_eq!(Recording::open(&out.join("c.wav")).unwrap().channel("pos").unwrap(), &[2.0]);
+    assert_eq!(Recording::open(&out.join("l.wav")).unwrap().channel("pos").unwrap(), &[4.0]);
+}
+
 #[test]
 fn dropped_committed_writer_removes_its_files_and_keeps_the_old_recording() {
     let dir = tempfile::tempdir().unwrap();
@@ -243,6 +276,12 @@ fn truncated_file_is_read_up_to_its_last_whole_frame() {
     let json = dir.path().join("cut.json");
     fs::write(&json, fs::read_to_string(&json).unwrap().replace("\"frames\": 1000", "\"frames\": 1200")).unwrap();
     assert_eq!(Recording::open(&p).unwrap().shortfall(), Some(Shortfall { claimed: 1200, present: 1000 }));
+    assert_eq!(Recording::open(&p).unwrap().sidecar_frames(), 1200);
+    // Claiming fewer is no shortfall (a live writer killed before it rewrote
+    // its sidecar), but what the sidecar says is there to see.
+    fs::write(&json, fs::read_to_string(&json).unwrap().replace("\"frames\": 1200", "\"frames\": 999")).unwrap();
+    let r = Recording::open(&p).unwrap();
+    assert_eq!((r.frames(), r.shortfall(), r.sidecar_frames()), (1000, None, 999));
 
     // Cut inside the header: not a WAV any more.
     fs::write(&p, &bytes[..30]).unwrap();

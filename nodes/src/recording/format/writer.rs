@@ -3,6 +3,7 @@
 use super::reader::non_finite_word;
 use super::wav::{self, DATA_SIZE_AT, FACT_FRAMES_AT, HEADER_LEN, RIFF_SIZE_AT, SAMPLE_BYTES};
 use super::{sidecar_json, RecordingError, RecordingMeta, RecordingPaths};
+use evflow_engine::atomic_file::{create_temporary, write_atomically};
 use std::fs::{File, OpenOptions};
 use std::io::{Seek, SeekFrom, Write};
 use std::path::Path;
@@ -44,6 +45,8 @@ pub struct Written {
 #[derive(Debug)]
 pub struct RecordingWriter {
     file: Option<File>,
+    /// The temporary sidecar, held open from the start (offline only).
+    json_file: Option<File>,
     /// Where the bytes go now (temporary or final).
     now: RecordingPaths,
     /// The final names.
@@ -64,11 +67,12 @@ pub struct RecordingWriter {
 impl RecordingWriter {
     /// Starts an atomically committed recording at `path` (`NAME.wav`,
     /// `NAME.json` or `NAME`): writes to `NAME.wav.tmp` / `NAME.json.tmp`
-    /// until [`RecordingWriter::finish`] renames them. A missing folder on
-    /// the way is created.
+    /// until [`RecordingWriter::finish`] renames them. Both are new files,
+    /// never a file or link already at those names (another name is taken
+    /// then: [`evflow_engine::atomic_file::create_temporary`]). A missing
+    /// folder on the way is created.
     pub fn create(path: &Path, meta: RecordingMeta) -> Result<Self, RecordingError> {
-        let target = RecordingPaths::new(path);
-        Self::start(target.temporary(), target, meta, false)
+        Self::start(RecordingPaths::new(path), meta, false)
     }
 
     /// Starts a live recording at `path`, written directly to the final
@@ -82,35 +86,43 @@ impl RecordingWriter {
                 return Err(RecordingError::Exists { path: p.clone() });
             }
         }
-        Self::start(target.clone(), target, meta, true)
+        Self::start(target, meta, true)
     }
 
-    fn start(
-        now: RecordingPaths,
-        target: RecordingPaths,
-        meta: RecordingMeta,
-        live: bool,
-    ) -> Result<Self, RecordingError> {
+    fn start(target: RecordingPaths, meta: RecordingMeta, live: bool) -> Result<Self, RecordingError> {
         meta.check().map_err(|message| RecordingError::InvalidMeta { path: target.wav.clone(), message })?;
         let channels = meta.channels.len();
         // A recording may name a folder of its own (`grid/u-felt-60g-3cms`):
         // create it, as a shell's `mkdir -p` would.
-        if let Some(dir) = now.wav.parent().filter(|d| !d.as_os_str().is_empty()) {
+        if let Some(dir) = target.wav.parent().filter(|d| !d.as_os_str().is_empty()) {
             std::fs::create_dir_all(dir).map_err(|e| RecordingError::io(dir, e))?;
         }
-        let mut opts = OpenOptions::new();
-        opts.read(true).write(true);
-        if live {
-            opts.create_new(true);
+        // Live: the final name, refused if taken. Offline: two new
+        // temporaries, never a file or a link planted at their names.
+        let (file, json_file, now) = if live {
+            let file =
+                OpenOptions::new().read(true).write(true).create_new(true).open(&target.wav).map_err(|e| {
+                    match e.kind() {
+                        std::io::ErrorKind::AlreadyExists => RecordingError::Exists { path: target.wav.clone() },
+                        _ => RecordingError::io(&target.wav, e),
+                    }
+                })?;
+            (file, None, target.clone())
         } else {
-            opts.create(true).truncate(true);
-        }
-        let file = opts.open(&now.wav).map_err(|e| match e.kind() {
-            std::io::ErrorKind::AlreadyExists => RecordingError::Exists { path: now.wav.clone() },
-            _ => RecordingError::io(&now.wav, e),
-        })?;
+            let (file, wav) = create_temporary(&target.wav).map_err(|e| RecordingError::io(&target.wav, e))?;
+            let (json_file, json) = match create_temporary(&target.json) {
+                Ok(made) => made,
+                Err(e) => {
+                    drop(file);
+                    let _ = std::fs::remove_file(&wav);
+                    return Err(RecordingError::io(&target.json, e));
+                }
+            };
+            (file, Some(json_file), RecordingPaths { wav, json })
+        };
         let mut w = RecordingWriter {
             file: Some(file),
+            json_file,
             header_rate: wav::header_rate(meta.rate),
             block: channels * SAMPLE_BYTES,
             max_frames: wav::max_frames(channels),
@@ -248,6 +260,7 @@ impl RecordingWriter {
         let path = self.now.wav.clone();
         self.file()?.sync_all().map_err(|e| RecordingError::io(&path, e))?;
         self.write_sidecar()?;
+        self.json_file = None;
         if !self.live {
             for (from, to) in [(&self.now.wav, &self.target.wav), (&self.now.json, &self.target.json)] {
                 std::fs::rename(from, to).map_err(|e| RecordingError::io(to, e))?;
@@ -267,11 +280,9 @@ impl RecordingWriter {
     fn discard(&mut self) {
         self.done = true;
         self.file = None; // close before removing (required on Windows)
+        self.json_file = None;
         let _ = std::fs::remove_file(&self.now.wav);
         let _ = std::fs::remove_file(&self.now.json);
-        if self.live {
-            let _ = std::fs::remove_file(self.target.temporary().json);
-        }
     }
 
     fn file(&mut self) -> Result<&mut File, RecordingError> {
@@ -312,24 +323,21 @@ impl RecordingWriter {
 
     /// Writes the sidecar for the frames on disk: through `NAME.json.tmp`
     /// and a rename when live (so a reader never sees half a sidecar),
-    /// straight to the temporary sidecar otherwise.
-    fn write_sidecar(&self) -> Result<(), RecordingError> {
+    /// into the temporary sidecar created at the start otherwise (rewritten
+    /// through its open handle). Either way never through a link at a name.
+    fn write_sidecar(&mut self) -> Result<(), RecordingError> {
         let text = sidecar_json(&self.meta, self.on_disk);
         if self.live {
-            let tmp = self.target.temporary().json;
-            write_synced(&tmp, &text)?;
-            std::fs::rename(&tmp, &self.target.json).map_err(|e| RecordingError::io(&self.target.json, e))
-        } else {
-            write_synced(&self.now.json, &text)
+            return write_atomically(&self.target.json, text).map_err(|e| RecordingError::io(&self.target.json, e));
         }
+        let path = &self.now.json;
+        let io = |e| RecordingError::io(path, e);
+        let f = self.json_file.as_mut().ok_or_else(|| io(std::io::Error::other("writer already closed")))?;
+        f.set_len(0).map_err(io)?;
+        f.seek(SeekFrom::Start(0)).map_err(io)?;
+        f.write_all(text.as_bytes()).map_err(io)?;
+        f.sync_all().map_err(io)
     }
-}
-
-fn write_synced(path: &Path, text: &str) -> Result<(), RecordingError> {
-    let io = |e| RecordingError::io(path, e);
-    let mut f = File::create(path).map_err(io)?;
-    f.write_all(text.as_bytes()).map_err(io)?;
-    f.sync_all().map_err(io)
 }
 
 impl Drop for RecordingWriter {

@@ -75,19 +75,19 @@ fn files_under(dir: &Path) -> Result<Vec<PathBuf>, MergeError> {
     Ok(out)
 }
 
-/// Creates the folder `path` goes into; returns the temporary name beside `path`.
-fn prepare(path: &Path) -> Result<PathBuf, MergeError> {
+/// Creates the folder `path` goes into.
+fn prepare(path: &Path) -> Result<(), MergeError> {
     if let Some(parent) = path.parent() {
         std::fs::create_dir_all(parent).map_err(|source| MergeError::Create { dir: parent.to_path_buf(), source })?;
     }
-    let name = path.file_name().map(|n| n.to_string_lossy().into_owned()).unwrap_or_default();
-    Ok(path.with_file_name(format!(".{name}.merge-tmp")))
+    Ok(())
 }
 
-/// Copies `from` to `to` through a temporary file beside `to`.
+/// Copies `from` to `to` through a temporary file beside `to`
+/// (`evflow_engine::atomic_file`).
 fn copy(from: &Path, to: &Path) -> Result<(), MergeError> {
-    let tmp = prepare(to)?;
-    std::fs::copy(from, &tmp).and_then(|_| std::fs::rename(&tmp, to)).map_err(|source| MergeError::Copy {
+    prepare(to)?;
+    evflow_engine::atomic_file::copy_atomically(from, to).map_err(|source| MergeError::Copy {
         from: from.to_path_buf(),
         to: to.to_path_buf(),
         source,
@@ -96,9 +96,8 @@ fn copy(from: &Path, to: &Path) -> Result<(), MergeError> {
 
 /// Writes `text` to `path` through a temporary file beside it.
 pub fn write(path: &Path, text: &str) -> Result<(), MergeError> {
-    let tmp = prepare(path)?;
-    std::fs::write(&tmp, text)
-        .and_then(|_| std::fs::rename(&tmp, path))
+    prepare(path)?;
+    evflow_engine::atomic_file::write_atomically(path, text)
         .map_err(|source| MergeError::Write { path: path.to_path_buf(), source })
 }
 

@@ -5,11 +5,14 @@
 //! — the graph's fingerprint, the seed, the overrides, the rate, the files
 //! and their ports (`identity`) — and, when it ends, every recording's frame
 //! count and a fingerprint of its samples (`end.files[].hash`). `evflow
-//! replay --check` holds the folder to them: a file cut short, a changed
-//! input (whether or not it feeds a recorded output), another seed or
-//! graph is a failure, named; what cannot be checked (a session killed
-//! before it ended has no end) is said. Fingerprints are FNV-1a, 64 bits —
-//! they catch accidents and careless edits, not a forger.
+//! replay --check` holds the folder to them: a file cut short, a sidecar
+//! whose `frames` is not what was written, a changed input (whether or not
+//! it feeds a recorded output), another seed or graph, a file in `inputs/`
+//! or `outputs/` the session did not write, a key in `session.json` its
+//! version does not define is a failure, named ([`Verdict::Fails`]); what
+//! cannot be checked (a session killed before it ended has no end) is said
+//! and leaves the session unproven ([`Verdict::Unproven`]). Fingerprints are
+//! FNV-1a, 64 bits — they catch accidents and careless edits, not a forger.
 
 use super::session::{FileSpec, Manifest};
 use serde_json::Value;
@@ -61,24 +64,38 @@ pub fn identity(
     format!("fnv1a64:{:016x}", fnv(FNV_START, text.as_bytes()))
 }
 
+/// What a finding means for the check.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Verdict {
+    /// Something is not as the session recorded it: the check fails.
+    Fails,
+    /// Something could not be checked: the check cannot prove the session.
+    Unproven,
+}
+
 /// One thing the check found.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Finding {
-    /// Whether it holds (false: the check fails).
-    pub ok: bool,
+    /// Whether it fails the check or leaves it unproven.
+    pub verdict: Verdict,
     /// What, for people.
     pub what: String,
 }
 
 fn bad(what: String) -> Finding {
-    Finding { ok: false, what }
+    Finding { verdict: Verdict::Fails, what }
+}
+
+fn unproven(what: String) -> Finding {
+    Finding { verdict: Verdict::Unproven, what }
 }
 
 /// Holds the session folder `dir` (its manifest `m`, read as `raw`) to what
-/// it recorded: the graph file and the manifest's fingerprints, then, for a
-/// session that ended, every recording's frames and fingerprint.
+/// it recorded: the manifest's keys, the graph file and the manifest's
+/// fingerprints, the files in `inputs/` and `outputs/`, then, for a session
+/// that ended, every recording's frames (WAV and sidecar) and fingerprint.
 pub fn check(dir: &Path, m: &Manifest, raw: &Value) -> Vec<Finding> {
-    let mut out = Vec::new();
+    let mut out = unknown_keys(m, raw);
     match (&m.graph_hash, &m.identity) {
         (Some(g), Some(id)) => {
             match file_hash(&dir.join("graph.toml")) {
@@ -93,20 +110,18 @@ pub fn check(dir: &Path, m: &Manifest, raw: &Value) -> Vec<Finding> {
                 ));
             }
         }
-        _ => out.push(Finding {
-            ok: true,
-            what: "could not check the graph and the seed: the session was recorded without fingerprints".into(),
-        }),
+        _ => out.push(unproven(
+            "could not check the graph and the seed: the session was recorded without fingerprints".into(),
+        )),
     }
     let status = raw["status"].as_str().unwrap_or("");
-    let Some(files) = raw["end"]["files"].as_array() else {
-        out.push(Finding {
-            ok: true,
-            what: format!(
-                "could not check that the recordings are whole: the session did not end (status `{status}`: \
-                 killed?), so it recorded neither their lengths nor their fingerprints; what they hold was compared"
-            ),
-        });
+    let ended = raw["end"]["files"].as_array();
+    out.extend(strangers(dir, m, ended.is_some()));
+    let Some(files) = ended else {
+        out.push(unproven(format!(
+            "could not check that the recordings are whole: the session did not end (status `{status}`: \
+             killed?), so it recorded neither their lengths nor their fingerprints; what they hold was compared"
+        )));
         return out;
     };
     let ticks = raw["end"]["ticks"].as_u64();
@@ -124,6 +139,11 @@ pub fn check(dir: &Path, m: &Manifest, raw: &Value) -> Vec<Finding> {
                 r.frames(),
                 if (r.frames() as u64) < frames { " (cut short)" } else { "" }
             ))),
+            Ok(r) if r.sidecar_frames() != frames => out.push(bad(format!(
+                "{}.json: says {} frames, the session wrote {frames}",
+                f.file,
+                r.sidecar_frames()
+            ))),
             Ok(_) => {}
             Err(e) => out.push(bad(format!("{}: cannot read: {e}", f.file))),
         }
@@ -131,10 +151,10 @@ pub fn check(dir: &Path, m: &Manifest, raw: &Value) -> Vec<Finding> {
             (Some(want), Ok(now)) if want != now => {
                 out.push(bad(format!("{}: its samples changed since the session wrote them", f.file)))
             }
-            (None, _) => out.push(Finding {
-                ok: true,
-                what: format!("could not check the samples of {}: the session recorded no fingerprint", f.file),
-            }),
+            (None, _) => out.push(unproven(format!(
+                "could not check the samples of {}: the session recorded no fingerprint",
+                f.file
+            ))),
             _ => {}
         }
         // The session's length: every stream as long as its ticks say, bar the gaps it logged.
@@ -147,6 +167,62 @@ pub fn check(dir: &Path, m: &Manifest, raw: &Value) -> Vec<Finding> {
                     f.file
                 )));
             }
+        }
+    }
+    out
+}
+
+/// Keys of `session.json` (and of its files' entries) that its version
+/// does not define. A newer evflow that adds a key raises `version`, which
+/// this one refuses by name ([`Manifest::read`]); so an unknown key in a
+/// manifest this evflow reads was not written by a session.
+fn unknown_keys(m: &Manifest, raw: &Value) -> Vec<Finding> {
+    let mut out = Vec::new();
+    let mut unknown = |raw: &Value, known: &Value, at: &str| {
+        if let (Some(raw), Some(known)) = (raw.as_object(), known.as_object()) {
+            for key in raw.keys().filter(|k| !known.contains_key(*k)) {
+                out.push(bad(format!("session.json: `{at}{key}` is not a key a session writes")));
+            }
+        }
+    };
+    let known = m.json("", None);
+    unknown(raw, &known, "");
+    // Inputs and outputs are described alike.
+    if let Some(known_entry) = known["inputs"].get(0).or_else(|| known["outputs"].get(0)) {
+        for list in ["inputs", "outputs"] {
+            for (k, entry) in raw[list].as_array().into_iter().flatten().enumerate() {
+                unknown(entry, known_entry, &format!("{list}[{k}]."));
+            }
+        }
+    }
+    out
+}
+
+/// Files in `inputs/` and `outputs/` that are not the session's recordings
+/// (`FILE.wav`, `FILE.json` of its manifest). A session that did not end
+/// may have left a sidecar's temporary (`FILE.json….tmp`) there.
+fn strangers(dir: &Path, m: &Manifest, ended: bool) -> Vec<Finding> {
+    let ours: Vec<String> = m
+        .inputs
+        .iter()
+        .chain(&m.outputs)
+        .flat_map(|f| [format!("{}.wav", f.file), format!("{}.json", f.file)])
+        .collect();
+    let temporary = |name: &str| {
+        name.ends_with(".tmp")
+            && m.inputs.iter().chain(&m.outputs).any(|f| name.starts_with(&format!("{}.json.", f.file)))
+    };
+    let mut out = Vec::new();
+    for sub in ["inputs", "outputs"] {
+        let Ok(entries) = std::fs::read_dir(dir.join(sub)) else { continue };
+        let mut names: Vec<String> =
+            entries.filter_map(Result::ok).map(|e| format!("{sub}/{}", e.file_name().to_string_lossy())).collect();
+        names.sort();
+        for name in names {
+            if ours.contains(&name) || (!ended && temporary(&name)) {
+                continue;
+            }
+            out.push(bad(format!("{name}: not a file the session wrote")));
         }
     }
     out

@@ -136,10 +136,9 @@ impl Manifest {
     /// Writes `session.json` atomically (temporary file, then rename).
     pub fn write(&self, dir: &Path, status: &str, end: Option<Value>) -> Result<()> {
         let text = serde_json::to_string_pretty(&self.json(status, end))? + "\n";
-        let tmp = dir.join("session.json.tmp");
-        std::fs::write(&tmp, text).with_context(|| format!("{}: cannot write", tmp.display()))?;
-        std::fs::rename(&tmp, dir.join("session.json"))
-            .with_context(|| format!("{}: cannot write", dir.join("session.json").display()))
+        let path = dir.join("session.json");
+        evflow_engine::atomic_file::write_atomically(&path, text)
+            .with_context(|| format!("{}: cannot write", path.display()))
     }
 
     /// Reads `SESSION/session.json`, and the JSON as it is.

@@ -171,9 +171,7 @@ fn save_png(plot: &evflow_tools::plot::Plot, path: &std::path::Path) {
 /// so an interrupted run leaves no half table) and says so.
 fn save_markdown(path: &std::path::Path, text: &str) -> anyhow::Result<()> {
     use anyhow::Context;
-    let tmp = path.with_extension("md.tmp");
-    std::fs::write(&tmp, text)
-        .and_then(|_| std::fs::rename(&tmp, path))
+    evflow_engine::atomic_file::write_atomically(path, text)
         .with_context(|| format!("{}: cannot write", path.display()))?;
     println!("wrote {}", path.display());
     Ok(())

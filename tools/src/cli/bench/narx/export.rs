@@ -104,10 +104,7 @@ fn csv(x: &[f64], u: &[f64]) -> String {
 
 /// Writes `text` to `path` through `path.tmp` and a rename.
 fn put(path: &Path, text: &str) -> Result<()> {
-    let tmp = path.with_extension("tmp");
-    std::fs::write(&tmp, text).with_context(|| format!("cannot write {}", tmp.display()))?;
-    std::fs::rename(&tmp, path).with_context(|| format!("cannot rename {} to {}", tmp.display(), path.display()))?;
-    Ok(())
+    evflow_engine::atomic_file::write_atomically(path, text).with_context(|| format!("cannot write {}", path.display()))
 }
 
 #[cfg(test)]

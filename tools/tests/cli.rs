@@ -404,8 +404,8 @@ fn check_shows_the_units_a_chain_carries() {
     assert!(line("velocity_1khz ").ends_with("out: out [cm/s]"), "{out}");
 }
 
-/// `live` prints a sink's values as `run` does, six significant digits, not
-/// seventeen (issue 37, point 13).
+/// `live` and `replay` print a sink's values as `run` does, six
+/// significant digits, not seventeen (issue 37, point 13).
 #[test]
 fn live_prints_values_as_run_does() {
     let dir = tempfile::tempdir().unwrap();
@@ -413,11 +413,20 @@ fn live_prints_values_as_run_does() {
     let o = evflow(&["live", "graphs/display-live.toml", "--duration", "0.3", "--out", out.to_str().unwrap()]);
     let (stdout, stderr) = text(&o);
     assert!(o.status.success(), "{stderr}");
-    let rms = stdout.lines().find(|l| l.starts_with("force_stats: rms = ")).unwrap_or_else(|| panic!("{stdout}"));
-    let number = rms.trim_start_matches("force_stats: rms = ").split(' ').next().unwrap();
-    let mantissa = number.split('e').next().unwrap();
-    let significant = mantissa.chars().filter(char::is_ascii_digit).skip_while(|c| *c == '0').count();
-    assert!(significant <= 6, "{rms}");
+    let six_digits = |stdout: &str| {
+        let rms = stdout.lines().find(|l| l.starts_with("force_stats: rms = ")).unwrap_or_else(|| panic!("{stdout}"));
+        let number = rms.trim_start_matches("force_stats: rms = ").split(' ').next().unwrap();
+        let mantissa = number.split('e').next().unwrap();
+        let significant = mantissa.chars().filter(char::is_ascii_digit).skip_while(|c| *c == '0').count();
+        assert!(significant <= 6, "{rms}");
+    };
+    six_digits(&stdout);
+    // And its replay.
+    let session = std::fs::read_dir(out.join("sessions")).unwrap().next().unwrap().unwrap().path();
+    let o = evflow(&["replay", session.to_str().unwrap()]);
+    let (stdout, stderr) = text(&o);
+    assert!(o.status.success(), "{stderr}");
+    six_digits(&stdout);
 }
 
 #[cfg(unix)]

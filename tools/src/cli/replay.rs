@@ -242,7 +242,12 @@ fn replay_one(session: &Path, graph: Option<&Path>, out: &Path, a: &Args) -> Res
                 let _ = writeln!(shown, "{node}: {l}");
             }
             for (k, v, unit) in &s.values {
-                let _ = writeln!(shown, "{node}: {k} = {v}{}", super::live::unit_suffix(unit));
+                let _ = writeln!(
+                    shown,
+                    "{node}: {k} = {}{}",
+                    evflow_tools::batch::tables::number(*v),
+                    super::live::unit_suffix(unit)
+                );
             }
         }
     }

@@ -7,25 +7,10 @@
 use evflow_study::stability::{self, graphs, Size};
 
 /// Cases that fail today: real findings of the suite, left for the nodes'
-/// owners (docs/numerics.md, "Findings"). Reports that sum or difference
-/// finite inputs near ±f64::MAX overflow to ±inf (or NaN), and
-/// `forward.train` reports NaN relative errors when the force's power
-/// underflows to 0.
-const FINDINGS: &[&str] = &[
-    "stats · steps ±f64::MAX",
-    "stats · impulses ±f64::MAX",
-    "peaks · steps ±f64::MAX",
-    "peaks · impulses ±f64::MAX",
-    "onoff · steps ±f64::MAX",
-    "error · steps ±1e300",
-    "error · steps ±f64::MAX",
-    "error · impulses ±f64::MAX",
-    "narx.score · steps ±1e300",
-    "narx.score · steps ±f64::MAX",
-    "narx.score · impulses ±f64::MAX",
-    "forward.train · parameters at limits",
-    "forward.train · subnormals",
-];
+/// owners (docs/numerics.md, "Findings"). Empty since issue 37, point 6
+/// fixed the last thirteen (the analysis sinks' sums overflowing near
+/// ±f64::MAX, `forward.train`'s NaN relative errors).
+const FINDINGS: &[&str] = &[];
 
 #[test]
 fn the_ci_suite_covers_every_node_type_and_graph_family_and_passes_but_for_its_findings() {

@@ -35,6 +35,7 @@ pub mod sum;
 pub mod synth;
 #[cfg(feature = "texture")]
 pub mod texture;
+pub mod wide_sum;
 
 use evflow_engine::{NodeSpec, Registry};
 

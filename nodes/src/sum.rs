@@ -1,4 +1,18 @@
-//! Compensated summation, for sinks that average long streams.
+//! Compensated summation, for sinks that average long streams, and the
+//! [`Accumulator`] a scaled sum ([`crate::wide_sum`]) is built on: this
+//! compensated [`Sum`] or a plain `f64`.
+
+/// A running sum: what [`crate::wide_sum`] scales. Implemented by [`Sum`]
+/// (compensated) and by `f64` (plain `+=`, for code whose results must stay
+/// what its plain sums gave, bit for bit).
+pub trait Accumulator: Copy + Default {
+    /// Adds `x`.
+    fn add(&mut self, x: f64);
+    /// The sum.
+    fn value(&self) -> f64;
+    /// Multiplies the sum by `f` (a power of two: exact unless it underflows).
+    fn scale(&mut self, f: f64);
+}
 
 /// A running sum that keeps the rounding error of every addition
 /// (Kahan–Babuška–Neumaier; the error term by Knuth's branch-free TwoSum,
@@ -22,6 +36,33 @@ impl Sum {
     /// The sum.
     pub fn value(&self) -> f64 {
         self.s + self.c
+    }
+}
+
+impl Accumulator for Sum {
+    #[inline]
+    fn add(&mut self, x: f64) {
+        Sum::add(self, x);
+    }
+    fn value(&self) -> f64 {
+        Sum::value(self)
+    }
+    fn scale(&mut self, f: f64) {
+        self.s *= f;
+        self.c *= f;
+    }
+}
+
+impl Accumulator for f64 {
+    #[inline]
+    fn add(&mut self, x: f64) {
+        *self += x;
+    }
+    fn value(&self) -> f64 {
+        *self
+    }
+    fn scale(&mut self, f: f64) {
+        *self *= f;
     }
 }
 

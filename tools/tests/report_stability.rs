@@ -33,15 +33,30 @@ fn a_passing_case_exits_0_and_writes_its_table_and_rows() {
 fn a_failing_case_exits_1_and_a_filter_matching_nothing_is_an_error() {
     let dir = tempfile::tempdir().unwrap();
     let out = dir.path().to_str().unwrap();
-    // A finding of the suite (tests/stability.rs, FINDINGS): `stats`
-    // reports an infinite mean of ±f64::MAX steps.
-    let (code, stdout, stderr) =
-        evflow(&["report", "stability", "--size", "ci", "--only", "stats · steps ±f64::MAX", "--out", out]);
+    // The shipped cases all pass: a graph folder holding a graph that
+    // cannot be loaded (an unknown node type) gives a failing case.
+    let graphs = dir.path().join("graphs");
+    std::fs::create_dir(&graphs).unwrap();
+    std::fs::write(
+        graphs.join("broken.toml"),
+        "[graph]\nformat = 1\nname = \"broken\"\nrate = 1000\nconnections = [\"s.out -> t.in\"]\n\
+         [nodes.s]\ntype = \"sine\"\n[nodes.t]\ntype = \"no.such.node\"\n",
+    )
+    .unwrap();
+    let (code, stdout, stderr) = evflow(&[
+        "report",
+        "stability",
+        "--size",
+        "ci",
+        "--only",
+        "graphs · broken",
+        "--graphs",
+        graphs.to_str().unwrap(),
+        "--out",
+        out,
+    ]);
     assert_eq!(code, Some(1), "{stdout}\n{stderr}");
-    assert!(
-        stderr.contains("FAIL stats · steps ±f64::MAX") && stderr.contains("1 stability case(s) failed"),
-        "{stderr}"
-    );
+    assert!(stderr.contains("FAIL graphs · broken") && stderr.contains("1 stability case(s) failed"), "{stderr}");
     let (code, _, stderr) = evflow(&["report", "stability", "--only", "no such case", "--out", out]);
     assert_eq!(code, Some(1));
     assert!(stderr.contains("no case matches `no such case`"), "{stderr}");

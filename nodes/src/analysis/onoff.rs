@@ -1,5 +1,6 @@
 //! `onoff`: the friction increase while an effect is on, against while it is off.
 
+use crate::wide_sum::WideSum;
 use evflow_engine::ports::InPort;
 use evflow_engine::typed_params::Float;
 use evflow_engine::{BuildContext, Io, Node, NodeError, NodeSpec, Params, PortSpec, Role, Summary};
@@ -24,7 +25,10 @@ force·sign(velocity) — the friction magnitude along the motion — and sample
 switch of the gate or start of motion (the transient of the force and its filter).\n\
 \n\
 Reports `on_mean`, `off_mean`, `increase` = on − off (N) and the samples counted in each. Ports \
-at any one rate (the node's). An error if either state has no counted sample, or on a NaN.\n\
+at any one rate (the node's). An error if either state has no counted sample, or on a NaN. The \
+sums scale by a power of two where a plain one would overflow (forces near ±f64::MAX), so the \
+means of finite forces are right; an `increase` beyond ±f64::MAX is reported as ±f64::MAX, with \
+a line saying so.\n\
 \n\
 **Checked against:** a synthetic force of known friction levels with a known gate, in both \
 directions, with a transient that `settle` removes.",
@@ -60,7 +64,7 @@ struct OnOff {
     skip: u64,
     last_on: Option<bool>,
     moving: bool,
-    sum: [f64; 2],
+    sum: [WideSum<f64>; 2],
     count: [u64; 2],
     n: u64,
     bad: Option<u64>,
@@ -73,7 +77,7 @@ fn build(p: &Params, ctx: &BuildContext) -> Result<Box<dyn Node>, NodeError> {
         skip: 0,
         last_on: None,
         moving: false,
-        sum: [0.0; 2],
+        sum: [WideSum::default(); 2],
         count: [0; 2],
         n: 0,
         bad: None,
@@ -104,7 +108,7 @@ impl Node for OnOff {
                 continue;
             }
             let i = usize::from(on);
-            self.sum[i] += f * v.signum();
+            self.sum[i].add(f * v.signum());
             self.count[i] += 1;
         }
         Ok(())
@@ -114,7 +118,7 @@ impl Node for OnOff {
         self.skip = 0;
         self.last_on = None;
         self.moving = false;
-        self.sum = [0.0; 2];
+        self.sum = [WideSum::default(); 2];
         self.count = [0; 2];
         self.n = 0;
         self.bad = None;
@@ -131,14 +135,23 @@ impl Node for OnOff {
                 )));
             }
         }
-        let off = self.sum[0] / self.count[0] as f64;
-        let on = self.sum[1] / self.count[1] as f64;
-        Ok(Summary::default()
+        let off = self.sum[0].mean(self.count[0] as f64);
+        let on = self.sum[1].mean(self.count[1] as f64);
+        let increase = on - off;
+        let s = Summary::default()
             .value("on_mean", on, "N")
             .value("off_mean", off, "N")
-            .value("increase", on - off, "N")
+            .value("increase", increase.clamp(-f64::MAX, f64::MAX), "N")
             .value("on_samples", self.count[1] as f64, "1")
-            .value("off_samples", self.count[0] as f64, "1"))
+            .value("off_samples", self.count[0] as f64, "1");
+        Ok(if increase.is_finite() {
+            s
+        } else {
+            s.line(format!(
+                "the increase {on:e} − ({off:e}) N is beyond f64::MAX: reported as {:e}",
+                increase.signum() * f64::MAX
+            ))
+        })
     }
 }
 
@@ -193,6 +206,27 @@ mod tests {
         assert!((get(&s, "off_mean") - 0.1).abs() < 1e-12);
         let raw = run(force, gate, vel, "settle = 0.0").unwrap();
         assert!((get(&raw, "increase") - 0.06).abs() > 1e-3, "the transient must matter without settling");
+    }
+
+    #[test]
+    fn forces_near_max_give_finite_true_means() {
+        // On for the first half at +MAX, off for the second at −MAX, moving
+        // right: the plain sums overflowed (on_mean, off_mean, increase inf).
+        let (n, half) = (40, 20);
+        let force: Vec<f64> = (0..n).map(|i| if i < half { f64::MAX } else { -f64::MAX }).collect();
+        let gate: Vec<f64> = (0..n).map(|i| if i < half { 1.0 } else { 0.0 }).collect();
+        let s = run(force, gate, vec![0.05; n], "settle = 0.0").unwrap();
+        let close = |v: f64, want: f64| (v - want).abs() <= 1e-15 * want.abs();
+        assert!(close(get(&s, "on_mean"), f64::MAX) && close(get(&s, "off_mean"), -f64::MAX), "{s:?}");
+        assert_eq!(get(&s, "increase"), f64::MAX);
+        assert!(s.lines.iter().any(|l| l.contains("beyond f64::MAX")), "{:?}", s.lines);
+        // Half the on samples at MAX, half at 0: the mean is MAX/2 and in range.
+        let force: Vec<f64> = (0..n).map(|i| if i < half / 2 { f64::MAX } else { 0.0 }).collect();
+        let gate: Vec<f64> = (0..n).map(|i| if i < half { 1.0 } else { 0.0 }).collect();
+        let s = run(force, gate, vec![0.05; n], "settle = 0.0").unwrap();
+        assert!(close(get(&s, "on_mean"), f64::MAX / 2.0) && close(get(&s, "increase"), f64::MAX / 2.0), "{s:?}");
+        assert_eq!(get(&s, "off_mean"), 0.0);
+        assert!(s.lines.is_empty(), "{:?}", s.lines);
     }
 
     #[test]

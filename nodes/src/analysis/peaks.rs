@@ -1,5 +1,6 @@
 //! `peaks`: the mean of the largest peak-to-peak amplitudes of a vibration.
 
+use crate::wide_sum::WideSum;
 use evflow_engine::ports::InPort;
 use evflow_engine::typed_params::Int;
 use evflow_engine::{BuildContext, Io, Node, NodeError, NodeSpec, Params, PortSpec, Role, Summary};
@@ -23,7 +24,9 @@ partial swings before the first and after the last turning point are not counted
 the end of the run the node reports `pp_mean`, the mean of the `count` largest swings (of all \
 of them if there are fewer), `pp_max`, the largest, and `swings`, how many there were. Low-pass \
 the force first (the dissertation used 500 Hz): noise adds small swings, which never rank among \
-the largest but split a noisy peak.\n\
+the largest but split a noisy peak. A swing between samples near ±f64::MAX can exceed f64::MAX: \
+it is kept exactly (as its half) and ranked and averaged as it is; a `pp_mean` or `pp_max` beyond \
+f64::MAX is reported as f64::MAX, with a line saying so.\n\
 \n\
 **Port** `in` at any rate. The largest swings are kept in a heap sized when the node is built; \
 `process` does not allocate. A NaN or infinite sample is an error naming its index.\n\
@@ -44,25 +47,41 @@ const IN: InPort = InPort::named(PORTS, "in");
 /// `count`: how many of the largest swings are averaged.
 const COUNT: Int = Int::new("count", 1, 1_000_000, 50, "1", "how many of the largest swings are averaged");
 
-/// An f64 ordered by `total_cmp`, for the heap.
+/// One swing's amplitude, ordered for the heap: `v` itself, or — where
+/// the amplitude overflows f64 (samples near ±f64::MAX) — `2·v`, with
+/// `double` set; a doubled swing ranks above every other.
 #[derive(Clone, Copy, PartialEq)]
-struct Ord64(f64);
-impl Eq for Ord64 {}
-impl PartialOrd for Ord64 {
+struct Swing {
+    double: bool,
+    v: f64,
+}
+impl Swing {
+    /// |a − b|, exactly.
+    fn between(a: f64, b: f64) -> Self {
+        let v = (a - b).abs();
+        if v.is_finite() {
+            Swing { double: false, v }
+        } else {
+            Swing { double: true, v: (0.5 * a - 0.5 * b).abs() }
+        }
+    }
+}
+impl Eq for Swing {}
+impl PartialOrd for Swing {
     fn partial_cmp(&self, o: &Self) -> Option<std::cmp::Ordering> {
         Some(self.cmp(o))
     }
 }
-impl Ord for Ord64 {
+impl Ord for Swing {
     fn cmp(&self, o: &Self) -> std::cmp::Ordering {
-        self.0.total_cmp(&o.0)
+        self.double.cmp(&o.double).then(self.v.total_cmp(&o.v))
     }
 }
 
 struct Peaks {
     count: usize,
     /// The largest swings so far (a min-heap: the smallest of them on top).
-    best: BinaryHeap<Reverse<Ord64>>,
+    best: BinaryHeap<Reverse<Swing>>,
     /// The last turning point's value, once there is one.
     turn: Option<f64>,
     /// The last sample and the direction since the last turning point
@@ -89,13 +108,13 @@ fn build(p: &Params, _: &BuildContext) -> Result<Box<dyn Node>, NodeError> {
 }
 
 impl Peaks {
-    fn swing(&mut self, pp: f64) {
+    fn swing(&mut self, pp: Swing) {
         self.swings += 1;
         if self.best.len() < self.count {
-            self.best.push(Reverse(Ord64(pp)));
-        } else if self.best.peek().is_some_and(|Reverse(m)| pp > m.0) {
+            self.best.push(Reverse(pp));
+        } else if self.best.peek().is_some_and(|Reverse(m)| pp > *m) {
             self.best.pop();
-            self.best.push(Reverse(Ord64(pp)));
+            self.best.push(Reverse(pp));
         }
     }
 
@@ -115,7 +134,7 @@ impl Peaks {
             if self.dir != 0 && d != self.dir {
                 // `prev` was a turning point: the swing from the last one ends there.
                 if let Some(t) = self.turn {
-                    self.swing((prev - t).abs());
+                    self.swing(Swing::between(prev, t));
                 }
                 self.turn = Some(prev);
             }
@@ -159,13 +178,28 @@ impl Node for Peaks {
             ));
         }
         let k = self.best.len();
-        let mean = self.best.iter().map(|Reverse(v)| v.0).sum::<f64>() / k as f64;
-        let max = self.best.iter().map(|Reverse(v)| v.0).fold(0.0, f64::max);
-        Ok(Summary::default()
+        // A doubled swing is summed as its half twice (exact, and a sum
+        // that overflows scales).
+        let mut sum = WideSum::<f64>::default();
+        for Reverse(s) in &self.best {
+            sum.add(s.v);
+            if s.double {
+                sum.add(s.v);
+            }
+        }
+        let (mean, mean_cut) = sum.mean_scaled(k as f64).saturated();
+        let top = self.best.iter().map(|Reverse(s)| *s).max().unwrap_or(Swing { double: false, v: 0.0 });
+        let (max, max_cut) = if top.double { (f64::MAX, true) } else { (top.v, false) };
+        let s = Summary::default()
             .value("pp_mean", mean, "N")
             .value("pp_max", max, "N")
             .value("swings", self.swings as f64, "1")
-            .value("averaged", k as f64, "1"))
+            .value("averaged", k as f64, "1");
+        Ok(match (mean_cut, max_cut) {
+            (false, false) => s,
+            (true, _) => s.line("pp_mean and pp_max are beyond f64::MAX: reported as f64::MAX"),
+            (false, true) => s.line(format!("pp_max ({:e} × 2) is beyond f64::MAX: reported as f64::MAX", top.v)),
+        })
     }
 }
 
@@ -207,6 +241,34 @@ mod tests {
         assert!(get(&s, "pp_mean") > 3.8 && get(&s, "pp_mean") <= 4.0, "{}", get(&s, "pp_mean"));
         assert!(get(&all, "pp_mean") < get(&s, "pp_mean"));
         assert_eq!(get(&all, "averaged"), get(&all, "swings"));
+    }
+
+    #[test]
+    fn swings_between_samples_near_max_are_measured() {
+        // Steps 0 → +MAX → −MAX → 0: swings of MAX, 2·MAX and MAX; the
+        // plain amplitudes overflowed to inf (pp_mean and pp_max inf).
+        let mut x = vec![0.0; 5];
+        x.extend([f64::MAX; 5]);
+        x.extend([-f64::MAX; 5]);
+        x.extend([0.0; 5]);
+        x.extend([1.0, 0.0]);
+        let s = summary(x.clone(), "count = 50").unwrap();
+        // Swings 2·MAX (+MAX down to −MAX) and MAX (up to 1): mean 1.5·MAX.
+        assert_eq!(get(&s, "swings"), 2.0);
+        assert_eq!((get(&s, "pp_mean"), get(&s, "pp_max")), (f64::MAX, f64::MAX));
+        assert!(s.lines.iter().any(|l| l.contains("beyond f64::MAX")), "{:?}", s.lines);
+        // With 15 more swings of 1 the mean is back in range: (2·MAX + MAX + 15)/17.
+        x.extend([0.0, 1.0].repeat(8));
+        let s = summary(x, "count = 20").unwrap();
+        assert_eq!(get(&s, "swings"), 17.0);
+        let want = f64::MAX / 17.0 * 3.0;
+        assert!((get(&s, "pp_mean") - want).abs() <= 4.0 * f64::EPSILON * want, "{:e}", get(&s, "pp_mean"));
+        assert_eq!(get(&s, "pp_max"), f64::MAX);
+        // Two impulses of MAX: three swings of MAX, whose plain sum overflowed.
+        let s = summary(vec![0.0, f64::MAX, 0.0, f64::MAX, 0.0, 1.0], "").unwrap();
+        assert_eq!(get(&s, "swings"), 3.0);
+        assert_eq!((get(&s, "pp_mean"), get(&s, "pp_max")), (f64::MAX, f64::MAX));
+        assert!(s.lines.is_empty(), "{:?}", s.lines);
     }
 
     #[test]

@@ -6,6 +6,7 @@
 //! off for a 0/c one.
 
 use super::model::ClosedLoopScore;
+use crate::wide_sum::SumSq;
 
 /// The level midway between the reference's extremes (0 for ±c).
 fn midpoint(reference: &[f64]) -> f64 {
@@ -14,7 +15,13 @@ fn midpoint(reference: &[f64]) -> f64 {
         .filter(|r| r.is_finite())
         .fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), &r| (lo.min(r), hi.max(r)));
     if lo.is_finite() && hi.is_finite() {
-        0.5 * (lo + hi)
+        let mid = 0.5 * (lo + hi);
+        // lo + hi overflows for a reference near f64::MAX.
+        if mid.is_finite() {
+            mid
+        } else {
+            0.5 * lo + 0.5 * hi
+        }
     } else {
         0.0
     }
@@ -22,14 +29,16 @@ fn midpoint(reference: &[f64]) -> f64 {
 
 /// Level ("sign") agreement and RMS error of `est` against `reference`,
 /// over the samples where the reference is not at its midpoint (the level
-/// of a binary excitation is what is compared; RMS over the same samples).
+/// of a binary excitation is what is compared; RMS over the same samples,
+/// its squares scaled where they would overflow, so a finite estimate and
+/// reference give a finite RMS — cut at f64::MAX if it lies beyond).
 /// `None` when no sample qualifies or the lengths differ.
 pub fn score(est: &[f64], reference: &[f64]) -> Option<ClosedLoopScore> {
     if est.len() != reference.len() {
         return None;
     }
     let mid = midpoint(reference);
-    let (mut n, mut agree, mut sq) = (0usize, 0usize, 0.0);
+    let (mut n, mut agree, mut sq) = (0usize, 0usize, SumSq::<f64>::default());
     for (&e, &r) in est.iter().zip(reference) {
         if r == mid || !r.is_finite() {
             continue;
@@ -38,12 +47,12 @@ pub fn score(est: &[f64], reference: &[f64]) -> Option<ClosedLoopScore> {
         if (e - mid) * (r - mid) > 0.0 {
             agree += 1;
         }
-        sq += (e - r) * (e - r);
+        sq.add_diff(e, r);
     }
     (n > 0).then(|| ClosedLoopScore {
         sign_agreement: agree as f64 / n as f64,
         transition_agreement: transition_agreement(est, reference).unwrap_or(f64::NAN),
-        rms: (sq / n as f64).sqrt(),
+        rms: sq.root_mean(n as f64).saturated().0,
         samples: n,
     })
 }
@@ -82,6 +91,19 @@ mod tests {
         let flipped: Vec<f64> = r.iter().map(|v| -v).collect();
         assert_eq!(transition_agreement(&flipped, &r), Some(1.0));
         assert_eq!(score(&flipped, &r).unwrap().sign_agreement, 0.0);
+    }
+
+    #[test]
+    fn a_reference_near_max_gives_a_finite_rms() {
+        // Steps to ±1e300 and ±f64::MAX: the plain squares overflowed (rms inf).
+        for big in [1e300, f64::MAX] {
+            let r = [big, big, -big, -big];
+            let s = score(&[0.5; 4], &r).unwrap();
+            assert!((s.rms - big).abs() <= 1e-15 * big, "{:e} vs {big:e}", s.rms);
+            assert_eq!((s.samples, s.sign_agreement), (4, 0.5));
+        }
+        // A constant reference of MAX: its midpoint is MAX, not inf.
+        assert_eq!(midpoint(&[f64::MAX, f64::MAX]), f64::MAX);
     }
 
     #[test]

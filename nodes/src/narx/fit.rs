@@ -11,6 +11,7 @@ use super::net::Mlp;
 use super::taps::{self, Taps};
 use super::train::{self, Data, Epoch, Options};
 use crate::rng::Rng;
+use crate::wide_sum::SumSq;
 use serde::{Deserialize, Serialize};
 
 /// The training algorithm.
@@ -203,7 +204,10 @@ pub fn closed_loop_score(
     let mut xs = x[s..].to_vec();
     if let Some(seed) = noise_seed {
         let tail = &mut xs[from - s..];
-        let rms = (tail.iter().map(|v| v * v).sum::<f64>() / tail.len() as f64).sqrt();
+        let mut sq = SumSq::<f64>::default();
+        tail.iter().for_each(|&v| sq.add(v));
+        // The force's RMS, right (and finite) for a force near ±f64::MAX too.
+        let rms = sq.root_mean(tail.len() as f64).saturated().0;
         let mut r = Rng::new(seed ^ 0x006e_6f69_7365);
         for v in tail.iter_mut() {
             *v = rms * r.gaussian();

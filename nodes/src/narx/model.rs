@@ -83,7 +83,7 @@ pub struct ClosedLoopScore {
     /// exactly when the reference does: the part of a binary actuation an
     /// even (square-law) display makes visible whatever the global sign.
     pub transition_agreement: f64,
-    /// RMS of estimate − reference, actuation units.
+    /// RMS of estimate − reference, actuation units (at most f64::MAX).
     pub rms: f64,
     /// Samples compared.
     pub samples: usize,

@@ -28,7 +28,9 @@ pub static SPEC: NodeSpec = NodeSpec::new(
      actuation over a warm-up of k_x + k_y + 50 samples, then on its own estimates — and scores the \
      estimate with `narx.train`'s validation scores: `sign_agreement` (the level of a binary \
      excitation, 0.5 is chance), `transition_agreement` (the changes of level a square-law display \
-     makes felt whatever the sign) and `rms`; then once more with the force replaced by Gaussian noise \
+     makes felt whatever the sign) and `rms` (its squares scaled where they would overflow, so a \
+     finite recording, even near ±f64::MAX, gives a finite RMS; cut at f64::MAX if it lies beyond); \
+     then once more with the force replaced by Gaussian noise \
      of its RMS (`noise_force_transition_agreement`, which stays near chance for a model that reads the \
      force). `samples` counts the scored samples. The model's rate must be the node's rate.\n\n\
      Use: a second excitation recording per condition, kept in a folder of its own \
@@ -183,5 +185,36 @@ mod tests {
         assert!(e.contains("trained at 1000 Hz") && e.contains("2000 Hz"), "{e}");
         let e = score(dir.path(), force(&v[..40]), v[..40].to_vec(), 1000.0).unwrap_err();
         assert!(e.contains("40 samples to score"), "{e}");
+    }
+
+    #[test]
+    fn a_recording_near_max_scores_finite() {
+        // Force and actuation step 0 → +big → −big → 0: the squares of the
+        // error (and of the force, for the noise run) overflowed (rms inf).
+        let dir = tempfile::tempdir().unwrap();
+        let u = rbs(1500, 4);
+        let cfg = FitConfig {
+            hidden: vec![4],
+            feedback: 1,
+            input: 2,
+            options: Options { max_epochs: 5, ..Options::default() },
+            ..FitConfig::default()
+        };
+        fit(&force(&u), &u, &cfg, &mut |_| {}).unwrap().save(&dir.path().join("m.json")).unwrap();
+        for big in [1e300, f64::MAX] {
+            let steps: Vec<f64> = (0..600)
+                .map(|i| match i / 150 {
+                    1 => big,
+                    2 => -big,
+                    _ => 0.0,
+                })
+                .collect();
+            let s = score(dir.path(), steps.clone(), steps, 1000.0).unwrap();
+            assert!(s.values.iter().all(|(_, v, _)| v.is_finite()), "{s:?}");
+            // The estimate stays within the model's actuation range: the
+            // error is the reference's ±big over its 300 scored samples.
+            let rms = s.get("rms").unwrap();
+            assert!((rms - big).abs() <= 1e-12 * big, "{rms:e}");
+        }
     }
 }

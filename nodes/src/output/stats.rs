@@ -1,6 +1,6 @@
 //! `stats`: a sink that reports count, mean, RMS, min, max and peak-to-peak.
 
-use crate::sum::Sum;
+use crate::wide_sum::{SumSq, WideSum};
 use evflow_engine::ports::InPort;
 use evflow_engine::{BuildContext, Io, Node, NodeError, NodeSpec, PortSpec, Role, Summary};
 
@@ -17,7 +17,10 @@ pub static SPEC: NodeSpec = NodeSpec::new(
              number of samples, the mean, the RMS (root of the mean square, about zero — not the \
              standard deviation), the minimum, the maximum and the peak-to-peak amplitude. Sums are \
              kept with Kahan–Babuška (Neumaier) compensation so long runs (10⁸ samples) lose no \
-             precision. Accepts any rate. A NaN or Inf in the input is an error naming the sample \
+             precision, and scaled by a power of two where a plain sum would over- or underflow \
+             (samples near ±f64::MAX, or subnormal), so the mean and RMS of any finite samples are \
+             right; a peak-to-peak beyond f64::MAX (max − min of samples near ±f64::MAX) is \
+             reported as f64::MAX, with a line saying so. Accepts any rate. A NaN or Inf in the input is an error naming the sample \
              index, since no node may let one through.",
 )
 .ports(PORTS)
@@ -30,8 +33,8 @@ const IN: InPort = InPort::named(PORTS, "in");
 
 struct Stats {
     n: u64,
-    sum: Sum,
-    sum_sq: Sum,
+    sum: WideSum,
+    sum_sq: SumSq,
     min: f64,
     max: f64,
     bad: Option<u64>,
@@ -41,8 +44,8 @@ impl Stats {
     fn new() -> Self {
         Self {
             n: 0,
-            sum: Sum::default(),
-            sum_sq: Sum::default(),
+            sum: WideSum::default(),
+            sum_sq: SumSq::default(),
             min: f64::INFINITY,
             max: f64::NEG_INFINITY,
             bad: None,
@@ -61,7 +64,7 @@ impl Node for Stats {
                 self.bad = Some(self.n);
             }
             self.sum.add(x);
-            self.sum_sq.add(x * x);
+            self.sum_sq.add(x);
             self.min = self.min.min(x);
             self.max = self.max.max(x);
             self.n += 1;
@@ -81,13 +84,22 @@ impl Node for Stats {
             return Err(NodeError::Data("no samples reached this sink".into()));
         }
         let n = self.n as f64;
-        Ok(Summary::default()
+        // The RMS of finite samples is at most the largest |sample|: a cut
+        // at f64::MAX only undoes rounding.
+        let rms = self.sum_sq.root_mean(n).saturated().0;
+        let pp = self.max - self.min;
+        let s = Summary::default()
             .value("samples", n, "1")
-            .value("mean", self.sum.value() / n, "1")
-            .value("rms", (self.sum_sq.value() / n).max(0.0).sqrt(), "1")
+            .value("mean", self.sum.mean(n), "1")
+            .value("rms", rms, "1")
             .value("min", self.min, "1")
             .value("max", self.max, "1")
-            .value("pp", self.max - self.min, "1"))
+            .value("pp", pp.min(f64::MAX), "1");
+        Ok(if pp.is_finite() {
+            s
+        } else {
+            s.line(format!("peak-to-peak {:e} − ({:e}) is beyond f64::MAX: reported as f64::MAX", self.max, self.min))
+        })
     }
 }
 
@@ -128,6 +140,34 @@ mod tests {
         let s = feed(&x).unwrap();
         let want = 1e-3 / x.len() as f64;
         assert!((get(&s, "mean") - want).abs() < 1e-15, "{}", get(&s, "mean"));
+    }
+
+    #[test]
+    fn samples_near_max_give_finite_true_statistics() {
+        // Steps 0 → +MAX → −MAX → 0: the plain sums overflowed (mean and
+        // RMS NaN, p-p inf).
+        let mut x = vec![0.0; 10];
+        x.extend([f64::MAX; 10]);
+        x.extend([-f64::MAX; 10]);
+        x.extend([0.0; 10]);
+        let s = feed(&x).unwrap();
+        assert_eq!(get(&s, "mean"), 0.0);
+        let want = f64::MAX * 0.5f64.sqrt();
+        assert!((get(&s, "rms") - want).abs() <= 4.0 * f64::EPSILON * want, "{:e}", get(&s, "rms"));
+        assert_eq!(get(&s, "pp"), f64::MAX);
+        assert!(s.lines.iter().any(|l| l.contains("beyond f64::MAX")), "{:?}", s.lines);
+        // One impulse of MAX among 4 samples: mean MAX/4, RMS MAX/2.
+        let s = feed(&[0.0, f64::MAX, 0.0, 0.0]).unwrap();
+        assert_eq!((get(&s, "mean"), get(&s, "rms"), get(&s, "pp")), (f64::MAX / 4.0, f64::MAX / 2.0, f64::MAX));
+        assert!(s.lines.is_empty());
+    }
+
+    #[test]
+    fn subnormal_samples_have_their_true_rms() {
+        // Their squares underflow to 0: the plain RMS was 0.
+        let s = feed(&[5e-324, -5e-324, 5e-324, -5e-324]).unwrap();
+        assert_eq!(get(&s, "rms"), 5e-324);
+        assert_eq!(get(&s, "mean"), 0.0);
     }
 
     #[test]

@@ -269,7 +269,7 @@ mod tests {
                 train_rows: 85,
                 validation_rows: 15,
                 train_rel_rms: 0.1,
-                validation_rel_rms: 0.12,
+                validation_rel_rms: Some(0.12),
             },
             actuation_rms: 0.3,
             actuation_peak: 0.5,

@@ -47,7 +47,11 @@ pub static SPEC: NodeSpec = NodeSpec::new(
      parameters (with the number needed) stop the run; nothing is written. The file (docs/synthesis.md) \
      is written through a temporary file and a rename.\n\n\
      **Summary.** `train_rel_rms`, `validation_rel_rms` (‖y − ŷ‖/‖y‖ on the fitted and the held-out \
-     kept samples), `carrier_gain` (N per unit² of a Nyquist-rate carrier), `noise_floor`, `noise_per_u2`, \
+     kept samples, from sums of squares scaled where plain ones would under- or overflow, so a \
+     subnormal force has its true relative error; where the force is exactly 0 on those samples, \
+     relative to the RMS force over all kept samples; with `validation = 0` nothing is held out and \
+     `validation_rel_rms` is absent, `null` in the file), `carrier_gain` (N per unit² of a \
+     Nyquist-rate carrier), `noise_floor`, `noise_per_u2`, \
      `samples`, `seconds`.\n\n\
      Checked against: exact recovery of a square law behind an FIR filter and a high-pass, a noise \
      model with known growth, the simulated lab (nodes/tests/forward_lab.rs).",
@@ -212,9 +216,11 @@ impl Node for Train {
         let file =
             ForwardModel::new(&model, self.rate, &self.cfg.filter, self.condition, noise, fitted.spectrum, training);
         file.save(&self.path)?;
-        let mut s = Summary::default()
-            .value("train_rel_rms", scores.train_rel_rms, "1")
-            .value("validation_rel_rms", scores.validation_rel_rms, "1")
+        let mut s = Summary::default().value("train_rel_rms", scores.train_rel_rms, "1");
+        if let Some(v) = scores.validation_rel_rms {
+            s = s.value("validation_rel_rms", v, "1");
+        }
+        let mut s = s
             .value("carrier_gain", file.carrier_gain_n, "N")
             .value("noise_floor", noise.floor_n2, "N²")
             .value("noise_per_u2", noise.per_u2_n2, "N²")
@@ -222,13 +228,70 @@ impl Node for Train {
         if self.record_time {
             s = s.value("seconds", seconds, "s");
         }
+        let validation = match scores.validation_rel_rms {
+            Some(v) => format!("validation error {v:.3}"),
+            None => "no validation error: none held out".to_string(),
+        };
         Ok(s.line(format!(
-            "wrote {} (memory {}, {} kept samples, validation error {:.3}, carrier gain {:.4} N)",
+            "wrote {} (memory {}, {} kept samples, {validation}, carrier gain {:.4} N)",
             self.shown,
             model.memory(),
             scores.samples,
-            scores.validation_rel_rms,
             file.carrier_gain_n
         )))
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::super::model_file::ForwardModel;
+    use super::SPEC;
+    use crate::rng::Rng;
+    use evflow_engine::harness::Single;
+    use evflow_engine::Summary;
+    use std::path::Path;
+
+    fn train(dir: &Path, u: Vec<f64>, force: Vec<f64>, params: &str) -> Summary {
+        let n = u.len() as u64;
+        let params = format!("path = \"f.json\"\nmemory = 2\nhighpass_order = 0\nrecord_time = false\n{params}");
+        Single::new(&SPEC, &params)
+            .input("u", u, 1000.0)
+            .input("force", force, 1000.0)
+            .ticks(n)
+            .block(128)
+            .base_dir(dir)
+            .summary()
+            .unwrap()
+    }
+
+    fn actuation(n: usize) -> Vec<f64> {
+        let mut r = Rng::new(5);
+        (0..n).map(|_| [-1.0, -0.5, 0.0, 0.5, 1.0][(r.uniform() * 5.0) as usize % 5]).collect()
+    }
+
+    #[test]
+    fn nothing_held_out_reports_no_validation_error() {
+        // validation = 0: the held-out error was NaN (and `null` in the file).
+        let dir = tempfile::tempdir().unwrap();
+        let u = actuation(400);
+        let force: Vec<f64> = (0..u.len()).map(|n| u[n] * u[n] + if n > 0 { 0.3 * u[n - 1] } else { 0.0 }).collect();
+        let s = train(dir.path(), u, force, "validation = 0.0");
+        assert!(s.values.iter().all(|(_, v, _)| v.is_finite()), "{s:?}");
+        assert_eq!(s.get("validation_rel_rms"), None);
+        assert!(s.get("train_rel_rms").unwrap() < 1e-6, "{s:?}");
+        assert!(s.lines[0].contains("none held out"), "{:?}", s.lines);
+        let m = ForwardModel::load(&dir.path().join("f.json")).unwrap();
+        assert_eq!((m.training.scores.validation_rows, m.training.scores.validation_rel_rms), (0, None));
+    }
+
+    #[test]
+    fn a_subnormal_force_has_finite_relative_errors() {
+        // Its squares underflow to 0: both relative errors were 0/0 = NaN.
+        let dir = tempfile::tempdir().unwrap();
+        let tiny = [5e-324, -5e-324, f64::MIN_POSITIVE / 3.0, -f64::MIN_POSITIVE / 7.0, f64::MIN_POSITIVE];
+        let force: Vec<f64> = (0..400).map(|n| tiny[n % 5]).collect();
+        let s = train(dir.path(), actuation(400), force, "");
+        assert!(s.values.iter().all(|(_, v, _)| v.is_finite()), "{s:?}");
+        assert!(s.get("validation_rel_rms").is_some() && s.get("train_rel_rms").is_some(), "{s:?}");
     }
 }

@@ -25,6 +25,7 @@ use super::error::SynthError;
 use super::output_filter::OutputFilter;
 use super::spectral::NoiseSpectrum;
 use super::volterra::{upper_index, Volterra, MAX_MEMORY};
+use crate::wide_sum::SumSq;
 use faer::linalg::solvers::Solve;
 use faer::{Mat, Par, Side};
 
@@ -83,10 +84,11 @@ pub struct FitScores {
     pub train_rows: usize,
     /// Of which held out.
     pub validation_rows: usize,
-    /// ‖y − ŷ‖ / ‖y‖ on the fitted rows.
+    /// ‖y − ŷ‖ / ‖y‖ on the fitted rows (see [`rel_rms`]).
     pub train_rel_rms: f64,
-    /// ‖y − ŷ‖ / ‖y‖ on the held-out rows (NaN without any).
-    pub validation_rel_rms: f64,
+    /// ‖y − ŷ‖ / ‖y‖ on the held-out rows; `None` (`null` in a model
+    /// file) without any (`validation` = 0).
+    pub validation_rel_rms: Option<f64>,
 }
 
 /// Identifies a model from actuation `u`, recorded force `y` (after the
@@ -198,21 +200,12 @@ pub fn fit(u: &[f64], y: &[f64], keep: &[bool], cfg: &FitConfig) -> Result<Fitte
         let pred: f64 = (0..p).map(|k| phi[(r, k)] * th[k]).sum();
         *out = kept_y[r] - pred;
     }
-    let rel = |a: usize, b: usize| {
-        let e: f64 = resid[a..b].iter().map(|v| v * v).sum();
-        let s: f64 = kept_y[a..b].iter().map(|v| v * v).sum();
-        if b > a && s > 0.0 {
-            (e / s).sqrt()
-        } else {
-            f64::NAN
-        }
-    };
     let scores = FitScores {
         samples: rows.len(),
         train_rows: n_tr,
         validation_rows: n_val,
-        train_rel_rms: rel(0, n_tr),
-        validation_rel_rms: rel(n_tr, rows.len()),
+        train_rel_rms: rel_rms(&resid[..n_tr], &kept_y[..n_tr], &kept_y),
+        validation_rel_rms: (n_val > 0).then(|| rel_rms(&resid[n_tr..], &kept_y[n_tr..], &kept_y)),
     };
 
     // Noise model: r² against the local mean of u² on the fitted rows.
@@ -232,6 +225,26 @@ pub fn fit(u: &[f64], y: &[f64], keep: &[bool], cfg: &FitConfig) -> Result<Fitte
     let kept_u: Vec<f64> = rows.iter().map(|&n| u[n]).collect();
     let spectrum = noise_spectrum(&resid, &kept_u, cfg.rate);
     Ok(Fitted { model, noise: NoiseModel { floor_n2: floor, per_u2_n2: beta }, spectrum, scores })
+}
+
+/// ‖resid‖ / ‖y‖: the relative RMS error of rows whose force is `y` and
+/// residual `resid`. The sums of squares are scaled where plain ones
+/// would over- or underflow ([`SumSq`]), so a subnormal force has its true
+/// relative error, not 0/0. Where `y` is exactly 0 on every row it is
+/// relative to the RMS force over `all` the kept rows instead: rms(resid)
+/// / rms(all) (the fit refuses a constant force, so that is not 0).
+pub fn rel_rms(resid: &[f64], y: &[f64], all: &[f64]) -> f64 {
+    let sum_sq = |v: &[f64]| {
+        let mut q = SumSq::<f64>::default();
+        v.iter().for_each(|&x| q.add(x));
+        q
+    };
+    let (e, s) = (sum_sq(resid), sum_sq(y));
+    if s.is_zero() {
+        e.root_mean(resid.len() as f64).ratio(sum_sq(all).root_mean(all.len() as f64))
+    } else {
+        e.sqrt_ratio(&s)
+    }
 }
 
 /// Solves the (weighted, ridge-stabilized) normal equations on the first
@@ -394,7 +407,7 @@ mod tests {
                 let want = if i < 4 { 0.1 * g[i] } else { 0.0 };
                 assert!((v.linear()[i] - want).abs() < 1e-6, "l[{i}]");
             }
-            assert!(s.validation_rel_rms < 1e-6 && s.train_rel_rms < 1e-6, "{s:?}");
+            assert!(s.validation_rel_rms.unwrap() < 1e-6 && s.train_rel_rms < 1e-6, "{s:?}");
             assert!(noise.per_u2_n2 < 1e-12 && noise.floor_n2 < 1e-12, "{noise:?}");
         }
     }
@@ -419,6 +432,34 @@ mod tests {
         let noise = fit(&u, &y, &keep, &cfg).unwrap().noise;
         assert!((noise.per_u2_n2 / 4e-4 - 1.0).abs() < 0.2, "{noise:?}");
         assert!((noise.floor_n2 / 1e-4 - 1.0).abs() < 0.2, "{noise:?}");
+    }
+
+    #[test]
+    fn relative_errors_are_defined_for_a_subnormal_force_and_without_held_out_rows() {
+        let g = [0.9, -0.4];
+        let levels = [-1.0, -0.5, 0.0, 0.5, 1.0];
+        let mut r = Rng::new(3);
+        let u: Vec<f64> = (0..1000).map(|_| levels[(r.uniform() * 5.0) as usize % 5]).collect();
+        let y = plant(&u, &g, &OutputFilter::none());
+        let keep = vec![true; u.len()];
+        // validation = 0 holds nothing out: no validation error (was NaN).
+        let cfg = FitConfig { memory: 3, validation: 0.0, ..FitConfig::default() };
+        let s = fit(&u, &y, &keep, &cfg).unwrap().scores;
+        assert_eq!((s.validation_rows, s.validation_rel_rms), (0, None));
+        assert!(s.train_rel_rms < 1e-6, "{s:?}");
+        // A subnormal force: its squares underflow to 0 (0/0 was NaN).
+        let tiny = [5e-324, -5e-324, f64::MIN_POSITIVE / 3.0, -f64::MIN_POSITIVE / 7.0, f64::MIN_POSITIVE];
+        let y: Vec<f64> = (0..1000).map(|n| tiny[n % 5]).collect();
+        let cfg = FitConfig { memory: 3, ..FitConfig::default() };
+        let s = fit(&u, &y, &keep, &cfg).unwrap().scores;
+        let (t, v) = (s.train_rel_rms, s.validation_rel_rms.unwrap());
+        assert!(t.is_finite() && v.is_finite() && t >= 0.0 && v >= 0.0, "{s:?}");
+        // The definition, on rows of known values: plain, subnormal, zero force.
+        assert_eq!(rel_rms(&[3.0, 4.0], &[6.0, 8.0], &[6.0, 8.0]), 0.5);
+        let small = [3e-320, 4e-320];
+        assert_eq!(rel_rms(&small, &small.map(|v| 2.0 * v), &[1.0]), 0.5);
+        // rms [3, 4] / rms [0, 0, 10, 10] = √12.5 / √50.
+        assert_eq!(rel_rms(&[3.0, 4.0], &[0.0, 0.0], &[0.0, 0.0, 10.0, 10.0]), 0.5);
     }
 
     #[test]

@@ -36,7 +36,10 @@ pub fn curve(size: Size) -> Result<Curve, PrecisionError> {
         points.push(WorkPoint {
             setting: format!("memory {m}"),
             series: "second-order Volterra".into(),
-            error: f.scores.validation_rel_rms,
+            error: f
+                .scores
+                .validation_rel_rms
+                .ok_or_else(|| PrecisionError::Method(format!("volterra fit, memory {m}: no held-out rows")))?,
             cost: seconds / n as f64,
             work: f.model.n_params() as f64,
         });

@@ -107,7 +107,7 @@ fn models_table(md: &mut String, study: &Study, timings: Timings) {
         let fwd = ForwardModel::load(&m.forward).map_or("–".to_string(), |f| {
             format!(
                 "{} / {:.4} / {}",
-                f3(f.training.scores.validation_rel_rms),
+                f3(f.training.scores.validation_rel_rms.unwrap_or(f64::NAN)),
                 f.carrier_gain_n,
                 secs(f.training.seconds)
             )

@@ -77,6 +77,9 @@ struct Entry {
     kind: &'static str,
     spec: &'static NodeSpec,
     out_names: Vec<String>,
+    /// The unit of what feeds the first input: the unit of summary values
+    /// declared [`crate::ports::SAME_AS_INPUT`].
+    in_unit: String,
     loc: Loc,
     node: Box<dyn Node>,
     ratio: Ratio,
@@ -275,7 +278,9 @@ impl Plan {
     }
 
     /// Ends the run: every node's `finish`, in plan order (sinks rename their
-    /// files here; trainers train). Returns each node's summary. The time
+    /// files here; trainers train). Returns each node's summary, a value
+    /// declared in [`crate::ports::SAME_AS_INPUT`] given the unit of what
+    /// feeds the node. The time
     /// each `finish` takes is charged to its node ([`Plan::times`]).
     pub fn finish(&mut self) -> Result<Vec<(String, Summary)>, Box<NodeFailure>> {
         let mut out = Vec::new();
@@ -286,7 +291,14 @@ impl Plan {
                 self.entries[k].finishing += s.elapsed();
             }
             match result {
-                Ok(s) if !s.is_empty() => out.push((self.entries[k].name.clone(), s)),
+                Ok(mut s) if !s.is_empty() => {
+                    for (_, _, unit) in &mut s.values {
+                        if unit == crate::ports::SAME_AS_INPUT {
+                            unit.clone_from(&self.entries[k].in_unit);
+                        }
+                    }
+                    out.push((self.entries[k].name.clone(), s))
+                }
                 Ok(_) => {}
                 Err(e) => return Err(self.failure(k, e)),
             }

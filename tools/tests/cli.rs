@@ -405,10 +405,24 @@ fn check_shows_the_units_a_chain_carries() {
 }
 
 /// `live` and `replay` print a sink's values as `run` does, six
-/// significant digits, not seventeen (issue 37, point 13).
+/// significant digits, not seventeen, and `stats` gives them the unit of
+/// what feeds it (a force in N; its sample count has none) (issue 37,
+/// point 13).
 #[test]
 fn live_prints_values_as_run_does() {
     let dir = tempfile::tempdir().unwrap();
+    let with_units = |stdout: &str| {
+        for k in ["mean", "rms", "min", "max", "pp"] {
+            let line = stdout.lines().find(|l| l.starts_with(&format!("force_stats: {k} = "))).unwrap();
+            assert!(line.ends_with(" N"), "{line}");
+        }
+        let samples = stdout.lines().find(|l| l.starts_with("force_stats: samples = ")).unwrap();
+        assert!(samples.trim_end().chars().last().unwrap().is_ascii_digit(), "{samples}");
+    };
+    let o = evflow(&["run", "graphs/display-live.toml", "-q", "--out", dir.path().to_str().unwrap()]);
+    let (stdout, stderr) = text(&o);
+    assert!(o.status.success(), "{stderr}");
+    with_units(&stdout);
     let out = dir.path().join("s");
     let o = evflow(&["live", "graphs/display-live.toml", "--duration", "0.3", "--out", out.to_str().unwrap()]);
     let (stdout, stderr) = text(&o);
@@ -421,12 +435,14 @@ fn live_prints_values_as_run_does() {
         assert!(significant <= 6, "{rms}");
     };
     six_digits(&stdout);
+    with_units(&stdout);
     // And its replay.
     let session = std::fs::read_dir(out.join("sessions")).unwrap().next().unwrap().unwrap().path();
     let o = evflow(&["replay", session.to_str().unwrap()]);
     let (stdout, stderr) = text(&o);
     assert!(o.status.success(), "{stderr}");
     six_digits(&stdout);
+    with_units(&stdout);
 }
 
 #[cfg(unix)]

@@ -33,6 +33,18 @@ fn follow(c: &Checked, node: usize, port: usize, seen: &mut Vec<usize>) -> Strin
         return UNKNOWN.into();
     }
     seen.push(node);
+    feeding(c, node, seen)
+}
+
+/// The unit of what feeds node `node`'s first input, followed upstream
+/// ([`UNKNOWN`] when nothing feeds it): the unit a sink reports values in
+/// when it declares them [`SAME_AS_INPUT`] (`stats`' mean, RMS, …).
+pub fn input_unit(c: &Checked, node: usize) -> String {
+    feeding(c, node, &mut vec![node])
+}
+
+fn feeding(c: &Checked, node: usize, seen: &mut Vec<usize>) -> String {
+    let n = &c.nodes[node];
     let first_input = n.ports.iter().position(|p| p.dir == Direction::In);
     let source = first_input.and_then(|i| c.edges.iter().find(|e| e.to == (node, i)));
     match source {
@@ -83,5 +95,20 @@ mod tests {
         let want = [("a", "N"), ("b", "g"), ("c", "g"), ("f", "N")];
         let got = units(doc);
         assert_eq!(got, want.map(|(a, b)| (a.to_string(), b.to_string())));
+    }
+
+    #[test]
+    fn a_sink_reports_in_the_unit_of_what_feeds_it() {
+        let doc = "[graph]\nformat = 1\nname = \"u\"\nrate = 1000\n\
+                   connections = [\"f.out -> a.in\", \"a.out -> t.in\", \"f.out -> b.in\", \"b.out -> s.in\"]\n\
+                   [nodes.f]\ntype = \"force\"\n[nodes.a]\ntype = \"scale\"\n\
+                   [nodes.b]\ntype = \"scale\"\nunit = \"g\"\n\
+                   [nodes.t]\ntype = \"harness.tap\"\n[nodes.s]\ntype = \"harness.tap\"\n";
+        let mut reg = Registry::new();
+        reg.add(&FORCE).add(&SCALE).add(&TAP);
+        let c = crate::check::check(&parse_graph(Path::new("u.toml"), doc).unwrap(), &reg, &[]).unwrap();
+        assert_eq!(input_unit(&c, c.index("t").unwrap()), "N");
+        assert_eq!(input_unit(&c, c.index("s").unwrap()), "g");
+        assert_eq!(input_unit(&c, c.index("f").unwrap()), UNKNOWN, "a source has no input");
     }
 }

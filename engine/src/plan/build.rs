@@ -219,6 +219,7 @@ impl Builder<'_> {
                 kind: n.spec.name,
                 spec: n.spec,
                 out_names: n.outputs().map(|p| n.ports[p].name.clone()).collect(),
+                in_unit: crate::check::units::input_unit(checked, i),
                 loc: n.loc,
                 node,
                 ratio: n.ratio,

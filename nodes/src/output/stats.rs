@@ -1,7 +1,7 @@
 //! `stats`: a sink that reports count, mean, RMS, min, max and peak-to-peak.
 
 use crate::wide_sum::{SumSq, WideSum};
-use evflow_engine::ports::InPort;
+use evflow_engine::ports::{InPort, SAME_AS_INPUT};
 use evflow_engine::{BuildContext, Io, Node, NodeError, NodeSpec, PortSpec, Role, Summary};
 
 /// Declaration of `stats`.
@@ -21,7 +21,9 @@ pub static SPEC: NodeSpec = NodeSpec::new(
              (samples near ±f64::MAX, or subnormal), so the mean and RMS of any finite samples are \
              right; a peak-to-peak beyond f64::MAX (max − min of samples near ±f64::MAX) is \
              reported as f64::MAX, with a line saying so. Accepts any rate. A NaN or Inf in the input is an error naming the sample \
-             index, since no node may let one through.",
+             index, since no node may let one through. The mean, RMS, minimum, maximum and \
+             peak-to-peak are in the unit of what feeds it (followed upstream, as `evflow check` \
+             shows it).",
 )
 .ports(PORTS)
 .example("");
@@ -90,11 +92,11 @@ impl Node for Stats {
         let pp = self.max - self.min;
         let s = Summary::default()
             .value("samples", n, "1")
-            .value("mean", self.sum.mean(n), "1")
-            .value("rms", rms, "1")
-            .value("min", self.min, "1")
-            .value("max", self.max, "1")
-            .value("pp", pp.min(f64::MAX), "1");
+            .value("mean", self.sum.mean(n), SAME_AS_INPUT)
+            .value("rms", rms, SAME_AS_INPUT)
+            .value("min", self.min, SAME_AS_INPUT)
+            .value("max", self.max, SAME_AS_INPUT)
+            .value("pp", pp.min(f64::MAX), SAME_AS_INPUT);
         Ok(if pp.is_finite() {
             s
         } else {

@@ -35,7 +35,7 @@ fn unit(q: &str, runs: &[(Point, RunReport)]) -> Option<String> {
         .flat_map(|(_, r)| r.summaries.iter().filter(|(n, _)| n == node))
         .flat_map(|(_, s)| s.values.iter().filter(|(k, _, _)| k == name))
         .map(|(_, _, u)| u.clone())
-        .find(|u| !u.is_empty() && u != "1")
+        .find(|u| !u.is_empty() && u != "1" && u != evflow_engine::check::units::UNKNOWN)
 }
 
 /// A variable's value in one run: swept, set on the command line, or declared.

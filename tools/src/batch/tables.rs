@@ -18,6 +18,16 @@ pub fn number(v: f64) -> String {
     }
 }
 
+/// ` unit` after a value for people, or nothing for a dimensionless value
+/// or one whose unit could not be followed (`?`).
+pub fn unit_suffix(unit: &str) -> String {
+    if unit.is_empty() || unit == "1" || unit == evflow_engine::check::units::UNKNOWN {
+        String::new()
+    } else {
+        format!(" {unit}")
+    }
+}
+
 pub use evflow_study::tables::Timings;
 
 /// One run as JSON.

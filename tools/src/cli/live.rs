@@ -228,12 +228,3 @@ fn close_studio(studio: evflow_tools::studio::Studio) {
     }
     studio.close();
 }
-
-/// ` unit`, or nothing for dimensionless values.
-pub(crate) fn unit_suffix(unit: &str) -> String {
-    if unit.is_empty() || unit == "1" {
-        String::new()
-    } else {
-        format!(" {unit}")
-    }
-}

@@ -246,7 +246,7 @@ fn replay_one(session: &Path, graph: Option<&Path>, out: &Path, a: &Args) -> Res
                     shown,
                     "{node}: {k} = {}{}",
                     evflow_tools::batch::tables::number(*v),
-                    super::live::unit_suffix(unit)
+                    evflow_tools::batch::tables::unit_suffix(unit)
                 );
             }
         }

@@ -2,7 +2,7 @@
 //! library code, `evflow_tools::batch::tables`).
 
 use evflow_engine::RunReport;
-use evflow_tools::batch::tables::{number, Timings};
+use evflow_tools::batch::tables::{number, unit_suffix, Timings};
 
 /// Prints what the sinks report and, unless `quiet`, the run's times.
 pub fn print_report(r: &RunReport, quiet: bool, timings: Timings) {
@@ -17,8 +17,7 @@ pub fn print_report(r: &RunReport, quiet: bool, timings: Timings) {
             println!("{node}: {l}");
         }
         for (k, v, unit) in &s.values {
-            let unit = if unit.is_empty() || unit == "1" { String::new() } else { format!(" {unit}") };
-            println!("{node}: {k} = {}{unit}", number(*v));
+            println!("{node}: {k} = {}{}", number(*v), unit_suffix(unit));
         }
     }
     if quiet || timings == Timings::Leave {

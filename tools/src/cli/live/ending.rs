@@ -3,7 +3,7 @@
 
 use super::recorder::RecorderReport;
 use super::session::Manifest;
-use super::{integrity, unit_suffix, Args};
+use super::{integrity, Args};
 use anyhow::{anyhow, Result};
 use evflow_engine::live::{Metrics, MetricsSummary, Percentiles, RtExit, RtThread, Shared};
 use evflow_engine::Summary;
@@ -158,7 +158,11 @@ impl End<'_> {
                 println!("{node}: {l}");
             }
             for (k, v, unit) in &s.values {
-                println!("{node}: {k} = {}{}", evflow_tools::batch::tables::number(*v), unit_suffix(unit));
+                println!(
+                    "{node}: {k} = {}{}",
+                    evflow_tools::batch::tables::number(*v),
+                    evflow_tools::batch::tables::unit_suffix(unit)
+                );
             }
         }
     }

@@ -445,6 +445,24 @@ fn live_prints_values_as_run_does() {
     with_units(&stdout);
 }
 
+/// A scheduled `--change` is echoed on the console as it lands, with its
+/// time; `-q` keeps the console quiet (issue 37, point 13).
+#[test]
+fn live_echoes_a_scheduled_change_as_it_lands() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().to_str().unwrap();
+    let args = ["live", "graphs/display-live.toml", "--duration", "0.3", "--change", "0.1:gain.gain=0.5", "--out", out];
+    let o = evflow(&args);
+    let (_, stderr) = text(&o);
+    assert!(o.status.success(), "{stderr}");
+    assert!(stderr.lines().any(|l| l == "at 0.100 s: gain.gain = 0.5"), "{stderr}");
+    assert!(!stderr.contains(".enable = 0"), "the ending's fade-out is not echoed: {stderr}");
+    let quiet = dir.path().join("quiet");
+    let o = evflow(&[&args[..6], &["--out", quiet.to_str().unwrap(), "-q"]].concat());
+    assert!(o.status.success(), "{}", text(&o).1);
+    assert!(!text(&o).1.contains("gain.gain = 0.5"), "{}", text(&o).1);
+}
+
 #[cfg(unix)]
 #[test]
 fn links_planted_at_the_temporary_names_are_never_written_through() {

@@ -153,6 +153,7 @@ pub fn main(a: Args) -> Result<()> {
     // Recorder, metrics display and console: ordinary threads.
     let done = Arc::new(AtomicBool::new(false));
     let recorder = Recorder::create(files, parts.taps, parts.events, names, threads::FLUSH_EVERY)?;
+    let recorder = if a.quiet { recorder } else { recorder.echo(base_rate) };
     #[cfg(feature = "studio")]
     let recorder = match &studio {
         Some((_, ingest)) => recorder.tee(Box::new(ingest.clone())),

@@ -7,6 +7,7 @@
 use super::disk::{Disk, DiskQueue, Files, Op, QUEUE_SECONDS};
 use super::session::{event_json, FileSpec};
 use evflow_engine::live::{rtrb, Event, EventKind, TapInfo};
+use std::io::IsTerminal;
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::Arc;
 use std::time::Duration;
@@ -53,6 +54,10 @@ pub struct Recorder {
     disk: DiskQueue,
     names: Vec<String>,
     events_logged: u64,
+    /// Echo applied and refused changes on the console: the base rate (for
+    /// the time), and whether the stop sequence began (its `enable` changes
+    /// are the ending's, not the user's).
+    echo: Option<(f64, bool)>,
 }
 
 impl Recorder {
@@ -97,13 +102,20 @@ impl Recorder {
         let per_second: f64 = sinks.iter().map(|s| s.spec.rate * s.spec.ports.len() as f64).sum();
         let budget = (QUEUE_SECONDS * per_second * std::mem::size_of::<f64>() as f64) as usize;
         let disk = DiskQueue::start(disk, sinks.len(), budget.max(1 << 16), flush_every)?;
-        Ok(Self { tee: None, sinks, rings, events, disk, names, events_logged: 0 })
+        Ok(Self { tee: None, sinks, rings, events, disk, names, events_logged: 0, echo: None })
     }
 
     /// Hands every drained sample and event to `tee` as well.
     #[cfg_attr(not(feature = "studio"), allow(dead_code))]
     pub fn tee(mut self, tee: Box<dyn Tee>) -> Self {
         self.tee = Some(tee);
+        self
+    }
+
+    /// Prints each parameter change on stderr as it lands (scheduled with
+    /// `--change`, typed, or from the studio), timed on the base rate.
+    pub fn echo(mut self, base_rate: f64) -> Self {
+        self.echo = Some((base_rate, false));
         self
     }
 
@@ -170,6 +182,14 @@ impl Recorder {
             if let Some(t) = self.tee.as_mut() {
                 t.event(&e);
             }
+            if let Some((rate, stopped)) = self.echo.as_mut() {
+                *stopped |= matches!(e.kind, EventKind::Stop(_));
+                if let Some(line) = echo_line(&e, &self.names, *rate).filter(|_| !*stopped) {
+                    // Over the once-a-second status line on a terminal.
+                    let clear = if std::io::stderr().is_terminal() { "\r\x1b[K" } else { "" };
+                    eprintln!("{clear}{line}");
+                }
+            }
             self.log_event(&e);
         }
         for s in 0..self.sinks.len() {
@@ -216,6 +236,21 @@ impl Recorder {
     }
 }
 
+/// The console's line for a change that landed (none for other events).
+fn echo_line(e: &Event, names: &[String], base_rate: f64) -> Option<String> {
+    let name = |k: u32| names.get(k as usize).map_or_else(|| format!("#{k}"), String::clone);
+    let t = e.tick as f64 / base_rate;
+    // As typed: the shortest text that reads back as the same value.
+    let v = |x: f64| format!("{x}");
+    match e.kind {
+        EventKind::Set { node, param, value } => Some(format!("at {t:.3} s: {}.{param} = {}", name(node), v(value))),
+        EventKind::Refused { node, param, value } => {
+            Some(format!("at {t:.3} s: {}.{param} = {} refused by the node (nothing changed)", name(node), v(value)))
+        }
+        _ => None,
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::super::disk::DiskReport;
@@ -223,6 +258,19 @@ mod tests {
     use evflow_engine::rate::Ratio;
     use std::sync::mpsc;
     use std::sync::Mutex;
+
+    #[test]
+    fn a_change_that_lands_is_echoed_with_its_time_and_a_refused_one_says_so() {
+        let names = vec!["drive".to_string(), "gain".to_string()];
+        let set = Event { tick: 5000, kind: EventKind::Set { node: 1, param: "gain", value: 0.5 } };
+        assert_eq!(echo_line(&set, &names, 1000.0).unwrap(), "at 5.000 s: gain.gain = 0.5");
+        let refused = Event { tick: 250, kind: EventKind::Refused { node: 0, param: "frequency", value: -3.0 } };
+        assert_eq!(
+            echo_line(&refused, &names, 1000.0).unwrap(),
+            "at 0.250 s: drive.frequency = -3 refused by the node (nothing changed)"
+        );
+        assert_eq!(echo_line(&Event { tick: 1, kind: EventKind::Replaced }, &names, 1000.0), None);
+    }
 
     /// A disk whose first write stalls until the test lets it go (an fsync
     /// that takes seconds), keeping every frame it is given.

@@ -6,6 +6,7 @@ mod connections;
 pub mod interpolate;
 mod names;
 mod params;
+mod partial;
 pub mod prune;
 mod rate_hint;
 mod topology;
@@ -165,6 +166,8 @@ pub fn check(graph: &Graph, registry: &Registry, overrides: &[Override]) -> Resu
     let edges = wiring.edges;
 
     if !sink.diags.is_empty() {
+        // The rate and cycle errors of the rest, so one check reports them all.
+        partial::topology_errors(&graph, &nodes, &edges, &mut sink);
         return Err(Diagnostics(sink.diags));
     }
     // Every node that failed validation has reported why; should one not

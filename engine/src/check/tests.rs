@@ -206,6 +206,53 @@ fn cycle_without_delay_is_refused() {
     assert!(e.iter().any(|d| d.message.contains("not broken by a `delay`")), "{e:#?}");
 }
 
+/// Errors of every stage in one check: a misspelt parameter and a wrong
+/// port (nodes and connections) beside a rate that does not fit and a rate
+/// mismatch (topology) — reported together, and nothing the first two
+/// cause (issue 37, point 13).
+#[test]
+fn one_check_reports_the_rate_errors_beside_the_others() {
+    let text = r#"[graph]
+format = 1
+name = "all"
+rate = 1000
+connections = ["a.out -> tap.in", "b.out -> f.in", "f.out -> tap2.in", "c.outt -> tap3.in", "s.out -> m.a", "fast.out -> m.b", "m.out -> tap4.in"]
+[nodes.a]
+type = "slow"
+rate = 333
+[nodes.b]
+type = "slow"
+[nodes.f]
+type = "filt"
+need = 0
+cutof = 3
+[nodes.c]
+type = "harness.feed"
+[nodes.s]
+type = "slow"
+[nodes.fast]
+type = "harness.feed"
+[nodes.m]
+type = "mix"
+[nodes.tap]
+type = "harness.tap"
+[nodes.tap2]
+type = "harness.tap"
+[nodes.tap3]
+type = "harness.tap"
+[nodes.tap4]
+type = "harness.tap"
+"#;
+    let e = errors(text);
+    let has = |s: &str| e.iter().filter(|d| d.message.contains(s)).count();
+    assert_eq!(has("cutof"), 1, "{e:#?}");
+    assert_eq!(has("outt"), 1, "{e:#?}");
+    assert_eq!(has("333 Hz"), 1, "{e:#?}");
+    assert_eq!(has("rate mismatch: `fast.out` runs at 1000 Hz but `m.b` at 40 Hz"), 1, "{e:#?}");
+    // Nothing about `f`'s or `tap3`'s rates: their errors come first.
+    assert_eq!(e.len(), 4, "{e:#?}");
+}
+
 #[test]
 fn rate_mismatch_is_refused_with_a_hint() {
     let text = r#"[graph]

@@ -239,6 +239,28 @@ fn the_page_shows_a_recorded_session_with_its_events_and_replay_check() {
     assert!((t0("faded").as_f64().unwrap() - 1.5).abs() < 1e-9, "{states:?}");
     assert!((t0("armed").as_f64().unwrap() - 2.0).abs() < 1e-9, "{states:?}");
     assert_eq!(states.last(), Some(&"faded"), "the stop fades the limiter out: {states:?}");
+    // The limiter panel gives the session's peaks, not its last window's
+    // (the fade-out: it read "peak in 0 out 0.265" where the output
+    // peaked at 0.66), and says its input was not recorded.
+    let info = cdp.eval("document.getElementById('limiter-info-limit').textContent");
+    let out_peak =
+        cdp.eval(&format!("Math.max(...studio.series[{i}].hi.map(Math.abs), ...studio.series[{i}].lo.map(Math.abs))"));
+    let want = format!(
+        "peak over the session in – (input not recorded) out {}",
+        cdp.eval(&format!("plot.fmt({out_peak})")).as_str().unwrap()
+    );
+    assert!(info.as_str().unwrap().contains(&want), "{info} / {want}");
+    // The Steer panel lists the session's changes (it was an empty list).
+    let changes = cdp.eval("[...document.querySelectorAll('#steer-log li')].map(l => l.textContent)");
+    assert_eq!(changes[0], json!("at 1.000 s: interp.texture = 2"), "{changes}");
+    assert_eq!(changes[1], json!("at 1.500 s: limit.enable = 0"), "{changes}");
+    // The Finger panel shows the recorded finger (it said none was tapped)
+    // and says how to record the grid's inputs.
+    let finger = cdp.eval("document.getElementById('scene-note').textContent");
+    assert!(
+        finger.as_str().unwrap().contains("--tap") && finger.as_str().unwrap().contains("user.x × user.y"),
+        "{finger}"
+    );
     // The traces' heading says what they show (it read "last scrub s").
     let heading = cdp.eval("document.getElementById('traces-window').textContent");
     assert!(heading.as_str().is_some_and(|h| h.contains("whole session") && !h.contains("last")), "{heading}");

@@ -210,3 +210,34 @@ fn a_browser_that_stops_reading_loses_frames_not_ticks() {
     let n: u64 = lost.split_whitespace().nth(3).and_then(|n| n.parse().ok()).unwrap();
     assert!(n > 0, "{lost}");
 }
+
+/// A browser that joins a running session late gets its recent frames
+/// first: the page's "last 10 s" starts full (it showed 0.6 s of a session
+/// joined 8 s in) (issue 37, point 12).
+#[test]
+fn a_browser_joining_late_gets_the_recent_seconds() {
+    let tmp = tempfile::tempdir().unwrap();
+    let s = common::start("display-live.toml", tmp.path(), &["127.0.0.1:0"], &["--duration", "30"]);
+    let host = s.host();
+    std::thread::sleep(Duration::from_secs(4));
+    let (mut ws, _) = tungstenite::client(format!("ws://{host}/ws"), std::net::TcpStream::connect(&host).unwrap())
+        .expect("the websocket");
+    let mut first_t0 = None;
+    let mut last_t = 0.0;
+    let started = Instant::now();
+    while started.elapsed() < Duration::from_secs(20) && last_t < 3.0 {
+        let Ok(Message::Text(m)) = ws.read() else { continue };
+        let v: Value = serde_json::from_str(m.as_str()).unwrap();
+        if v["type"] != "frame" {
+            continue;
+        }
+        if first_t0.is_none() {
+            first_t0 = v["taps"].as_array().and_then(|t| t.first()).and_then(|t| t["t0"].as_f64());
+        }
+        last_t = v["t"].as_f64().unwrap_or(0.0);
+    }
+    let first = first_t0.expect("frames with samples arrive");
+    assert!(last_t >= 3.0, "joined {last_t} s in");
+    assert!(first < 0.5, "the first frame it gets starts at {first} s, not when it joined ({last_t} s)");
+    drop(s);
+}

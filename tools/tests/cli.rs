@@ -456,6 +456,12 @@ fn live_echoes_a_scheduled_change_as_it_lands() {
     let (_, stderr) = text(&o);
     assert!(o.status.success(), "{stderr}");
     assert!(stderr.lines().any(|l| l == "at 0.100 s: gain.gain = 0.5"), "{stderr}");
+    // The end says what was recorded and how to record more (point 12).
+    assert!(
+        text(&o).0.contains("every source's outputs and every safety guard's; `--tap NODE.PORT`"),
+        "{}",
+        text(&o).0
+    );
     assert!(!stderr.contains(".enable = 0"), "the ending's fade-out is not echoed: {stderr}");
     let quiet = dir.path().join("quiet");
     let o = evflow(&[&args[..6], &["--out", quiet.to_str().unwrap(), "-q"]].concat());

@@ -233,7 +233,7 @@ pub(crate) fn connection(mut s: TcpStream, ctx: &Ctx, id: u64, closed: &AtomicBo
 fn websocket(s: TcpStream, ctx: &Ctx) {
     bound_send_buffer(&s);
     let Ok(mut ws) = tungstenite::accept(s) else { return };
-    let Some((rx, drops)) = ctx.hub.join() else {
+    let Some(super::hub::Joined { history, rx, drops }) = ctx.hub.join() else {
         let _ = ws.send(Message::text(r#"{"type":"error","message":"too many browsers are connected"}"#));
         let _ = ws.close(None);
         return;
@@ -241,7 +241,7 @@ fn websocket(s: TcpStream, ctx: &Ctx) {
     let _ = ws.get_mut().set_read_timeout(Some(Duration::from_millis(2)));
     let _ = ws.get_mut().set_write_timeout(Some(Duration::from_secs(2)));
     let initial: Vec<Arc<str>> = ctx.initial.lock().unwrap_or_else(|e| e.into_inner()).clone();
-    for m in std::iter::once(&ctx.hello).chain(&initial) {
+    for m in std::iter::once(&ctx.hello).chain(&initial).chain(&history) {
         if ws.send(Message::text(m.to_string())).is_err() {
             return;
         }

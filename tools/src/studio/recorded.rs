@@ -116,6 +116,14 @@ impl RecordedSession {
                 }
                 t = t1;
             }
+            // The panel shows the peaks over the whole session: its last
+            // window alone is the fade-out at the end.
+            let peak = |i: Option<usize>| {
+                i.map(|i| self.taps[i].samples.iter().filter(|v| v.is_finite()).fold(0.0f64, |m, v| m.max(v.abs())))
+            };
+            if last.is_object() {
+                last["session"] = json!({ "in_peak": peak(spec.input), "out_peak": peak(spec.output) });
+            }
             lines.push(json!({ "node": spec.node, "segments": segs, "last": last }));
         }
         (hello, lines)
@@ -288,6 +296,16 @@ mod tests {
         let states =
             l["segments"].as_array().unwrap().iter().map(|x| x["state"].as_str().unwrap().to_string()).collect();
         (states, l["last"].clone())
+    }
+
+    #[test]
+    fn the_limiter_panel_gets_the_peaks_of_the_whole_session() {
+        let mut s = faded_session(true);
+        s.taps[0].samples[40] = -0.66;
+        let (_, last) = strip(&s);
+        assert_eq!(last["out_peak"], 0.5, "the last window");
+        assert_eq!(last["session"]["out_peak"], 0.66);
+        assert_eq!(last["session"]["in_peak"], Value::Null, "the input is not recorded");
     }
 
     #[test]

@@ -102,7 +102,7 @@ impl Bound {
                     let mut f = feed.lock().unwrap_or_else(|e| e.into_inner());
                     f.frame(hub.drops.load(Ordering::Relaxed), hub.len())
                 };
-                hub.broadcast(Arc::from(frame.to_string()));
+                hub.broadcast_frame(Arc::from(frame.to_string()));
             }
         })?);
         Ok((studio, ingest))

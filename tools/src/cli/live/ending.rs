@@ -153,6 +153,7 @@ impl End<'_> {
         if let Some(e) = &self.rec.event_error {
             println!("event log: FAILED: {e}");
         }
+        println!("{RECORDED}");
         for (node, s) in sums {
             for l in &s.lines {
                 println!("{node}: {l}");
@@ -167,6 +168,11 @@ impl End<'_> {
         }
     }
 }
+
+/// What a session records, said after the list of its files.
+pub(super) const RECORDED: &str = "(a session records what its replay needs: every source's outputs and every safety \
+     guard's; `--tap NODE.PORT` records another output too, to see it in `evflow studio` or read it later — \
+     `evflow check FILE` lists the outputs there are)";
 
 /// The session's metrics as JSON (microseconds).
 fn metrics_json(s: &MetricsSummary) -> serde_json::Value {

@@ -82,6 +82,7 @@ function frame(f) {
   if (f.timing) timingShow(f);
   if (f.studio) { $("drops-all").textContent = f.studio.frames_dropped; $("browsers").textContent = f.studio.browsers; }
   if (f.limiter_timelines) S.timelines = f.limiter_timelines;
+  if (S.recorded && !$("steer-log").children.length) logLine($("steer-log"), "no parameter was changed during the session", "");
   if (S.recorded) draw(); else requestDraw();
 }
 
@@ -167,7 +168,12 @@ function limiterShow(l) {
   const counts = l.source === "node"
     ? `clamped or slew-limited ${l.clamped_samples} samples · faults ${l.faults}` + (l.watching_input ? ` · non-finite inputs ${l.non_finite_inputs}` : "")
     : `clamped ${l.clamped_samples} samples · non-finite inputs ${l.non_finite_inputs}` + (l.watching_input ? "" : " · (input not tapped: clamping not seen)");
-  $(`limiter-info-${l.node}`).textContent = `enable ${l.enable} · peak in ${plot.fmt(l.in_peak)} out ${plot.fmt(l.out_peak)} · ${counts}` +
+  // A recorded session: the peaks over the whole session (the last window
+  // alone is its fade-out); an input not recorded or tapped has no peak.
+  const pk = l.session || l;
+  const inPk = l.watching_input ? plot.fmt(pk.in_peak) : "– (input not recorded)";
+  const span = l.session ? "peak over the session" : "peak";
+  $(`limiter-info-${l.node}`).textContent = `enable ${l.enable} · ${span} in ${inPk} out ${plot.fmt(pk.out_peak)} · ${counts}` +
     (l.source === "node" ? " · state reported by the node" : " · state inferred (limit.state not recorded)");
 }
 
@@ -175,6 +181,13 @@ function limiterShow(l) {
 function steerInit(h) {
   const vars = $("vars"); vars.textContent = "";
   const sel = $("param-select"); sel.textContent = "";
+  $("steer-row").style.display = S.recorded ? "none" : "";
+  if (S.recorded) {
+    // Nothing to steer: the changes the session had, as they landed.
+    $("steer-title").textContent = "Changes";
+    vars.append(el("p", { class: "small", id: "steer-note" }, "a recorded session is not steered: the parameter changes it had are listed below and marked on the time axis"));
+    return;
+  }
   for (const v of h.vars) {
     const p = v.param || {};
     const input = el("input", { id: "var-" + v.name, size: 8, value: p.value === null || p.value === undefined ? "" : String(p.value) });
@@ -246,10 +259,18 @@ function heightColor(z, zmax) {
 function sceneDraw(t0, t1) {
   const c = $("scene"), sc = S.hello.scene || { kind: "none" }, g = S.hello.graph;
   const tnow = S.view ? t1 : S.t;
-  let xi, yi, ci, xl, yl, background = null, xr = null, yr = null, note = "";
+  let xi, yi, ci, xl, yl, background = null, xr = null, yr = null, note = "", fallback = false;
   if (sc.kind === "grid") {
     const src = inp => { const e = g.edges.find(e => e.to === sc.node && e.in === inp); return e ? findTap(t => t.node === e.from && t.port === e.out) : -1; };
     xi = src("velocity"); yi = src("load"); ci = findTap(t => t.port === "force"); xl = "velocity (cm/s)"; yl = "load (g)";
+  }
+  if (sc.kind === "grid" && (xi < 0 || yi < 0)) {
+    // The grid's inputs were not recorded: the finger's position instead.
+    const feed = inp => { const e = g.edges.find(e => e.to === sc.node && e.in === inp); return e ? `--tap ${e.from}.${e.out}` : ""; };
+    note = `the velocity and load feeding ${sc.node} are not recorded (record them with ${feed("velocity")} ${feed("load")}): the finger's position instead; `;
+    fallback = true;
+  }
+  if (sc.kind === "grid" && !fallback) {
     const k = paramAt(sc.node, "texture", sc.texture, tnow), grid = sc.grids[k] || sc.grids[0];
     const L = grid.loads_g, V = grid.velocities_cm_s;
     xr = plot.range(Math.min(V[0], 0), V[V.length - 1] * 1.25); yr = plot.range(Math.min(L[0], 0), L[L.length - 1] * 1.25);
@@ -269,10 +290,11 @@ function sceneDraw(t0, t1) {
       S.cells = [[l0, v0], [l0, v1], [l1, v0], [l1, v1]];
     };
   } else {
+    ci = -1;
     xi = findTap(t => t.port === "x" && g.nodes.some(n => n.name === t.node && n.type.startsWith("sim.user")));
     if (xi < 0) xi = findTap(t => t.port === "x");
     yi = findTap(t => t.port === "y" && t.node === (S.taps[xi] || {}).node);
-    ci = findTap(t => t.port === "intensity");
+    if (sc.kind !== "grid") ci = findTap(t => t.port === "intensity");
     xl = "x (m)"; yl = "y (m)";
     if (sc.kind === "mesh" && sc.maps.length) {
       const k = paramAt(sc.node, "scene", sc.scene, tnow), m = sc.maps[k] || sc.maps[0];
@@ -357,6 +379,10 @@ function eventShow(e) {
   else if (e.event === "gap") text += `gap: ${e.ticks} ticks of samples lost`;
   else text += e.event;
   logLine($("events"), text, e.event === "refused" || e.event === "gap" ? "err" : "");
+  // A recorded session's changes under "Changes" (the stop's fade-outs are not the user's).
+  if (S.recorded && (e.event === "set" || e.event === "refused") && !S.ended)
+    logLine($("steer-log"), `at ${e.t.toFixed(3)} s: ${e.node}.${e.param} = ${e.value}` + (e.event === "refused" ? " (refused)" : ""), e.event === "refused" ? "err" : "ok");
+
 }
 
 // --- recorded sessions ---

@@ -114,6 +114,9 @@ static void on_frame(void *ctx, const evdev_frame *f) {
         return;
     }
     d->counters.actuation++;
+    if (d->board->received) {
+        d->board->received(d->board->ctx, (int16_t)evdev_get_u16(f->payload));
+    }
     if (d->faults & EVDEV_FAULT_HOST_TIMEOUT) {
         return; /* not played until the next HELLO */
     }

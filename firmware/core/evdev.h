@@ -134,8 +134,10 @@ typedef struct {
  * board's main loop (never from an interrupt). */
 typedef struct {
     void *ctx;
-    /* Queues bytes for the host (UART or USB). Must not block for long:
-     * at 1 kHz the core sends about 12 bytes per ms. */
+    /* Queues bytes for the host (UART or USB) and returns at once: it must
+     * never wait for the link — a host that went away (a USB port nobody
+     * reads) would stall the tick and with it the watchdog. Drop a frame
+     * that does not fit. At 1 kHz the core sends about 12 bytes per ms. */
     void (*write)(void *ctx, const uint8_t *bytes, size_t n);
     /* Applies an actuation sample now: +32767 = +1.0 = +50 V at the
      * amplifier's output, -32767 = -50 V, 0 = 0 V. */
@@ -149,6 +151,9 @@ typedef struct {
     /* The board's own fault bits (overcurrent, supply, temperature,
      * emergency stop); NULL for none. */
     uint16_t (*faults)(void *ctx);
+    /* Told each ACTUATION sample as it arrives, before the FIFO (for a
+     * log); NULL for none. */
+    void (*received)(void *ctx, int16_t sample);
 } evdev_board;
 
 /* Fixed settings. */

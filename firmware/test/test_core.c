@@ -67,7 +67,7 @@ static int fake_force(void *ctx, float *n) {
 static uint16_t fake_faults(void *ctx) { return ((fake *)ctx)->faults; }
 
 static evdev_board board_of(fake *f) {
-    evdev_board b = {f, fake_write, fake_dac, fake_touch, fake_force, fake_faults};
+    evdev_board b = {f, fake_write, fake_dac, fake_touch, fake_force, fake_faults, NULL};
     return b;
 }
 

@@ -357,3 +357,45 @@ fn after_a_corrupted_stream_the_device_takes_every_intact_frame() {
     let got: Vec<i16> = rx.iter().map(|r| r.1).collect();
     assert_eq!(got, intact, "every intact frame, in order, and no damaged one");
 }
+
+/// The two real boards' images build (nothing here can flash them), and
+/// each begins with a vector table a Cortex-M boots from: the stack's top
+/// at the end of the board's RAM, then the reset handler, a Thumb address
+/// inside its flash.
+#[test]
+fn the_real_boards_build_with_a_bootable_vector_table() {
+    let tmp = tempfile::tempdir().unwrap();
+    if image(tmp.path()).is_none() {
+        return;
+    }
+    let build = tmp.path().join("build");
+    let o = Command::new("make")
+        .arg("-C")
+        .arg(root().join("firmware"))
+        .args(["due", "nucleo"])
+        .arg(format!("BUILD={}", build.display()))
+        .output()
+        .unwrap();
+    assert!(
+        o.status.success(),
+        "make due nucleo:\n{}{}",
+        String::from_utf8_lossy(&o.stdout),
+        String::from_utf8_lossy(&o.stderr)
+    );
+    // (image, flash origin and size, RAM end)
+    for (bin, flash, size, ram_end) in [
+        ("due.bin", 0x0008_0000u32, 512 * 1024u32, 0x2007_0000u32 + 96 * 1024),
+        ("nucleo-f446re.bin", 0x0800_0000, 512 * 1024, 0x2000_0000 + 128 * 1024),
+    ] {
+        let b = std::fs::read(build.join(bin)).unwrap();
+        let word = |k: usize| u32::from_le_bytes([b[4 * k], b[4 * k + 1], b[4 * k + 2], b[4 * k + 3]]);
+        assert_eq!(word(0), ram_end, "{bin}: initial stack pointer");
+        let reset = word(1);
+        assert!(
+            reset & 1 == 1 && (flash..flash + b.len() as u32).contains(&(reset & !1)),
+            "{bin}: reset vector {reset:#x}"
+        );
+        assert_eq!(word(15), word(15) | 1, "{bin}: SysTick vector is a Thumb address");
+        assert!(b.len() < 16 * 1024 && (b.len() as u32) < size, "{bin}: {} bytes", b.len());
+    }
+}

@@ -107,6 +107,13 @@ static void on_frame(void *ctx, const evdev_frame *f) {
         return;
     }
     if (!d->engaged) {
+        /* A host streaming to a device it never said HELLO to (its HELLO
+         * lost, or our power-up HELLO taken for an answer): ask for one. */
+        if (!d->prompted || d->ms - d->prompt_ms >= EVDEV_PROMPT_MS) {
+            d->prompted = 1;
+            d->prompt_ms = d->ms;
+            send_hello(d);
+        }
         return;
     }
     d->last_rx_ms = d->ms;

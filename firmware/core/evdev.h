@@ -58,6 +58,9 @@ extern "C" {
 #define EVDEV_WATCHDOG_MS 100u
 #define EVDEV_RAMP_MS 10u
 #define EVDEV_HEARTBEAT_MS 100u
+/* Not engaged, hearing host frames: a HELLO at most this often (asks the
+ * host, which took an earlier HELLO for its answer, for its own). */
+#define EVDEV_PROMPT_MS 250u
 /* ACTUATION samples waiting to be played; older ones are dropped. */
 #define EVDEV_FIFO 8u
 
@@ -195,6 +198,8 @@ typedef struct {
     int16_t fifo[EVDEV_FIFO];
     uint32_t next_touch_ms;
     uint32_t next_heartbeat_ms;
+    uint32_t prompt_ms;     /* when it last said HELLO to a host it was not engaged with */
+    uint8_t prompted;
 } evdev_device;
 
 /* The configuration of docs/serial-protocol.md: version 1, 1 kHz, 40 Hz,

@@ -333,6 +333,17 @@ static void power_up_then_handshake(void) {
     }
     decode(f.out, f.n_out, &c, NULL);
     CHECK(c.n == 1 && f.dac[49] == 0);
+    /* Frames before any host HELLO: a HELLO asks for one, at most every
+     * 250 ticks. */
+    uint8_t a[16];
+    size_t before = f.n_out;
+    for (int k = 0; k < 600; k++) {
+        evdev_device_receive(&d, a, actuation(a, (uint16_t)(k + 1), 100));
+        evdev_device_tick(&d);
+    }
+    decode(f.out + before, f.n_out - before, &c, NULL);
+    CHECK(c.n == 3 && count_type(&c, EVDEV_HELLO) == 3); /* ticks 50, 300, 550 */
+    CHECK(d.counters.actuation == 0);
     /* Another version: answered, not engaged. */
     uint8_t h[EVDEV_MAX_FRAME];
     evdev_device_receive(&d, h, host_hello(h, 0, 2));
@@ -340,7 +351,7 @@ static void power_up_then_handshake(void) {
     evdev_device_receive(&d, h, host_hello(h, 1, 1));
     CHECK(d.engaged);
     decode(f.out, f.n_out, &c, NULL);
-    CHECK(count_type(&c, EVDEV_HELLO) == 3);
+    CHECK(count_type(&c, EVDEV_HELLO) == 6);
 }
 
 static void streaming_cadence(void) {

@@ -15,6 +15,8 @@ use std::time::{Duration, Instant};
 pub const WATCHDOG: Duration = Duration::from_millis(100);
 /// Steps (calls of [`DeviceSession::play`]) of the watchdog's ramp to zero.
 pub const WATCHDOG_RAMP: u32 = 10;
+/// A device not engaged that hears host frames says HELLO at most this often.
+pub const PROMPT_EVERY: Duration = Duration::from_millis(250);
 /// The FIFO holds at most this many samples; older ones are dropped.
 pub const FIFO_MAX: usize = 8;
 
@@ -71,6 +73,8 @@ pub struct DeviceSession {
     u: i16,
     ramp_left: u32,
     ramp_from: i16,
+    /// When it last said HELLO to a host it was not engaged with.
+    prompted: Option<Instant>,
     counters: DeviceCounters,
     scratch: Vec<super::frame::Frame>,
 }
@@ -91,6 +95,7 @@ impl DeviceSession {
             u: 0,
             ramp_left: 0,
             ramp_from: 0,
+            prompted: None,
             counters: DeviceCounters::default(),
             scratch: Vec::with_capacity(256),
         }
@@ -165,7 +170,16 @@ impl DeviceSession {
                         self.engaged = false;
                     }
                 }
-                _ if !self.engaged => {}
+                // A host streaming to a device it never said HELLO to (its
+                // HELLO lost, or it took our power-up HELLO for an answer):
+                // a HELLO, at most every 250 ms, asks it for its own.
+                _ if !self.engaged => {
+                    if self.prompted.is_none_or(|t| now.saturating_duration_since(t) >= PROMPT_EVERY) {
+                        self.prompted = Some(now);
+                        let hello = self.hello();
+                        self.send(hello, out);
+                    }
+                }
                 Message::Actuation(v) => {
                     self.last_rx = now;
                     self.counters.actuation += 1;

@@ -133,6 +133,10 @@ pub struct HostSession {
     next_heartbeat: Instant,
     started: Instant,
     device: Option<Hello>,
+    /// When this host last sent HELLO, and whether a device HELLO it did
+    /// not ask for (the device reset, or never got ours) awaits an answer.
+    hello_sent: Option<Instant>,
+    rehello: bool,
     faults: u16,
     /// Last actuation sample sent, when it came and the fade in progress.
     last_u: i16,
@@ -160,6 +164,8 @@ impl HostSession {
             next_heartbeat: now,
             started: now,
             device: None,
+            hello_sent: None,
+            rehello: false,
             faults: 0,
             last_u: 0,
             last_sample_at: now,
@@ -297,6 +303,14 @@ impl HostSession {
             }
             self.last_rx = now;
             self.device = Some(h);
+            // A device HELLO while up that answers none of ours: the device
+            // reset (its power-up HELLO) or never got our HELLO (it says
+            // so when it hears frames before one). Say HELLO again, or it
+            // stays idle while we stream.
+            let asked = self.hello_sent.is_some_and(|t| now.saturating_duration_since(t) <= HELLO_EVERY);
+            if self.phase == Phase::Up && !asked {
+                self.rehello = true;
+            }
             if self.phase != Phase::Up {
                 self.phase = Phase::Up;
                 self.faults = 0;
@@ -367,19 +381,18 @@ impl HostSession {
             Phase::Handshake => {
                 self.counters.dropped_down += samples.len() as u64;
                 if now >= self.next_hello {
-                    let h = Hello {
-                        version: VERSION,
-                        role: Role::Host,
-                        caps: if self.config.actuation { caps::ACTUATION } else { 0 },
-                        actuation_hz: self.config.actuation_hz,
-                        touch_hz: self.config.touch_hz,
-                    };
-                    self.push(Message::Hello(h), out);
+                    self.push(Message::Hello(self.hello()), out);
+                    self.hello_sent = Some(now);
                     self.next_hello = now + HELLO_EVERY;
                 }
                 return;
             }
             Phase::Up => {}
+        }
+        if self.rehello {
+            self.rehello = false;
+            self.push(Message::Hello(self.hello()), out);
+            self.hello_sent = Some(now);
         }
         if !samples.is_empty() {
             for &u in samples {
@@ -398,6 +411,17 @@ impl HostSession {
             let uptime_ms = now.saturating_duration_since(self.started).as_millis() as u32;
             self.push(Message::Heartbeat { faults: 0, uptime_ms }, out);
             self.next_heartbeat = now + HEARTBEAT_EVERY;
+        }
+    }
+
+    /// The HELLO this host sends.
+    fn hello(&self) -> Hello {
+        Hello {
+            version: VERSION,
+            role: Role::Host,
+            caps: if self.config.actuation { caps::ACTUATION } else { 0 },
+            actuation_hz: self.config.actuation_hz,
+            touch_hz: self.config.touch_hz,
         }
     }
 

@@ -225,3 +225,61 @@ fn goodbye_sends_a_zero_sample() {
     h.goodbye(&mut out);
     assert!(matches!(frames(&out)[..], [(_, Message::Actuation(0))]));
 }
+
+/// A device HELLO the host did not ask for — the device reset mid-session
+/// (its power-up HELLO), or it never got the host's HELLO and says so — is
+/// answered with a HELLO once, so the device engages again; the answer to
+/// that HELLO is not answered again.
+#[test]
+fn an_unasked_device_hello_is_answered_once() {
+    let t0 = Instant::now();
+    let mut sink = Sink::new();
+    let mut h = up(t0, &mut sink);
+    let mut out = Vec::new();
+    // Long after the handshake: the device resets.
+    let t1 = t0 + 2000 * MS;
+    sink.receive(&mut h, t1, &bytes(device_hello(VERSION), 0));
+    h.transmit(t1, &[0.5], &mut out);
+    let sent = frames(&out);
+    assert!(matches!(sent[0].1, Message::Hello(x) if x.role == Role::Host), "{sent:?}");
+    assert!(matches!(sent[1].1, Message::Actuation(_)), "{sent:?}");
+    // The device's answer comes back at once: no HELLO again.
+    out.clear();
+    sink.receive(&mut h, t1 + MS, &bytes(device_hello(VERSION), 1));
+    h.transmit(t1 + MS, &[0.5], &mut out);
+    assert!(frames(&out).iter().all(|(_, m)| !matches!(m, Message::Hello(_))), "{:?}", frames(&out));
+    assert!(h.connected());
+}
+
+/// Host and device back to back, the host's first HELLO lost on the way
+/// and the device's power-up HELLO taken for its answer: the device says
+/// HELLO when it hears frames, the host answers, and the samples flow.
+#[test]
+fn a_lost_host_hello_is_recovered() {
+    use crate::serial::device::{DeviceConfig, DeviceSession};
+    let t0 = Instant::now();
+    let mut dev = DeviceSession::new(DeviceConfig::default(), t0);
+    let mut d2h = Vec::new();
+    let power_up = dev.hello();
+    dev.send(power_up, &mut d2h);
+    let mut h = HostSession::new(config(), t0);
+    h.opened(t0);
+    let mut h2d = Vec::new();
+    h.transmit(t0, &[], &mut h2d);
+    h2d.clear(); // lost
+    let mut sink = Sink::new();
+    sink.receive(&mut h, t0, &d2h);
+    d2h.clear();
+    assert!(h.connected(), "the power-up HELLO taken for an answer");
+    let mut received = Vec::new();
+    for k in 1..600u32 {
+        let now = t0 + k * MS;
+        h.transmit(now, &[0.25], &mut h2d);
+        dev.receive(now, &h2d, &mut d2h, &mut |v| received.push(v));
+        h2d.clear();
+        sink.receive(&mut h, now, &d2h);
+        d2h.clear();
+    }
+    assert!(dev.engaged(), "the device engaged after all");
+    assert!(received.len() > 250, "{} samples reached it", received.len());
+}

@@ -75,11 +75,13 @@ impl fmt::Display for RealtimeReport {
 #[cfg(target_os = "linux")]
 pub fn apply(req: &RealtimeRequest) -> RealtimeReport {
     let errno = || std::io::Error::last_os_error().to_string();
-    // SAFETY (all blocks below): plain system calls on the calling thread
-    // with valid arguments; failures are reported through errno.
+    // Each block below is a plain system call on the calling thread; a
+    // failure is reported through errno, never undefined behaviour.
+    // SAFETY: prctl(PR_SET_TIMERSLACK) takes integer arguments only.
     let slack = unsafe { libc::prctl(libc::PR_SET_TIMERSLACK, 1 as libc::c_ulong, 0, 0, 0) } == 0;
     let mut r = RealtimeReport { timer_slack: Some(if slack { Ok(()) } else { Err(errno()) }), ..Default::default() };
     if req.lock_memory {
+        // SAFETY: mlockall takes flags only and touches no Rust memory.
         let ok = unsafe { libc::mlockall(libc::MCL_CURRENT | libc::MCL_FUTURE) } == 0;
         r.memory_locked = Some(if ok { Ok(()) } else { Err(errno()) });
     }
@@ -87,8 +89,11 @@ pub fn apply(req: &RealtimeRequest) -> RealtimeReport {
         r.cpu = Some(if cpu >= libc::CPU_SETSIZE as usize {
             Err(format!("CPU {cpu} does not exist"))
         } else {
+            // SAFETY: cpu_set_t is a plain bit array: all zeros is a valid (empty) set.
             let mut set: libc::cpu_set_t = unsafe { std::mem::zeroed() };
+            // SAFETY: `cpu` < CPU_SETSIZE (checked above), so the bit is inside `set`.
             unsafe { libc::CPU_SET(cpu, &mut set) };
+            // SAFETY: `set` is a valid cpu_set_t of the size passed; pid 0 is this thread.
             if unsafe { libc::sched_setaffinity(0, std::mem::size_of::<libc::cpu_set_t>(), &set) } == 0 {
                 Ok(cpu)
             } else {
@@ -98,6 +103,7 @@ pub fn apply(req: &RealtimeRequest) -> RealtimeReport {
     }
     if let Some(p) = req.priority {
         let param = libc::sched_param { sched_priority: p };
+        // SAFETY: `param` is a valid sched_param that outlives the call; pid 0 is this thread.
         r.fifo = Some(if unsafe { libc::sched_setscheduler(0, libc::SCHED_FIFO, &param) } == 0 {
             Ok(p)
         } else {

@@ -167,6 +167,10 @@ impl Volterra {
 
     /// [`Volterra::eval`] compiled for AVX2 (the same code; no fused
     /// multiply-add is written, so the results are the portable build's).
+    ///
+    /// # Safety
+    ///
+    /// The CPU must have AVX2 and FMA.
     #[cfg(target_arch = "x86_64")]
     #[target_feature(enable = "avx2,fma")]
     unsafe fn eval_avx2(&self, u: &[f64], y: &mut [f64]) {
@@ -223,6 +227,10 @@ impl Volterra {
     }
 
     /// [`Volterra::eval_grad`] compiled for AVX2 (same results).
+    ///
+    /// # Safety
+    ///
+    /// The CPU must have AVX2 and FMA.
     #[cfg(target_arch = "x86_64")]
     #[target_feature(enable = "avx2,fma")]
     unsafe fn eval_grad_avx2(&self, u: &[f64], ybar: &[f64], y: &mut [f64], du: &mut [f64]) {

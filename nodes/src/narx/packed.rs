@@ -153,6 +153,10 @@ impl PackedMlp {
     /// The forward pass compiled for AVX2 and FMA: the same code, with
     /// fused multiply-adds in the sums and the tanh when the tanh is fast
     /// (the exact tanh keeps separate roundings, equal to the portable build).
+    ///
+    /// # Safety
+    ///
+    /// The CPU must have AVX2 and FMA.
     #[cfg(target_arch = "x86_64")]
     #[target_feature(enable = "avx2,fma")]
     unsafe fn forward_avx2(&mut self, head: &[f64], tail: &[f64]) -> f64 {

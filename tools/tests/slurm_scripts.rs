@@ -45,4 +45,20 @@ fn one_task_of_an_array_reruns_alone_given_the_arrays_size() {
     let record: serde_json::Value = serde_json::from_str(&record).unwrap();
     assert_eq!(record["range"], serde_json::json!([5, 6]), "{record}");
     assert!(dir.path().join("parts/grid/6/narx-85g-5cms.json").exists(), "the sixth run is mass=85 speed=5");
+    // Merged alone, the other eight are named with the commands that rerun
+    // them: the Slurm one, and task 6's own command moved to shard 1.
+    let o = Command::new(env!("CARGO_BIN_EXE_evflow"))
+        .args(["merge", "models", "parts/grid/6"])
+        .current_dir(dir.path())
+        .output()
+        .expect("evflow runs");
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert_eq!(o.status.code(), Some(1), "{err}");
+    assert!(err.starts_with("shards missing: 1/9, 2/9, 3/9, 4/9, 5/9, 7/9, 8/9, 9/9 (given 1 of 9)"), "{err}");
+    assert!(err.contains("EVFLOW_SHARDS=9 sbatch --array=1-5,7-9 <the array's script"), "{err}");
+    let by_hand = "evflow run graphs/model-build.toml --sweep mass=60,85,110 --sweep speed=3,4,5 --shard 1/9 \
+                   --jobs 1 --no-times -q --out parts/grid/1 --csv parts/grid/1/models.csv --json \
+                   parts/grid/1/models.json --set epochs=1 --set samples=600 --set passes=2";
+    assert!(err.lines().any(|l| l.trim() == by_hand), "no line `{by_hand}` in\n{err}");
+    assert!(!dir.path().join("models").exists());
 }

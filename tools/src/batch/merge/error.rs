@@ -1,6 +1,7 @@
 //! Why shards could not be merged.
 
 use super::super::shard_record::RecordError;
+use super::gaps::Gaps;
 use evflow_engine::batch::Shard;
 use std::ops::Range;
 use std::path::PathBuf;
@@ -56,6 +57,26 @@ pub enum MergeError {
         given: usize,
         /// N.
         n: usize,
+    },
+    /// Some K of N have no record among the folders given, or some
+    /// folders hold none (`evflow merge` without `--partial`): each named,
+    /// with the commands that rerun them.
+    #[error("{}", gaps.refusal())]
+    Incomplete {
+        /// What is missing.
+        gaps: Box<Gaps>,
+    },
+    /// No folder given holds a shard's record.
+    #[error(
+        "none of {} holds a shard's record (shard.json, or a report's *-shard.json; a shard writes it last): \
+         their tasks were killed or cancelled, failed before their end, or are still running. Rerun them \
+         (with Slurm: EVFLOW_SHARDS=N sbatch --array=K,… <the array's script>; by hand: the same command with \
+         --shard K/N), then merge again",
+        dirs.iter().map(|d| d.display().to_string()).collect::<Vec<_>>().join(", ")
+    )]
+    NoRecords {
+        /// The folders given.
+        dirs: Vec<PathBuf>,
     },
     /// Two shards wrote different files of one name.
     #[error("{} and {}: two shards wrote different files of one name", first.display(), second.display())]

@@ -1,7 +1,9 @@
 //! contrib/slurm's array scripts, run by bash as Slurm would run one task
 //! (its environment set by hand): rerunning one task of an array alone
 //! (`sbatch --array=6`, so Slurm counts one task) works when the array's
-//! size is given, and says how when it is not (issue 37, point 16).
+//! size is given, and says how when it is not (issue 37, point 16). The
+//! shipped slurm.conf keeps a record of ended jobs without a database, in
+//! a folder the set-up creates for slurmctld (issue 37, point 17).
 
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
@@ -61,4 +63,38 @@ fn one_task_of_an_array_reruns_alone_given_the_arrays_size() {
                    parts/grid/1/models.json --set epochs=1 --set samples=600 --set passes=2";
     assert!(err.lines().any(|l| l.trim() == by_hand), "no line `{by_hand}` in\n{err}");
     assert!(!dir.path().join("models").exists());
+}
+
+/// The settings of contrib/slurm/slurm.conf, `Key=value` lines without comments.
+fn slurm_conf() -> Vec<(String, String)> {
+    let text = std::fs::read_to_string(root().join("contrib/slurm/slurm.conf")).unwrap();
+    text.lines()
+        .map(str::trim)
+        .filter(|l| !l.starts_with('#'))
+        .filter_map(|l| l.split_once('='))
+        .map(|(k, v)| (k.to_string(), v.to_string()))
+        .collect()
+}
+
+#[test]
+fn slurm_conf_keeps_a_job_record_in_a_folder_the_setup_creates() {
+    let conf = slurm_conf();
+    let get =
+        |key: &str| conf.iter().find(|(k, _)| k == key).map(|(_, v)| v.as_str()).unwrap_or_else(|| panic!("no {key}="));
+    // sacct needs slurmdbd, which one node does without: ended jobs go to a
+    // text file, and slurmctld keeps them an hour for `scontrol show job`.
+    assert_eq!(get("JobCompType"), "jobcomp/filetxt");
+    let log = Path::new(get("JobCompLoc"));
+    assert!(log.is_absolute(), "{}", log.display());
+    let age: u64 = get("MinJobAge").parse().expect("MinJobAge is a number of seconds");
+    assert!(age >= 3600, "MinJobAge={age}: ended jobs vanish from scontrol within the hour");
+    // slurmctld writes it as SlurmUser: its folder is created owned by that user.
+    let user = get("SlurmUser");
+    let folder = log.parent().unwrap().to_str().unwrap();
+    let setup = std::fs::read_to_string(root().join("contrib/slurm/setup-single-node.sh")).unwrap();
+    let owned = format!("install -d -o {user} -g {user} ");
+    assert!(
+        setup.lines().any(|l| l.trim_start().starts_with(&owned) && l.split_whitespace().any(|w| w == folder)),
+        "setup-single-node.sh creates no {folder} owned by {user}"
+    );
 }

@@ -1,7 +1,6 @@
 //! Why shards could not be merged.
 
 use super::super::shard_record::RecordError;
-use super::gaps::Gaps;
 use evflow_engine::batch::Shard;
 use std::ops::Range;
 use std::path::PathBuf;
@@ -60,11 +59,15 @@ pub enum MergeError {
     },
     /// Some K of N have no record among the folders given, or some
     /// folders hold none (`evflow merge` without `--partial`): each named,
-    /// with the commands that rerun them.
-    #[error("{}", gaps.refusal())]
+    /// with the commands that rerun them (`gaps::Gaps::refusal`).
+    #[error("{refusal}")]
     Incomplete {
-        /// What is missing.
-        gaps: Box<Gaps>,
+        /// The K without a record.
+        missing: Vec<usize>,
+        /// N.
+        n: usize,
+        /// The whole message: every gap, the commands that rerun them.
+        refusal: String,
     },
     /// No folder given holds a shard's record.
     #[error(

@@ -48,10 +48,10 @@ impl Kind {
             if evflow_study::saved::SavedStudy::is_in(dir) {
                 return Some(Kind::Textures);
             }
-            if super::live::is_live_shard(dir) {
+            if evflow_study::live::saved::LiveRecord::is_in(dir) {
                 return Some(Kind::Live);
             }
-            if super::narx::is_narx_shard(dir) {
+            if dir.join(evflow_study::narx::saved::NARX_RECORD).is_file() {
                 return Some(Kind::Narx);
             }
         }

@@ -86,7 +86,8 @@ pub struct Outcome {
 pub fn merge(out: &Path, dirs: &[PathBuf], coverage: Coverage) -> Result<Outcome, MergeError> {
     let (done, gaps) = gaps::survey(dirs)?;
     if !gaps.is_empty() && coverage == Coverage::All {
-        return Err(MergeError::Incomplete { gaps: Box::new(gaps) });
+        let missing = gaps.missing.iter().map(|g| g.k).collect();
+        return Err(MergeError::Incomplete { missing, n: gaps.n, refusal: gaps.refusal() });
     }
     let merged = merge_shards(out, &done, coverage)?;
     let note = out.join(PARTIAL_NOTE);

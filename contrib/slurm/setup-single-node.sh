@@ -131,7 +131,9 @@ fi
 chown munge:munge /etc/munge/munge.key
 chmod 0400 /etc/munge/munge.key
 
-# 3. Slurm's folders, owned by slurm.
+# 3. Slurm's folders, owned by slurm: /var/log/slurm holds the daemons'
+# logs and the job record (JobCompLoc=/var/log/slurm/jobcomp.log), both
+# written by slurmctld as slurm.
 install -d -o slurm -g slurm -m 0755 /var/spool/slurmctld /var/spool/slurmd /var/log/slurm
 install -d -m 0755 /etc/slurm
 
@@ -239,4 +241,4 @@ if ! wait_for 60 node_idle; then
 fi
 sinfo --version
 sinfo
-say "ready: submit from a folder with graphs/ (contrib/slurm/README.md)"
+say "ready: submit from a folder with graphs/ (contrib/slurm/README.md); ended jobs: /var/log/slurm/jobcomp.log, scontrol show job ID"

@@ -39,7 +39,10 @@ enum Command {
     /// shards of a model library (`library build --shard`) and of the
     /// reports `report textures --shard` (textures.md and rows.csv written
     /// from every shard's rows) and `report narx --shard` (narx.md) merge
-    /// alike.
+    /// alike. A shard missing, or a folder without its record (a task
+    /// killed mid-run), refuses the merge, each named with the commands
+    /// that rerun it; `--partial` merges the shards there are into an
+    /// output marked PARTIAL.txt and exits with status 3.
     ///
     /// Example (docs/scale.md):
     ///   for k in 1 2 3; do evflow run graphs/excitation.toml --shard $k/3 --out part$k --csv part$k/grid.csv; done
@@ -211,6 +214,8 @@ fn main() -> ExitCode {
             eprintln!("{}", evflow_engine::diag::cut_words(&format!("{e:#}"), evflow_engine::diag::MAX_WORD));
             if e.downcast_ref::<cli::replay::Unproven>().is_some() {
                 ExitCode::from(cli::replay::UNPROVEN_EXIT)
+            } else if e.downcast_ref::<cli::merge::Partial>().is_some() {
+                ExitCode::from(cli::merge::PARTIAL_EXIT)
             } else {
                 ExitCode::FAILURE
             }

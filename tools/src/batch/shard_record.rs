@@ -48,6 +48,11 @@ pub struct ShardRecord {
     pub json: Option<String>,
     /// The `--set` values the runs took (the plots read variables through them).
     pub sets: Vec<Override>,
+    /// The shard's command line after `evflow` (`run GRAPH … --shard K/N
+    /// --out DIR …`), so that a merge missing another shard can print the
+    /// command that reruns it ([`super::merge::rerun`]); empty in records
+    /// written before it was kept.
+    pub command: Vec<String>,
 }
 
 /// `path` relative to `dir` when it lies inside it, else as given.
@@ -63,6 +68,9 @@ pub fn relative_to(path: &Path, dir: &Path) -> String {
 /// `shard.json`.
 #[derive(Serialize, Deserialize)]
 struct RecordFile {
+    /// Absent in records written before `command` was: no command to show.
+    #[serde(default)]
+    command: Vec<String>,
     csv: Option<String>,
     failures: Vec<FailureFile>,
     graph: String,
@@ -226,6 +234,7 @@ impl ShardRecord {
     /// Writes the record into `dir` (through a temporary file).
     pub fn write(&self, dir: &Path) -> Result<(), RecordError> {
         let file = RecordFile {
+            command: self.command.clone(),
             csv: self.csv.clone(),
             failures: self.failures.iter().map(|(l, r)| FailureFile { reason: r.clone(), run: l.clone() }).collect(),
             graph: self.graph.clone(),
@@ -285,6 +294,7 @@ impl RecordFile {
             csv: self.csv,
             json: self.json,
             sets: self.sets.into_iter().map(|(k, t)| Override { key: k, value: parse_cli_value(&t) }).collect(),
+            command: self.command,
         })
     }
 }
@@ -339,6 +349,9 @@ pub(crate) mod tests {
             csv: Some("t.csv".into()),
             json: None,
             sets: vec![Override::parse("mass=85.5").unwrap(), Override::parse("sample=\"felt\"").unwrap()],
+            command: ["run", "graphs/g.toml", "--shard", &shard.to_string(), "--out", "parts/a b"]
+                .map(String::from)
+                .to_vec(),
         }
     }
 
@@ -360,6 +373,7 @@ pub(crate) mod tests {
             (true, Timings::Show, rec.csv, None)
         );
         assert_eq!(back.sets, rec.sets);
+        assert_eq!(back.command, rec.command);
         for ((p, r), (q, s)) in rec.runs.iter().zip(&back.runs) {
             assert_eq!(p.label(), q.label());
             assert_eq!(r.base_rate.to_bits(), s.base_rate.to_bits());
@@ -460,11 +474,13 @@ pub(crate) mod tests {
         // The layout the hand-built document had: serde_json's map sorts keys.
         let as_map: Json = serde_json::from_str(&text).unwrap();
         assert_eq!(text, serde_json::to_string_pretty(&as_map).unwrap());
-        // A record written before `sets` existed reads, with none.
+        // A record written before `sets` or `command` existed reads, with none.
         let mut old = as_map.clone();
         old.as_object_mut().unwrap().remove("sets");
+        old.as_object_mut().unwrap().remove("command");
         std::fs::write(dir.path().join(RECORD), old.to_string()).unwrap();
-        assert!(ShardRecord::read(dir.path()).unwrap().sets.is_empty());
+        let back = ShardRecord::read(dir.path()).unwrap();
+        assert!(back.sets.is_empty() && back.command.is_empty());
     }
 
     #[test]

@@ -3,10 +3,25 @@
 //! build --shard K/N`) or of a report (`evflow report textures|narx
 //! --shard K/N`) into what one run would have written. The merge is
 //! library code (`evflow_tools::batch::merge`); this parses, calls and prints.
+//!
+//! Missing shards refuse the merge, each named with the commands that
+//! rerun it; with `--partial` the shards there are merge, the output is
+//! marked partial (`PARTIAL.txt`) and the program exits with
+//! [`PARTIAL_EXIT`] ([`Partial`]).
 
 use anyhow::{bail, Result};
-use evflow_tools::batch::merge::{merge, Merged};
+use evflow_tools::batch::merge::{merge, Coverage, Merged, PARTIAL_NOTE};
 use std::path::PathBuf;
+
+/// The exit status of a merge with `--partial` that left shards out
+/// (1 stays for failures: a refused merge, or failed runs in the shards).
+pub const PARTIAL_EXIT: u8 = 3;
+
+/// The error a partial merge ends with; the program then exits with
+/// [`PARTIAL_EXIT`].
+#[derive(Debug, thiserror::Error)]
+#[error("{0}")]
+pub struct Partial(String);
 
 /// Arguments of `evflow merge`.
 #[derive(clap::Args, Debug)]
@@ -16,11 +31,39 @@ pub struct Args {
     /// The shards' output folders (`--out` of each `evflow run --shard`), in any order.
     #[arg(required = true)]
     shards: Vec<PathBuf>,
+    /// Merge the shards there are when some are missing (a task killed,
+    /// cancelled or not yet rerun): the output gets PARTIAL.txt, naming the
+    /// missing shards and how to rerun them, and the program exits with
+    /// status 3. Without it a missing shard refuses the merge.
+    #[arg(long)]
+    partial: bool,
 }
 
 /// Runs `evflow merge`.
 pub fn main(a: Args) -> Result<()> {
-    match merge(&a.out, &a.shards)? {
+    let coverage = if a.partial { Coverage::Partial } else { Coverage::All };
+    let outcome = merge(&a.out, &a.shards, coverage)?;
+    if let Some(gaps) = &outcome.partial {
+        println!("partial: {}", gaps.summary());
+    }
+    let printed = print(outcome.merged);
+    match outcome.partial {
+        Some(gaps) if printed.is_ok() => Err(Partial(format!(
+            "partial merge into {}: {} ({} says so)\n{}",
+            a.out.display(),
+            gaps.summary(),
+            a.out.join(PARTIAL_NOTE).display(),
+            gaps.details().trim_end()
+        ))
+        .into()),
+        Some(gaps) => printed.map_err(|e| e.context(format!("partial merge: {}", gaps.summary()))),
+        None => printed,
+    }
+}
+
+/// Prints what the merge did; an error when runs or steps failed in the shards.
+fn print(merged: Merged) -> Result<()> {
+    match merged {
         #[cfg(feature = "synth")]
         Merged::Library(m) => {
             println!(

@@ -97,6 +97,12 @@ pub fn main(a: Args) -> Result<()> {
         items.iter().filter_map(|(_, p, c)| c.as_ref().ok().map(|c| (p.label(), output_files(c, &a.out)))).collect();
     check_outputs(&outputs).map_err(|e| anyhow!("{}: {e}", graph.file.display()))?;
     std::fs::create_dir_all(&a.out).map_err(|e| anyhow!("{}: cannot create output folder: {e}", a.out.display()))?;
+    if a.batch.shard.is_some() {
+        // A shard's record is its last file and says it finished: one left
+        // from an earlier run goes first, so that a rerun killed half-way
+        // leaves none and `evflow merge` does not take its files as done.
+        remove_record(&a.out)?;
+    }
 
     let stop = Arc::new(AtomicBool::new(false));
     {
@@ -192,6 +198,7 @@ pub fn main(a: Args) -> Result<()> {
             csv: a.csv.as_deref().map(|p| relative_to(p, &a.out)),
             json: a.json.as_deref().map(|p| relative_to(p, &a.out)),
             sets: overrides.clone(),
+            command: std::env::args_os().skip(1).map(|a| a.to_string_lossy().into_owned()).collect(),
         };
         record.write(&a.out)?;
     }
@@ -199,6 +206,18 @@ pub fn main(a: Args) -> Result<()> {
         bail!("{}", failures.summary(n, "sweep runs").trim_end());
     }
     Ok(())
+}
+
+/// Removes the shard record in `dir`, if there is one.
+fn remove_record(dir: &std::path::Path) -> Result<()> {
+    let path = dir.join(evflow_tools::batch::shard_record::RECORD);
+    match std::fs::remove_file(&path) {
+        Err(e) if e.kind() != std::io::ErrorKind::NotFound => Err(anyhow!(
+            "{}: cannot remove the record of an earlier run of this shard ({e}); remove it, or give another --out",
+            path.display()
+        )),
+        _ => Ok(()),
+    }
 }
 
 /// Writes `text` to `path` through a temporary file beside it (an

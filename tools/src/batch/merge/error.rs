@@ -57,6 +57,30 @@ pub enum MergeError {
         /// N.
         n: usize,
     },
+    /// Some K of N have no record among the folders given, or some
+    /// folders hold none (`evflow merge` without `--partial`): each named,
+    /// with the commands that rerun them (`gaps::Gaps::refusal`).
+    #[error("{refusal}")]
+    Incomplete {
+        /// The K without a record.
+        missing: Vec<usize>,
+        /// N.
+        n: usize,
+        /// The whole message: every gap, the commands that rerun them.
+        refusal: String,
+    },
+    /// No folder given holds a shard's record.
+    #[error(
+        "none of {} holds a shard's record (shard.json, or a report's *-shard.json; a shard writes it last): \
+         their tasks were killed or cancelled, failed before their end, or are still running. Rerun them \
+         (with Slurm: EVFLOW_SHARDS=N sbatch --array=K,… <the array's script>; by hand: the same command with \
+         --shard K/N), then merge again",
+        dirs.iter().map(|d| d.display().to_string()).collect::<Vec<_>>().join(", ")
+    )]
+    NoRecords {
+        /// The folders given.
+        dirs: Vec<PathBuf>,
+    },
     /// Two shards wrote different files of one name.
     #[error("{} and {}: two shards wrote different files of one name", first.display(), second.display())]
     DifferentFiles {

@@ -6,8 +6,22 @@ use super::error::MergeError;
 use evflow_engine::batch::Shard;
 use std::path::{Path, PathBuf};
 
-/// Checks that the shards' K are 1..=N, each once, and puts them in K order.
-pub fn k_order<T>(mut shards: Vec<(PathBuf, Shard, T)>) -> Result<Vec<(PathBuf, Shard, T)>, MergeError> {
+/// Whether a merge needs every K of N, or takes the shards there are
+/// (`evflow merge --partial`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Coverage {
+    /// Every K of N, each once.
+    All,
+    /// The K there are, each once.
+    Partial,
+}
+
+/// Checks that the shards' K are each once, and with [`Coverage::All`]
+/// that they are 1..=N; puts them in K order.
+pub fn k_order<T>(
+    mut shards: Vec<(PathBuf, Shard, T)>,
+    coverage: Coverage,
+) -> Result<Vec<(PathBuf, Shard, T)>, MergeError> {
     shards.sort_by_key(|(_, s, _)| s.k);
     let n = shards[0].1.n;
     for w in shards.windows(2) {
@@ -17,7 +31,7 @@ pub fn k_order<T>(mut shards: Vec<(PathBuf, Shard, T)>) -> Result<Vec<(PathBuf, 
     }
     let have: Vec<usize> = shards.iter().map(|(_, s, _)| s.k).collect();
     let missing: Vec<String> = (1..=n).filter(|k| !have.contains(k)).map(|k| format!("{k}/{n}")).collect();
-    if !missing.is_empty() {
+    if !missing.is_empty() && coverage == Coverage::All {
         return Err(MergeError::Missing { missing, given: shards.len(), n });
     }
     Ok(shards)
@@ -25,12 +39,14 @@ pub fn k_order<T>(mut shards: Vec<(PathBuf, Shard, T)>) -> Result<Vec<(PathBuf, 
 
 /// Reads every shard folder of `dirs` with `read` (its slice and record),
 /// puts them in K order and checks that they are the N slices of one batch:
-/// the same N, and records `same` as the first's (else `what` differs).
+/// the same N, and records `same` as the first's (else `what` differs);
+/// every K of N, or those there are ([`Coverage`]).
 pub fn one_batch<T>(
     dirs: &[PathBuf],
     read: impl Fn(&Path) -> Result<(Shard, T), MergeError>,
     same: impl Fn(&T, &T) -> bool,
     what: &'static str,
+    coverage: Coverage,
 ) -> Result<Vec<(PathBuf, Shard, T)>, MergeError> {
     if dirs.is_empty() {
         return Err(MergeError::NoShards);
@@ -51,7 +67,7 @@ pub fn one_batch<T>(
             return Err(differs(what));
         }
     }
-    k_order(shards)
+    k_order(shards, coverage)
 }
 
 /// Every file under `dir`, as paths relative to it, sorted.

@@ -7,7 +7,7 @@
 //! uses — one run's, byte for byte.
 
 use super::error::MergeError;
-use super::files::{copy_files, one_batch, write};
+use super::files::{copy_files, one_batch, write, Coverage};
 use evflow_engine::batch::{Failures, Shard};
 use evflow_study::live::saved::{LiveRecord, RECORD};
 use evflow_study::tables::live::{csv, figures, markdown};
@@ -40,7 +40,7 @@ pub fn is_live_shard(dir: &Path) -> bool {
 
 /// Merges the shards of `evflow report live --shard` in `dirs` (in any
 /// order) into `out`.
-pub fn merge_live(out: &Path, dirs: &[PathBuf]) -> Result<LiveMerge, MergeError> {
+pub fn merge_live(out: &Path, dirs: &[PathBuf], coverage: Coverage) -> Result<LiveMerge, MergeError> {
     let read = |d: &Path| -> Result<(Shard, LiveRecord), MergeError> {
         let saved = LiveRecord::read(d)?;
         let shard = saved.slice().map_err(|e| StudyError::Config(format!("{}: {e}", d.display())))?;
@@ -52,6 +52,7 @@ pub fn merge_live(out: &Path, dirs: &[PathBuf]) -> Result<LiveMerge, MergeError>
         |a, b| a.scope == b.scope && a.items == b.items,
         "the reports' settings: profiles, samples, users, gains, grid, epochs, iterations, seconds, floor or the \
          live synthesis' settings",
+        coverage,
     )?;
     let folders: Vec<&Path> = shards.iter().map(|(d, _, _)| d.as_path()).collect();
     let files = copy_files(out, &folders, &[PathBuf::from(RECORD)])?;

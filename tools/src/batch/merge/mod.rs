@@ -16,21 +16,31 @@
 //! merges into its tables ([`textures`]), a live report's into its own
 //! ([`live`]).
 //!
+//! A shard writes its record last; a folder without one is a task that did
+//! not end ([`gaps`]). A merge refuses missing shards, naming each and
+//! printing the commands that rerun them ([`rerun`]), unless asked to merge
+//! the shards there are ([`Coverage::Partial`]): its output then holds
+//! [`gaps::PARTIAL_NOTE`], which says what is missing.
+//!
 //! One file per kind of shard; [`error`] and [`files`] are what they share.
 
 pub mod error;
 pub mod files;
+pub mod gaps;
 #[cfg(feature = "synth")]
 pub mod library;
 #[cfg(feature = "synth")]
 pub mod live;
 #[cfg(feature = "synth")]
 pub mod narx;
+pub mod rerun;
 pub mod sweep;
 #[cfg(feature = "synth")]
 pub mod textures;
 
 pub use error::MergeError;
+pub use files::Coverage;
+pub use gaps::{Gaps, PARTIAL_NOTE};
 #[cfg(feature = "synth")]
 pub use library::{merge_library, LibraryMerge};
 pub use sweep::{merge_sweep, SweepMerge};
@@ -56,30 +66,68 @@ pub enum Merged {
     Live(live::LiveMerge),
 }
 
-/// Merges the shard folders `dirs` (in any order) into `out`: a texture
-/// report's when a folder holds a study shard's record, a `report
-/// narx`'s when a folder holds its record ([`narx`]), a model
+/// What `evflow merge` did, and what it left out.
+#[derive(Debug)]
+pub struct Outcome {
+    /// The merge of the shards there were.
+    pub merged: Merged,
+    /// With [`Coverage::Partial`], the shards that were missing (and the
+    /// folders without a record), when there were any: the output is
+    /// partial and its [`PARTIAL_NOTE`] says so.
+    pub partial: Option<Gaps>,
+}
+
+/// Merges the shard folders `dirs` (in any order) into `out`. Folders
+/// without a shard's record ([`gaps::survey`]) are not read: with
+/// [`Coverage::All`] they, and any K of N no folder holds, refuse the
+/// merge ([`MergeError::Incomplete`]); with [`Coverage::Partial`] the
+/// shards there are merge, and `out` gets [`PARTIAL_NOTE`]. A complete
+/// merge removes a note left by an earlier partial one.
+pub fn merge(out: &Path, dirs: &[PathBuf], coverage: Coverage) -> Result<Outcome, MergeError> {
+    let (done, gaps) = gaps::survey(dirs)?;
+    if !gaps.is_empty() && coverage == Coverage::All {
+        let missing = gaps.missing.iter().map(|g| g.k).collect();
+        return Err(MergeError::Incomplete { missing, n: gaps.n, refusal: gaps.refusal() });
+    }
+    let merged = merge_shards(out, &done, coverage)?;
+    let note = out.join(PARTIAL_NOTE);
+    if gaps.is_empty() {
+        match std::fs::remove_file(&note) {
+            Err(e) if e.kind() != std::io::ErrorKind::NotFound => {
+                return Err(MergeError::Write { path: note, source: e });
+            }
+            _ => {}
+        }
+        return Ok(Outcome { merged, partial: None });
+    }
+    files::write(&note, &format!("partial merge: {}\n{}", gaps.summary(), gaps.details()))?;
+    Ok(Outcome { merged, partial: Some(gaps) })
+}
+
+/// Merges the folders `dirs`, each holding a shard's record, into `out`:
+/// a texture report's when a folder holds a study shard's record, a
+/// `report narx`'s when a folder holds its record ([`narx`]), a model
 /// library's when every folder is one (and none holds a sweep's shard
 /// record), else a sweep's.
-pub fn merge(out: &Path, dirs: &[PathBuf]) -> Result<Merged, MergeError> {
+fn merge_shards(out: &Path, dirs: &[PathBuf], coverage: Coverage) -> Result<Merged, MergeError> {
     if dirs.is_empty() {
         return Err(MergeError::NoShards);
     }
     #[cfg(feature = "synth")]
     if dirs.iter().any(|d| evflow_study::saved::SavedStudy::is_in(d)) {
-        return textures::merge_textures(out, dirs).map(Merged::Textures);
+        return textures::merge_textures(out, dirs, coverage).map(Merged::Textures);
     }
     #[cfg(feature = "synth")]
     if dirs.iter().any(|d| live::is_live_shard(d)) {
-        return live::merge_live(out, dirs).map(Merged::Live);
+        return live::merge_live(out, dirs, coverage).map(Merged::Live);
     }
     #[cfg(feature = "synth")]
     if dirs.iter().any(|d| narx::is_narx_shard(d)) {
-        return narx::merge_narx(out, dirs).map(Merged::Narx);
+        return narx::merge_narx(out, dirs, coverage).map(Merged::Narx);
     }
     #[cfg(feature = "synth")]
     if dirs.iter().all(|d| !d.join(super::shard_record::RECORD).exists() && evflow_study::library::is_library(d)) {
-        return merge_library(out, dirs).map(Merged::Library);
+        return merge_library(out, dirs, coverage).map(Merged::Library);
     }
-    merge_sweep(out, dirs).map(Merged::Sweep)
+    merge_sweep(out, dirs, coverage).map(Merged::Sweep)
 }

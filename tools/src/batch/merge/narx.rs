@@ -5,7 +5,7 @@
 //! narx.md is byte for byte that of one run.
 
 use super::error::MergeError;
-use super::files::{copy_files, k_order, write};
+use super::files::{copy_files, k_order, write, Coverage};
 use crate::plot::{write_png, PlotError, Written};
 use evflow_engine::batch::Failures;
 use evflow_study::narx::run::{aggregate, item_label, Item};
@@ -46,7 +46,7 @@ pub fn is_narx_shard(dir: &Path) -> bool {
 }
 
 /// Merges the shards of `evflow report narx --shard` in `dirs` (any order) into `out`.
-pub fn merge_narx(out: &Path, dirs: &[PathBuf]) -> Result<NarxMerge, MergeError> {
+pub fn merge_narx(out: &Path, dirs: &[PathBuf], coverage: Coverage) -> Result<NarxMerge, MergeError> {
     if dirs.is_empty() {
         return Err(MergeError::NoShards);
     }
@@ -80,7 +80,7 @@ pub fn merge_narx(out: &Path, dirs: &[PathBuf]) -> Result<NarxMerge, MergeError>
             return Err(differs("the textures scored"));
         }
     }
-    let shards = k_order(shards.into_iter().map(|(d, s, r, items)| (d, s, (r, items))).collect())?;
+    let shards = k_order(shards.into_iter().map(|(d, s, r, items)| (d, s, (r, items))).collect(), coverage)?;
     let folders: Vec<&Path> = shards.iter().map(|(d, _, _)| d.as_path()).collect();
     let skip = [NARX_RECORD, NARX_TABLE, NARX_FIGURE].map(PathBuf::from);
     let files = copy_files(out, &folders, &skip)?;
@@ -197,7 +197,7 @@ mod tests {
         let mut dirs = three_shards(base.path());
         dirs.swap(0, 2);
         let out = base.path().join("out");
-        let m = merge_narx(&out, &dirs).unwrap();
+        let m = merge_narx(&out, &dirs, Coverage::All).unwrap();
         let (all, items) = record(Shard::ALL);
         let a = &all.scope;
         let scored = aggregate(&a.settings, a.seeds, &items);
@@ -223,12 +223,12 @@ mod tests {
         let base = tempfile::tempdir().unwrap();
         let dirs = three_shards(base.path());
         let out = base.path().join("out");
-        let e = merge_narx(&out, &dirs[..2]).unwrap_err();
+        let e = merge_narx(&out, &dirs[..2], Coverage::All).unwrap_err();
         assert_eq!(e.to_string(), "shards missing: 3/3 (given 2 of 3)");
         let mut other = NarxRecord::read(&dirs[2]).unwrap();
         other.scope.epochs = 4;
         other.write(&dirs[2]).unwrap();
-        let e = merge_narx(&out, &dirs).unwrap_err();
+        let e = merge_narx(&out, &dirs, Coverage::All).unwrap_err();
         let (d0, d2) = (dirs[0].display(), dirs[2].display());
         assert_eq!(
             e.to_string(),
@@ -237,13 +237,13 @@ mod tests {
         other.scope.epochs = 3;
         other.items.clear();
         other.write(&dirs[2]).unwrap();
-        let e = merge_narx(&out, &dirs).unwrap_err();
+        let e = merge_narx(&out, &dirs, Coverage::All).unwrap_err();
         let record = dirs[2].join(NARX_RECORD);
         assert_eq!(e.to_string(), format!("{}: the items are not items 3..4 in order", record.display()));
         assert!(!out.exists(), "a refused merge wrote {}", out.display());
         let sweep = base.path().join("sweep");
         std::fs::create_dir_all(&sweep).unwrap();
-        let e = merge_narx(&out, &[dirs[0].clone(), sweep.clone()]).unwrap_err();
+        let e = merge_narx(&out, &[dirs[0].clone(), sweep.clone()], Coverage::All).unwrap_err();
         assert_eq!(
             e.to_string(),
             format!(

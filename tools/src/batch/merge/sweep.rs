@@ -3,7 +3,7 @@
 //! order with the code `evflow run` uses.
 
 use super::error::MergeError;
-use super::files::{copy_files, k_order, write};
+use super::files::{copy_files, k_order, write, Coverage};
 use crate::batch::shard_record::{ShardRecord, RECORD};
 use crate::batch::tables::{report_json, sweep_csv};
 use evflow_engine::batch::Failures;
@@ -31,13 +31,14 @@ pub struct SweepMerge {
     /// people (files written, fits), and why a plot could not be drawn.
     pub plots: (Vec<String>, Vec<String>),
 }
-/// Merges the shards of a sweep (`evflow run --shard`) in `dirs` into `out`.
-pub fn merge_sweep(out: &Path, dirs: &[PathBuf]) -> Result<SweepMerge, MergeError> {
+/// Merges the shards of a sweep (`evflow run --shard`) in `dirs` into
+/// `out`: every K of N, or those there are ([`Coverage`]).
+pub fn merge_sweep(out: &Path, dirs: &[PathBuf], coverage: Coverage) -> Result<SweepMerge, MergeError> {
     if dirs.is_empty() {
         return Err(MergeError::NoShards);
     }
     let shards = dirs.iter().map(|d| Ok((d.clone(), ShardRecord::read(d)?))).collect::<Result<Vec<_>, MergeError>>()?;
-    let shards = in_order(shards)?;
+    let shards = in_order(shards, coverage)?;
     let first = shards[0].1.clone();
     // The files the graphs wrote: each once; two shards writing the same
     // name must have written the same bytes.
@@ -94,8 +95,12 @@ pub fn merge_sweep(out: &Path, dirs: &[PathBuf]) -> Result<SweepMerge, MergeErro
         failures,
     })
 }
-/// The shards in K order, checked to be the N slices of one sweep.
-fn in_order(mut shards: Vec<(PathBuf, ShardRecord)>) -> Result<Vec<(PathBuf, ShardRecord)>, MergeError> {
+/// The shards in K order, checked to be the N slices of one sweep (or
+/// some of them, with [`Coverage::Partial`]).
+fn in_order(
+    mut shards: Vec<(PathBuf, ShardRecord)>,
+    coverage: Coverage,
+) -> Result<Vec<(PathBuf, ShardRecord)>, MergeError> {
     shards.sort_by_key(|(_, r)| r.shard.k);
     let (first_dir, first) = &shards[0];
     let n = first.shard.n;
@@ -123,7 +128,7 @@ fn in_order(mut shards: Vec<(PathBuf, ShardRecord)>) -> Result<Vec<(PathBuf, Sha
             });
         }
     }
-    let shards = k_order(shards.into_iter().map(|(d, r)| (d, r.shard, r)).collect())?;
+    let shards = k_order(shards.into_iter().map(|(d, r)| (d, r.shard, r)).collect(), coverage)?;
     Ok(shards.into_iter().map(|(d, _, r)| (d, r)).collect())
 }
 
@@ -160,7 +165,7 @@ mod tests {
         let mut dirs = three_shards(base.path());
         dirs.reverse();
         let out = base.path().join("out");
-        let m = merge_sweep(&out, &dirs).unwrap();
+        let m = merge_sweep(&out, &dirs, Coverage::All).unwrap();
         let all: Vec<_> = (0..5).map(|i| run(i as f64 * 0.1, 1000 + i)).collect();
         assert_eq!(std::fs::read_to_string(out.join("t.csv")).unwrap(), sweep_csv(&all, Timings::Show));
         assert_eq!((m.shards, m.runs, m.total, m.files, m.graph.as_str()), (3, 5, 5, 4, "graphs/g.toml"));
@@ -178,16 +183,17 @@ mod tests {
         let base = tempfile::tempdir().unwrap();
         let dirs = three_shards(base.path());
         let out = base.path().join("out");
-        let e = merge_sweep(&out, &dirs[..2]).unwrap_err();
+        let e = merge_sweep(&out, &dirs[..2], Coverage::All).unwrap_err();
         assert_eq!(e.to_string(), "shards missing: 3/3 (given 2 of 3)");
-        let e = merge_sweep(&out, &[dirs[0].clone(), dirs[1].clone(), dirs[1].clone(), dirs[2].clone()]).unwrap_err();
+        let e = merge_sweep(&out, &[dirs[0].clone(), dirs[1].clone(), dirs[1].clone(), dirs[2].clone()], Coverage::All)
+            .unwrap_err();
         assert_eq!(e.to_string(), format!("{} and {}: both are shard 2/3", dirs[1].display(), dirs[1].display()));
-        assert!(matches!(merge_sweep(&out, &[]), Err(MergeError::NoShards)));
+        assert!(matches!(merge_sweep(&out, &[], Coverage::All), Err(MergeError::NoShards)));
 
         let mut other = ShardRecord::read(&dirs[2]).unwrap();
         other.graph = "graphs/other.toml".into();
         other.write(&dirs[2]).unwrap();
-        let e = merge_sweep(&out, &dirs).unwrap_err();
+        let e = merge_sweep(&out, &dirs, Coverage::All).unwrap_err();
         let (d0, d2) = (dirs[0].display(), dirs[2].display());
         assert_eq!(e.to_string(), format!("{d0} and {d2}: not shards of one batch (the graphs differ)"));
 
@@ -195,7 +201,7 @@ mod tests {
         other.graph = "graphs/g.toml".into();
         other.range = 0..1;
         other.write(&dirs[2]).unwrap();
-        let e = merge_sweep(&out, &dirs).unwrap_err();
+        let e = merge_sweep(&out, &dirs, Coverage::All).unwrap_err();
         assert_eq!(e.to_string(), format!("{d2}: shard 3/3 should hold runs 4..5 of 5"));
         assert!(!out.exists(), "a refused merge wrote {}", out.display());
     }
@@ -205,7 +211,7 @@ mod tests {
         let base = tempfile::tempdir().unwrap();
         let dirs = three_shards(base.path());
         std::fs::write(dirs[1].join("common.txt"), "differs").unwrap();
-        let e = merge_sweep(&base.path().join("out"), &dirs).unwrap_err();
+        let e = merge_sweep(&base.path().join("out"), &dirs, Coverage::All).unwrap_err();
         let (a, b) = (dirs[0].join("common.txt"), dirs[1].join("common.txt"));
         assert_eq!(
             e.to_string(),

@@ -8,7 +8,7 @@
 //! on the shards they are byte for byte one run's.
 
 use super::error::MergeError;
-use super::files::{copy_files, one_batch, write};
+use super::files::{copy_files, one_batch, write, Coverage};
 use evflow_engine::batch::{Failures, Shard};
 use evflow_study::run::StudyConfig;
 use evflow_study::saved::{SavedStudy, RECORD};
@@ -39,7 +39,7 @@ pub struct TexturesMerge {
 
 /// Merges the shards of `evflow report textures --shard` in `dirs` (in any
 /// order) into `out`.
-pub fn merge_textures(out: &Path, dirs: &[PathBuf]) -> Result<TexturesMerge, MergeError> {
+pub fn merge_textures(out: &Path, dirs: &[PathBuf], coverage: Coverage) -> Result<TexturesMerge, MergeError> {
     let read = |d: &Path| -> Result<(Shard, SavedStudy), MergeError> {
         let saved = SavedStudy::read(d)?;
         let shard = saved.slice().map_err(|e| StudyError::Config(format!("{}: {e}", d.display())))?;
@@ -51,6 +51,7 @@ pub fn merge_textures(out: &Path, dirs: &[PathBuf]) -> Result<TexturesMerge, Mer
         |a, b| a.scope == b.scope && a.cells == b.cells,
         "the reports' settings: samples, conditions, profiles, gains, epochs, iterations, objective, floor, \
          multilevel or --no-times",
+        coverage,
     )?;
     let folders: Vec<&Path> = shards.iter().map(|(d, _, _)| d.as_path()).collect();
     let files = copy_files(out, &folders, &[PathBuf::from(RECORD)])?;

@@ -23,13 +23,16 @@
 //! (`.ci/test` installs them); `EVFLOW_SKIP_FIRMWARE=1` skips, loudly.
 #![cfg(all(feature = "serial", unix))]
 
-use evflow_nodes::recording::format::Recording;
 use evflow_nodes::serial::message::{actuation_to_i16, Hello, Message, Role};
 use evflow_nodes::serial::stream::StreamDecoder;
 use std::io::{BufRead, BufReader, Read, Write};
 use std::path::{Path, PathBuf};
 use std::process::{Child, Command, Stdio};
 use std::time::{Duration, Instant};
+
+#[path = "common/serial.rs"]
+mod common;
+use common::{channel, in_order, value};
 
 /// One at a time: QEMU and a live session already fill two cores.
 static ONE_AT_A_TIME: std::sync::Mutex<()> = std::sync::Mutex::new(());
@@ -185,31 +188,6 @@ fn live(graph: &str, port: &Path, session: &Path, seconds: f64) -> Command {
         .args(["--no-realtime", "--miss-streak", "0", "-q", "--session"])
         .arg(session);
     c
-}
-
-fn channel(dir: &Path, name: &str, ch: &str) -> Vec<f64> {
-    let r = Recording::open(&dir.join(name)).unwrap_or_else(|e| panic!("{name}: {e}"));
-    r.channel(ch).unwrap_or_else(|| panic!("{name} has no channel {ch}")).to_vec()
-}
-
-fn value(text: &str, key: &str) -> f64 {
-    let l = text.lines().find(|l| l.starts_with(key)).unwrap_or_else(|| panic!("no `{key}` in\n{text}"));
-    l[key.len()..].trim().trim_start_matches('=').split_whitespace().next().unwrap().parse().unwrap()
-}
-
-/// (values of `want` missing from `have`, values of `have` not in `want`),
-/// by the longest common subsequence.
-fn in_order(want: &[i16], have: &[i16]) -> (usize, usize) {
-    let mut prev = vec![0u32; have.len() + 1];
-    let mut row = vec![0u32; have.len() + 1];
-    for w in want {
-        for (j, h) in have.iter().enumerate() {
-            row[j + 1] = if w == h { prev[j] + 1 } else { prev[j + 1].max(row[j]) };
-        }
-        std::mem::swap(&mut prev, &mut row);
-    }
-    let common = prev[have.len()] as usize;
-    (want.len() - common, have.len() - common)
 }
 
 /// Checks that every sample `limit` sent reached the device in order: the

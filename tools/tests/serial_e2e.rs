@@ -14,13 +14,16 @@
 use evflow_nodes::lab::display_model::DisplayModel;
 use evflow_nodes::lab::integrator::Method;
 use evflow_nodes::lab::LabProfile;
-use evflow_nodes::recording::format::Recording;
 use evflow_nodes::serial::message::actuation_to_i16;
 use std::io::{BufRead, BufReader, Write};
 use std::path::{Path, PathBuf};
 use std::process::{Child, ChildStderr, Command, Stdio};
 use std::sync::mpsc::{Receiver, RecvTimeoutError};
 use std::time::{Duration, Instant};
+
+#[path = "common/serial.rs"]
+mod common;
+use common::{channel, in_order, value};
 
 /// The tests run one at a time: each runs a live session and an emulator,
 /// and two cores shared by several would starve them.
@@ -93,32 +96,6 @@ fn wait_line(rx: &Receiver<String>, what: &str, seen: &mut Vec<String>) {
             Err(RecvTimeoutError::Disconnected) => panic!("the process ended before `{what}`: {seen:#?}"),
         }
     }
-}
-
-fn channel(dir: &Path, name: &str, ch: &str) -> Vec<f64> {
-    let r = Recording::open(&dir.join(name)).unwrap_or_else(|e| panic!("{name}: {e}"));
-    r.channel(ch).unwrap_or_else(|| panic!("{name} has no channel {ch}")).to_vec()
-}
-
-/// How `have` differs from `want` as sequences: (values of `want` missing
-/// from `have`, values of `have` not in `want`), by the longest common
-/// subsequence.
-fn in_order(want: &[i16], have: &[i16]) -> (usize, usize) {
-    let mut prev = vec![0u32; have.len() + 1];
-    let mut row = vec![0u32; have.len() + 1];
-    for w in want {
-        for (j, h) in have.iter().enumerate() {
-            row[j + 1] = if w == h { prev[j] + 1 } else { prev[j + 1].max(row[j]) };
-        }
-        std::mem::swap(&mut prev, &mut row);
-    }
-    let common = prev[have.len()] as usize;
-    (want.len() - common, have.len() - common)
-}
-
-fn value(text: &str, key: &str) -> f64 {
-    let l = text.lines().find(|l| l.starts_with(key)).unwrap_or_else(|| panic!("no `{key}` in\n{text}"));
-    l[key.len()..].trim().trim_start_matches('=').split_whitespace().next().unwrap().parse().unwrap()
 }
 
 /// Runs the serial texture graph live for 2 s against the device at `link`,

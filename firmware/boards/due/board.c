@@ -15,7 +15,7 @@
  *
  * Not run on hardware here: it compiles in CI; the register settings
  * follow the SAM3X datasheet (Atmel 11057). */
-#include "../../core/evdev.h"
+#include "../cortex-m/board_loop.h"
 
 #include <stdint.h>
 
@@ -43,10 +43,6 @@
 #define DACC_MR REG(0x400C8004u)
 #define DACC_CHER REG(0x400C8010u)
 #define DACC_CDR REG(0x400C8020u)
-/* SysTick. */
-#define SYST_CSR REG(0xE000E010u)
-#define SYST_RVR REG(0xE000E014u)
-#define SYST_CVR REG(0xE000E018u)
 
 #define MCK_HZ 12000000u
 #define BAUD 250000u
@@ -54,34 +50,10 @@
 #define ID_PIOA 11u
 #define ID_DACC 38u
 
-static volatile uint32_t ticks_due;
-static evdev_device device;
-
-void SysTick_Handler(void) { ticks_due++; }
-
-/* Transmit ring drained as the UART takes bytes: writing never waits. */
-#define TX_RING 1024u
-static uint8_t tx_ring[TX_RING];
-static uint32_t tx_head, tx_len;
-
-static void uart_write(void *ctx, const uint8_t *p, size_t n) {
-    (void)ctx;
-    if (n > TX_RING - tx_len) {
-        return; /* dropped whole: the host counts it by sequence number */
-    }
-    for (size_t k = 0; k < n; k++) {
-        tx_ring[(tx_head + tx_len) % TX_RING] = p[k];
-        tx_len++;
-    }
-}
-
-static void uart_drain(void) {
-    while (tx_len && (UART_SR & (1u << 1))) { /* TXRDY */
-        UART_THR = tx_ring[tx_head];
-        tx_head = (tx_head + 1u) % TX_RING;
-        tx_len--;
-    }
-}
+static int rx_ready(void) { return (UART_SR & 1u) != 0; } /* RXRDY */
+static uint8_t rx_byte(void) { return (uint8_t)UART_RHR; }
+static int tx_ready(void) { return (UART_SR & (1u << 1)) != 0; } /* TXRDY */
+static void tx_byte(uint8_t b) { UART_THR = b; }
 
 /* ±32767 → 0 … 4095 (mid-scale 2048 = 0 V at the amplifier). */
 static void dac(void *ctx, int16_t sample) {
@@ -106,26 +78,10 @@ int main(void) {
     DACC_CR = 1u;                    /* software reset */
     DACC_MR = (8u << 24);            /* free running, channel 0, start-up time */
     DACC_CHER = 1u;
-    static const evdev_board board = {0, uart_write, dac, 0, 0, 0, 0};
+    static evdev_device device;
+    static const evdev_board board = {0, board_loop_write, dac, 0, 0, 0, 0};
+    static const board_uart uart = {rx_ready, rx_byte, tx_ready, tx_byte, 0};
     evdev_device_init(&device, &board, evdev_default_config(EVDEV_CAP_ACTUATION));
-    SYST_RVR = MCK_HZ / 1000u - 1u;
-    SYST_CVR = 0;
-    SYST_CSR = 0x7u;
-    for (;;) {
-        uart_drain();
-        uint8_t in[32];
-        size_t n = 0;
-        while (n < sizeof in && (UART_SR & 1u)) { /* RXRDY */
-            in[n++] = (uint8_t)UART_RHR;
-        }
-        if (n) {
-            evdev_device_receive(&device, in, n);
-        }
-        if (ticks_due) {
-            __asm__ volatile("cpsid i");
-            ticks_due--;
-            __asm__ volatile("cpsie i");
-            evdev_device_tick(&device);
-        }
-    }
+    board_loop_run(&device, &uart, MCK_HZ);
+    return 0;
 }

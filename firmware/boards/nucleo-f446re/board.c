@@ -12,7 +12,7 @@
  *
  * Not run on hardware here: it compiles in CI; the register settings
  * follow the STM32F446 reference manual (RM0390). */
-#include "../../core/evdev.h"
+#include "../cortex-m/board_loop.h"
 
 #include <stdint.h>
 
@@ -28,41 +28,14 @@
 #define USART2_CR1 REG(0x4000440Cu)
 #define DAC_CR REG(0x40007400u)
 #define DAC_DHR12R1 REG(0x40007408u)
-#define SYST_CSR REG(0xE000E010u)
-#define SYST_RVR REG(0xE000E014u)
-#define SYST_CVR REG(0xE000E018u)
 
 #define HSI_HZ 16000000u
 #define BAUD 460800u
 
-static volatile uint32_t ticks_due;
-static evdev_device device;
-
-void SysTick_Handler(void) { ticks_due++; }
-
-/* Transmit ring drained as the USART takes bytes: writing never waits. */
-#define TX_RING 1024u
-static uint8_t tx_ring[TX_RING];
-static uint32_t tx_head, tx_len;
-
-static void uart_write(void *ctx, const uint8_t *p, size_t n) {
-    (void)ctx;
-    if (n > TX_RING - tx_len) {
-        return; /* dropped whole: the host counts it by sequence number */
-    }
-    for (size_t k = 0; k < n; k++) {
-        tx_ring[(tx_head + tx_len) % TX_RING] = p[k];
-        tx_len++;
-    }
-}
-
-static void uart_drain(void) {
-    while (tx_len && (USART2_SR & (1u << 7))) { /* TXE */
-        USART2_DR = tx_ring[tx_head];
-        tx_head = (tx_head + 1u) % TX_RING;
-        tx_len--;
-    }
-}
+static int rx_ready(void) { return (USART2_SR & (1u << 5)) != 0; } /* RXNE */
+static uint8_t rx_byte(void) { return (uint8_t)USART2_DR; }
+static int tx_ready(void) { return (USART2_SR & (1u << 7)) != 0; } /* TXE */
+static void tx_byte(uint8_t b) { USART2_DR = b; }
 
 /* ±32767 → 0 … 4095 (mid-scale 2048 = 0 V at the amplifier). */
 static void dac(void *ctx, int16_t sample) {
@@ -79,26 +52,10 @@ int main(void) {
     USART2_BRR = (HSI_HZ + BAUD / 2u) / BAUD;
     USART2_CR1 = (1u << 13) | (1u << 3) | (1u << 2); /* UE, TE, RE */
     DAC_CR = 1u;                                     /* EN1 */
-    static const evdev_board board = {0, uart_write, dac, 0, 0, 0, 0};
+    static evdev_device device;
+    static const evdev_board board = {0, board_loop_write, dac, 0, 0, 0, 0};
+    static const board_uart uart = {rx_ready, rx_byte, tx_ready, tx_byte, 0};
     evdev_device_init(&device, &board, evdev_default_config(EVDEV_CAP_ACTUATION));
-    SYST_RVR = HSI_HZ / 1000u - 1u;
-    SYST_CVR = 0;
-    SYST_CSR = 0x7u;
-    for (;;) {
-        uart_drain();
-        uint8_t in[32];
-        size_t n = 0;
-        while (n < sizeof in && (USART2_SR & (1u << 5))) { /* RXNE */
-            in[n++] = (uint8_t)USART2_DR;
-        }
-        if (n) {
-            evdev_device_receive(&device, in, n);
-        }
-        if (ticks_due) {
-            __asm__ volatile("cpsid i");
-            ticks_due--;
-            __asm__ volatile("cpsie i");
-            evdev_device_tick(&device);
-        }
-    }
+    board_loop_run(&device, &uart, HSI_HZ);
+    return 0;
 }

@@ -12,7 +12,7 @@
  * reads them back, with the device's counters (`stats.bin`, every 500
  * ticks). The finger is a scripted stroke: 8 cm side to side at
  * 5 cm/s, y = 3 cm, 0.8 N. No force sensor. */
-#include "../../core/evdev.h"
+#include "../cortex-m/board_loop.h"
 
 #include <stdint.h>
 
@@ -25,10 +25,6 @@
 #define UART_TX_FULL 0x1u
 #define UART_RX_FULL 0x2u
 
-/* ---- SysTick ---- */
-#define SYST_CSR (*(volatile uint32_t *)0xE000E010u)
-#define SYST_RVR (*(volatile uint32_t *)0xE000E014u)
-#define SYST_CVR (*(volatile uint32_t *)0xE000E018u)
 #define SYSCLK_HZ 25000000u
 
 /* ---- semihosting ---- */
@@ -101,36 +97,21 @@ static void log_put(log_file *l, const void *rec, uint32_t size) {
 /* ---- the board ---- */
 
 static log_file dac_log, rx_log;
-static volatile uint32_t ticks_due;
 static evdev_device device;
 
-void SysTick_Handler(void) { ticks_due++; }
+static int rx_ready(void) { return (UART_STATE & UART_RX_FULL) != 0; }
+static uint8_t rx_byte(void) { return (uint8_t)UART_DATA; }
+static int tx_ready(void) { return (UART_STATE & UART_TX_FULL) == 0; }
+static void tx_byte(uint8_t b) { UART_DATA = b; }
 
-/* Bytes for the host wait in a ring the main loop drains as the UART takes
- * them: writing never waits, so a host that went away (QEMU then stops
- * taking bytes) cannot stall the tick and its watchdog. A frame that does
- * not fit is dropped whole and counted. */
-#define TX_RING 2048u
-static uint8_t tx_ring[TX_RING];
-static uint32_t tx_head, tx_len, tx_dropped;
-
-static void uart_write(void *ctx, const uint8_t *p, size_t n) {
-    (void)ctx;
-    if (n > TX_RING - tx_len) {
-        tx_dropped++;
-        return;
+/* The logs at most 50 ticks behind, the counters every 500. */
+static void after_tick(const evdev_device *d) {
+    if (d->ms % 50u == 0) {
+        log_flush(&dac_log);
+        log_flush(&rx_log);
     }
-    for (size_t k = 0; k < n; k++) {
-        tx_ring[(tx_head + tx_len) % TX_RING] = p[k];
-        tx_len++;
-    }
-}
-
-static void uart_drain(void) {
-    while (tx_len && !(UART_STATE & UART_TX_FULL)) {
-        UART_DATA = tx_ring[tx_head];
-        tx_head = (tx_head + 1u) % TX_RING;
-        tx_len--;
+    if (d->ms % 500u == 0) {
+        write_stats(d);
     }
 }
 
@@ -166,33 +147,9 @@ int main(void) {
     rx_log.handle = open_write("rx.bin", 6);
     UART_BAUDDIV = SYSCLK_HZ / 921600u;
     UART_CTRL = 0x3u; /* TX and RX enabled, no interrupts: polled */
-    static const evdev_board board = {0, uart_write, dac, touch, 0, 0, received};
+    static const evdev_board board = {0, board_loop_write, dac, touch, 0, 0, received};
+    static const board_uart uart = {rx_ready, rx_byte, tx_ready, tx_byte, after_tick};
     evdev_device_init(&device, &board, evdev_default_config(EVDEV_CAP_ACTUATION | EVDEV_CAP_TOUCH));
-    SYST_RVR = SYSCLK_HZ / 1000u - 1u;
-    SYST_CVR = 0;
-    SYST_CSR = 0x7u; /* processor clock, interrupt, enabled */
-    for (;;) {
-        uart_drain();
-        uint8_t in[64];
-        size_t n = 0;
-        while (n < sizeof in && (UART_STATE & UART_RX_FULL)) {
-            in[n++] = (uint8_t)UART_DATA;
-        }
-        if (n) {
-            evdev_device_receive(&device, in, n);
-        }
-        if (ticks_due) {
-            __asm__ volatile("cpsid i");
-            ticks_due--;
-            __asm__ volatile("cpsie i");
-            evdev_device_tick(&device);
-            if (device.ms % 50u == 0) { /* the logs at most 50 ticks behind */
-                log_flush(&dac_log);
-                log_flush(&rx_log);
-            }
-            if (device.ms % 500u == 0) {
-                write_stats(&device);
-            }
-        }
-    }
+    board_loop_run(&device, &uart, SYSCLK_HZ);
+    return 0;
 }

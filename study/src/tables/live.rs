@@ -361,44 +361,68 @@ pub fn csv(study: &LiveStudy) -> String {
     out
 }
 
-/// One figure per profile: E_s (Welch, mean over the users) of nothing,
-/// every chain at its best gain and the stroke's floor, sample by sample
-/// (x = the sample's number in the scope, 1 …).
+/// The y-axis label of the live figures.
+pub const ES_AXIS: &str = "E_s (spectral error; lower is better)";
+
+/// What E_s is, under each live figure.
+pub const ES_NOTE: &str = "E_s: the relative spectral RMS error of the display's force against the force the same \
+    finger meets on the real sample, √Σ(V − R)² / √ΣR² over the Welch magnitude spectra (Hann, 1 s segments) \
+    between 2 and 200 Hz, mean over the users: 0 = the real spectrum, 1 = as far from it as no force at all. \
+    Points: each chain at its best gain; bars: the stroke's achievable floor (docs/texture.md §9.2).";
+
+/// One figure per profile: E_s (Welch, mean over the users) of nothing and
+/// every chain at its best gain as points, and the stroke's floor as a bar,
+/// sample by sample. The samples are categories (the k-th with results at
+/// x = k, named on the axis); each series of points sits a little to the
+/// side of its sample's centre so that none hides another, and the legend
+/// is under the plot, off the data.
 pub fn figures(study: &LiveStudy, scope: &LiveScope) -> Vec<(String, crate::figure::Plot)> {
-    use crate::figure::{Plot, Series};
+    use crate::figure::{Legend, Plot, Series};
     let chains = played(scope);
     let mut out = Vec::new();
     for p in scope.profiles.iter().map(|p| profile_name(p)) {
-        let cells: Vec<(f64, Cell)> = scope
+        let cells: Vec<(&str, Cell)> = scope
             .samples
             .iter()
-            .enumerate()
-            .map(|(k, s)| ((k + 1) as f64, cell(study, &chains, p, s)))
+            .map(|s| (s.as_str(), cell(study, &chains, p, s)))
             .filter(|(_, c)| c.users > 0)
             .collect();
         if cells.is_empty() {
             continue;
         }
-        let pts =
-            |f: &dyn Fn(&Cell) -> f64| cells.iter().map(|(x, c)| (*x, f(c))).filter(|p| p.1.is_finite()).collect();
-        let mut series = vec![Series::line_points("nothing", pts(&|c| c.nothing))];
+        // The series of points, each a value per cell: nothing, each chain, the target's floor.
+        let of = |f: &dyn Fn(&Cell) -> f64| cells.iter().map(|(_, c)| f(c)).collect::<Vec<f64>>();
+        let mut readings = vec![("nothing".to_string(), of(&|c| c.nothing))];
         for (k, ch) in chains.iter().enumerate() {
-            series.push(Series::line_points(format!("{} (best gain)", ch.label()), pts(&|c| c.chains[k].1)));
+            readings.push((format!("{} (best gain)", ch.label()), of(&|c| c.chains[k].1)));
         }
         if chains.contains(&Chain::Live) {
-            series.push(Series::line_points("target's floor", pts(&|c| c.target)));
+            readings.push(("target's floor".into(), of(&|c| c.target)));
         }
-        series.push(Series::line_points("stroke floor", pts(&|c| c.floor)));
-        let names: Vec<String> = scope.samples.iter().enumerate().map(|(k, s)| format!("{} {s}", k + 1)).collect();
+        // Category j + 1, shifted by `offset`; non-finite values left out.
+        let at = |values: &[f64], offset: f64| -> Vec<(f64, f64)> {
+            values.iter().enumerate().map(|(j, v)| ((j + 1) as f64 + offset, *v)).filter(|p| p.1.is_finite()).collect()
+        };
+        let n = readings.len() as f64;
+        let step = (0.6 / n).min(0.12);
+        let mut series: Vec<Series> = readings
+            .iter()
+            .enumerate()
+            .map(|(k, (name, v))| Series::points(name.clone(), at(v, (k as f64 - (n - 1.0) / 2.0) * step)))
+            .collect();
+        series.push(Series::level("stroke's floor", at(&of(&|c| c.floor), 0.0)));
         out.push((
             format!("live-{p}.png"),
             Plot {
-                title: format!("{p}: E_s under the virtual users (Welch, mean over users)"),
-                x_label: format!("sample: {}", names.join(", ")),
-                y_label: "E_s".into(),
+                title: format!("{p}: E_s per sample under the virtual users (Welch, mean over the users)"),
+                x_label: "texture sample".into(),
+                y_label: ES_AXIS.into(),
                 log_x: false,
                 log_y: false,
                 series,
+                categories: cells.iter().map(|(s, _)| s.to_string()).collect(),
+                legend: Legend::Below,
+                note: ES_NOTE.into(),
             },
         ));
     }
@@ -490,5 +514,54 @@ mod tests {
         assert_eq!(csv.lines().filter(|l| l.contains(",target_floor,")).count(), 4);
         assert!(csv.contains("tuning-01,felt-fabric,person,live,1,0.48,0.48,1,0.48,1,0.48,0.48\n"), "{csv}");
         assert_eq!(figures(&study, &scope).len(), 2);
+    }
+
+    #[test]
+    fn the_figure_puts_samples_on_a_category_axis_with_points_a_floor_bar_and_a_defined_e_s() {
+        use crate::figure::{Legend, Style};
+        let mut scope = LiveScope::defaults();
+        scope.profiles = vec!["family/tuning-01".into()];
+        scope.samples = vec!["felt-fabric".into(), "chair-fabric".into(), "plastic-sheet".into()];
+        scope.chains = vec![Chain::Live];
+        let study = LiveStudy {
+            rows: vec![
+                row("tuning-01", "felt-fabric", 0.8, 0.48, 0.44, 0.4),
+                // No row for the chair fabric: it has no category.
+                row("tuning-01", "plastic-sheet", 0.6, 0.6, 0.5, 0.3),
+            ],
+            failures: vec![],
+            seconds: 0.0,
+        };
+        let figs = figures(&study, &scope);
+        assert_eq!(figs.len(), 1);
+        let (file, plot) = &figs[0];
+        assert_eq!(file, "live-tuning-01.png");
+        assert_eq!(plot.categories, ["felt-fabric", "plastic-sheet"]);
+        assert_eq!(plot.legend, Legend::Below, "the legend is off the data");
+        assert_eq!(plot.y_label, ES_AXIS);
+        assert!(plot.y_label.contains("lower is better"));
+        for part in ["between 2 and 200 Hz", "0 = the real spectrum", "1 = as far from it as no force at all"] {
+            assert!(plot.note.contains(part), "{part}: {}", plot.note);
+        }
+        let names: Vec<&str> = plot.series.iter().map(|s| s.name.as_str()).collect();
+        assert_eq!(names, ["nothing", "live synthesis (best gain)", "target's floor", "stroke's floor"]);
+        // The floor: a bar at each sample's centre, the values of the table.
+        let floor = &plot.series[3];
+        assert_eq!(floor.style, Style::Level);
+        assert_eq!(floor.points, [(1.0, 0.4), (2.0, 0.3)]);
+        // Every reading a marker (no line joins two samples), beside its
+        // sample's centre and apart from the others.
+        for (k, cat) in [(0usize, 1.0), (1, 2.0)] {
+            let xs: Vec<f64> = plot.series[..3]
+                .iter()
+                .map(|s| {
+                    assert_eq!(s.style, Style::Points, "{}", s.name);
+                    s.points[k].0
+                })
+                .collect();
+            assert!(xs.iter().all(|x| (x - cat).abs() < 0.35), "{xs:?}");
+            assert!(xs.windows(2).all(|w| w[1] - w[0] > 0.05), "{xs:?}");
+        }
+        assert_eq!(plot.series[0].points.iter().map(|p| p.1).collect::<Vec<_>>(), [0.8, 0.6]);
     }
 }

@@ -207,6 +207,7 @@ fn draw(
         log_x: p.log_x,
         log_y: p.log_y,
         series,
+        ..Default::default()
     };
     let written = write_png(&plot, &out.join(&p.file)).map_err(|e| e.to_string())?;
     let note = if written.labelled { "" } else { " (no font found: drawn without text; see tools/src/plot.rs)" };

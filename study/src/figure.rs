@@ -11,6 +11,19 @@ pub enum Style {
     Points,
     /// Points joined by a line, each marked.
     LinePoints,
+    /// Each point a short horizontal bar, 0.8 x units wide centred on it: a
+    /// level per category on a category axis (a floor, a target).
+    Level,
+}
+
+/// Where the legend goes.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum Legend {
+    /// Inside the plotting area, at its right (plotters' default).
+    #[default]
+    Inside,
+    /// Under the plot, outside the data: it hides no point.
+    Below,
 }
 
 /// One named series of (x, y) points.
@@ -38,6 +51,10 @@ impl Series {
     pub fn points(name: impl Into<String>, points: Vec<(f64, f64)>) -> Self {
         Self { name: name.into(), points, style: Style::Points }
     }
+    /// A series drawn as a level (a short horizontal bar) at each point.
+    pub fn level(name: impl Into<String>, points: Vec<(f64, f64)>) -> Self {
+        Self { name: name.into(), points, style: Style::Level }
+    }
 }
 
 /// A plot: title, axis labels and scales, series.
@@ -55,4 +72,11 @@ pub struct Plot {
     pub log_y: bool,
     /// The series.
     pub series: Vec<Series>,
+    /// A category axis when not empty: category k (from 0) sits at x = k + 1
+    /// and is labelled with its name; the axis spans 0.5 … n + 0.5.
+    pub categories: Vec<String>,
+    /// Where the legend goes.
+    pub legend: Legend,
+    /// A note under the plot (a definition of a quantity); empty for none.
+    pub note: String,
 }

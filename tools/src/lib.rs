@@ -6,6 +6,7 @@
 
 pub mod batch;
 pub mod fit;
+pub mod floor_fit;
 pub mod plot;
 #[cfg(feature = "studio")]
 pub mod studio;

@@ -11,7 +11,9 @@ use plotters::prelude::*;
 use std::path::{Path, PathBuf};
 use std::sync::OnceLock;
 
-pub use evflow_study::figure::{Plot, Series, Style};
+pub use evflow_study::figure::{Legend, Plot, Series, Style};
+
+mod legend;
 
 /// What was written.
 #[derive(Debug, Clone, PartialEq)]
@@ -165,13 +167,18 @@ fn colour(i: usize) -> RGBColor {
 /// link.
 pub fn write_png(plot: &Plot, path: &Path) -> Result<Written, PlotError> {
     let shown = path.display().to_string();
+    let log_x = plot.log_x && plot.categories.is_empty();
     let series: Vec<Drawable<'_>> =
-        plot.series.iter().enumerate().map(|(i, s)| (i, s, drawable(s, plot.log_x, plot.log_y))).collect();
+        plot.series.iter().enumerate().map(|(i, s)| (i, s, drawable(s, log_x, plot.log_y))).collect();
     if series.iter().all(|(_, _, p)| p.is_empty()) {
-        return Err(PlotError::Empty { path: shown, log: plot.log_x || plot.log_y });
+        return Err(PlotError::Empty { path: shown, log: log_x || plot.log_y });
     }
     let all = || series.iter().flat_map(|(_, _, p)| p.iter().copied());
-    let xr = range(all().map(|p| p.0), plot.log_x);
+    let xr = if plot.categories.is_empty() {
+        range(all().map(|p| p.0), log_x)
+    } else {
+        (0.5, plot.categories.len() as f64 + 0.5)
+    };
     let yr = range(all().map(|p| p.1), plot.log_y);
     let labelled = font();
     if let Some(dir) = path.parent().filter(|d| !d.as_os_str().is_empty()) {
@@ -199,6 +206,17 @@ fn encode_png(pixels: &[u8], out: &mut impl std::io::Write) -> std::io::Result<(
 /// A series with its index (for its colour) and its drawable points.
 type Drawable<'a> = (usize, &'a Series, Vec<(f64, f64)>);
 type Pts<'a> = [Drawable<'a>];
+type Area<'a> = DrawingArea<BitMapBackend<'a>, plotters::coord::Shift>;
+
+/// The name of the category at `v` (categories sit at 1, 2, …), if any.
+fn category(names: &[String], v: f64) -> Option<&str> {
+    let k = v.round();
+    // NaN fails both tests.
+    if !((v - k).abs() <= 1e-9 && k >= 1.0 && k <= names.len() as f64) {
+        return None;
+    }
+    names.get(k as usize - 1).map(String::as_str)
+}
 
 fn draw(
     plot: &Plot,
@@ -210,24 +228,23 @@ fn draw(
 ) -> Result<(), String> {
     let root = BitMapBackend::with_buffer(pixels, SIZE).into_drawing_area();
     root.fill(&WHITE).map_err(|e| e.to_string())?;
+    let (chart, below) = legend::split(&root, plot, series, text);
     let lx = || (xr.0..xr.1).log_scale().with_key_points(log_keys(xr));
     let ly = || (yr.0..yr.1).log_scale().with_key_points(log_keys(yr));
-    match (plot.log_x, plot.log_y) {
-        (false, false) => body(&root, plot, series, (xr.0..xr.1, yr.0..yr.1), text),
-        (true, false) => body(&root, plot, series, (lx(), yr.0..yr.1), text),
-        (false, true) => body(&root, plot, series, (xr.0..xr.1, ly()), text),
-        (true, true) => body(&root, plot, series, (lx(), ly()), text),
+    let log_x = plot.log_x && plot.categories.is_empty();
+    match (log_x, plot.log_y) {
+        (false, false) => body(&chart, plot, series, (xr.0..xr.1, yr.0..yr.1), text),
+        (true, false) => body(&chart, plot, series, (lx(), yr.0..yr.1), text),
+        (false, true) => body(&chart, plot, series, (xr.0..xr.1, ly()), text),
+        (true, true) => body(&chart, plot, series, (lx(), ly()), text),
     }?;
+    if let Some(area) = below {
+        legend::draw_below(&area, plot, series)?;
+    }
     root.present().map_err(|e| e.to_string())
 }
 
-fn body<X, Y>(
-    root: &DrawingArea<BitMapBackend<'_>, plotters::coord::Shift>,
-    plot: &Plot,
-    series: &Pts<'_>,
-    (x, y): (X, Y),
-    text: bool,
-) -> Result<(), String>
+fn body<X, Y>(root: &Area<'_>, plot: &Plot, series: &Pts<'_>, (x, y): (X, Y), text: bool) -> Result<(), String>
 where
     X: plotters::coord::ranged1d::AsRangedCoord<Value = f64>,
     Y: plotters::coord::ranged1d::AsRangedCoord<Value = f64>,
@@ -243,34 +260,59 @@ where
     }
     let mut chart = b.build_cartesian_2d(x, y).map_err(|e| e.to_string())?;
     let mut mesh = chart.configure_mesh();
+    // On a category axis only the categories are named (a tick between two is blank).
+    let x_tick = |v: &f64| match category(&plot.categories, *v) {
+        Some(name) => name.to_string(),
+        None if plot.categories.is_empty() => tick_label(*v),
+        None => String::new(),
+    };
+    if !plot.categories.is_empty() {
+        mesh.x_labels(plot.categories.len().max(2));
+    }
     if text {
         mesh.x_desc(&plot.x_label)
             .y_desc(&plot.y_label)
             .label_style((FONT, 16))
-            .x_label_formatter(&|v| tick_label(*v))
+            .x_label_formatter(&x_tick)
             .y_label_formatter(&|v| tick_label(*v));
     } else {
         mesh.x_labels(0).y_labels(0);
     }
     mesh.draw().map_err(|e| e.to_string())?;
+    // Lines and levels first, markers over them: no line hides a point.
     for (i, s, pts) in series {
         let c = colour(*i);
-        if matches!(s.style, Style::Line | Style::LinePoints) {
-            let a = chart
-                .draw_series(LineSeries::new(pts.iter().copied(), c.stroke_width(2)))
-                .map_err(|e| e.to_string())?;
-            if text {
-                a.label(&s.name).legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], c.stroke_width(2)));
+        match s.style {
+            Style::Line | Style::LinePoints => {
+                chart
+                    .draw_series(LineSeries::new(pts.iter().copied(), c.stroke_width(2)))
+                    .map_err(|e| e.to_string())?;
             }
-        }
-        if matches!(s.style, Style::Points | Style::LinePoints) {
-            let a = chart.draw_series(pts.iter().map(|&p| Circle::new(p, 4, c.filled()))).map_err(|e| e.to_string())?;
-            if text && s.style == Style::Points {
-                a.label(&s.name).legend(move |(x, y)| Circle::new((x + 10, y), 4, c.filled()));
+            Style::Level => {
+                let bar = |&(x, y): &(f64, f64)| PathElement::new(vec![(x - 0.4, y), (x + 0.4, y)], c.stroke_width(3));
+                chart.draw_series(pts.iter().map(bar)).map_err(|e| e.to_string())?;
             }
+            Style::Points => {}
         }
     }
-    if text && series.len() > 1 {
+    for (i, s, pts) in series {
+        if matches!(s.style, Style::Points | Style::LinePoints) {
+            let c = colour(*i);
+            chart.draw_series(pts.iter().map(|&p| Circle::new(p, 4, c.filled()))).map_err(|e| e.to_string())?;
+        }
+    }
+    if text && series.len() > 1 && plot.legend == Legend::Inside {
+        // The legend in the series' order: an empty series per entry.
+        for (i, s, _) in series {
+            let (path, line, marker) = legend::glyph(s.style, colour(*i));
+            chart
+                .draw_series(std::iter::empty::<Circle<(f64, f64), i32>>())
+                .map_err(|e| e.to_string())?
+                .label(&s.name)
+                .legend(move |(x, y)| {
+                    EmptyElement::at((x, y)) + PathElement::new(path.clone(), line) + Circle::new((10, 0), 4, marker)
+                });
+        }
         chart
             .configure_series_labels()
             .label_font((FONT, 16))
@@ -318,6 +360,7 @@ mod tests {
                 Series::line_points("exact", (1..8).map(|k| (k as f64 * 1e-3, 10f64.powi(-k))).collect()),
                 Series::points("rk4", vec![(1e-3, 1e-2), (f64::NAN, 1.0), (0.0, 1.0)]),
             ],
+            ..Default::default()
         };
         let w = write_png(&plot, &path).unwrap();
         let bytes = std::fs::read(&w.path).unwrap();
@@ -344,6 +387,48 @@ mod tests {
         let mut ours = Vec::new();
         encode_png(&pixels, &mut ours).unwrap();
         assert_eq!(ours, std::fs::read(&by_plotters).unwrap());
+    }
+
+    #[test]
+    fn categories_are_named_at_whole_positions_only() {
+        let names: Vec<String> = ["felt", "paper"].map(String::from).to_vec();
+        assert_eq!(category(&names, 1.0), Some("felt"));
+        assert_eq!(category(&names, 2.0 + 1e-12), Some("paper"));
+        assert_eq!(category(&names, 1.5), None);
+        assert_eq!(category(&names, 0.0), None);
+        assert_eq!(category(&names, 3.0), None);
+        assert_eq!(category(&names, -1.0), None);
+        assert_eq!(category(&names, f64::NAN), None);
+    }
+
+    #[test]
+    fn a_note_wraps_at_spaces_within_its_width() {
+        let note = "word ".repeat(60);
+        let lines = legend::note_lines(&note);
+        assert!(lines.len() >= 2 && lines.iter().all(|l| l.chars().count() <= 115), "{lines:?}");
+        assert_eq!(lines.join(" "), note.trim_end());
+        assert!(legend::note_lines("").is_empty());
+    }
+
+    #[test]
+    fn a_category_plot_with_levels_a_note_and_the_legend_below_is_drawn() {
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("c.png");
+        let plot = Plot {
+            title: "categories".into(),
+            y_label: "E_s".into(),
+            series: vec![
+                Series::points("nothing", vec![(0.9, 0.8), (1.9, 0.5)]),
+                Series::level("floor", vec![(1.0, 0.3), (2.0, 0.4)]),
+            ],
+            categories: vec!["felt".into(), "paper".into()],
+            legend: Legend::Below,
+            note: "E_s: what it is.".into(),
+            log_x: true,
+            ..Plot::default()
+        };
+        let w = write_png(&plot, &path).unwrap();
+        assert_eq!(&std::fs::read(&w.path).unwrap()[..8], b"\x89PNG\r\n\x1a\n");
     }
 
     #[test]

@@ -13,11 +13,17 @@ pub enum Fit {
     Quadratic,
     /// y = a + b·x², least squares: the square law of electrovibration.
     Square,
+    /// The square law above a measured floor: y = (f^p + (b·x²)^p)^(1/p),
+    /// f the mean y at x = 0 (the sweep must hold x = 0), b and p ≥ 1 by
+    /// least squares over the other points. For a measure that reads a
+    /// floor with the effect off (noise, the tribometer's reversals) and
+    /// the square law once the effect rises above it.
+    SquareOverFloor,
 }
 
 impl Fit {
     /// The names accepted in a graph file.
-    pub const NAMES: [&'static str; 4] = ["none", "linear", "quadratic", "square"];
+    pub const NAMES: [&'static str; 5] = ["none", "linear", "quadratic", "square", "square-over-floor"];
 
     /// The fit of that name.
     pub fn from_name(s: &str) -> Option<Self> {
@@ -26,6 +32,7 @@ impl Fit {
             "linear" => Some(Fit::Linear),
             "quadratic" => Some(Fit::Quadratic),
             "square" => Some(Fit::Square),
+            "square-over-floor" => Some(Fit::SquareOverFloor),
             _ => None,
         }
     }
@@ -37,6 +44,7 @@ impl Fit {
             Fit::Linear => "linear",
             Fit::Quadratic => "quadratic",
             Fit::Square => "square",
+            Fit::SquareOverFloor => "square-over-floor",
         }
     }
 }
@@ -72,4 +80,18 @@ pub struct PlotDecl {
 impl PlotDecl {
     /// The keys a `[[plot]]` table may hold.
     pub const KEYS: [&'static str; 8] = ["file", "title", "x", "y", "series", "log_x", "log_y", "fit"];
+}
+
+#[cfg(test)]
+mod tests {
+    use super::Fit;
+
+    #[test]
+    fn every_fit_name_round_trips_and_the_floor_fit_is_named() {
+        for n in Fit::NAMES {
+            assert_eq!(Fit::from_name(n).map(Fit::name), Some(n));
+        }
+        assert_eq!(Fit::from_name("square-over-floor"), Some(Fit::SquareOverFloor));
+        assert_eq!(Fit::from_name("square_over_floor"), None);
+    }
 }

@@ -169,6 +169,7 @@ pub fn figure(c: &Curve) -> Plot {
         log_x: true,
         log_y: true,
         series,
+        ..Default::default()
     }
 }
 

@@ -147,5 +147,6 @@ pub fn figure(s: &Score) -> Plot {
         log_x: false,
         log_y: true,
         series,
+        ..Default::default()
     }
 }

@@ -8,7 +8,8 @@ use crate::live::run::LiveStudy;
 use crate::live::scope::LiveScope;
 use std::fmt::Write as _;
 
-/// The factor of the stroke's floor the best chain is held to (issue 24, point 5).
+/// The factor of the stroke's floor the best chain is held to: the target of
+/// the "Targets" section.
 pub const WITHIN: f64 = 1.3;
 
 fn f3(x: f64) -> String {
@@ -81,6 +82,12 @@ fn cell(study: &LiveStudy, chains: &[Chain], profile: &str, sample: &str) -> Cel
 }
 
 impl Cell {
+    /// Whether the best chain at its best gain scores below nothing (false
+    /// when no chain has a reading).
+    fn beaten(&self) -> bool {
+        self.best().is_some_and(|(_, b)| b < self.nothing)
+    }
+
     /// The best chain at its best gain (index into the played chains) and its E_s.
     fn best(&self) -> Option<(usize, f64)> {
         self.chains
@@ -89,6 +96,38 @@ impl Cell {
             .filter(|(_, c)| c.1.is_finite())
             .map(|(k, c)| (k, c.1))
             .min_by(|a, b| a.1.total_cmp(&b.1))
+    }
+}
+
+/// The sentences under a table: where no chain beats nothing (the best
+/// chain / floor ratio is no success there), and where the display floor
+/// scores above nothing, and why.
+fn notes(md: &mut String, rows: &[(&str, &Cell)]) {
+    let hollow: Vec<&str> = rows.iter().filter(|(_, c)| c.best().is_some() && !c.beaten()).map(|(n, _)| *n).collect();
+    if !hollow.is_empty() {
+        let _ = writeln!(
+            md,
+            "No chain beats nothing on {}: there the best chain / floor ratio is marked, and it is no success — \
+             playing nothing scores as well or better.\n",
+            hollow.join(", ")
+        );
+    }
+    let above: Vec<String> = rows
+        .iter()
+        .filter(|(_, c)| c.display_floor > c.nothing)
+        .map(|(n, c)| format!("{n} ({} against {})", f3(c.display_floor), f3(c.nothing)))
+        .collect();
+    if !above.is_empty() {
+        let _ = writeln!(
+            md,
+            "The display floor scores above nothing on {}. It adds the texture's own force to the display's own \
+             force rather than replacing it, and independent forces add in power: where the display's own force \
+             already holds about as much power between 2 and 200 Hz as the real sample's (a weak texture), the sum \
+             overshoots the real spectrum — in a frequency bin where the display's own magnitude D exceeds ¾ of \
+             the real R (the texture's force being about the real one), √(D² + R²) − R is larger than |D − R|, \
+             nothing's error there.\n",
+            above.join(", ")
+        );
     }
 }
 
@@ -180,7 +219,8 @@ pub fn markdown(study: &LiveStudy, scope: &LiveScope) -> String {
          **Welch reading** (Hann, half-overlapping one-second segments), mean over the users; each chain \
          **at Table 5.1's gain rule / at its best gain** over the sweep {}. Beside them: nothing (the display \
          with no actuation), the display floor (no actuation, the texture's own force added: a perfect \
-         rendering on top of the display's friction) and the **stroke's floor** (the actuation over the whole \
+         rendering on top of the display's friction — added, not in place of it, so it can score above \
+         nothing, below) and the **stroke's floor** (the actuation over the whole \
          stroke optimized through the display's twin knowing the finger's path, load and the real force, \
          within |u| ≤ 1, played with noise on like every chain; where a chain scores lower, the chain's value), \
          and that floor's actuation with nothing played within 150 ms of a reversal (how much of the floor \
@@ -224,6 +264,11 @@ pub fn markdown(study: &LiveStudy, scope: &LiveScope) -> String {
         let ratio = best.map_or(f64::NAN, |(_, b)| b / c.floor);
         let live = live_k.map_or(f64::NAN, |k| c.chains[k].1 / c.target);
         let times = |r: f64| if r.is_finite() { format!("{r:.2}×") } else { "–".into() };
+        // Near the floor is no success where playing nothing does as well.
+        let ratio = match times(ratio) {
+            t if best.is_some() && !c.beaten() && ratio.is_finite() => format!("{t} (no chain beats nothing)"),
+            t => t,
+        };
         let _ = writeln!(
             md,
             " {} | {} | {} | {} | {} | {} |",
@@ -231,7 +276,7 @@ pub fn markdown(study: &LiveStudy, scope: &LiveScope) -> String {
             f3(c.floor),
             f3(c.sliding),
             f3(c.display_floor),
-            times(ratio),
+            ratio,
             times(live)
         );
     };
@@ -239,6 +284,7 @@ pub fn markdown(study: &LiveStudy, scope: &LiveScope) -> String {
     let _ = writeln!(md, "## Mean over samples and users\n");
     header(&mut md, "profile");
     let mut per_profile = Vec::new();
+    let mut summary = Vec::new();
     for p in &scope.profiles {
         let name = profile_name(p);
         let cells: Vec<Cell> =
@@ -259,32 +305,44 @@ pub fn markdown(study: &LiveStudy, scope: &LiveScope) -> String {
             users: cells.iter().map(|c| c.users).sum(),
         };
         line(&mut md, name, &m);
+        summary.push((name.to_string(), m));
         per_profile.push((name.to_string(), cells));
     }
     let _ = writeln!(md);
+    notes(&mut md, &summary.iter().map(|(n, c)| (n.as_str(), c)).collect::<Vec<_>>());
     // Per profile, per sample.
     for (p, _) in &per_profile {
         let _ = writeln!(md, "## {p}\n");
         header(&mut md, "sample");
+        let mut rows = Vec::new();
         for s in &scope.samples {
             let c = cell(study, chains, p, s);
             if c.users > 0 {
                 line(&mut md, s, &c);
+                rows.push((s.as_str(), c));
             }
         }
         let _ = writeln!(md);
+        notes(&mut md, &rows.iter().map(|(s, c)| (*s, c)).collect::<Vec<_>>());
     }
     // The targets.
-    let _ = writeln!(md, "## Targets (issue 24, point 5)\n");
+    let _ = writeln!(md, "## Targets: the best chain against the stroke's floor and against nothing\n");
     for (p, cells) in &per_profile {
         let within = cells.iter().filter(|c| c.best().is_some_and(|(_, b)| b <= WITHIN * c.floor)).count();
+        let hollow =
+            cells.iter().filter(|c| c.best().is_some_and(|(_, b)| b <= WITHIN * c.floor) && !c.beaten()).count();
         let room: Vec<&Cell> = cells.iter().filter(|c| c.floor <= 0.9 * c.nothing).collect();
         let beats = room.iter().filter(|c| c.best().is_some_and(|(_, b)| b < c.nothing)).count();
         let _ = write!(
             md,
-            "* {p}: the best chain within {WITHIN}× of the stroke's floor on {within} of {} samples; where the \
+            "* {p}: the best chain within {WITHIN}× of the stroke's floor on {within} of {} samples{}; where the \
              floor is ≥ 10 % below nothing ({} samples), the best chain beats nothing on {beats}",
             cells.len(),
+            if hollow > 0 {
+                format!(" (on {hollow} of them no chain beats nothing: no success there)")
+            } else {
+                String::new()
+            },
             room.len()
         );
         if let Some(k) = live_k {
@@ -361,44 +419,68 @@ pub fn csv(study: &LiveStudy) -> String {
     out
 }
 
-/// One figure per profile: E_s (Welch, mean over the users) of nothing,
-/// every chain at its best gain and the stroke's floor, sample by sample
-/// (x = the sample's number in the scope, 1 …).
+/// The y-axis label of the live figures.
+pub const ES_AXIS: &str = "E_s (spectral error; lower is better)";
+
+/// What E_s is, under each live figure.
+pub const ES_NOTE: &str = "E_s: the relative spectral RMS error of the display's force against the force the same \
+    finger meets on the real sample, √Σ(V − R)² / √ΣR² over the Welch magnitude spectra (Hann, 1 s segments) \
+    between 2 and 200 Hz, mean over the users: 0 = the real spectrum, 1 = as far from it as no force at all. \
+    Points: each chain at its best gain; bars: the stroke's achievable floor (docs/texture.md §9.2).";
+
+/// One figure per profile: E_s (Welch, mean over the users) of nothing and
+/// every chain at its best gain as points, and the stroke's floor as a bar,
+/// sample by sample. The samples are categories (the k-th with results at
+/// x = k, named on the axis); each series of points sits a little to the
+/// side of its sample's centre so that none hides another, and the legend
+/// is under the plot, off the data.
 pub fn figures(study: &LiveStudy, scope: &LiveScope) -> Vec<(String, crate::figure::Plot)> {
-    use crate::figure::{Plot, Series};
+    use crate::figure::{Legend, Plot, Series};
     let chains = played(scope);
     let mut out = Vec::new();
     for p in scope.profiles.iter().map(|p| profile_name(p)) {
-        let cells: Vec<(f64, Cell)> = scope
+        let cells: Vec<(&str, Cell)> = scope
             .samples
             .iter()
-            .enumerate()
-            .map(|(k, s)| ((k + 1) as f64, cell(study, &chains, p, s)))
+            .map(|s| (s.as_str(), cell(study, &chains, p, s)))
             .filter(|(_, c)| c.users > 0)
             .collect();
         if cells.is_empty() {
             continue;
         }
-        let pts =
-            |f: &dyn Fn(&Cell) -> f64| cells.iter().map(|(x, c)| (*x, f(c))).filter(|p| p.1.is_finite()).collect();
-        let mut series = vec![Series::line_points("nothing", pts(&|c| c.nothing))];
+        // The series of points, each a value per cell: nothing, each chain, the target's floor.
+        let of = |f: &dyn Fn(&Cell) -> f64| cells.iter().map(|(_, c)| f(c)).collect::<Vec<f64>>();
+        let mut readings = vec![("nothing".to_string(), of(&|c| c.nothing))];
         for (k, ch) in chains.iter().enumerate() {
-            series.push(Series::line_points(format!("{} (best gain)", ch.label()), pts(&|c| c.chains[k].1)));
+            readings.push((format!("{} (best gain)", ch.label()), of(&|c| c.chains[k].1)));
         }
         if chains.contains(&Chain::Live) {
-            series.push(Series::line_points("target's floor", pts(&|c| c.target)));
+            readings.push(("target's floor".into(), of(&|c| c.target)));
         }
-        series.push(Series::line_points("stroke floor", pts(&|c| c.floor)));
-        let names: Vec<String> = scope.samples.iter().enumerate().map(|(k, s)| format!("{} {s}", k + 1)).collect();
+        // Category j + 1, shifted by `offset`; non-finite values left out.
+        let at = |values: &[f64], offset: f64| -> Vec<(f64, f64)> {
+            values.iter().enumerate().map(|(j, v)| ((j + 1) as f64 + offset, *v)).filter(|p| p.1.is_finite()).collect()
+        };
+        let n = readings.len() as f64;
+        let step = (0.6 / n).min(0.12);
+        let mut series: Vec<Series> = readings
+            .iter()
+            .enumerate()
+            .map(|(k, (name, v))| Series::points(name.clone(), at(v, (k as f64 - (n - 1.0) / 2.0) * step)))
+            .collect();
+        series.push(Series::level("stroke's floor", at(&of(&|c| c.floor), 0.0)));
         out.push((
             format!("live-{p}.png"),
             Plot {
-                title: format!("{p}: E_s under the virtual users (Welch, mean over users)"),
-                x_label: format!("sample: {}", names.join(", ")),
-                y_label: "E_s".into(),
+                title: format!("{p}: E_s per sample under the virtual users (Welch, mean over the users)"),
+                x_label: "texture sample".into(),
+                y_label: ES_AXIS.into(),
                 log_x: false,
                 log_y: false,
                 series,
+                categories: cells.iter().map(|(s, _)| s.to_string()).collect(),
+                legend: Legend::Below,
+                note: ES_NOTE.into(),
             },
         ));
     }
@@ -490,5 +572,88 @@ mod tests {
         assert_eq!(csv.lines().filter(|l| l.contains(",target_floor,")).count(), 4);
         assert!(csv.contains("tuning-01,felt-fabric,person,live,1,0.48,0.48,1,0.48,1,0.48,0.48\n"), "{csv}");
         assert_eq!(figures(&study, &scope).len(), 2);
+    }
+
+    #[test]
+    fn the_figure_puts_samples_on_a_category_axis_with_points_a_floor_bar_and_a_defined_e_s() {
+        use crate::figure::{Legend, Style};
+        let mut scope = LiveScope::defaults();
+        scope.profiles = vec!["family/tuning-01".into()];
+        scope.samples = vec!["felt-fabric".into(), "chair-fabric".into(), "plastic-sheet".into()];
+        scope.chains = vec![Chain::Live];
+        let study = LiveStudy {
+            rows: vec![
+                row("tuning-01", "felt-fabric", 0.8, 0.48, 0.44, 0.4),
+                // No row for the chair fabric: it has no category.
+                row("tuning-01", "plastic-sheet", 0.6, 0.6, 0.5, 0.3),
+            ],
+            failures: vec![],
+            seconds: 0.0,
+        };
+        let figs = figures(&study, &scope);
+        assert_eq!(figs.len(), 1);
+        let (file, plot) = &figs[0];
+        assert_eq!(file, "live-tuning-01.png");
+        assert_eq!(plot.categories, ["felt-fabric", "plastic-sheet"]);
+        assert_eq!(plot.legend, Legend::Below, "the legend is off the data");
+        assert_eq!(plot.y_label, ES_AXIS);
+        assert!(plot.y_label.contains("lower is better"));
+        for part in ["between 2 and 200 Hz", "0 = the real spectrum", "1 = as far from it as no force at all"] {
+            assert!(plot.note.contains(part), "{part}: {}", plot.note);
+        }
+        let names: Vec<&str> = plot.series.iter().map(|s| s.name.as_str()).collect();
+        assert_eq!(names, ["nothing", "live synthesis (best gain)", "target's floor", "stroke's floor"]);
+        // The floor: a bar at each sample's centre, the values of the table.
+        let floor = &plot.series[3];
+        assert_eq!(floor.style, Style::Level);
+        assert_eq!(floor.points, [(1.0, 0.4), (2.0, 0.3)]);
+        // Every reading a marker (no line joins two samples), beside its
+        // sample's centre and apart from the others.
+        for (k, cat) in [(0usize, 1.0), (1, 2.0)] {
+            let xs: Vec<f64> = plot.series[..3]
+                .iter()
+                .map(|s| {
+                    assert_eq!(s.style, Style::Points, "{}", s.name);
+                    s.points[k].0
+                })
+                .collect();
+            assert!(xs.iter().all(|x| (x - cat).abs() < 0.35), "{xs:?}");
+            assert!(xs.windows(2).all(|w| w[1] - w[0] > 0.05), "{xs:?}");
+        }
+        assert_eq!(plot.series[0].points.iter().map(|p| p.1).collect::<Vec<_>>(), [0.8, 0.6]);
+    }
+
+    #[test]
+    fn the_report_names_its_sections_marks_a_ratio_no_chain_earns_and_says_why_the_display_floor_loses() {
+        let mut scope = LiveScope::defaults();
+        scope.profiles = vec!["nominal".into()];
+        scope.samples = vec!["felt-fabric".into(), "plastic-sheet".into()];
+        scope.chains = vec![Chain::Live];
+        // Felt: the live synthesis (0.50) is 1.25× the floor but above nothing (0.48); the display
+        // floor (0.494) above nothing too. Plastic: the live synthesis beats nothing.
+        let mut felt = row("nominal", "felt-fabric", 0.48, 0.5, 0.45, 0.4);
+        felt.display_floor = Reading { rect: 0.494, welch: 0.494 };
+        let study = LiveStudy {
+            rows: vec![felt, row("nominal", "plastic-sheet", 0.8, 0.5, 0.45, 0.4)],
+            failures: vec![],
+            seconds: 0.0,
+        };
+        let md = markdown(&study, &scope);
+        assert!(!md.to_lowercase().contains("issue") && !md.contains("point 5"), "{md}");
+        assert!(md.contains("## Targets: the best chain against the stroke's floor and against nothing"), "{md}");
+        // The felt's ratio is marked; the plastic sheet's, which beats nothing, is not.
+        let felt_row = md.lines().find(|l| l.starts_with("| felt-fabric |")).unwrap();
+        assert!(felt_row.contains("| 1.25× (no chain beats nothing) |"), "{felt_row}");
+        let plastic_row = md.lines().find(|l| l.starts_with("| plastic-sheet |")).unwrap();
+        assert!(plastic_row.contains("| 1.25× |") && !plastic_row.contains("beats"), "{plastic_row}");
+        assert!(
+            md.contains("No chain beats nothing on felt-fabric: there the best chain / floor ratio is marked"),
+            "{md}"
+        );
+        assert!(md.contains("within 1.3× of the stroke's floor on 2 of 2 samples (on 1 of them no chain beats nothing"));
+        // The display floor above nothing is explained, where it happens only.
+        assert!(md.contains("The display floor scores above nothing on felt-fabric (0.494 against 0.480)."), "{md}");
+        assert!(md.contains("independent forces add in power"), "{md}");
+        assert!(!md.contains("above nothing on plastic-sheet"), "{md}");
     }
 }

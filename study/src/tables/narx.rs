@@ -92,6 +92,7 @@ pub fn figure(condition: &Cond, scored: &[Scored]) -> Plot {
             .filter(|s| s.seeds > 0)
             .map(|s| Series::points(format!("{} ({})", s.setting.name, s.setting.describe()), vec![(s.seconds, s.es)]))
             .collect(),
+        ..Default::default()
     }
 }
 

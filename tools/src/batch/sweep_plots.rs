@@ -2,7 +2,8 @@
 //! run` after a sweep, and `evflow merge` after joining a sweep's shards (a
 //! plot of the whole sweep is drawn from every run, never by a shard).
 
-use crate::fit::{polyfit, square_law};
+use crate::fit::{polyfit, square_law, PolyFit};
+use crate::floor_fit::{square_over_floor, FloorFit};
 use crate::plot::{write_png, Plot, Series};
 use evflow_engine::check::interpolate::text_of;
 use evflow_engine::graph::{Fit, Graph, PlotDecl};
@@ -47,6 +48,60 @@ fn var(name: &str, point: &Point, sets: &[Override], graph: &Graph) -> Option<Va
         .map(|(_, v)| v.clone())
         .or_else(|| sets.iter().find(|o| o.key == name).map(|o| o.value.clone()))
         .or_else(|| graph.vars.iter().find(|v| v.name == name).map(|v| v.value.clone()))
+}
+
+/// A curve fitted to a series.
+enum Curve {
+    /// A polynomial (linear, quadratic, the square law).
+    Poly(PolyFit),
+    /// The square law over a measured floor.
+    Floor(FloorFit),
+}
+
+impl Curve {
+    fn eval(&self, x: f64) -> f64 {
+        match self {
+            Curve::Poly(f) => f.eval(x),
+            Curve::Floor(f) => f.eval(x),
+        }
+    }
+    fn formula(&self) -> String {
+        match self {
+            Curve::Poly(f) => f.formula(),
+            Curve::Floor(f) => f.formula(),
+        }
+    }
+    fn r2(&self) -> f64 {
+        match self {
+            Curve::Poly(f) => f.r2,
+            Curve::Floor(f) => f.r2,
+        }
+    }
+}
+
+/// The fit `fit` through `pts`: `None` for no fit, an error saying why a
+/// fit could not be made.
+fn fit_curve(fit: Fit, pts: &[(f64, f64)]) -> Option<Result<Curve, String>> {
+    let poly = |f: Option<PolyFit>, d: usize| {
+        f.map(Curve::Poly).ok_or_else(|| format!("too few distinct points for a degree-{d} fit"))
+    };
+    match fit {
+        Fit::None => None,
+        Fit::Linear => Some(poly(polyfit(pts, 1), 1)),
+        Fit::Quadratic => Some(poly(polyfit(pts, 2), 2)),
+        Fit::Square => Some(poly(square_law(pts), 2)),
+        Fit::SquareOverFloor => Some(square_over_floor(pts).map(Curve::Floor).map_err(|e| e.to_string())),
+    }
+}
+
+/// A value for a legend: four significant digits (exponent form far from 1).
+fn short(v: f64) -> String {
+    let mag = if v == 0.0 { 0.0 } else { v.abs().log10().floor() };
+    if !(-4.0..6.0).contains(&mag) {
+        return format!("{v:.3e}");
+    }
+    let decimals = (3.0 - mag).max(0.0) as usize;
+    format!("{v:.decimals$}")
 }
 
 /// Draws every plot of `graph` into `out`; returns lines for people (files
@@ -103,25 +158,38 @@ fn draw(
     }
     let mut lines = Vec::new();
     let mut series = Vec::new();
+    let y_unit = |name: &str| {
+        p.y.iter()
+            .find(|y| name.starts_with(y.as_str()))
+            .and_then(|y| unit(y, runs))
+            .map_or(String::new(), |u| format!(" {u}"))
+    };
     for (name, mut pts) in groups {
         pts.sort_by(|a, b| a.0.total_cmp(&b.0));
-        let fitted = match p.fit {
-            Fit::None => None,
-            Fit::Linear => Some((1, polyfit(&pts, 1))),
-            Fit::Quadratic => Some((2, polyfit(&pts, 2))),
-            Fit::Square => Some((2, square_law(&pts))),
-        };
-        match fitted {
-            Some((_, Some(f))) => {
-                lines.push(format!("plot {}: {name}: {} fit {}, R² = {:.5}", p.file, p.fit.name(), f.formula(), f.r2));
+        match fit_curve(p.fit, &pts) {
+            Some(Ok(f)) => {
+                lines.push(format!(
+                    "plot {}: {name}: {} fit {}, R² = {:.5}",
+                    p.file,
+                    p.fit.name(),
+                    f.formula(),
+                    f.r2()
+                ));
+                // A floor fit draws from x = 0, where the floor is measured.
                 let (lo, hi) = (pts[0].0, pts[pts.len() - 1].0);
                 let curve: Vec<(f64, f64)> =
                     (0..=100).map(|k| lo + (hi - lo) * k as f64 / 100.0).map(|x| (x, f.eval(x))).collect();
                 series.push(Series::points(name.clone(), pts));
-                series.push(Series::line(format!("{name}, {} fit (R² = {:.4})", p.fit.name(), f.r2), curve));
+                series.push(Series::line(format!("{name}, {} fit (R² = {:.4})", p.fit.name(), f.r2()), curve));
+                if let Curve::Floor(ff) = &f {
+                    series.push(Series::line(
+                        format!("floor: {name} at {} = 0, {}{}", p.x, short(ff.floor), y_unit(&name)),
+                        vec![(lo, ff.floor), (hi, ff.floor)],
+                    ));
+                }
             }
-            Some((d, None)) => {
-                lines.push(format!("plot {}: {name}: too few distinct points for a degree-{d} fit", p.file));
+            Some(Err(why)) => {
+                lines.push(format!("plot {}: {name}: no {} fit: {why}", p.file, p.fit.name()));
                 series.push(Series::line_points(name, pts));
             }
             None => series.push(Series::line_points(name, pts)),
@@ -139,6 +207,7 @@ fn draw(
         log_x: p.log_x,
         log_y: p.log_y,
         series,
+        ..Default::default()
     };
     let written = write_png(&plot, &out.join(&p.file)).map_err(|e| e.to_string())?;
     let note = if written.labelled { "" } else { " (no font found: drawn without text; see tools/src/plot.rs)" };

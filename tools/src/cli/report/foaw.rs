@@ -71,6 +71,7 @@ pub fn main(a: Args) -> Result<()> {
         log_x: false,
         log_y: true,
         series: scatter.into_iter().map(|(n, p)| Series::points(n, p)).collect(),
+        ..Default::default()
     };
     let steps = &TRAJECTORIES[1];
     let y = sample(steps, a.rate, a.seconds, step);
@@ -94,6 +95,7 @@ pub fn main(a: Args) -> Result<()> {
             Series::line("moving average (5)", trace(&Estimator::MovingAverage(5))),
             Series::line(foaw_default.label(), trace(&foaw_default)),
         ],
+        ..Default::default()
     };
     println!();
     for (plot, name) in [(&tradeoff, "foaw-tradeoff.png"), (&traces, "foaw-steps.png")] {

@@ -113,6 +113,7 @@ pub fn main(a: Args) -> Result<()> {
         log_x: false,
         log_y: true,
         series,
+        ..Default::default()
     };
     println!();
     super::save_png(&plot, &a.out.join("freqvel.png"));

@@ -89,6 +89,7 @@ pub fn main(a: Args) -> Result<()> {
             ),
             Series::line_points("triangle normal", rows.iter().map(|r| (r.tick_us_normal, r.rms_fsq_normal)).collect()),
         ],
+        ..Default::default()
     };
     report_png(&wp, &a.out.join("mesh-gradient-work-precision.png"))?;
     let res = Plot {
@@ -104,6 +105,7 @@ pub fn main(a: Args) -> Result<()> {
                 rows.iter().map(|r| (r.triangles as f64, r.rms_slope_normal)).collect(),
             ),
         ],
+        ..Default::default()
     };
     report_png(&res, &a.out.join("mesh-gradient-resolution.png"))?;
     let coarse = a.resolutions.iter().copied().find(|&r| r >= 8).unwrap_or(8);
@@ -119,6 +121,7 @@ pub fn main(a: Args) -> Result<()> {
             Series::line("secant", t.iter().map(|r| (r[0], r[2])).collect()),
             Series::line("triangle normal", t.iter().map(|r| (r[0], r[3])).collect()),
         ],
+        ..Default::default()
     };
     report_png(&line, &a.out.join("mesh-fsq-line.png"))?;
 

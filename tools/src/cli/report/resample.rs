@@ -54,6 +54,7 @@ pub fn main(a: Args) -> Result<()> {
         log_x: true,
         log_y: true,
         series: families.into_iter().map(|(f, p)| Series::line_points(f, p)).collect(),
+        ..Default::default()
     };
     println!();
     super::save_png(&plot, &a.out.join("resample-work-precision.png"));

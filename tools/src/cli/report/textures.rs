@@ -221,5 +221,6 @@ fn spectra_plot(r: &Row) -> Result<Plot> {
         log_x: false,
         log_y: true,
         series,
+        ..Default::default()
     })
 }

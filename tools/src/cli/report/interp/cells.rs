@@ -69,6 +69,7 @@ fn spectra_plot(run: &Run, method: Method) -> Result<Plot> {
         log_x: false,
         log_y: true,
         series,
+        ..Default::default()
     })
 }
 

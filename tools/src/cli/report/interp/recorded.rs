@@ -93,6 +93,7 @@ fn evaluate(a: &Args, sample: &str, tmp: &Path, band: &Band) -> Result<(Vec<Row>
                     Series::line("basic (§5.3.3)", pts(&sb)),
                     Series::line("improved (Eq. 6.4)", pts(&si)),
                 ],
+                ..Default::default()
             });
         }
     }

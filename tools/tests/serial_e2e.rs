@@ -142,7 +142,9 @@ fn the_force_the_device_renders_from_the_actuation_comes_back() {
 
     // Every actuation sample the limiter put out reached the device, in
     // order (the I/O thread may have added stall-fade frames in between).
-    let sent: Vec<i16> = channel(&s, "outputs/limit.out", "out").iter().map(|u| actuation_to_i16(*u).0).collect();
+    // Quantized as the host does: through the f32 of its ring to the I/O thread.
+    let sent: Vec<i16> =
+        channel(&s, "outputs/limit.out", "out").iter().map(|u| actuation_to_i16(*u as f32 as f64).0).collect();
     let got: Vec<i16> = channel(&log, "actuation", "u").iter().map(|u| actuation_to_i16(*u).0).collect();
     let (missing, extra) = in_order(&sent, &got);
     let stale = value(&text, "display: dropped_stale") + value(&text, "display: ring_overruns");

@@ -379,7 +379,9 @@ fn roots(dir: &Path) -> Vec<PathBuf> {
     ["src/lib.rs", "src/main.rs"].iter().map(|r| dir.join(r)).filter(|p| p.is_file()).collect()
 }
 
-/// The evflow crates a Cargo.toml depends on (`[dependencies]` only).
+/// The evflow crates a Cargo.toml depends on, in its `[dependencies]` and
+/// its `[dev-dependencies]` (a test that imports a crate above is an arrow
+/// up too, and with that crate's own dependency, a circle).
 fn evflow_dependencies(manifest: &Path) -> Vec<String> {
     let text = std::fs::read_to_string(manifest).unwrap();
     let mut section = String::new();
@@ -388,7 +390,7 @@ fn evflow_dependencies(manifest: &Path) -> Vec<String> {
         let t = line.trim();
         if t.starts_with('[') {
             section = t.to_string();
-        } else if section == "[dependencies]" {
+        } else if section == "[dependencies]" || section == "[dev-dependencies]" {
             let name = t.split(['=', ' ', '.']).next().unwrap_or("");
             if name.starts_with("evflow") {
                 deps.push(name.to_string());
@@ -515,5 +517,7 @@ fn a_dependency_on_a_higher_layer_is_named() {
         "[package]\nname = \"x\"\n\n[dependencies]\nevflow-engine.workspace = true\nevflow-study = { path = \"../study\" }\n\n[dev-dependencies]\nevflow = { path = \"../tools\" }\n",
     )
     .unwrap();
-    assert_eq!(evflow_dependencies(&manifest), ["evflow-engine", "evflow-study"]);
+    // A dev-dependency counts: `tools` once dev-depended on `evflow-tests`,
+    // which depends on `tools` — a circle through the tests.
+    assert_eq!(evflow_dependencies(&manifest), ["evflow-engine", "evflow-study", "evflow"]);
 }

@@ -5,7 +5,7 @@
 //! (`tests/live_alloc.rs` runs the same graph without a device and also
 //! traps system calls; here the nodes' connected path — ring pops and
 //! pushes, atomics — is the one exercised.)
-#![cfg(all(feature = "serial", unix))]
+#![cfg(unix)]
 
 use evflow_engine::live::{self, LiveConfig, LivePlan};
 use evflow_engine::{check, graph::parse_graph, Override, Plan, PlanOptions};
@@ -13,6 +13,9 @@ use evflow_tests::alloc_counter;
 use std::io::{BufRead, BufReader};
 use std::path::Path;
 use std::process::{Command, Stdio};
+
+#[path = "studio_common.rs"]
+mod common;
 
 #[global_allocator]
 static GLOBAL: alloc_counter::Counting = alloc_counter::Counting;
@@ -33,7 +36,7 @@ fn connected_serial_nodes_do_not_allocate_on_the_real_time_thread() {
 
     let tmp = tempfile::tempdir().unwrap();
     let link = tmp.path().join("dev");
-    let mut dev = Command::new(env!("CARGO_BIN_EXE_evflow"))
+    let mut dev = Command::new(common::evflow())
         .arg("devsim")
         .arg("--link")
         .arg(&link)

@@ -521,3 +521,41 @@ fn a_dependency_on_a_higher_layer_is_named() {
     // which depends on `tools` — a circle through the tests.
     assert_eq!(evflow_dependencies(&manifest), ["evflow-engine", "evflow-study", "evflow"]);
 }
+
+/// Every `X.rs` in `dir` (recursively) beside a folder `X/` that holds
+/// Rust files: a module with files of its own is written one way only,
+/// as `X/mod.rs`.
+fn file_and_folder_pairs(dir: &Path) -> Vec<PathBuf> {
+    let mut found = Vec::new();
+    let Ok(entries) = std::fs::read_dir(dir) else { return found };
+    for e in entries.flatten() {
+        let p = e.path();
+        if p.is_dir() {
+            found.extend(file_and_folder_pairs(&p));
+        } else if p.extension().is_some_and(|x| x == "rs") {
+            let folder = p.with_extension("");
+            let holds_rust = std::fs::read_dir(&folder)
+                .map(|es| es.flatten().any(|e| e.path().extension().is_some_and(|x| x == "rs")))
+                .unwrap_or(false);
+            if holds_rust {
+                found.push(p);
+            }
+        }
+    }
+    found.sort();
+    found
+}
+
+#[test]
+fn a_module_with_files_is_a_folder_with_mod_rs() {
+    let root = evflow_tests::root();
+    let pairs: Vec<PathBuf> =
+        LAYERS.iter().flat_map(|(_, dir)| file_and_folder_pairs(&root.join(dir).join("src"))).collect();
+    assert!(pairs.is_empty(), "write these as FOLDER/mod.rs: {pairs:?}");
+    // The reader sees a pair.
+    let d = tempfile::tempdir().unwrap();
+    std::fs::create_dir_all(d.path().join("a")).unwrap();
+    std::fs::write(d.path().join("a.rs"), "mod b;").unwrap();
+    std::fs::write(d.path().join("a/b.rs"), "").unwrap();
+    assert_eq!(file_and_folder_pairs(d.path()), [d.path().join("a.rs")]);
+}

@@ -210,7 +210,7 @@ fn draw(
         ..Default::default()
     };
     let written = write_png(&plot, &out.join(&p.file)).map_err(|e| e.to_string())?;
-    let note = if written.labelled { "" } else { " (no font found: drawn without text; see tools/src/plot.rs)" };
+    let note = if written.labelled { "" } else { " (no font found: drawn without text; see tools/src/plot/mod.rs)" };
     lines.push(format!("wrote {}{note}", written.path.display()));
     Ok(lines)
 }

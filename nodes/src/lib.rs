@@ -16,6 +16,8 @@ pub mod families;
 pub mod filters;
 #[cfg(feature = "lab")]
 pub mod lab;
+#[cfg(feature = "narx")]
+pub mod linalg;
 pub mod math;
 #[cfg(feature = "mesh")]
 pub mod mesh;

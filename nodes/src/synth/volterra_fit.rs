@@ -25,9 +25,9 @@ use super::error::SynthError;
 use super::output_filter::OutputFilter;
 use super::spectral::NoiseSpectrum;
 use super::volterra::{upper_index, Volterra, MAX_MEMORY};
+use crate::linalg::{add_lower_gram, Cholesky};
 use crate::wide_sum::SumSq;
-use faer::linalg::solvers::Solve;
-use faer::{Mat, Par, Side};
+use ndarray::{Array1, Array2};
 
 /// How to identify a model.
 #[derive(Debug, Clone, PartialEq)]
@@ -142,8 +142,8 @@ pub fn fit(u: &[f64], y: &[f64], keep: &[bool], cfg: &FitConfig) -> Result<Fitte
     // Regressor columns over the whole series, filtered, then the kept rows.
     let at = |k: isize| if k >= 0 { u[k as usize] } else { 0.0 };
     let mut col = vec![0.0; u.len()];
-    let mut phi = Mat::<f64>::zeros(rows.len(), p);
-    let mut fill = |c: usize, f: &dyn Fn(usize) -> f64, phi: &mut Mat<f64>| {
+    let mut phi = Array2::<f64>::zeros((rows.len(), p));
+    let mut fill = |c: usize, f: &dyn Fn(usize) -> f64, phi: &mut Array2<f64>| {
         for (n, v) in col.iter_mut().enumerate() {
             *v = f(n);
         }
@@ -249,24 +249,22 @@ pub fn rel_rms(resid: &[f64], y: &[f64], all: &[f64]) -> f64 {
 
 /// Solves the (weighted, ridge-stabilized) normal equations on the first
 /// `n_tr` rows.
-fn solve(phi: &Mat<f64>, y: &[f64], weights: &[f64], n_tr: usize, ridge: f64) -> Result<Vec<f64>, SynthError> {
+fn solve(phi: &Array2<f64>, y: &[f64], weights: &[f64], n_tr: usize, ridge: f64) -> Result<Vec<f64>, SynthError> {
     let p = phi.ncols();
-    let wphi = Mat::<f64>::from_fn(n_tr, p, |r, k| phi[(r, k)] * weights[r].sqrt());
-    let wy = Mat::<f64>::from_fn(n_tr, 1, |r, _| y[r] * weights[r].sqrt());
-    let mut ata = Mat::<f64>::zeros(p, p);
-    faer::linalg::matmul::matmul(ata.as_mut(), faer::Accum::Replace, wphi.transpose(), wphi.as_ref(), 1.0, Par::Seq);
-    let mut aty = Mat::<f64>::zeros(p, 1);
-    faer::linalg::matmul::matmul(aty.as_mut(), faer::Accum::Replace, wphi.transpose(), wy.as_ref(), 1.0, Par::Seq);
+    let wphi = Array2::<f64>::from_shape_fn((n_tr, p), |(r, k)| phi[(r, k)] * weights[r].sqrt());
+    let wy = Array1::<f64>::from_shape_fn(n_tr, |r| y[r] * weights[r].sqrt());
+    // AᵀA's lower triangle (what the factorization reads) and Aᵀy.
+    let mut ata = Array2::<f64>::zeros((p, p));
+    add_lower_gram(&mut ata, wphi.view(), false);
+    let aty = wphi.t().dot(&wy);
     let mean_diag = (0..p).map(|k| ata[(k, k)]).sum::<f64>() / p as f64;
     let delta = ridge.max(0.0) * mean_diag.max(f64::MIN_POSITIVE);
     for k in 0..p {
         ata[(k, k)] += delta;
     }
-    let llt = ata
-        .llt(Side::Lower)
+    let llt = Cholesky::factor(&ata)
         .map_err(|_| SynthError::Data("the regressors are degenerate (raise `ridge` or vary the excitation)".into()))?;
-    let theta = llt.solve(aty.as_ref());
-    let th: Vec<f64> = (0..p).map(|k| theta[(k, 0)]).collect();
+    let th = llt.solve(aty.as_slice().expect("a new vector is contiguous"));
     if th.iter().any(|v| !v.is_finite()) {
         return Err(SynthError::Data("the fit is not finite (raise `ridge`)".into()));
     }

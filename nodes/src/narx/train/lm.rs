@@ -11,7 +11,7 @@
 //! If the step lowers the training MSE it is taken and μ is multiplied by
 //! `mu_dec` (0.1); otherwise μ is multiplied by `mu_inc` (10) and the step
 //! recomputed, until μ exceeds `mu_max` (1e10), which stops training.
-//! JᵀJ + μI is factored by Cholesky (faer's LLᵀ); a factorization that
+//! JᵀJ + μI is factored by Cholesky (LLᵀ, `crate::linalg`); a factorization that
 //! fails (the matrix not numerically positive definite) is treated like a
 //! step that did not improve: μ is raised. Training also stops after
 //! `max_epochs`, when the MSE gradient norm 2‖Jᵀe‖/N falls below
@@ -25,10 +25,10 @@
 //! formed (half the multiply-adds of the full product).
 
 use super::{mse, Data, EarlyStop, Epoch, Options, Report, StopReason};
+use crate::linalg::{add_lower_gram, Cholesky};
 use crate::narx::net::Mlp;
-use faer::linalg::matmul::triangular::{self, BlockStructure};
-use faer::linalg::solvers::Solve;
-use faer::{Accum, Mat, Par, Side};
+use ndarray::linalg::general_mat_vec_mul;
+use ndarray::{s, Array1, Array2};
 use std::time::Instant;
 
 /// Rows of the Jacobian formed at once.
@@ -51,12 +51,12 @@ pub fn train(
     let mut stop = EarlyStop::new(net.weights(), mse(net, val), perf, opts.max_fail);
     let mut mu = opts.mu;
     // JᵀJ: only its lower triangle is formed and read (Cholesky of the lower half).
-    let mut jtj = Mat::<f64>::zeros(p, p);
+    let mut jtj = Array2::<f64>::zeros((p, p));
     let mut diag = vec![0.0; p];
-    let mut jte = Mat::<f64>::zeros(p, 1);
-    // Jᵀ of a block of rows: column i holds ∂y/∂w of row i, written in place.
-    let mut jt_block = Mat::<f64>::zeros(p, BLOCK);
-    let mut eblock = Mat::<f64>::zeros(BLOCK, 1);
+    let mut jte = Array1::<f64>::zeros(p);
+    // J of a block of rows: row i holds ∂y/∂w of row i, written in place.
+    let mut j_block = Array2::<f64>::zeros((BLOCK, p));
+    let mut eblock = Array1::<f64>::zeros(BLOCK);
     let mut trial = vec![0.0; p];
     let mut epochs = 0;
     let mut reason = StopReason::MaxEpochs;
@@ -74,28 +74,18 @@ pub fn train(
         while s < n {
             let m = BLOCK.min(n - s);
             for i in 0..m {
-                let col = jt_block.as_mut().col_mut(i).try_as_col_major_mut().expect("a Mat's columns are contiguous");
-                let y = net.jacobian_row(train.row(s + i), &mut ws, col.as_slice_mut());
-                eblock[(i, 0)] = y - train.target(s + i);
+                let mut row = j_block.row_mut(i);
+                let row = row.as_slice_mut().expect("rows of a standard-layout array are contiguous");
+                let y = net.jacobian_row(train.row(s + i), &mut ws, row);
+                eblock[i] = y - train.target(s + i);
             }
-            let (jb, eb) = (jt_block.as_ref().subcols(0, m), eblock.as_ref().subrows(0, m));
-            let acc = if first { Accum::Replace } else { Accum::Add };
-            triangular::matmul(
-                jtj.as_mut(),
-                BlockStructure::TriangularLower,
-                acc,
-                jb,
-                BlockStructure::Rectangular,
-                jb.transpose(),
-                BlockStructure::Rectangular,
-                1.0,
-                Par::Seq,
-            );
-            faer::linalg::matmul::matmul(jte.as_mut(), acc, jb, eb, 1.0, Par::Seq);
+            let (jb, eb) = (j_block.slice(s![0..m, ..]), eblock.slice(s![0..m]));
+            add_lower_gram(&mut jtj, jb, !first);
+            general_mat_vec_mul(1.0, &jb.t(), &eb, if first { 0.0 } else { 1.0 }, &mut jte);
             first = false;
             s += m;
         }
-        let gradient = 2.0 * (0..p).map(|k| jte[(k, 0)] * jte[(k, 0)]).sum::<f64>().sqrt() / n as f64;
+        let gradient = 2.0 * (0..p).map(|k| jte[k] * jte[k]).sum::<f64>().sqrt() / n as f64;
         if gradient.is_nan() || gradient < opts.min_grad {
             reason = StopReason::MinGradient;
             break;
@@ -109,13 +99,13 @@ pub fn train(
             for (k, d) in diag.iter().enumerate() {
                 jtj[(k, k)] = d + mu;
             }
-            if let Ok(llt) = jtj.llt(Side::Lower) {
-                let dx = llt.solve(jte.as_ref());
+            if let Ok(llt) = Cholesky::factor(&jtj) {
+                let dx = llt.solve(jte.as_slice().expect("a vector is contiguous"));
                 let w = net.weights();
-                let ok = (0..p).all(|k| dx[(k, 0)].is_finite());
+                let ok = dx.iter().all(|d| d.is_finite());
                 if ok {
                     for k in 0..p {
-                        trial[k] = w[k] - dx[(k, 0)];
+                        trial[k] = w[k] - dx[k];
                     }
                     let saved: Vec<f64> = w.to_vec();
                     net.weights_mut().copy_from_slice(&trial);

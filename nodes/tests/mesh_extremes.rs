@@ -6,7 +6,7 @@
 //! the screen plane; an empty or all-degenerate file is refused. Every
 //! output finite.
 
-mod mesh_formats_util;
+use crate::mesh_formats_util;
 
 use evflow_engine::harness::Single;
 use evflow_engine::Summary;

@@ -5,7 +5,7 @@
 //! to the same welded triangles and render the same gradient; malformed
 //! files are refused naming the file and the line or byte.
 
-mod mesh_formats_util;
+use crate::mesh_formats_util;
 
 use evflow_nodes::mesh::formats::load_file;
 use evflow_nodes::mesh::place::{reorient, Up};

@@ -5,7 +5,7 @@
 //! everything near the Nyquist rate — keeps them. Checked on a grid whose
 //! envelopes are the sines of §6.2 on an offset.
 
-mod texture_util;
+use crate::texture_util;
 
 use evflow_nodes::texture::grid::{Grid, GridSource};
 use std::path::Path;

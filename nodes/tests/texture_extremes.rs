@@ -3,7 +3,7 @@
 //! one-column grids, a velocity ratio of 10, missing and duplicate cells,
 //! and cells outside the session's range never being opened.
 
-mod texture_util;
+use crate::texture_util;
 
 use evflow_nodes::texture::grid::{Grid, GridError, GridSource};
 use evflow_nodes::texture::kernel::SincKernel;

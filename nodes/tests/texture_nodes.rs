@@ -1,7 +1,7 @@
 //! `interp` → `playback` end to end: the played signal's spectrum, block ≡
 //! tick, time and position modes, and switching tables without a click.
 
-mod texture_util;
+use crate::texture_util;
 
 use texture_util::{amplitudes, peak, run_chain, write_cell, write_sine_grid};
 

@@ -2,7 +2,7 @@
 //! the operators (𝒲𝒜 Eq. 6.1, 𝓡𝓢 §6.2) and of the schemes over a grid
 //! whose cells are those sines (velocity standing for frequency, §6.3).
 
-mod texture_util;
+use crate::texture_util;
 
 use evflow_nodes::texture::grid::Grid;
 use evflow_nodes::texture::kernel::SincKernel;

@@ -4,7 +4,7 @@
 //! once and without a click, and a replay at any block size applies it at
 //! the same tick.
 
-mod texture_util;
+use crate::texture_util;
 
 use texture_util::{amplitudes, peak, run_chain, run_chain_with, write_sine_grid};
 

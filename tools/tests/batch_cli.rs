@@ -5,8 +5,7 @@
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
 
-#[path = "common/files.rs"]
-mod files;
+use crate::files;
 use files::tree;
 
 fn root() -> PathBuf {

@@ -10,8 +10,7 @@
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
 
-#[path = "common/files.rs"]
-mod files;
+use crate::files;
 use files::tree;
 
 fn root() -> PathBuf {

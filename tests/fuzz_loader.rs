@@ -22,8 +22,7 @@ use std::cell::RefCell;
 use std::path::{Path, PathBuf};
 use std::sync::OnceLock;
 
-#[path = "fuzz_common.rs"]
-mod common;
+use crate::fuzz_common as common;
 
 /// Cases per property in the deterministic run (about 1.5 s for all three).
 const CI_CASES: u32 = 400;

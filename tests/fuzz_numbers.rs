@@ -13,8 +13,7 @@
 //! `# expect-error:` / `# expect: ok` lines; `EVFLOW_FUZZ_CASES=N` and
 //! `EVFLOW_FUZZ_SEED=S` as for `fuzz_loader.rs` (README.md, "Fuzzing").
 
-#[path = "fuzz_common.rs"]
-mod common;
+use crate::fuzz_common as common;
 
 #[path = "fuzz_numbers_case.rs"]
 mod numbers;

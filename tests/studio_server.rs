@@ -4,8 +4,7 @@
 //! no foreign Host or Origin), what the page is told first, and that a
 //! browser that stops reading does not hold the session up.
 
-#[path = "studio_common.rs"]
-mod common;
+use crate::studio_common as common;
 
 use serde_json::Value;
 use std::process::Command;

@@ -4,7 +4,7 @@
  * the receiver's resynchronization, sequence numbers that wrap, the FIFO,
  * the streaming cadence and the watchdog's ramp.
  *
- *   make -C firmware host-test   (or: cargo test -p evflow-tests --test firmware_core)
+ *   make -C firmware host-test   (or: cargo test -p evflow-tests --test end_to_end firmware_core)
  */
 #include "../core/evdev.h"
 

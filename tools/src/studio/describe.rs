@@ -264,6 +264,66 @@ type = "gain"
 gain = 2.0
 "#;
 
+    /// Every shipped graph's wanted taps, `graph: node.port …`, in order.
+    fn shipped_wanted_taps() -> Vec<String> {
+        let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).parent().unwrap().join("graphs");
+        let mut files: Vec<_> = std::fs::read_dir(&root)
+            .unwrap()
+            .map(|e| e.unwrap().path())
+            .filter(|p| p.extension().is_some_and(|x| x == "toml"))
+            .collect();
+        files.sort();
+        files
+            .iter()
+            .map(|f| {
+                let c = evflow_engine::load_file(f, &evflow_nodes::registry(), &[]).unwrap();
+                let taps: Vec<String> = wanted_taps(&c).iter().map(|t| format!("{}.{}", t.node, t.port)).collect();
+                format!("{}: {}", f.file_stem().unwrap().to_string_lossy(), taps.join(" "))
+            })
+            .collect()
+    }
+
+    /// The streams the studio showed by default in every shipped graph
+    /// when the node types' knowledge of them still lived in this file
+    /// (issue 35): the declarations must give the same.
+    const SHIPPED_TAPS: &[&str] = &[
+        "characterize: display.force",
+        "display-live: limit.state display.force gain.out",
+        "display-serial: limit.state gain.out",
+        "excitation: display.force",
+        "forces-recordings: ",
+        "forward-build-recordings: ",
+        "forward-build: display.force",
+        "lab-work-precision: display_ref.force display.force",
+        "mesh-live: surface.intensity edges.intensity limit.state display.force gain.out",
+        "mesh-scan: surface.intensity edges.intensity limit.state display.force gain.out",
+        "mesh-serial: surface.intensity edges.intensity limit.state gain.out",
+        "model-build-multilevel: display.force",
+        "model-build-recordings: ",
+        "model-build: display.force",
+        "model-validate-recordings: ",
+        "play-actuation: limit.state display.force gain.out",
+        "record-stroke: ",
+        "record-textures: ",
+        "synthesize-optimized: ",
+        "synthesize-recordings: ",
+        "synthesize: narx_limit.state narx_display.force narx_ml_limit.state narx_ml_display.force optimized_limit.state optimized_display.force playback_limit.state playback_display.force floor_display.force narx_gain.out narx_ml_gain.out optimized_gain.out playback_gain.out",
+        "texture-cross-validation: display.force playback_display.force ff_display.force cells_limit.state playback_limit.state ff_limit.state load.out speed.out playback.out playback_loop.out ff_gain.out",
+        "texture-forces-live: limit.state display.force velocity_cm_s.out load_g.out gain.out",
+        "texture-live-play: limit.state display.force gain.out",
+        "texture-live-quality: nothing_display.force playback_limit.state playback_display.force narx_limit.state narx_display.force optimized_limit.state optimized_display.force ff_limit.state ff_display.force live_synth.target live_synth.predicted live_synth.iterations live_synth.fallbacks live_limit.state live_display.force velocity_cm_s.out load_g.out playback_gain.out narx_gain.out optimized_gain.out ff_gain.out live_gain.out",
+        "texture-live-recorded: synth.target synth.predicted synth.iterations synth.fallbacks limit.state velocity_cm_s.out load_g.out gain.out",
+        "texture-live: synth.target synth.predicted synth.iterations synth.fallbacks limit.state display.force velocity_cm_s.out load_g.out gain.out",
+        "texture-quality: velocity_cm_s.out load_g.out",
+        "texture-render-quality: display.force forces_display.force limit.state forces_limit.state velocity_cm_s.out load_g.out gain.out forces_gain.out",
+        "texture-serial: synth.target synth.predicted synth.iterations synth.fallbacks limit.state velocity_cm_s.out load_g.out gain.out",
+    ];
+
+    #[test]
+    fn the_default_taps_of_every_shipped_graph_are_as_they_were() {
+        assert_eq!(shipped_wanted_taps(), SHIPPED_TAPS);
+    }
+
     #[test]
     fn the_page_is_told_the_graph_the_plan_left_out_the_limits_and_the_limiter() {
         let g = evflow_engine::graph::parse_graph(std::path::Path::new("d.toml"), DOC).unwrap();

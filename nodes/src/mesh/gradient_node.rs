@@ -64,6 +64,7 @@ gradient of the Gaussian scene (fidelity report), and the robustness cases of `d
 )
 .ports(PORTS)
 .params(source::with_scene_params![
+    unit: UNIT.spec();
     SWITCH_FADE.spec(),
     SLOPE.spec(),
     MIN_STEP.spec(),
@@ -158,10 +159,20 @@ const CALIB_SPEEDS: Floats =
     Floats::new("calib_speeds", 1e-6, 100.0, "m/s", "finger speeds of the calibration scan; empty: 0.02, 0.05, 0.1");
 /// `calib_directions`: the calibration scan's directions.
 const CALIB_DIRECTIONS: Int =
-    Int::new("calib_directions", 1, 360, 12, "1", "directions of the calibration scan (over 360°)");
+    Int::new("calib_directions", 1, 360, 12, "1", "directions of the calibration scan (over 360°)")
+        .costly(36.0, SCAN_COST);
 /// `calib_lines`: parallel lines per direction in the calibration scan.
 const CALIB_LINES: Int =
-    Int::new("calib_lines", 1, 1000, 24, "1", "parallel lines per direction in the calibration scan");
+    Int::new("calib_lines", 1, 1000, 24, "1", "parallel lines per direction in the calibration scan")
+        .costly(48.0, SCAN_COST);
+/// Why the calibration scan's size is capped in the stability suite.
+const SCAN_COST: &str = "calibration scan time grows with directions × lines";
+/// `unit` (the shared mesh parameter), capped in the stability suite: the
+/// calibration scan crosses the mesh at finger speed.
+const UNIT: Float = source::UNIT.costly(
+    0.1,
+    "the calibration scan crosses the mesh at finger speed: at 1000 m a unit, 162 s (found by this suite)",
+);
 /// `cache`: the calibration cache folder, or `none`.
 const CACHE: Text = Text::new(
     "cache",

@@ -12,6 +12,7 @@ use crate::metric::spectrum::{SpectrumConfig, Window};
 use crate::narx::model::Model;
 use crate::recording::format::Recording;
 use evflow_engine::ports::OutPort;
+use evflow_engine::spec::{BoundArgs, PortBound};
 use evflow_engine::typed_params::{Choice, Flag, Float, Int, Text};
 use evflow_engine::{BuildContext, Io, Node, NodeError, NodeSpec, Params, PortSpec, Role, Summary};
 
@@ -81,6 +82,7 @@ pub static SPEC: NodeSpec = NodeSpec::new(
     RECORD_TIME.spec(),
 ])
 .offline_only("it synthesizes the whole actuation from a recording before playing it")
+.bound(output_bound)
 .example("target = \"recordings/felt\"\nmodel = \"models/forward.json\"\niterations = 5");
 
 struct Optimize {
@@ -212,6 +214,11 @@ const RECORD_TIME: Flag =
 /// A band error, naming this node's parameter.
 fn band_error(e: BandError) -> NodeError {
     e.naming([FMIN.name(), FMAX.name(), NFFT.name()])
+}
+
+/// The output bound the stability suite checks: |u| ≤ `bound`.
+fn output_bound(b: &BoundArgs<'_>) -> Option<PortBound> {
+    Some(("u", b.num(&BOUND.spec()), "|u| ≤ bound".into()))
 }
 
 fn build(p: &Params, ctx: &BuildContext) -> Result<Box<dyn Node>, NodeError> {

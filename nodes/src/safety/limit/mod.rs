@@ -2,6 +2,7 @@
 
 use super::envelope::Envelope;
 use evflow_engine::ports::{InPort, OutPort};
+use evflow_engine::spec::{BoundArgs, PortBound};
 use evflow_engine::typed_params::{Flag, Float, Words};
 use evflow_engine::{BuildContext, Change, Io, Node, NodeError, NodeSpec, Params, PortSpec, Refused, Role, Summary};
 
@@ -121,6 +122,7 @@ input and a disable; the latch and re-arm; the `state` code at each transition; 
 .ports(PORTS)
 .params(&[AMPLITUDE.spec(), SLEW.spec(), RAMP.spec(), FAULTS.spec(), ENABLE.spec()])
 .safety_guard(ENABLE.name())
+.bound(output_bound)
 .example("amplitude = 1.0\nslew = 4000.0\nramp = 0.01");
 
 /// The ports: the signal and one fault flag per `faults` entry in; the
@@ -182,6 +184,11 @@ struct Limit {
 
 /// Faults kept for the summary (more are counted, not listed).
 const FAULTS_LISTED: usize = 16;
+
+/// The output bound the stability suite checks: |out| ≤ `amplitude`.
+fn output_bound(b: &BoundArgs<'_>) -> Option<PortBound> {
+    Some(("out", b.num(&AMPLITUDE.spec()), "|out| ≤ amplitude".into()))
+}
 
 fn build(p: &Params, ctx: &BuildContext) -> Result<Box<dyn Node>, NodeError> {
     let ramp_steps = (RAMP.get(p) * ctx.rate).round().max(1.0);

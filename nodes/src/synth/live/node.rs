@@ -10,6 +10,7 @@ use crate::filters::butterworth::design::{butterworth, Kind};
 use crate::filters::butterworth::sos::Cascade;
 use crate::synth::model_file::ForwardModel;
 use evflow_engine::ports::{InPort, OutPort};
+use evflow_engine::spec::{BoundArgs, PortBound};
 use evflow_engine::typed_params::{Float, Int, Words};
 use evflow_engine::{BuildContext, Io, Node, NodeError, NodeSpec, Params, PortSpec, Role, Summary};
 use std::time::{Duration, Instant};
@@ -79,6 +80,7 @@ pub static SPEC: NodeSpec = NodeSpec::new(
     UPDATE_RATE.spec(),
     BUDGET.spec(),
 ])
+.bound(output_bound)
 .example("models = [\"models/forward-60g-3cms.json\", \"models/forward-60g-7cms.json\", \"models/forward-110g-3cms.json\", \"models/forward-110g-7cms.json\"]\nlookahead = 15\niterations = 4");
 
 /// The ports: the target force and the finger's condition in; the
@@ -232,6 +234,11 @@ struct Live {
     bad_inputs: u64,
     reduction: f64,
     optimized_ticks: u64,
+}
+
+/// The output bound the stability suite checks: |u| ≤ `bound`.
+fn output_bound(b: &BoundArgs<'_>) -> Option<PortBound> {
+    Some(("u", b.num(&BOUND.spec()), "|u| ≤ bound".into()))
 }
 
 fn build(p: &Params, ctx: &BuildContext) -> Result<Box<dyn Node>, NodeError> {

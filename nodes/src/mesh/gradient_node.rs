@@ -6,6 +6,7 @@ use super::gradient::{intensity, Gradient, GradientSettings, SlopeMode};
 use super::raycast::RayCaster;
 use super::source::{self, Fit, Placed};
 use evflow_engine::ports::{InPort, OutPort};
+use evflow_engine::spec::Scene;
 use evflow_engine::typed_params::{Choice, Float, Floats, Int, Text};
 use evflow_engine::{BuildContext, Change, Io, Node, NodeError, NodeSpec, Params, PortSpec, Refused, Role, Summary};
 
@@ -80,6 +81,7 @@ gradient of the Gaussian scene (fidelity report), and the robustness cases of `d
     CALIB_LINES.spec(),
     CACHE.spec(),
 ])
+.scene(Scene::Mesh)
 .example("shape = \"gaussian\"\nconfig = \"bump\"\nresolution = 12\ncalib_directions = 4\ncalib_lines = 8");
 
 /// The ports: the touch point in; intensity, F^sq, slope, height and the
@@ -87,7 +89,7 @@ gradient of the Gaussian scene (fidelity report), and the robustness cases of `d
 const PORTS: &[PortSpec] = &[
     PortSpec::input("x", "m", "touch x on the screen"),
     PortSpec::input("y", "m", "touch y on the screen"),
-    PortSpec::output("intensity", "1", "AREA-EVEN intensity I (Eq. 4.7), 0.3 … 1.0"),
+    PortSpec::output("intensity", "1", "AREA-EVEN intensity I (Eq. 4.7), 0.3 … 1.0").view(),
     PortSpec::output("fsq", "sqrt(N)", "signed square root of the lateral force, F^sq (Eq. 4.6)"),
     PortSpec::output("slope", "1", "tan α, the surface slope along the motion"),
     PortSpec::output("z", "m", "height of the surface under the finger"),

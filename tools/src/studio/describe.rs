@@ -44,10 +44,14 @@ pub struct Description {
 }
 
 /// Streams worth seeing by default on top of the sources and guards the
-/// session records anyway: the display's force, the mesh intensities, what
-/// feeds each limiter (its peak shows), each limiter's `state` (also a
-/// guard output, so normally tapped already), and the (load, velocity)
-/// point of each texture interpolator. Only nodes the plan kept.
+/// session records anyway: the ports each node type declares shown
+/// ([`evflow_engine::PortSpec::view`]) — an output's samples (the
+/// display's force, the mesh intensities, each limiter's `state`, which is
+/// also a guard output and so normally tapped already, the live
+/// synthesis' target beside what it expects to render and its running
+/// counts), or for an input, the stream that feeds it (what reaches each
+/// limiter, whose peak shows; the (load, velocity) point of each texture
+/// interpolator). Only nodes the plan kept.
 pub fn default_taps(checked: &Checked, plan: &evflow_engine::Plan) -> Vec<Tap> {
     wanted_taps(checked).into_iter().filter(|t| plan.index(&t.node).is_some()).collect()
 }
@@ -61,26 +65,14 @@ fn wanted_taps(checked: &Checked) -> Vec<Tap> {
         }
     };
     for n in &checked.nodes {
-        match n.spec.name {
-            "sim.display" => add(&n.name, "force"),
-            "mesh.gradient" | "mesh.edges" => add(&n.name, "intensity"),
-            "limit" => add(&n.name, "state"),
-            // The live synthesis: its target beside what it expects to render,
-            // and its running counts (the studio shows their rates).
-            "synth.live" => {
-                for port in ["target", "predicted", "iterations", "fallbacks"] {
-                    add(&n.name, port);
-                }
-            }
-            _ => {}
+        for port in n.spec.viewed(Direction::Out) {
+            add(&n.name, port);
         }
     }
     for e in &checked.edges {
         let to = &checked.nodes[e.to.0];
         let port = &to.ports[e.to.1].name;
-        let wanted =
-            matches!((to.spec.name, port.as_str()), ("limit", "in") | ("interp", "load") | ("interp", "velocity"));
-        if wanted {
+        if to.spec.viewed(Direction::In).any(|p| p == port) {
             let from = &checked.nodes[e.from.0];
             add(&from.name, &from.ports[e.from.1].name);
         }

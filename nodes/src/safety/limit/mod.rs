@@ -128,14 +128,15 @@ input and a disable; the latch and re-arm; the `state` code at each transition; 
 /// The ports: the signal and one fault flag per `faults` entry in; the
 /// limited signal and the limiter's state out.
 const PORTS: &[PortSpec] = &[
-    PortSpec::input("in", "1", "actuation signal"),
+    PortSpec::input("in", "1", "actuation signal").view(),
     PortSpec::input("fault", "1", "fault flag: nonzero (or NaN) closes the gate and latches").per(FAULTS.name()),
     PortSpec::output("out", "1", "limited actuation signal"),
     PortSpec::output(
         "state",
         "1",
         "what the limiter did at each sample: 0 armed, 1 clamping, 2 fading, 3 faded, 4 faulted",
-    ),
+    )
+    .view(),
 ];
 /// `in`: the actuation signal.
 const IN: InPort = InPort::named(PORTS, "in");

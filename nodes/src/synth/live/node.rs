@@ -90,10 +90,10 @@ const PORTS: &[PortSpec] = &[
     PortSpec::input("load", "g", "finger's normal load"),
     PortSpec::input("velocity", "cm/s", "finger's signed velocity"),
     PortSpec::output("u", "1", "actuation: the envelope on a Nyquist-rate carrier"),
-    PortSpec::output("target", "N", "the target force at this tick"),
-    PortSpec::output("predicted", "N", "the force change the model expects from the actuation now"),
-    PortSpec::output("iterations", "1", "optimizer iterations made since the start (a running count)"),
-    PortSpec::output("fallbacks", "1", "ticks played from a fallback since the start (a running count)"),
+    PortSpec::output("target", "N", "the target force at this tick").view(),
+    PortSpec::output("predicted", "N", "the force change the model expects from the actuation now").view(),
+    PortSpec::output("iterations", "1", "optimizer iterations made since the start (a running count)").view(),
+    PortSpec::output("fallbacks", "1", "ticks played from a fallback since the start (a running count)").view(),
 ];
 /// The target force, `lookahead` samples ahead.
 const FORCE: InPort = InPort::named(PORTS, "force");

@@ -25,7 +25,7 @@
 //! formed (half the multiply-adds of the full product).
 
 use super::{mse, Data, EarlyStop, Epoch, Options, Report, StopReason};
-use crate::narx::net::Mlp;
+use crate::narx::net::{Mlp, Workspace};
 use faer::linalg::matmul::triangular::{self, BlockStructure};
 use faer::linalg::solvers::Solve;
 use faer::{Accum, Mat, Par, Side};
@@ -44,20 +44,12 @@ pub fn train(
     progress: &mut dyn FnMut(&Epoch),
 ) -> Report {
     let start = Instant::now();
-    let p = net.n_params();
     let n = train.len();
     let mut ws = net.workspace();
     let mut perf = mse(net, train);
     let mut stop = EarlyStop::new(net.weights(), mse(net, val), perf, opts.max_fail);
     let mut mu = opts.mu;
-    // JᵀJ: only its lower triangle is formed and read (Cholesky of the lower half).
-    let mut jtj = Mat::<f64>::zeros(p, p);
-    let mut diag = vec![0.0; p];
-    let mut jte = Mat::<f64>::zeros(p, 1);
-    // Jᵀ of a block of rows: column i holds ∂y/∂w of row i, written in place.
-    let mut jt_block = Mat::<f64>::zeros(p, BLOCK);
-    let mut eblock = Mat::<f64>::zeros(BLOCK, 1);
-    let mut trial = vec![0.0; p];
+    let mut normal = Normal::new(net.n_params());
     let mut epochs = 0;
     let mut reason = StopReason::MaxEpochs;
     for epoch in 1..=opts.max_epochs {
@@ -68,69 +60,13 @@ pub fn train(
             reason = StopReason::Goal;
             break;
         }
-        // JᵀJ and Jᵀe, block by block.
-        let mut first = true;
-        let mut s = 0;
-        while s < n {
-            let m = BLOCK.min(n - s);
-            for i in 0..m {
-                let col = jt_block.as_mut().col_mut(i).try_as_col_major_mut().expect("a Mat's columns are contiguous");
-                let y = net.jacobian_row(train.row(s + i), &mut ws, col.as_slice_mut());
-                eblock[(i, 0)] = y - train.target(s + i);
-            }
-            let (jb, eb) = (jt_block.as_ref().subcols(0, m), eblock.as_ref().subrows(0, m));
-            let acc = if first { Accum::Replace } else { Accum::Add };
-            triangular::matmul(
-                jtj.as_mut(),
-                BlockStructure::TriangularLower,
-                acc,
-                jb,
-                BlockStructure::Rectangular,
-                jb.transpose(),
-                BlockStructure::Rectangular,
-                1.0,
-                Par::Seq,
-            );
-            faer::linalg::matmul::matmul(jte.as_mut(), acc, jb, eb, 1.0, Par::Seq);
-            first = false;
-            s += m;
-        }
-        let gradient = 2.0 * (0..p).map(|k| jte[(k, 0)] * jte[(k, 0)]).sum::<f64>().sqrt() / n as f64;
+        normal.form(net, train, &mut ws);
+        let gradient = normal.gradient(n);
         if gradient.is_nan() || gradient < opts.min_grad {
             reason = StopReason::MinGradient;
             break;
         }
-        // Raise μ until a step lowers the training error.
-        let mut improved = false;
-        for (k, d) in diag.iter_mut().enumerate() {
-            *d = jtj[(k, k)];
-        }
-        while mu <= opts.mu_max {
-            for (k, d) in diag.iter().enumerate() {
-                jtj[(k, k)] = d + mu;
-            }
-            if let Ok(llt) = jtj.llt(Side::Lower) {
-                let dx = llt.solve(jte.as_ref());
-                let w = net.weights();
-                let ok = (0..p).all(|k| dx[(k, 0)].is_finite());
-                if ok {
-                    for k in 0..p {
-                        trial[k] = w[k] - dx[(k, 0)];
-                    }
-                    let saved: Vec<f64> = w.to_vec();
-                    net.weights_mut().copy_from_slice(&trial);
-                    let perf2 = mse(net, train);
-                    if perf2 < perf {
-                        perf = perf2;
-                        mu *= opts.mu_dec;
-                        improved = true;
-                        break;
-                    }
-                    net.weights_mut().copy_from_slice(&saved);
-                }
-            }
-            mu *= opts.mu_inc;
-        }
+        let improved = normal.step(net, train, &mut perf, &mut mu, opts);
         epochs = epoch;
         let vperf = mse(net, val);
         progress(&Epoch {
@@ -151,6 +87,110 @@ pub fn train(
         }
     }
     stop.finish(net.weights_mut(), epochs, reason, start)
+}
+
+/// The normal equations of an epoch, JᵀJ and Jᵀe, and the buffers they
+/// are formed and solved in (allocated once for the whole training).
+struct Normal {
+    /// JᵀJ: only its lower triangle is formed and read (Cholesky of the lower half).
+    jtj: Mat<f64>,
+    /// JᵀJ's diagonal, before μ is added.
+    diag: Vec<f64>,
+    /// Jᵀe.
+    jte: Mat<f64>,
+    /// Jᵀ of a block of rows: column i holds ∂y/∂w of row i, written in place.
+    jt_block: Mat<f64>,
+    /// The errors of a block of rows.
+    eblock: Mat<f64>,
+    /// The weights of a trial step.
+    trial: Vec<f64>,
+}
+
+impl Normal {
+    fn new(p: usize) -> Self {
+        Self {
+            jtj: Mat::<f64>::zeros(p, p),
+            diag: vec![0.0; p],
+            jte: Mat::<f64>::zeros(p, 1),
+            jt_block: Mat::<f64>::zeros(p, BLOCK),
+            eblock: Mat::<f64>::zeros(BLOCK, 1),
+            trial: vec![0.0; p],
+        }
+    }
+
+    /// Forms JᵀJ and Jᵀe over `train`, block by block.
+    fn form(&mut self, net: &Mlp, train: &Data<'_>, ws: &mut Workspace) {
+        let n = train.len();
+        let mut first = true;
+        let mut s = 0;
+        while s < n {
+            let m = BLOCK.min(n - s);
+            for i in 0..m {
+                let col =
+                    self.jt_block.as_mut().col_mut(i).try_as_col_major_mut().expect("a Mat's columns are contiguous");
+                let y = net.jacobian_row(train.row(s + i), ws, col.as_slice_mut());
+                self.eblock[(i, 0)] = y - train.target(s + i);
+            }
+            let (jb, eb) = (self.jt_block.as_ref().subcols(0, m), self.eblock.as_ref().subrows(0, m));
+            let acc = if first { Accum::Replace } else { Accum::Add };
+            triangular::matmul(
+                self.jtj.as_mut(),
+                BlockStructure::TriangularLower,
+                acc,
+                jb,
+                BlockStructure::Rectangular,
+                jb.transpose(),
+                BlockStructure::Rectangular,
+                1.0,
+                Par::Seq,
+            );
+            faer::linalg::matmul::matmul(self.jte.as_mut(), acc, jb, eb, 1.0, Par::Seq);
+            first = false;
+            s += m;
+        }
+    }
+
+    /// The MSE gradient norm 2‖Jᵀe‖/N over `n` rows.
+    fn gradient(&self, n: usize) -> f64 {
+        let p = self.diag.len();
+        2.0 * (0..p).map(|k| self.jte[(k, 0)] * self.jte[(k, 0)]).sum::<f64>().sqrt() / n as f64
+    }
+
+    /// Raises μ until a step lowers the training error `perf`: true when
+    /// one did (the net holds its weights, `perf` and `mu` are updated),
+    /// false once μ passed `mu_max` (the net keeps its weights).
+    fn step(&mut self, net: &mut Mlp, train: &Data<'_>, perf: &mut f64, mu: &mut f64, opts: &Options) -> bool {
+        let p = self.diag.len();
+        for (k, d) in self.diag.iter_mut().enumerate() {
+            *d = self.jtj[(k, k)];
+        }
+        while *mu <= opts.mu_max {
+            for (k, d) in self.diag.iter().enumerate() {
+                self.jtj[(k, k)] = d + *mu;
+            }
+            if let Ok(llt) = self.jtj.llt(Side::Lower) {
+                let dx = llt.solve(self.jte.as_ref());
+                let w = net.weights();
+                let ok = (0..p).all(|k| dx[(k, 0)].is_finite());
+                if ok {
+                    for k in 0..p {
+                        self.trial[k] = w[k] - dx[(k, 0)];
+                    }
+                    let saved: Vec<f64> = w.to_vec();
+                    net.weights_mut().copy_from_slice(&self.trial);
+                    let perf2 = mse(net, train);
+                    if perf2 < *perf {
+                        *perf = perf2;
+                        *mu *= opts.mu_dec;
+                        return true;
+                    }
+                    net.weights_mut().copy_from_slice(&saved);
+                }
+            }
+            *mu *= opts.mu_inc;
+        }
+        false
+    }
 }
 
 #[cfg(test)]

@@ -83,16 +83,18 @@ pub struct PortSpec {
     /// the entries of the named text-list parameter (e.g. one port per
     /// channel of a recording).
     pub multi: Option<&'static str>,
+    /// True when the studio shows it by default (see [`PortSpec::view`]).
+    pub view: bool,
 }
 
 impl PortSpec {
     /// An input port at the node's rate.
     pub const fn input(name: &'static str, unit: &'static str, doc: &'static str) -> Self {
-        Self { name, dir: Direction::In, rate: RateSpec::Node, unit, doc, multi: None }
+        Self { name, dir: Direction::In, rate: RateSpec::Node, unit, doc, multi: None, view: false }
     }
     /// An output port at the node's rate.
     pub const fn output(name: &'static str, unit: &'static str, doc: &'static str) -> Self {
-        Self { name, dir: Direction::Out, rate: RateSpec::Node, unit, doc, multi: None }
+        Self { name, dir: Direction::Out, rate: RateSpec::Node, unit, doc, multi: None, view: false }
     }
     /// The same port with another rate.
     pub const fn at(mut self, rate: RateSpec) -> Self {
@@ -102,6 +104,14 @@ impl PortSpec {
     /// The same port repeated once per entry of a text-list parameter.
     pub const fn per(mut self, list_param: &'static str) -> Self {
         self.multi = Some(list_param);
+        self
+    }
+    /// The same port, shown by default in the studio (`evflow live
+    /// --studio`, `evflow studio`): an output's samples, or for an input,
+    /// the stream that feeds it (e.g. what reaches the safety limiter).
+    /// A repeated port ([`PortSpec::per`]) is never shown by default.
+    pub const fn view(mut self) -> Self {
+        self.view = true;
         self
     }
 }

@@ -113,6 +113,10 @@ pub struct ParamSpec {
     /// True when the node takes changes of this parameter while it runs
     /// ([`crate::node::Node::set`], the live runner's parameter queue).
     pub live: bool,
+    /// When its largest values buy run time or memory rather than a
+    /// numerical extreme: the value the stability suite runs instead of any
+    /// larger one, and why (see [`ParamSpec::costly`]).
+    pub cost_cap: Option<(f64, &'static str)>,
 }
 
 impl ParamSpec {
@@ -132,6 +136,7 @@ impl ParamSpec {
             unit,
             doc,
             live: false,
+            cost_cap: None,
         }
     }
     /// An integer parameter.
@@ -143,11 +148,27 @@ impl ParamSpec {
         unit: &'static str,
         doc: &'static str,
     ) -> Self {
-        Self { name, kind: ParamKind::Int { min, max }, default: ParamDefault::Int(default), unit, doc, live: false }
+        Self {
+            name,
+            kind: ParamKind::Int { min, max },
+            default: ParamDefault::Int(default),
+            unit,
+            doc,
+            live: false,
+            cost_cap: None,
+        }
     }
     /// A boolean parameter.
     pub const fn flag(name: &'static str, default: bool, doc: &'static str) -> Self {
-        Self { name, kind: ParamKind::Bool, default: ParamDefault::Bool(default), unit: "", doc, live: false }
+        Self {
+            name,
+            kind: ParamKind::Bool,
+            default: ParamDefault::Bool(default),
+            unit: "",
+            doc,
+            live: false,
+            cost_cap: None,
+        }
     }
     /// A choice among fixed words.
     pub const fn choice(
@@ -156,19 +177,51 @@ impl ParamSpec {
         default: &'static str,
         doc: &'static str,
     ) -> Self {
-        Self { name, kind: ParamKind::Choice(words), default: ParamDefault::Text(default), unit: "", doc, live: false }
+        Self {
+            name,
+            kind: ParamKind::Choice(words),
+            default: ParamDefault::Text(default),
+            unit: "",
+            doc,
+            live: false,
+            cost_cap: None,
+        }
     }
     /// A text parameter with a default.
     pub const fn text(name: &'static str, default: &'static str, doc: &'static str) -> Self {
-        Self { name, kind: ParamKind::Text, default: ParamDefault::Text(default), unit: "", doc, live: false }
+        Self {
+            name,
+            kind: ParamKind::Text,
+            default: ParamDefault::Text(default),
+            unit: "",
+            doc,
+            live: false,
+            cost_cap: None,
+        }
     }
     /// A list of words, empty by default.
     pub const fn text_list(name: &'static str, doc: &'static str) -> Self {
-        Self { name, kind: ParamKind::TextList, default: ParamDefault::EmptyList, unit: "", doc, live: false }
+        Self {
+            name,
+            kind: ParamKind::TextList,
+            default: ParamDefault::EmptyList,
+            unit: "",
+            doc,
+            live: false,
+            cost_cap: None,
+        }
     }
     /// A list of real numbers, empty by default.
     pub const fn float_list(name: &'static str, min: f64, max: f64, unit: &'static str, doc: &'static str) -> Self {
-        Self { name, kind: ParamKind::FloatList { min, max }, default: ParamDefault::EmptyList, unit, doc, live: false }
+        Self {
+            name,
+            kind: ParamKind::FloatList { min, max },
+            default: ParamDefault::EmptyList,
+            unit,
+            doc,
+            live: false,
+            cost_cap: None,
+        }
     }
     /// The same parameter without a default: the graph file must set it.
     pub const fn required(mut self) -> Self {
@@ -181,6 +234,29 @@ impl ParamSpec {
     pub const fn live(mut self) -> Self {
         self.live = true;
         self
+    }
+    /// The same parameter, whose values above `cap` only cost run time or
+    /// memory (a finer mesh, a longer calibration scan), saying `why`: the
+    /// stability suite (`evflow report stability`) tries it at `cap`
+    /// instead of its declared maximum, and says so.
+    pub const fn costly(mut self, cap: f64, why: &'static str) -> Self {
+        self.cost_cap = Some((cap, why));
+        self
+    }
+    /// The value to try instead of `value` when `value` is above the
+    /// parameter's cost cap, and why (see [`ParamSpec::costly`]).
+    pub fn capped(&self, value: f64) -> Option<(f64, &'static str)> {
+        self.cost_cap.filter(|(cap, _)| value > *cap)
+    }
+    /// Its default as a number (flags as 0/1); `None` for text, lists and
+    /// a required parameter.
+    pub fn default_f64(&self) -> Option<f64> {
+        match self.default {
+            ParamDefault::Float(x) => Some(x),
+            ParamDefault::Int(i) => Some(i as f64),
+            ParamDefault::Bool(b) => Some(f64::from(u8::from(b))),
+            _ => None,
+        }
     }
 }
 
@@ -262,6 +338,59 @@ impl<'a> FoldArgs<'a> {
 /// output given finite inputs.
 pub type Fold = fn(&FoldArgs<'_>) -> Option<Constant>;
 
+/// A bound on one output port: `(port, bound, where it comes from)`.
+pub type PortBound = (&'static str, f64, String);
+
+/// What a node type's [`OutputBound`] sees: its parameters as numbers and
+/// the largest |input| it is fed.
+#[derive(Clone, Copy)]
+pub struct BoundArgs<'a> {
+    get: &'a dyn Fn(&str) -> Option<f64>,
+    input_max: f64,
+}
+
+impl<'a> BoundArgs<'a> {
+    /// The arguments of one bound: `get(name)` is the parameter's value as
+    /// a number (flags as 0/1; `None`: not set, so the declared default);
+    /// `input_max` is the largest |input| (0 for a source).
+    pub fn new(get: &'a dyn Fn(&str) -> Option<f64>, input_max: f64) -> Self {
+        Self { get, input_max }
+    }
+    /// The largest |input|.
+    pub fn input_max(&self) -> f64 {
+        self.input_max
+    }
+    /// A number parameter's value, else its declared default (NaN when it
+    /// has none, so no bound from it holds).
+    pub fn num(&self, p: &ParamSpec) -> f64 {
+        (self.get)(p.name).or_else(|| p.default_f64()).unwrap_or(f64::NAN)
+    }
+    /// A flag parameter's value, else its declared default.
+    pub fn flag(&self, p: &ParamSpec) -> bool {
+        (self.get)(p.name).map(|x| x != 0.0).unwrap_or(p.default == ParamDefault::Bool(true))
+    }
+}
+
+/// A node type's output bound, tighter than "finite": given its
+/// parameters and the largest |input|, the port, the bound on its |value|
+/// and where the bound comes from; `None` when only "finite" is known
+/// (e.g. `gain` when |gain|·max|in| overflows). The stability suite
+/// (`evflow report stability`, docs/numerics.md) checks it in every case
+/// that runs the node.
+pub type OutputBound = fn(&BoundArgs<'_>) -> Option<PortBound>;
+
+/// What the studio's finger view draws under the finger for a node of
+/// this type (the first such node of a graph, in the plan's order).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Scene {
+    /// The height maps of the meshes the node can switch between
+    /// (`mesh.gradient`).
+    Mesh,
+    /// The (load, velocity) axes of the texture grids the node can switch
+    /// between (`interp`).
+    TextureGrid,
+}
+
 /// The one declaration of a node type.
 #[derive(Debug, Clone, Copy)]
 pub struct NodeSpec {
@@ -303,6 +432,11 @@ pub struct NodeSpec {
     pub build: Constructor,
     /// How the node folds to a constant (see [`Fold`]); `None`: never.
     pub fold: Option<Fold>,
+    /// The bound on one of its outputs (see [`OutputBound`]); `None`: only
+    /// "finite" is checked.
+    pub bound: Option<OutputBound>,
+    /// What the studio draws under the finger for it (see [`Scene`]).
+    pub scene: Option<Scene>,
 }
 
 impl NodeSpec {
@@ -330,6 +464,8 @@ impl NodeSpec {
             example: "",
             build,
             fold: None,
+            bound: None,
+            scene: None,
         }
     }
     /// Sets the long description.
@@ -388,8 +524,82 @@ impl NodeSpec {
         self.fold = Some(fold);
         self
     }
+    /// Declares the bound on one of its outputs (see [`OutputBound`]).
+    pub const fn bound(mut self, bound: OutputBound) -> Self {
+        self.bound = Some(bound);
+        self
+    }
+    /// Declares what the studio draws under the finger for it (see [`Scene`]).
+    pub const fn scene(mut self, scene: Scene) -> Self {
+        self.scene = Some(scene);
+        self
+    }
+    /// Its output bound for the parameters `get` gives and inputs up to
+    /// `input_max` (see [`OutputBound`]).
+    pub fn output_bound(&self, get: &dyn Fn(&str) -> Option<f64>, input_max: f64) -> Option<PortBound> {
+        self.bound.and_then(|f| f(&BoundArgs::new(get, input_max)))
+    }
+    /// The ports the studio shows by default (see [`PortSpec::view`]) in
+    /// direction `dir`, in their declared order.
+    pub fn viewed(&self, dir: Direction) -> impl Iterator<Item = &'static str> + '_ {
+        self.ports.iter().filter(move |p| p.view && p.multi.is_none() && p.dir == dir).map(|p| p.name)
+    }
     /// The declared parameter of that name.
     pub fn param(&self, name: &str) -> Option<&ParamSpec> {
         self.params.iter().find(|p| p.name == name)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn never(_: &Params, _: &BuildContext) -> Result<Box<dyn Node>, NodeError> {
+        Err(NodeError::Other("test only".into()))
+    }
+
+    const LEVEL: ParamSpec = ParamSpec::float("level", 0.0, 1e6, 2.0, "1", "level").costly(10.0, "slow above 10");
+    const CLAMP: ParamSpec = ParamSpec::flag("clamp", true, "clamp");
+
+    fn clamped_level(b: &BoundArgs<'_>) -> Option<PortBound> {
+        b.flag(&CLAMP).then(|| ("out", b.num(&LEVEL) + b.input_max(), "level + max|in|".into()))
+    }
+
+    static SPEC: NodeSpec = NodeSpec::new("test.spec", "test", Role::Filter, "test only", never)
+        .ports(&[
+            PortSpec::input("in", "1", "in").view(),
+            PortSpec::input("more", "1", "more").per("names").view(),
+            PortSpec::output("out", "1", "out"),
+            PortSpec::output("seen", "1", "seen").view(),
+        ])
+        .params(&[LEVEL, CLAMP])
+        .bound(clamped_level)
+        .scene(Scene::Mesh);
+
+    #[test]
+    fn a_bound_reads_the_parameters_their_defaults_and_the_input() {
+        let set = |name: &str| match name {
+            "level" => Some(0.5),
+            _ => None,
+        };
+        assert_eq!(SPEC.output_bound(&set, 2.0), Some(("out", 2.5, "level + max|in|".to_string())));
+        assert_eq!(SPEC.output_bound(&|_| None, 0.0).unwrap().1, 2.0, "the declared default");
+        assert_eq!(SPEC.output_bound(&|n| (n == "clamp").then_some(0.0), 0.0), None, "a flag off");
+        let plain = NodeSpec::new("test.plain", "test", Role::Filter, "test only", never);
+        assert_eq!(plain.output_bound(&|_| None, 1.0), None);
+    }
+
+    #[test]
+    fn a_costly_parameter_is_capped_above_its_cap_only() {
+        assert_eq!(LEVEL.capped(1e6), Some((10.0, "slow above 10")));
+        assert_eq!(LEVEL.capped(10.0), None);
+        assert_eq!(CLAMP.capped(1e6), None);
+    }
+
+    #[test]
+    fn the_viewed_ports_are_the_declared_ones_but_a_repeated_port() {
+        assert_eq!(SPEC.viewed(Direction::In).collect::<Vec<_>>(), ["in"]);
+        assert_eq!(SPEC.viewed(Direction::Out).collect::<Vec<_>>(), ["seen"]);
+        assert_eq!(SPEC.scene, Some(Scene::Mesh));
     }
 }

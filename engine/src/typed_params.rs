@@ -156,7 +156,7 @@ impl Floats {
 }
 
 /// What every one-spec handle has: its declaration, its name, and the
-/// same parameter made live or required.
+/// same parameter made live, required or costly.
 macro_rules! handle_basics {
     ($($handle:ident),*) => {$(
         impl $handle {
@@ -178,6 +178,12 @@ macro_rules! handle_basics {
             /// The same parameter without a default: the graph file must set it.
             pub const fn required(self) -> Self {
                 Self(self.0.required())
+            }
+
+            /// The same parameter, whose values above `cap` only cost run
+            /// time or memory (see [`ParamSpec::costly`]).
+            pub const fn costly(self, cap: f64, why: &'static str) -> Self {
+                Self(self.0.costly(cap, why))
             }
         }
     )*};

@@ -1,13 +1,15 @@
 //! Generic checks run on every node type of the library:
 //! - its declaration is complete (doc, example, units and docs on every port
-//!   and parameter) and its example builds;
+//!   and parameter; a cost cap within its parameter's limits, a bound on one
+//!   of its outputs) and its example builds;
 //! - block processing ≡ per-sample processing (the live tick), bit for bit;
 //! - `reset` restores the initial output;
 //! - no NaN or Inf leaves it on a random input.
 
 use evflow_engine::graph::parse_graph;
 use evflow_engine::harness::Single;
-use evflow_engine::{NodeSpec, Value};
+use evflow_engine::spec::ParamKind;
+use evflow_engine::{Direction, NodeSpec, Value};
 use evflow_nodes::example_files::signal;
 use std::path::Path;
 
@@ -81,6 +83,29 @@ fn every_declaration_is_complete() {
         }
         for p in spec.params {
             assert!(!p.doc.is_empty(), "{}: parameter `{}` needs a doc", spec.name, p.name);
+            if let Some((cap, why)) = p.cost_cap {
+                let numeric = matches!(p.kind, ParamKind::Float { .. } | ParamKind::Int { .. });
+                assert!(numeric && !why.is_empty(), "{}: costly `{}` needs a number and a reason", spec.name, p.name);
+                let (min, max) = match p.kind {
+                    ParamKind::Float { min, max } => (min, max),
+                    ParamKind::Int { min, max } => (min as f64, max as f64),
+                    _ => unreachable!(),
+                };
+                assert!(
+                    min <= cap && cap < max,
+                    "{}: `{}`'s cost cap {cap} is not below its limits",
+                    spec.name,
+                    p.name
+                );
+            }
+        }
+        for p in spec.ports.iter().filter(|p| p.view) {
+            assert!(p.multi.is_none(), "{}.{}: a repeated port is never shown by default", spec.name, p.name);
+        }
+        // A declared bound names an output of the type (any parameters, any input).
+        if let Some((port, _, why)) = spec.output_bound(&|_| None, 1.0) {
+            let out = spec.ports.iter().any(|p| p.dir == Direction::Out && p.name == port);
+            assert!(out && !why.is_empty(), "{}: its bound's port `{port}` is not one of its outputs", spec.name);
         }
     }
 }

@@ -77,72 +77,10 @@ pub(super) fn analyse(graph: &Graph, nodes: &mut [CheckedNode], edges: &[Edge], 
 }
 
 fn resolve_rates(graph: &Graph, nodes: &mut [CheckedNode], edges: &[Edge], topo: &[usize], sink: &mut Sink) {
-    let base = graph.rate;
     let mut resolved = vec![false; nodes.len()];
-    // A rate that does not fit is reported at the line of the parameter
-    // that sets it, with the nearest rates that fit.
-    let ratio_of = |hz: f64, node: &CheckedNode, what: &str, param: &str, sink: &mut Sink| -> Ratio {
-        match Ratio::of(hz, base) {
-            Some(r) => r,
-            None => {
-                let loc = (graph.nodes.iter().find(|d| d.name == node.name))
-                    .and_then(|d| d.params.iter().find(|p| p.name == param))
-                    .map_or(node.loc, |p| p.loc);
-                sink.err(
-                    loc,
-                    Some(&node.name),
-                    format!(
-                        "{what} runs at {hz} Hz (`{param}`), which is not an integer multiple or divisor of the base rate {base} Hz"
-                    ),
-                    Some(rate_hint::fitting_help(hz, base)),
-                );
-                Ratio::ONE
-            }
-        }
-    };
     for &i in topo {
-        let producer_ratio = |port: usize, nodes: &[CheckedNode], resolved: &[bool]| -> Option<Ratio> {
-            edges
-                .iter()
-                .find(|e| e.to == (i, port))
-                .filter(|e| resolved[e.from.0])
-                .map(|e| nodes[e.from.0].ports[e.from.1].ratio)
-        };
-        let node = &nodes[i];
-        let from_node_inputs = node
-            .ports
-            .iter()
-            .enumerate()
-            .filter(|(_, p)| p.dir == Direction::In && p.rate == RateSpec::Node)
-            .find_map(|(k, _)| producer_ratio(k, nodes, &resolved));
-        let from_any_inputs = || {
-            node.ports
-                .iter()
-                .enumerate()
-                .filter(|(_, p)| p.dir == Direction::In && p.rate == RateSpec::Any)
-                .find_map(|(k, _)| producer_ratio(k, nodes, &resolved))
-        };
-        let ratio = if let Some(r) = from_node_inputs {
-            r
-        } else if let Some(p) = node.spec.rate_param {
-            let hz = node.params.f64(p);
-            ratio_of(hz, node, "the node", p, sink)
-        } else if let Some(r) = from_any_inputs() {
-            r
-        } else {
-            Ratio::ONE
-        };
-        let mut port_ratios = Vec::with_capacity(node.ports.len());
-        for (k, p) in node.ports.iter().enumerate() {
-            let r = match p.rate {
-                RateSpec::Node => ratio,
-                RateSpec::Param(name) => {
-                    ratio_of(node.params.f64(name), node, &format!("port `{}`", p.name), name, sink)
-                }
-                RateSpec::Any => producer_ratio(k, nodes, &resolved).unwrap_or(ratio),
-            };
-            port_ratios.push(r);
-        }
+        let ratio = node_ratio(graph, nodes, edges, &resolved, i, sink);
+        let port_ratios = port_ratios(graph, nodes, edges, &resolved, i, ratio, sink);
         let node = &mut nodes[i];
         node.ratio = ratio;
         for (p, r) in node.ports.iter_mut().zip(port_ratios) {
@@ -150,7 +88,102 @@ fn resolve_rates(graph: &Graph, nodes: &mut [CheckedNode], edges: &[Edge], topo:
         }
         resolved[i] = true;
     }
-    // Every connection joins equal rates (inputs of any rate take their producer's).
+    check_connection_rates(graph, nodes, edges, sink);
+}
+
+/// The ratio of `hz` to the base rate. A rate that does not fit is
+/// reported at the line of the parameter that sets it, with the nearest
+/// rates that fit (and taken as the base rate).
+fn ratio_of(graph: &Graph, hz: f64, node: &CheckedNode, what: &str, param: &str, sink: &mut Sink) -> Ratio {
+    let base = graph.rate;
+    match Ratio::of(hz, base) {
+        Some(r) => r,
+        None => {
+            let loc = (graph.nodes.iter().find(|d| d.name == node.name))
+                .and_then(|d| d.params.iter().find(|p| p.name == param))
+                .map_or(node.loc, |p| p.loc);
+            sink.err(
+                loc,
+                Some(&node.name),
+                format!(
+                    "{what} runs at {hz} Hz (`{param}`), which is not an integer multiple or divisor of the base rate {base} Hz"
+                ),
+                Some(rate_hint::fitting_help(hz, base)),
+            );
+            Ratio::ONE
+        }
+    }
+}
+
+/// The rate of what feeds input `port` of node `i`, once its producer's
+/// rates are resolved.
+fn producer_ratio(edges: &[Edge], i: usize, port: usize, nodes: &[CheckedNode], resolved: &[bool]) -> Option<Ratio> {
+    edges
+        .iter()
+        .find(|e| e.to == (i, port))
+        .filter(|e| resolved[e.from.0])
+        .map(|e| nodes[e.from.0].ports[e.from.1].ratio)
+}
+
+/// Node `i`'s own rate: its inputs' at the node's rate, else its rate
+/// parameter's, else its any-rate inputs', else the base rate.
+fn node_ratio(
+    graph: &Graph,
+    nodes: &[CheckedNode],
+    edges: &[Edge],
+    resolved: &[bool],
+    i: usize,
+    sink: &mut Sink,
+) -> Ratio {
+    let node = &nodes[i];
+    let from_inputs = |rate: RateSpec| {
+        node.ports
+            .iter()
+            .enumerate()
+            .filter(|(_, p)| p.dir == Direction::In && p.rate == rate)
+            .find_map(|(k, _)| producer_ratio(edges, i, k, nodes, resolved))
+    };
+    if let Some(r) = from_inputs(RateSpec::Node) {
+        r
+    } else if let Some(p) = node.spec.rate_param {
+        let hz = node.params.f64(p);
+        ratio_of(graph, hz, node, "the node", p, sink)
+    } else if let Some(r) = from_inputs(RateSpec::Any) {
+        r
+    } else {
+        Ratio::ONE
+    }
+}
+
+/// The rate of each port of node `i`, whose own rate is `ratio`.
+fn port_ratios(
+    graph: &Graph,
+    nodes: &[CheckedNode],
+    edges: &[Edge],
+    resolved: &[bool],
+    i: usize,
+    ratio: Ratio,
+    sink: &mut Sink,
+) -> Vec<Ratio> {
+    let node = &nodes[i];
+    let mut port_ratios = Vec::with_capacity(node.ports.len());
+    for (k, p) in node.ports.iter().enumerate() {
+        let r = match p.rate {
+            RateSpec::Node => ratio,
+            RateSpec::Param(name) => {
+                ratio_of(graph, node.params.f64(name), node, &format!("port `{}`", p.name), name, sink)
+            }
+            RateSpec::Any => producer_ratio(edges, i, k, nodes, resolved).unwrap_or(ratio),
+        };
+        port_ratios.push(r);
+    }
+    port_ratios
+}
+
+/// Every connection joins equal rates (inputs of any rate take their
+/// producer's); a mismatch is reported at the connection.
+fn check_connection_rates(graph: &Graph, nodes: &mut [CheckedNode], edges: &[Edge], sink: &mut Sink) {
+    let base = graph.rate;
     for e in edges {
         let out = nodes[e.from.0].ports[e.from.1].ratio;
         let inp = &nodes[e.to.0].ports[e.to.1];

@@ -136,103 +136,142 @@ impl RtState {
         }
         let start = clock::now_ns() + self.period_ns;
         let mut k: u64 = 0;
-        let mut streak = 0u64;
-        let mut end: Option<(u64, StopReason)> = None;
-        let mut handover: Option<u64> = None;
-        let mut stop_at_sources = sources_stop(&self.plan, 0, self.stop_ticks);
-        let mut gap_from: Option<u64> = None;
+        let mut course = Course {
+            end: None,
+            handover: None,
+            stop_at_sources: sources_stop(&self.plan, 0, self.stop_ticks),
+            gap_from: None,
+            streak: 0,
+        };
         let mut failure = None;
         loop {
             let deadline = start + k * self.period_ns;
             clock::wait_until(deadline, wait);
             let woke = clock::now_ns();
-
-            // Stop: requested, by the duration, or before a source runs dry.
-            if end.is_none() {
-                let why = self
-                    .shared
-                    .stop_requested()
-                    .or_else(|| self.duration_ticks.filter(|&d| k >= d).map(|_| StopReason::Duration))
-                    .or_else(|| stop_at_sources.filter(|&s| k >= s).map(|_| StopReason::SourcesEnded));
-                if let Some(why) = why {
-                    self.event(k, EventKind::Stop(why));
-                    self.disable_guards(k);
-                    end = Some((k + self.stop_ticks, why));
-                }
+            if self.stop_sequence(k, &mut course) {
+                break;
             }
-            if let Some((e, _)) = end {
-                if k >= e {
-                    break;
-                }
-            }
-
-            // A replacement plan: fade the old one out, then hand over.
-            if handover.is_none() && end.is_none() && !self.plans.is_empty() && self.retired.slots() > 0 {
-                self.disable_guards(k);
-                handover = Some(k + self.stop_ticks);
-            }
-            if let Some(h) = handover {
-                if k >= h {
-                    if let Ok(next) = self.plans.pop() {
-                        let old = std::mem::replace(&mut self.plan, next);
-                        // A slot was checked free before the handover began.
-                        let _ = self.retired.push(old);
-                        self.event(k, EventKind::Replaced);
-                        stop_at_sources = sources_stop(&self.plan, k, self.stop_ticks);
-                    }
-                    handover = None;
-                }
-            }
-
+            self.hand_over(k, &mut course);
             // Commands wait while a handover is under way (they are meant
             // for the plan that will run).
-            if handover.is_none() {
-                self.apply_commands(k, end.is_some());
+            if course.handover.is_none() {
+                self.apply_commands(k, course.end.is_some());
             }
             if let Err(e) = self.plan.plan.tick() {
                 failure = Some(e);
                 break;
             }
-            if self.write_taps() {
-                if let Some(g) = gap_from.take() {
-                    self.event(g, EventKind::Gap { ticks: k - g });
-                }
-            } else {
-                gap_from.get_or_insert(k);
-                self.shared.tap_overruns.fetch_add(1, Ordering::Relaxed);
-            }
-
-            let done = clock::now_ns();
-            let missed = done > deadline + self.period_ns;
-            if missed {
-                streak += 1;
-                self.shared.misses.fetch_add(1, Ordering::Relaxed);
-                if self.miss_streak > 0 && streak >= self.miss_streak {
-                    self.shared.request_stop(StopReason::DeadlineMisses);
-                }
-            } else {
-                streak = 0;
-            }
-            let stat = TickStat {
-                tick: k,
-                jitter_ns: woke.saturating_sub(deadline),
-                compute_ns: done.saturating_sub(woke),
-                missed,
-            };
-            if self.stats.push(stat).is_err() {
-                self.shared.stat_overruns.fetch_add(1, Ordering::Relaxed);
-            }
+            self.tap(k, &mut course);
+            self.account(k, deadline, woke, &mut course);
             k += 1;
             self.shared.tick.store(k, Ordering::Relaxed);
         }
-        if let Some(g) = gap_from.take() {
+        if let Some(g) = course.gap_from.take() {
             self.event(g, EventKind::Gap { ticks: k - g });
         }
         if let Some(h) = self.hook {
             h(false);
         }
-        RtExit { plan: self.plan, ticks: k, reason: end.map(|(_, r)| r), failure, realtime }
+        RtExit { plan: self.plan, ticks: k, reason: course.end.map(|(_, r)| r), failure, realtime }
     }
+
+    /// Stop: requested, by the duration, or before a source runs dry — at
+    /// tick `k` the stop sequence begins (the guards fade out); true once
+    /// it has run out, when the loop ends.
+    #[inline]
+    fn stop_sequence(&mut self, k: u64, c: &mut Course) -> bool {
+        if c.end.is_none() {
+            let why = self
+                .shared
+                .stop_requested()
+                .or_else(|| self.duration_ticks.filter(|&d| k >= d).map(|_| StopReason::Duration))
+                .or_else(|| c.stop_at_sources.filter(|&s| k >= s).map(|_| StopReason::SourcesEnded));
+            if let Some(why) = why {
+                self.event(k, EventKind::Stop(why));
+                self.disable_guards(k);
+                c.end = Some((k + self.stop_ticks, why));
+            }
+        }
+        matches!(c.end, Some((e, _)) if k >= e)
+    }
+
+    /// A replacement plan: fade the old one out, then hand over (the old
+    /// one goes to the retired ring, dropped off this thread).
+    #[inline]
+    fn hand_over(&mut self, k: u64, c: &mut Course) {
+        if c.handover.is_none() && c.end.is_none() && !self.plans.is_empty() && self.retired.slots() > 0 {
+            self.disable_guards(k);
+            c.handover = Some(k + self.stop_ticks);
+        }
+        if let Some(h) = c.handover {
+            if k >= h {
+                if let Ok(next) = self.plans.pop() {
+                    let old = std::mem::replace(&mut self.plan, next);
+                    // A slot was checked free before the handover began.
+                    let _ = self.retired.push(old);
+                    self.event(k, EventKind::Replaced);
+                    c.stop_at_sources = sources_stop(&self.plan, k, self.stop_ticks);
+                }
+                c.handover = None;
+            }
+        }
+    }
+
+    /// Copies tick `k`'s tap samples; while their rings are too full, a
+    /// gap (one event when it closes) and an overrun per tick.
+    #[inline]
+    fn tap(&mut self, k: u64, c: &mut Course) {
+        if self.write_taps() {
+            if let Some(g) = c.gap_from.take() {
+                self.event(g, EventKind::Gap { ticks: k - g });
+            }
+        } else {
+            c.gap_from.get_or_insert(k);
+            self.shared.tap_overruns.fetch_add(1, Ordering::Relaxed);
+        }
+    }
+
+    /// Tick `k`'s timing, woken at `woke` for `deadline`: a missed
+    /// deadline counts (a streak of them stops the session) and the tick's
+    /// statistics go to their ring.
+    #[inline]
+    fn account(&mut self, k: u64, deadline: u64, woke: u64, c: &mut Course) {
+        let done = clock::now_ns();
+        let missed = done > deadline + self.period_ns;
+        if missed {
+            c.streak += 1;
+            self.shared.misses.fetch_add(1, Ordering::Relaxed);
+            if self.miss_streak > 0 && c.streak >= self.miss_streak {
+                self.shared.request_stop(StopReason::DeadlineMisses);
+            }
+        } else {
+            c.streak = 0;
+        }
+        let stat = TickStat {
+            tick: k,
+            jitter_ns: woke.saturating_sub(deadline),
+            compute_ns: done.saturating_sub(woke),
+            missed,
+        };
+        if self.stats.push(stat).is_err() {
+            self.shared.stat_overruns.fetch_add(1, Ordering::Relaxed);
+        }
+    }
+}
+
+/// Where the loop stands between ticks (plain values: nothing allocated).
+#[derive(Debug, Clone, Copy)]
+struct Course {
+    /// The tick the stop sequence ends at, and why it began.
+    end: Option<(u64, StopReason)>,
+    /// The tick a replacement plan takes over at, while one is under way.
+    handover: Option<u64>,
+    /// The tick to begin the stop sequence at before a source runs dry.
+    stop_at_sources: Option<u64>,
+    /// The first tick of a gap in the taps, while one is open.
+    gap_from: Option<u64>,
+    /// Deadlines missed in a row.
+    streak: u64,
 }
 
 /// Touches the stack the loop will use, so its pages are mapped (and

@@ -2,6 +2,7 @@
 //! lets a feedback cycle through.
 
 use evflow_engine::ports::{InPort, OutPort, SAME_AS_INPUT};
+use evflow_engine::spec::{BoundArgs, PortBound};
 use evflow_engine::typed_params::Int;
 use evflow_engine::{BuildContext, Io, Node, NodeError, NodeSpec, Params, PortSpec, Role};
 
@@ -28,6 +29,7 @@ pub static SPEC: NodeSpec =
         .ports(PORTS)
         .params(&[SAMPLES.spec()])
         .breaks_cycles()
+        .bound(output_bound)
         .example("samples = 1");
 
 /// The ports: one signal in, the same signal d samples later out.
@@ -46,6 +48,11 @@ const SAMPLES: Int = Int::new("samples", 1, MAX_SAMPLES, 1, "samples", "delay d 
 struct Delay {
     ring: Vec<f64>,
     pos: usize,
+}
+
+/// The output bound the stability suite checks: |out| ≤ max |in| (a delayed input).
+fn output_bound(b: &BoundArgs<'_>) -> Option<PortBound> {
+    Some(("out", b.input_max(), "a delayed input".into()))
 }
 
 fn build(p: &Params, _: &BuildContext) -> Result<Box<dyn Node>, NodeError> {

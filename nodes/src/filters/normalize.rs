@@ -2,6 +2,7 @@
 //! `mapminmax` with fixed settings).
 
 use evflow_engine::ports::{InPort, OutPort};
+use evflow_engine::spec::{BoundArgs, PortBound};
 use evflow_engine::typed_params::{Flag, Float};
 use evflow_engine::{BuildContext, Io, Node, NodeError, NodeSpec, Params, PortSpec, Role};
 
@@ -25,6 +26,7 @@ pub static SPEC: NodeSpec = NodeSpec::new(
 )
 .ports(PORTS)
 .params(&[MIN.spec(), MAX.spec(), CLAMP.spec()])
+.bound(output_bound)
 .example("min = -0.08\nmax = 0.11\nclamp = true");
 
 /// The ports: one signal in, the normalized signal out.
@@ -45,6 +47,11 @@ struct Normalize {
     scale: f64,
     min: f64,
     clamp: bool,
+}
+
+/// The output bound the stability suite checks: with `clamp`, |out| ≤ 1.
+fn output_bound(b: &BoundArgs<'_>) -> Option<PortBound> {
+    b.flag(&CLAMP.spec()).then(|| ("out", 1.0, "clamped to [−1, 1]".into()))
 }
 
 fn build(p: &Params, _ctx: &BuildContext) -> Result<Box<dyn Node>, NodeError> {

@@ -48,7 +48,8 @@ const PORTS: &[PortSpec] = &[
     PortSpec::input("u", "1", "actuation (1.0 = 50 V at the amplifier output; ±1 = 100 Vpp)"),
     PortSpec::input("load", "N", "normal force pressing the pen (or finger) on the display"),
     PortSpec::input("velocity", "m/s", "sliding velocity of the holder along the display"),
-    PortSpec::output("force", "N", "lateral friction force transmitted to the holder (positive opposes +x motion)"),
+    PortSpec::output("force", "N", "lateral friction force transmitted to the holder (positive opposes +x motion)")
+        .view(),
 ];
 /// `u`: the actuation.
 const U: InPort = InPort::named(PORTS, "u");

@@ -57,7 +57,7 @@ const PORTS: &[PortSpec] = &[
     PortSpec::input("x", "m", "touch x on the screen"),
     PortSpec::input("y", "m", "touch y on the screen"),
     PortSpec::input("tri", "1", "triangle hit (mesh.gradient's `tri`), −1 off the mesh"),
-    PortSpec::output("intensity", "1", "EDGE-TICK intensity I_e (Eq. 4.9) on the crossing tick, else 0"),
+    PortSpec::output("intensity", "1", "EDGE-TICK intensity I_e (Eq. 4.9) on the crossing tick, else 0").view(),
     PortSpec::output("sharpness", "1", "sharpness S (Eq. 4.8) on the crossing tick, else 0"),
     PortSpec::output("angle", "deg", "dihedral angle θ crossed this tick (180: none)"),
 ];

@@ -6,6 +6,7 @@ use super::gradient::{intensity, Gradient, GradientSettings, SlopeMode};
 use super::raycast::RayCaster;
 use super::source::{self, Fit, Placed};
 use evflow_engine::ports::{InPort, OutPort};
+use evflow_engine::spec::Scene;
 use evflow_engine::typed_params::{Choice, Float, Floats, Int, Text};
 use evflow_engine::{BuildContext, Change, Io, Node, NodeError, NodeSpec, Params, PortSpec, Refused, Role, Summary};
 
@@ -64,6 +65,7 @@ gradient of the Gaussian scene (fidelity report), and the robustness cases of `d
 )
 .ports(PORTS)
 .params(source::with_scene_params![
+    unit: UNIT.spec();
     SWITCH_FADE.spec(),
     SLOPE.spec(),
     MIN_STEP.spec(),
@@ -79,6 +81,7 @@ gradient of the Gaussian scene (fidelity report), and the robustness cases of `d
     CALIB_LINES.spec(),
     CACHE.spec(),
 ])
+.scene(Scene::Mesh)
 .example("shape = \"gaussian\"\nconfig = \"bump\"\nresolution = 12\ncalib_directions = 4\ncalib_lines = 8");
 
 /// The ports: the touch point in; intensity, F^sq, slope, height and the
@@ -86,7 +89,7 @@ gradient of the Gaussian scene (fidelity report), and the robustness cases of `d
 const PORTS: &[PortSpec] = &[
     PortSpec::input("x", "m", "touch x on the screen"),
     PortSpec::input("y", "m", "touch y on the screen"),
-    PortSpec::output("intensity", "1", "AREA-EVEN intensity I (Eq. 4.7), 0.3 … 1.0"),
+    PortSpec::output("intensity", "1", "AREA-EVEN intensity I (Eq. 4.7), 0.3 … 1.0").view(),
     PortSpec::output("fsq", "sqrt(N)", "signed square root of the lateral force, F^sq (Eq. 4.6)"),
     PortSpec::output("slope", "1", "tan α, the surface slope along the motion"),
     PortSpec::output("z", "m", "height of the surface under the finger"),
@@ -158,10 +161,20 @@ const CALIB_SPEEDS: Floats =
     Floats::new("calib_speeds", 1e-6, 100.0, "m/s", "finger speeds of the calibration scan; empty: 0.02, 0.05, 0.1");
 /// `calib_directions`: the calibration scan's directions.
 const CALIB_DIRECTIONS: Int =
-    Int::new("calib_directions", 1, 360, 12, "1", "directions of the calibration scan (over 360°)");
+    Int::new("calib_directions", 1, 360, 12, "1", "directions of the calibration scan (over 360°)")
+        .costly(36.0, SCAN_COST);
 /// `calib_lines`: parallel lines per direction in the calibration scan.
 const CALIB_LINES: Int =
-    Int::new("calib_lines", 1, 1000, 24, "1", "parallel lines per direction in the calibration scan");
+    Int::new("calib_lines", 1, 1000, 24, "1", "parallel lines per direction in the calibration scan")
+        .costly(48.0, SCAN_COST);
+/// Why the calibration scan's size is capped in the stability suite.
+const SCAN_COST: &str = "calibration scan time grows with directions × lines";
+/// `unit` (the shared mesh parameter), capped in the stability suite: the
+/// calibration scan crosses the mesh at finger speed.
+const UNIT: Float = source::UNIT.costly(
+    0.1,
+    "the calibration scan crosses the mesh at finger speed: at 1000 m a unit, 162 s (found by this suite)",
+);
 /// `cache`: the calibration cache folder, or `none`.
 const CACHE: Text = Text::new(
     "cache",

@@ -4,7 +4,7 @@
 
 use evflow_engine::node::Constant;
 use evflow_engine::ports::{InPort, OutPort};
-use evflow_engine::spec::FoldArgs;
+use evflow_engine::spec::{BoundArgs, FoldArgs, PortBound};
 use evflow_engine::typed_params::{Float, Words};
 use evflow_engine::{BuildContext, Io, Node, NodeError, NodeSpec, Params, PortSpec, Role};
 use std::f64::consts::TAU;
@@ -57,6 +57,7 @@ node.",
     TICK_LENGTH.spec(),
     EDGES.spec(),
 ])
+.bound(output_bound)
 .example("area_frequency = 100.0\nedges = [\"edge\"]")
 .fold(fold);
 
@@ -117,6 +118,11 @@ struct Grain {
     /// Samples since the burst started (≥ tick_samples: none playing).
     tick_pos: u64,
     env: f64,
+}
+
+/// The output bound the stability suite checks: |out| ≤ 1, the actuation full scale (within rounding).
+fn output_bound(_: &BoundArgs<'_>) -> Option<PortBound> {
+    Some(("out", 1.0 + 1e-12, "actuation full scale".into()))
 }
 
 fn build(p: &Params, ctx: &BuildContext) -> Result<Box<dyn Node>, NodeError> {

@@ -3,6 +3,7 @@
 //! tangential force profile and the IP0.5 / IP0.7 intensity profiles.
 
 use evflow_engine::ports::{InPort, OutPort};
+use evflow_engine::spec::{BoundArgs, PortBound};
 use evflow_engine::typed_params::{Choice, Float};
 use evflow_engine::{BuildContext, Io, Node, NodeError, NodeSpec, Params, PortSpec, Role};
 
@@ -45,6 +46,7 @@ IP0.5/IP0.7 knot values (unit tests).",
     WIDTH.spec(),
     NORMAL_FORCE.spec(),
 ])
+.bound(output_bound)
 .example("shape = \"bump\"\nprofile = \"ip0.7\"");
 
 /// The ports: the touch position in; height, force and intensity out.
@@ -219,6 +221,11 @@ impl Profile1d {
 }
 
 struct Profile1dNode(Profile1d);
+
+/// The output bound the stability suite checks: the intensity lies in [0, 1].
+fn output_bound(_: &BoundArgs<'_>) -> Option<PortBound> {
+    Some(("intensity", 1.0, "an intensity in [0, 1]".into()))
+}
 
 fn build(p: &Params, _: &BuildContext) -> Result<Box<dyn Node>, NodeError> {
     let (shape, profile) = (SHAPE.get(p), PROFILE.get(p));

@@ -15,15 +15,17 @@ use evflow_engine::{BuildContext, NodeError, Params};
 /// The parameters of a node that loads its scenes here (`file`, `shape`,
 /// `config`, `resolution`, `unit`, `offset_x`, `offset_y`, `up`, `fit`,
 /// `fit_size`, `weld`, `scenes`, `scene`), then the node's own: the one
-/// list `mesh.gradient` and `mesh.edges` both declare.
+/// list `mesh.gradient` and `mesh.edges` both declare. A node whose cost
+/// grows with `unit` (a calibration scan) declares its own costly `unit`
+/// first: `with_scene_params![unit: UNIT.spec(); …]`.
 macro_rules! with_scene_params {
-    ($($own:expr),* $(,)?) => {
+    (unit: $unit:expr; $($own:expr),* $(,)?) => {
         &[
             $crate::mesh::source::FILE.spec(),
             $crate::mesh::source::SHAPE.spec(),
             $crate::mesh::source::CONFIG.spec(),
             $crate::mesh::source::RESOLUTION.spec(),
-            $crate::mesh::source::UNIT.spec(),
+            $unit,
             $crate::mesh::source::OFFSET_X.spec(),
             $crate::mesh::source::OFFSET_Y.spec(),
             $crate::mesh::source::UP.spec(),
@@ -34,6 +36,9 @@ macro_rules! with_scene_params {
             $crate::mesh::source::SCENE.spec(),
             $($own),*
         ]
+    };
+    ($($own:expr),* $(,)?) => {
+        $crate::mesh::source::with_scene_params![unit: $crate::mesh::source::UNIT.spec(); $($own),*]
     };
 }
 pub(crate) use with_scene_params;
@@ -59,7 +64,8 @@ pub const CONFIG: Choice<&str> =
     Choice::new("config", CONFIGS, CONFIGS, "2B2H", "generated scene: bumps and holes (Fig. 4.6), or one bump/hole");
 /// `resolution` of a generated Gaussian scene.
 pub const RESOLUTION: Int =
-    Int::new("resolution", 2, 4096, 48, "1", "generated Gaussian scene: grid cells per 6 cm object side");
+    Int::new("resolution", 2, 4096, 48, "1", "generated Gaussian scene: grid cells per 6 cm object side")
+        .costly(512.0, "4096² cells: 34 M triangles, minutes to build");
 /// `unit`: metres per mesh unit.
 pub const UNIT: Float = Float::new(
     "unit",

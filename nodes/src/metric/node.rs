@@ -254,6 +254,18 @@ impl Node for Metric {
     }
 
     fn finish(&mut self) -> Result<Summary, NodeError> {
+        self.check_finite()?;
+        let spectra = self.spectra()?;
+        let (sv, sr) = (&spectra[0], &spectra[1]);
+        let es = self.spectral_error(sv, sr)?;
+        let summary = self.values(es, sv, sr)?;
+        Ok(self.lines(summary, es, sv, sr))
+    }
+}
+
+impl Metric {
+    /// Every input sample was finite.
+    fn check_finite(&self) -> Result<(), NodeError> {
         for c in &self.channels {
             if let Some(i) = c.stats.bad {
                 return Err(NodeError::Data(format!(
@@ -263,8 +275,13 @@ impl Node for Metric {
                 )));
             }
         }
-        let spectra: Vec<Spectrum> = self
-            .channels
+        Ok(())
+    }
+
+    /// The spectrum of each input (virtual, real); an input without a
+    /// sample has none, which the error explains.
+    fn spectra(&self) -> Result<Vec<Spectrum>, NodeError> {
+        self.channels
             .iter()
             .map(|c| {
                 c.spectrum.spectrum().ok_or_else(|| {
@@ -283,10 +300,12 @@ impl Node for Metric {
                     ))
                 })
             })
-            .collect::<Result<_, _>>()?;
-        let (sv, sr) = (&spectra[0], &spectra[1]);
-        let band = &self.band;
-        let es = spectral_rms_error(&sv.magnitude, &sr.magnitude, band).map_err(|e| {
+            .collect()
+    }
+
+    /// E_s of the virtual spectrum `sv` against the real `sr` over the band.
+    fn spectral_error(&self, sv: &Spectrum, sr: &Spectrum) -> Result<f64, NodeError> {
+        spectral_rms_error(&sv.magnitude, &sr.magnitude, &self.band).map_err(|e| {
             NodeError::Data(match e {
                 SpectralError::NoRealEnergy { .. } if !self.include_dc => format!(
                     "{e}; check that `real` is connected to a recorded force that varies, or set \
@@ -301,7 +320,13 @@ impl Node for Metric {
                 }
                 _ => e.to_string(),
             })
-        })?;
+        })
+    }
+
+    /// The values reported (E_s `es`, RMS, peak-to-peak, peaks of the
+    /// spectra `sv`, `sr`, counts); one that overflows f64 is an error.
+    fn values(&self, es: f64, sv: &Spectrum, sr: &Spectrum) -> Result<Summary, NodeError> {
+        let band = &self.band;
         let peak = |s: &Spectrum| s.largest_peak(band.first(), band.last()).map_or(0.0, |k| s.freq(k));
         let [v, r] = [&self.channels[0].stats, &self.channels[1].stats];
         let top = |s: &Spectrum| s.magnitude[band.first()..=band.last()].iter().fold(0.0f64, |a, &m| a.max(m));
@@ -330,6 +355,13 @@ impl Node for Metric {
             }
             summary = summary.value(name, x, unit);
         }
+        Ok(summary)
+    }
+
+    /// The summary's lines: how E_s was read, what the gate kept, what
+    /// the segments left out, a spectrum without a peak.
+    fn lines(&self, mut summary: Summary, es: f64, sv: &Spectrum, sr: &Spectrum) -> Summary {
+        let band = &self.band;
         let cfg = self.channels[0].spectrum.config();
         let dc = if !self.include_dc && self.fmin == 0.0 { ", 0 Hz excluded" } else { "" };
         summary = summary.line(format!(
@@ -355,7 +387,7 @@ impl Node for Metric {
                 summary = summary.line(format!("no spectral peak in `{}` within the band (reported as 0 Hz)", c.name));
             }
         }
-        Ok(summary)
+        summary
     }
 }
 

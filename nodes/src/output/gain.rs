@@ -2,7 +2,7 @@
 
 use evflow_engine::node::Constant;
 use evflow_engine::ports::{InPort, OutPort, SAME_AS_INPUT, UNIT_PARAM};
-use evflow_engine::spec::FoldArgs;
+use evflow_engine::spec::{BoundArgs, FoldArgs, PortBound};
 use evflow_engine::typed_params::{Float, Text};
 use evflow_engine::{BuildContext, Change, Io, Node, NodeError, NodeSpec, Params, PortSpec, Refused, Role};
 
@@ -26,6 +26,7 @@ pub static SPEC: NodeSpec =
         )
         .ports(PORTS)
         .params(&[GAIN.spec(), RAMP.spec(), UNIT.spec()])
+        .bound(output_bound)
         .example("gain = 1.2")
         .fold(fold);
 
@@ -66,6 +67,12 @@ struct Gain {
     delta: f64,
     left: u64,
     ramp_samples: u64,
+}
+
+/// The output bound the stability suite checks: |out| ≤ |gain|·max |in| (none when that overflows).
+fn output_bound(b: &BoundArgs<'_>) -> Option<PortBound> {
+    let g = b.num(&GAIN.spec());
+    (g * b.input_max()).is_finite().then(|| ("out", g.abs() * b.input_max(), "|gain|·max|in|".into()))
 }
 
 fn build(p: &Params, ctx: &BuildContext) -> Result<Box<dyn Node>, NodeError> {

@@ -2,6 +2,7 @@
 
 use super::clock::Clock;
 use evflow_engine::ports::{InPort, OutPort, SAME_AS_INPUT};
+use evflow_engine::spec::{BoundArgs, PortBound};
 use evflow_engine::typed_params::Float;
 use evflow_engine::{BuildContext, Io, Node, NodeError, NodeSpec, Params, PortSpec, RateSpec, Role};
 
@@ -27,6 +28,7 @@ per-sample processing.\n\n\
 .ports(PORTS)
 .params(&[RATE.spec()])
 .rate_param(RATE.name())
+.bound(output_bound)
 .example("rate = 1000.0");
 
 /// The ports: the stream at any rate in, held at `rate` out.
@@ -48,6 +50,11 @@ struct Hold {
     value: f64,
     received: u64,
     sent: u64,
+}
+
+/// The output bound the stability suite checks: |out| ≤ max |in| (a held input).
+fn output_bound(b: &BoundArgs<'_>) -> Option<PortBound> {
+    Some(("out", b.input_max(), "a held input".into()))
 }
 
 fn build(_p: &Params, ctx: &BuildContext) -> Result<Box<dyn Node>, NodeError> {

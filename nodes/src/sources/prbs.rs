@@ -3,6 +3,7 @@
 
 use super::prbs_taps::{self, Taps};
 use evflow_engine::ports::OutPort;
+use evflow_engine::spec::{BoundArgs, PortBound};
 use evflow_engine::typed_params::{Float, Int};
 use evflow_engine::{BuildContext, Io, Node, NodeError, NodeSpec, Params, PortSpec, Role};
 
@@ -79,6 +80,7 @@ steps and after no proper divisor, by GF(2) matrix powers).",
 .ports(PORTS)
 .params(&[ORDER.spec(), CLOCK.spec(), LEVEL.spec(), PERIODS.spec(), RATE.spec()])
 .rate_param(RATE.name())
+.bound(output_bound)
 .example("order = 9\nclock = 1\nlevel = 1.0\nperiods = 6\nrate = 1000.0");
 
 /// The port: the signal out.
@@ -142,6 +144,11 @@ struct Prbs {
     pos: u64,
     held: u64,
     value: f64,
+}
+
+/// The output bound the stability suite checks: |out| ≤ `level`.
+fn output_bound(b: &BoundArgs<'_>) -> Option<PortBound> {
+    Some(("out", b.num(&LEVEL.spec()), "the level c".into()))
 }
 
 fn build(p: &Params, _: &BuildContext) -> Result<Box<dyn Node>, NodeError> {

@@ -4,6 +4,7 @@
 use super::prms_field::{self, Recurrence};
 use crate::rng::Rng;
 use evflow_engine::ports::OutPort;
+use evflow_engine::spec::{BoundArgs, PortBound};
 use evflow_engine::typed_params::{Choice, Float, Int};
 use evflow_engine::{BuildContext, Io, Node, NodeError, NodeSpec, Params, PortSpec, Role};
 
@@ -50,6 +51,7 @@ two-valued autocorrelation and the real one above; the random mode's level frequ
 .ports(PORTS)
 .params(&[Q.spec(), ORDER.spec(), CLOCK.spec(), LEVEL.spec(), PERIODS.spec(), MODE.spec(), SEED.spec(), RATE.spec()])
 .rate_param(RATE.name())
+.bound(output_bound)
 .example("q = 5\norder = 6\nclock = 1\nlevel = 1.0\nperiods = 1\nmode = \"mls\"\nrate = 1000.0");
 
 /// The port: the signal out.
@@ -131,6 +133,11 @@ struct Prms {
     pos: u64,
     held: u64,
     value: f64,
+}
+
+/// The output bound the stability suite checks: |out| ≤ `level`.
+fn output_bound(b: &BoundArgs<'_>) -> Option<PortBound> {
+    Some(("out", b.num(&LEVEL.spec()), "the level c".into()))
 }
 
 fn build(p: &Params, ctx: &BuildContext) -> Result<Box<dyn Node>, NodeError> {

@@ -1,6 +1,7 @@
 //! `pulse`: a rectangular gate that switches between two levels.
 
 use evflow_engine::ports::OutPort;
+use evflow_engine::spec::{BoundArgs, PortBound};
 use evflow_engine::typed_params::Float;
 use evflow_engine::{BuildContext, Io, Node, NodeError, NodeSpec, Params, PortSpec, Role};
 
@@ -27,6 +28,7 @@ one-sample processing agree and `reset` returns to n = 0.\n\
 .ports(PORTS)
 .params(&[PERIOD.spec(), DUTY.spec(), DELAY.spec(), HIGH.spec(), LOW.spec(), RATE.spec()])
 .rate_param(RATE.name())
+.bound(output_bound)
 .example("period = 1.0\nduty = 0.125\nrate = 1000.0");
 
 /// The port: the gate out.
@@ -53,6 +55,11 @@ struct Pulse {
     delay: u64,
     high: f64,
     low: f64,
+}
+
+/// The output bound the stability suite checks: |out| ≤ max(|high|, |low|).
+fn output_bound(b: &BoundArgs<'_>) -> Option<PortBound> {
+    Some(("out", b.num(&HIGH.spec()).abs().max(b.num(&LOW.spec()).abs()), "max(|high|, |low|)".into()))
 }
 
 fn build(p: &Params, ctx: &BuildContext) -> Result<Box<dyn Node>, NodeError> {

@@ -1,6 +1,7 @@
 //! `sine`: a sine wave whose phase is exact at any sample index.
 
 use evflow_engine::ports::OutPort;
+use evflow_engine::spec::{BoundArgs, PortBound};
 use evflow_engine::typed_params::Float;
 use evflow_engine::{BuildContext, Io, Node, NodeError, NodeSpec, Params, PortSpec, Role};
 use std::f64::consts::TAU;
@@ -35,6 +36,7 @@ rejection of f > fs/2.",
 .ports(PORTS)
 .params(&[FREQUENCY.spec(), AMPLITUDE.spec(), PHASE.spec(), OFFSET.spec(), RATE.spec()])
 .rate_param(RATE.name())
+.bound(output_bound)
 .example("frequency = 10.0\namplitude = 1.0\nrate = 1000.0");
 
 /// The port: the wave out.
@@ -98,6 +100,11 @@ impl Sine {
         let x = ((turn >> 64) as u64 as i64) as f64 / TWO64;
         self.offset + self.amplitude * (TAU * x).sin()
     }
+}
+
+/// The output bound the stability suite checks: |out| ≤ |offset| + amplitude.
+fn output_bound(b: &BoundArgs<'_>) -> Option<PortBound> {
+    Some(("out", b.num(&OFFSET.spec()).abs() + b.num(&AMPLITUDE.spec()), "|offset| + amplitude".into()))
 }
 
 fn build(p: &Params, ctx: &BuildContext) -> Result<Box<dyn Node>, NodeError> {

@@ -96,8 +96,8 @@ pub struct Outcome {
 /// counts as +∞ (the line search backs off from it).
 pub fn minimize(f: &mut dyn FnMut(&[f64], &mut [f64]) -> f64, x0: &[f64], lo: f64, hi: f64, opts: &Options) -> Outcome {
     let n = x0.len();
-    let proj = |v: f64| if v.is_nan() { 0.5 * (lo + hi) } else { v.clamp(lo, hi) };
-    let mut x: Vec<f64> = x0.iter().map(|&v| proj(v)).collect();
+    let b = Box1 { lo, hi };
+    let mut x: Vec<f64> = x0.iter().map(|&v| b.proj(v)).collect();
     let mut g = vec![0.0; n];
     let mut fx = f(&x, &mut g);
     let mut evals = 1;
@@ -105,17 +105,14 @@ pub fn minimize(f: &mut dyn FnMut(&[f64], &mut [f64]) -> f64, x0: &[f64], lo: f6
         return Outcome { x, f: fx, history: vec![fx], evaluations: evals, stop: Stop::LineSearch };
     }
     let mut history = vec![fx];
-    let mem = opts.memory.max(1);
-    let mut s_hist: Vec<Vec<f64>> = Vec::with_capacity(mem);
-    let mut y_hist: Vec<Vec<f64>> = Vec::with_capacity(mem);
+    let mut mem = Memory::new(opts.memory.max(1));
     let (mut d, mut xt, mut gt) = (vec![0.0; n], vec![0.0; n], vec![0.0; n]);
     let mut free = vec![true; n];
-    let mut alpha_buf = vec![0.0; mem];
     let eps = 1e-12 * (hi - lo).abs().max(1.0);
     let mut stop = Stop::MaxIter;
     for _ in 0..opts.max_iter {
         // 1. Stationarity.
-        let pg = x.iter().zip(&g).map(|(&xi, &gi)| (xi - proj(xi - gi)).abs()).fold(0.0, f64::max);
+        let pg = x.iter().zip(&g).map(|(&xi, &gi)| (xi - b.proj(xi - gi)).abs()).fold(0.0, f64::max);
         if pg < opts.pg_tol {
             stop = Stop::Stationary;
             break;
@@ -124,101 +121,15 @@ pub fn minimize(f: &mut dyn FnMut(&[f64], &mut [f64]) -> f64, x0: &[f64], lo: f6
         for i in 0..n {
             free[i] = !((x[i] <= lo + eps && g[i] > 0.0) || (x[i] >= hi - eps && g[i] < 0.0));
         }
-        let dot = |a: &[f64], b: &[f64], free: &[bool]| -> f64 {
-            a.iter().zip(b).zip(free).filter(|(_, f)| **f).map(|((a, b), _)| a * b).sum()
-        };
-        for i in 0..n {
-            d[i] = if free[i] { g[i] } else { 0.0 };
-        }
-        let k = s_hist.len();
-        for j in (0..k).rev() {
-            let sy = dot(&s_hist[j], &y_hist[j], &free);
-            if sy <= 0.0 {
-                alpha_buf[j] = 0.0;
-                continue;
-            }
-            let a = dot(&s_hist[j], &d, &free) / sy;
-            alpha_buf[j] = a;
-            for i in 0..n {
-                if free[i] {
-                    d[i] -= a * y_hist[j][i];
-                }
-            }
-        }
-        if k > 0 {
-            let (sy, yy) = (dot(&s_hist[k - 1], &y_hist[k - 1], &free), dot(&y_hist[k - 1], &y_hist[k - 1], &free));
-            if sy > 0.0 && yy > 0.0 {
-                let gamma = sy / yy;
-                d.iter_mut().for_each(|v| *v *= gamma);
-            }
-        }
-        for j in 0..k {
-            let sy = dot(&s_hist[j], &y_hist[j], &free);
-            if sy <= 0.0 {
-                continue;
-            }
-            let b = dot(&y_hist[j], &d, &free) / sy;
-            for i in 0..n {
-                if free[i] {
-                    d[i] += s_hist[j][i] * (alpha_buf[j] - b);
-                }
-            }
-        }
-        d.iter_mut().for_each(|v| *v = -*v);
-        let gd: f64 = g.iter().zip(&d).map(|(a, b)| a * b).sum();
-        let gnorm = g.iter().map(|v| v * v).sum::<f64>().sqrt();
-        let dnorm = d.iter().map(|v| v * v).sum::<f64>().sqrt();
-        let descent = gd.is_finite() && gd < -1e-14 * gnorm * dnorm;
-        if !descent {
-            // Not a descent direction: forget the curvature pairs, go down the gradient.
-            s_hist.clear();
-            y_hist.clear();
-            for i in 0..n {
-                d[i] = if free[i] { -g[i] } else { 0.0 };
-            }
-        }
-        // First step, or after a reset: scale so the largest move is at most the box size.
-        let mut step = 1.0;
-        if s_hist.is_empty() {
-            let dmax = d.iter().map(|v| v.abs()).fold(0.0, f64::max);
-            if dmax > 0.0 {
-                step = ((hi - lo).abs() / dmax).min(1.0);
-            }
-        }
+        mem.direction(&g, &free, &mut d);
+        let step = mem.first_step(&g, &free, &mut d, &b);
         // 3. Backtracking along the projection arc.
-        let mut accepted = None;
-        for _ in 0..60 {
-            if evals >= opts.max_evals {
-                break;
-            }
-            for i in 0..n {
-                xt[i] = proj(x[i] + step * d[i]);
-            }
-            let decrease: f64 = g.iter().zip(xt.iter().zip(&x)).map(|(gi, (a, b))| gi * (a - b)).sum();
-            let ft = f(&xt, &mut gt);
-            evals += 1;
-            if ft.is_finite() && gt.iter().all(|v| v.is_finite()) && ft <= fx + opts.c1 * decrease && ft <= fx {
-                accepted = Some(ft);
-                break;
-            }
-            step *= 0.5;
-        }
-        let Some(f_new) = accepted else {
+        let Some(f_new) = line_search(f, &b, (&x, &g, fx), &d, step, (&mut xt, &mut gt), &mut evals, opts) else {
             stop = if evals >= opts.max_evals { Stop::MaxEvals } else { Stop::LineSearch };
             break;
         };
         // 4. Curvature pair.
-        let s: Vec<f64> = xt.iter().zip(&x).map(|(a, b)| a - b).collect();
-        let y: Vec<f64> = gt.iter().zip(&g).map(|(a, b)| a - b).collect();
-        let sy: f64 = s.iter().zip(&y).map(|(a, b)| a * b).sum();
-        if sy > 1e-16 * y.iter().map(|v| v * v).sum::<f64>() {
-            if s_hist.len() == mem {
-                s_hist.remove(0);
-                y_hist.remove(0);
-            }
-            s_hist.push(s);
-            y_hist.push(y);
-        }
+        mem.remember(&x, &xt, &g, &gt);
         let fprev = fx;
         std::mem::swap(&mut x, &mut xt);
         std::mem::swap(&mut g, &mut gt);
@@ -234,6 +145,163 @@ pub fn minimize(f: &mut dyn FnMut(&[f64], &mut [f64]) -> f64, x0: &[f64], lo: f6
         }
     }
     Outcome { x, f: fx, history, evaluations: evals, stop }
+}
+
+/// The box lo ≤ x_i ≤ hi.
+struct Box1 {
+    lo: f64,
+    hi: f64,
+}
+
+impl Box1 {
+    /// The projection onto the box (NaN to its middle).
+    fn proj(&self, v: f64) -> f64 {
+        if v.is_nan() {
+            0.5 * (self.lo + self.hi)
+        } else {
+            v.clamp(self.lo, self.hi)
+        }
+    }
+}
+
+/// aᵀb over the free variables.
+fn dot(a: &[f64], b: &[f64], free: &[bool]) -> f64 {
+    a.iter().zip(b).zip(free).filter(|(_, f)| **f).map(|((a, b), _)| a * b).sum()
+}
+
+/// The last pairs (s, y) of L-BFGS, oldest first.
+struct Memory {
+    cap: usize,
+    s: Vec<Vec<f64>>,
+    y: Vec<Vec<f64>>,
+    alpha: Vec<f64>,
+}
+
+impl Memory {
+    fn new(cap: usize) -> Self {
+        Self { cap, s: Vec::with_capacity(cap), y: Vec::with_capacity(cap), alpha: vec![0.0; cap] }
+    }
+
+    /// d = −H·g on the free variables (0 on the others): the two-loop
+    /// recursion over the pairs kept, scaled by sᵀy/yᵀy of the last.
+    fn direction(&mut self, g: &[f64], free: &[bool], d: &mut [f64]) {
+        let n = g.len();
+        for i in 0..n {
+            d[i] = if free[i] { g[i] } else { 0.0 };
+        }
+        let k = self.s.len();
+        for j in (0..k).rev() {
+            let sy = dot(&self.s[j], &self.y[j], free);
+            if sy <= 0.0 {
+                self.alpha[j] = 0.0;
+                continue;
+            }
+            let a = dot(&self.s[j], d, free) / sy;
+            self.alpha[j] = a;
+            for i in 0..n {
+                if free[i] {
+                    d[i] -= a * self.y[j][i];
+                }
+            }
+        }
+        if k > 0 {
+            let (sy, yy) = (dot(&self.s[k - 1], &self.y[k - 1], free), dot(&self.y[k - 1], &self.y[k - 1], free));
+            if sy > 0.0 && yy > 0.0 {
+                let gamma = sy / yy;
+                d.iter_mut().for_each(|v| *v *= gamma);
+            }
+        }
+        for j in 0..k {
+            let sy = dot(&self.s[j], &self.y[j], free);
+            if sy <= 0.0 {
+                continue;
+            }
+            let b = dot(&self.y[j], d, free) / sy;
+            for i in 0..n {
+                if free[i] {
+                    d[i] += self.s[j][i] * (self.alpha[j] - b);
+                }
+            }
+        }
+        d.iter_mut().for_each(|v| *v = -*v);
+    }
+
+    /// The first trial step along `d`: 1, or where `d` is no descent
+    /// direction (the pairs are forgotten and `d` becomes −g on the free
+    /// variables) or no pair is kept, scaled so that the largest move is
+    /// at most the box size.
+    fn first_step(&mut self, g: &[f64], free: &[bool], d: &mut [f64], b: &Box1) -> f64 {
+        let gd: f64 = g.iter().zip(d.iter()).map(|(a, b)| a * b).sum();
+        let gnorm = g.iter().map(|v| v * v).sum::<f64>().sqrt();
+        let dnorm = d.iter().map(|v| v * v).sum::<f64>().sqrt();
+        let descent = gd.is_finite() && gd < -1e-14 * gnorm * dnorm;
+        if !descent {
+            // Not a descent direction: forget the curvature pairs, go down the gradient.
+            self.s.clear();
+            self.y.clear();
+            for i in 0..g.len() {
+                d[i] = if free[i] { -g[i] } else { 0.0 };
+            }
+        }
+        // First step, or after a reset: scale so the largest move is at most the box size.
+        let mut step = 1.0;
+        if self.s.is_empty() {
+            let dmax = d.iter().map(|v| v.abs()).fold(0.0, f64::max);
+            if dmax > 0.0 {
+                step = ((b.hi - b.lo).abs() / dmax).min(1.0);
+            }
+        }
+        step
+    }
+
+    /// Keeps the pair (s, y) of the step from `x` (gradient `g`) to `xt`
+    /// (gradient `gt`) when sᵀy > 0 (curvature), dropping the oldest when full.
+    fn remember(&mut self, x: &[f64], xt: &[f64], g: &[f64], gt: &[f64]) {
+        let s: Vec<f64> = xt.iter().zip(x).map(|(a, b)| a - b).collect();
+        let y: Vec<f64> = gt.iter().zip(g).map(|(a, b)| a - b).collect();
+        let sy: f64 = s.iter().zip(&y).map(|(a, b)| a * b).sum();
+        if sy > 1e-16 * y.iter().map(|v| v * v).sum::<f64>() {
+            if self.s.len() == self.cap {
+                self.s.remove(0);
+                self.y.remove(0);
+            }
+            self.s.push(s);
+            self.y.push(y);
+        }
+    }
+}
+
+/// Backtracking along the projection arc from `x` (gradient `g`, value
+/// `fx`) in direction `d`, from `step` halving up to 60 times: the first
+/// trial point with the Armijo decrease, left in `xt` (gradient in `gt`),
+/// and its value; `None` when none was found (or `max_evals` was reached).
+#[allow(clippy::too_many_arguments)]
+fn line_search(
+    f: &mut dyn FnMut(&[f64], &mut [f64]) -> f64,
+    b: &Box1,
+    (x, g, fx): (&[f64], &[f64], f64),
+    d: &[f64],
+    mut step: f64,
+    (xt, gt): (&mut [f64], &mut [f64]),
+    evals: &mut usize,
+    opts: &Options,
+) -> Option<f64> {
+    for _ in 0..60 {
+        if *evals >= opts.max_evals {
+            break;
+        }
+        for i in 0..x.len() {
+            xt[i] = b.proj(x[i] + step * d[i]);
+        }
+        let decrease: f64 = g.iter().zip(xt.iter().zip(x)).map(|(gi, (a, b))| gi * (a - b)).sum();
+        let ft = f(xt, gt);
+        *evals += 1;
+        if ft.is_finite() && gt.iter().all(|v| v.is_finite()) && ft <= fx + opts.c1 * decrease && ft <= fx {
+            return Some(ft);
+        }
+        step *= 0.5;
+    }
+    None
 }
 
 #[cfg(test)]

@@ -12,6 +12,7 @@ use crate::metric::spectrum::{SpectrumConfig, Window};
 use crate::narx::model::Model;
 use crate::recording::format::Recording;
 use evflow_engine::ports::OutPort;
+use evflow_engine::spec::{BoundArgs, PortBound};
 use evflow_engine::typed_params::{Choice, Flag, Float, Int, Text};
 use evflow_engine::{BuildContext, Io, Node, NodeError, NodeSpec, Params, PortSpec, Role, Summary};
 
@@ -81,6 +82,7 @@ pub static SPEC: NodeSpec = NodeSpec::new(
     RECORD_TIME.spec(),
 ])
 .offline_only("it synthesizes the whole actuation from a recording before playing it")
+.bound(output_bound)
 .example("target = \"recordings/felt\"\nmodel = \"models/forward.json\"\niterations = 5");
 
 struct Optimize {
@@ -214,7 +216,52 @@ fn band_error(e: BandError) -> NodeError {
     e.naming([FMIN.name(), FMAX.name(), NFFT.name()])
 }
 
+/// The output bound the stability suite checks: |u| ≤ `bound`.
+fn output_bound(b: &BoundArgs<'_>) -> Option<PortBound> {
+    Some(("u", b.num(&BOUND.spec()), "|u| ≤ bound".into()))
+}
+
 fn build(p: &Params, ctx: &BuildContext) -> Result<Box<dyn Node>, NodeError> {
+    let (force, keep) = target(p, ctx)?;
+    let model = ForwardModel::load(&ctx.path(MODEL.get(p)))?;
+    if (model.rate_hz - ctx.rate).abs() > 1e-9 * ctx.rate {
+        return Err(NodeError::param(
+            MODEL.name(),
+            format!("the model was identified at {} Hz, the node runs at {} Hz", model.rate_hz, ctx.rate),
+        ));
+    }
+    let bound = BOUND.get(p);
+    let starts = starts(p, ctx, &force, &keep, &model, bound)?;
+    let (objective, objective_used) = objective(p, ctx, &keep)?;
+    let noise = match NOISE.get(p) {
+        Noise::Fixed => NoiseWeight::Fixed(LAMBDA.get(p)),
+        Noise::Learned => NoiseWeight::Learned,
+    };
+    let cfg = SynthConfig {
+        objective,
+        noise,
+        bound,
+        options: Options { max_iter: ITERATIONS.count(p), ..Options::default() },
+    };
+    Ok(Box::new(Optimize {
+        force,
+        keep,
+        starts,
+        margin: START_MARGIN.get(p),
+        objective_used,
+        model,
+        cfg,
+        u: None,
+        summary: Summary::default(),
+        pos: 0,
+        record_time: RECORD_TIME.get(p),
+    }))
+}
+
+/// The target force (the `channel` of the `target` recording) and the
+/// samples that count (where the recording's velocity holds `speed`, or
+/// all).
+fn target(p: &Params, ctx: &BuildContext) -> Result<(Vec<f64>, Vec<bool>), NodeError> {
     let shown = TARGET.get(p);
     let channel = CHANNEL.get(p);
     let speed = SPEED.get(p);
@@ -242,33 +289,37 @@ fn build(p: &Params, ctx: &BuildContext) -> Result<Box<dyn Node>, NodeError> {
             format!("{shown}: its velocity never holds {speed} cm/s within the tolerance; is the speed right?"),
         ));
     }
-    let model = ForwardModel::load(&ctx.path(MODEL.get(p)))?;
-    if (model.rate_hz - ctx.rate).abs() > 1e-9 * ctx.rate {
-        return Err(NodeError::param(
-            MODEL.name(),
-            format!("the model was identified at {} Hz, the node runs at {} Hz", model.rate_hz, ctx.rate),
-        ));
-    }
-    let bound = BOUND.get(p);
+    Ok((force, keep))
+}
+
+/// The starting actuations `start` asks for, each named.
+fn starts(
+    p: &Params,
+    ctx: &BuildContext,
+    force: &[f64],
+    keep: &[bool],
+    model: &ForwardModel,
+    bound: f64,
+) -> Result<Vec<(String, Vec<f64>)>, NodeError> {
     let narx_start = |why: &str| -> Result<Vec<f64>, NodeError> {
         let path = NARX_MODEL.get(p);
         if path.is_empty() {
             return Err(NodeError::param(NARX_MODEL.name(), format!("{why} needs the inverse model's file")));
         }
         let m = Model::load(&ctx.path(path))?;
-        Ok(m.closed_loop()?.run(&force).into_iter().map(|u| u.clamp(-bound, bound)).collect())
+        Ok(m.closed_loop()?.run(force).into_iter().map(|u| u.clamp(-bound, bound)).collect())
     };
     let kappa = model.carrier_gain_n;
     let kappa_positive = kappa.is_finite() && kappa > 0.0;
     let has_narx = !NARX_MODEL.get(p).is_empty();
-    let starts: Vec<(String, Vec<f64>)> = match START.get(p) {
+    Ok(match START.get(p) {
         Start::Narx => vec![("narx".into(), narx_start("start = \"narx\"")?)],
         Start::Zero => vec![("zero".into(), vec![0.0; force.len()])],
         // Every start there is; the objective picks.
         Start::Best => {
             let mut v = Vec::new();
             if kappa_positive {
-                v.push(("carrier".into(), carrier(&force, &keep, kappa, bound)?));
+                v.push(("carrier".into(), carrier(force, keep, kappa, bound)?));
             }
             if has_narx {
                 v.push(("narx".into(), narx_start("start = \"narx\"")?));
@@ -284,17 +335,22 @@ fn build(p: &Params, ctx: &BuildContext) -> Result<Box<dyn Node>, NodeError> {
         Start::Carrier if has_narx && !kappa_positive => {
             vec![("narx (the model's carrier gain is not positive)".into(), narx_start("the fallback start")?)]
         }
-        Start::Carrier => vec![("carrier".into(), carrier(&force, &keep, kappa, bound)?)],
-    };
+        Start::Carrier => vec![("carrier".into(), carrier(force, keep, kappa, bound)?)],
+    })
+}
+
+/// The objective `objective` asks for over the counted samples `keep`,
+/// and its name for the summary. A counted stretch shorter than one
+/// spectral segment (one pass at 7 cm/s keeps less than a second) has no
+/// spectrum: the spectral objectives give way to the waveform, and the
+/// summary says so.
+fn objective(p: &Params, ctx: &BuildContext, keep: &[bool]) -> Result<(ObjectiveKind, &'static str), NodeError> {
     let nfft = match NFFT.count(p) {
         0 => ctx.rate.round() as usize,
         n => n,
     };
-    // A counted stretch shorter than one spectral segment (one pass at
-    // 7 cm/s keeps less than a second) has no spectrum: the spectral
-    // objectives give way to the waveform, and the summary says so.
     let short = keep.iter().filter(|k| **k).count() < nfft;
-    let (objective, objective_used) = match OBJECTIVE.get(p) {
+    Ok(match OBJECTIVE.get(p) {
         Objective::Expected | Objective::Spectral if short => {
             (ObjectiveKind::Time, "time (fewer counted samples than one spectral segment)")
         }
@@ -310,30 +366,7 @@ fn build(p: &Params, ctx: &BuildContext) -> Result<Box<dyn Node>, NodeError> {
             (ObjectiveKind::Spectral { cfg, band }, "spectral")
         }
         Objective::Time => (ObjectiveKind::Time, "time"),
-    };
-    let noise = match NOISE.get(p) {
-        Noise::Fixed => NoiseWeight::Fixed(LAMBDA.get(p)),
-        Noise::Learned => NoiseWeight::Learned,
-    };
-    let cfg = SynthConfig {
-        objective,
-        noise,
-        bound,
-        options: Options { max_iter: ITERATIONS.count(p), ..Options::default() },
-    };
-    Ok(Box::new(Optimize {
-        force,
-        keep,
-        starts,
-        margin: START_MARGIN.get(p),
-        objective_used,
-        model,
-        cfg,
-        u: None,
-        summary: Summary::default(),
-        pos: 0,
-        record_time: RECORD_TIME.get(p),
-    }))
+    })
 }
 
 impl Optimize {

@@ -94,6 +94,57 @@ pub struct FitScores {
 /// Identifies a model from actuation `u`, recorded force `y` (after the
 /// filter) and the rows to use (`keep[n]`), all of one length.
 pub fn fit(u: &[f64], y: &[f64], keep: &[bool], cfg: &FitConfig) -> Result<Fitted, SynthError> {
+    check_inputs(u, y, keep, cfg)?;
+    let m = cfg.memory;
+    let rows: Vec<usize> = (0..u.len()).filter(|&n| keep[n]).collect();
+    let p = m * (m + 1) / 2 + m + 1;
+    let n_val = (rows.len() as f64 * cfg.validation).round() as usize;
+    let n_tr = rows.len() - n_val;
+    if n_tr < 2 * p {
+        return Err(SynthError::Data(format!(
+            "{} kept samples give {n_tr} rows to fit {p} parameters (memory {m}); record at least {} kept samples \
+             (more passes) or shorten the memory",
+            rows.len(),
+            ((2 * p) as f64 / (1.0 - cfg.validation)).ceil() as usize
+        )));
+    }
+    let kept_y: Vec<f64> = rows.iter().map(|&n| y[n]).collect();
+    check_excitation(u, &rows, &kept_y)?;
+    let phi = regressors(u, &rows, cfg);
+    let power = local_power(u, &rows, cfg.noise_window);
+    let th = coefficients(&phi, &kept_y, &power, n_tr, cfg)?;
+    // The column of u[n−i]·u[n−j], i < j, carries H_ij + H_ji = 2·H_ij.
+    let q = m * (m + 1) / 2;
+    let mut upper = th[..q].to_vec();
+    for i in 0..m {
+        for j in i + 1..m {
+            upper[upper_index(m, i, j)] *= 0.5;
+        }
+    }
+    let model = Volterra::from_upper(&upper, th[q..q + m].to_vec(), th[q + m])?;
+
+    // Residuals on every kept row.
+    let mut resid = vec![0.0; rows.len()];
+    for (r, out) in resid.iter_mut().enumerate() {
+        let pred: f64 = (0..p).map(|k| phi[(r, k)] * th[k]).sum();
+        *out = kept_y[r] - pred;
+    }
+    let scores = FitScores {
+        samples: rows.len(),
+        train_rows: n_tr,
+        validation_rows: n_val,
+        train_rel_rms: rel_rms(&resid[..n_tr], &kept_y[..n_tr], &kept_y),
+        validation_rel_rms: (n_val > 0).then(|| rel_rms(&resid[n_tr..], &kept_y[n_tr..], &kept_y)),
+    };
+    let noise = noise_model(&power[..n_tr], &resid[..n_tr]);
+    let kept_u: Vec<f64> = rows.iter().map(|&n| u[n]).collect();
+    let spectrum = noise_spectrum(&resid, &kept_u, cfg.rate);
+    Ok(Fitted { model, noise, spectrum, scores })
+}
+
+/// The settings and the series a fit can take: a memory within bounds, one
+/// length, finite samples, a validation fraction below 0.9.
+fn check_inputs(u: &[f64], y: &[f64], keep: &[bool], cfg: &FitConfig) -> Result<(), SynthError> {
     let m = cfg.memory;
     if m == 0 || m > MAX_MEMORY {
         return Err(SynthError::Config(format!("memory must be 1 ..= {MAX_MEMORY} samples, not {m}")));
@@ -115,19 +166,12 @@ pub fn fit(u: &[f64], y: &[f64], keep: &[bool], cfg: &FitConfig) -> Result<Fitte
     if !(0.0..0.9).contains(&cfg.validation) {
         return Err(SynthError::Config(format!("validation must be in [0, 0.9), not {}", cfg.validation)));
     }
-    let rows: Vec<usize> = (0..u.len()).filter(|&n| keep[n]).collect();
-    let p = m * (m + 1) / 2 + m + 1;
-    let n_val = (rows.len() as f64 * cfg.validation).round() as usize;
-    let n_tr = rows.len() - n_val;
-    if n_tr < 2 * p {
-        return Err(SynthError::Data(format!(
-            "{} kept samples give {n_tr} rows to fit {p} parameters (memory {m}); record at least {} kept samples \
-             (more passes) or shorten the memory",
-            rows.len(),
-            ((2 * p) as f64 / (1.0 - cfg.validation)).ceil() as usize
-        )));
-    }
-    let kept_y: Vec<f64> = rows.iter().map(|&n| y[n]).collect();
+    Ok(())
+}
+
+/// Over the kept `rows`, the force (`kept_y`) must vary and the actuation
+/// `u` must not be 0 throughout.
+fn check_excitation(u: &[f64], rows: &[usize], kept_y: &[f64]) -> Result<(), SynthError> {
     let mean = kept_y.iter().sum::<f64>() / kept_y.len() as f64;
     if kept_y.iter().all(|v| (v - mean).abs() <= 1e-12 * mean.abs().max(1e-300)) {
         return Err(SynthError::Data(format!(
@@ -138,8 +182,14 @@ pub fn fit(u: &[f64], y: &[f64], keep: &[bool], cfg: &FitConfig) -> Result<Fitte
     if umax == 0.0 {
         return Err(SynthError::Data("the actuation is 0 over the kept samples: nothing excites the display".into()));
     }
+    Ok(())
+}
 
-    // Regressor columns over the whole series, filtered, then the kept rows.
+/// Φ: the regressor columns — u[n−i]·u[n−j] (i ≤ j), u[n−i], 1 — over the
+/// whole series, filtered, then at the kept `rows`.
+fn regressors(u: &[f64], rows: &[usize], cfg: &FitConfig) -> Array2<f64> {
+    let m = cfg.memory;
+    let p = m * (m + 1) / 2 + m + 1;
     let at = |k: isize| if k >= 0 { u[k as usize] } else { 0.0 };
     let mut col = vec![0.0; u.len()];
     let mut phi = Array2::<f64>::zeros((rows.len(), p));
@@ -163,9 +213,13 @@ pub fn fit(u: &[f64], y: &[f64], keep: &[bool], cfg: &FitConfig) -> Result<Fitte
         fill(q + i, &|n| at(n as isize - i as isize), &mut phi);
     }
     fill(q + m, &|_| 1.0, &mut phi);
+    phi
+}
 
-    // Local actuation power of each kept row (the noise model's regressor).
-    let w = cfg.noise_window.max(1);
+/// The local actuation power of each kept row (the noise model's
+/// regressor): the mean of u² over `window` samples around it.
+fn local_power(u: &[f64], rows: &[usize], window: usize) -> Vec<f64> {
+    let w = window.max(1);
     let mut cum = vec![0.0; u.len() + 1];
     for (n, v) in u.iter().enumerate() {
         cum[n + 1] = cum[n] + v * v;
@@ -175,56 +229,47 @@ pub fn fit(u: &[f64], y: &[f64], keep: &[bool], cfg: &FitConfig) -> Result<Fitte
         let b = (n + w - w / 2).min(u.len());
         (cum[b] - cum[a]) / (b - a) as f64
     };
-    let power: Vec<f64> = rows.iter().map(|&n| local(n)).collect();
-    // Ordinary least squares, then (with `reweight`) weighted by the
-    // inverse residual variance at each row's actuation power.
+    rows.iter().map(|&n| local(n)).collect()
+}
+
+/// θ by ordinary least squares on the first `n_tr` rows, then (with
+/// `reweight`) weighted by the inverse residual variance at each row's
+/// actuation `power`.
+fn coefficients(
+    phi: &Array2<f64>,
+    kept_y: &[f64],
+    power: &[f64],
+    n_tr: usize,
+    cfg: &FitConfig,
+) -> Result<Vec<f64>, SynthError> {
+    let p = phi.ncols();
     let mut weights = vec![1.0; n_tr];
-    let mut th = solve(&phi, &kept_y, &weights, n_tr, cfg.ridge)?;
+    let mut th = solve(phi, kept_y, &weights, n_tr, cfg.ridge)?;
     if cfg.reweight {
         let resid: Vec<f64> = (0..n_tr).map(|r| kept_y[r] - (0..p).map(|k| phi[(r, k)] * th[k]).sum::<f64>()).collect();
         weights = inverse_variance(&power[..n_tr], &resid);
-        th = solve(&phi, &kept_y, &weights, n_tr, cfg.ridge)?;
+        th = solve(phi, kept_y, &weights, n_tr, cfg.ridge)?;
     }
-    // The column of u[n−i]·u[n−j], i < j, carries H_ij + H_ji = 2·H_ij.
-    let mut upper = th[..q].to_vec();
-    for i in 0..m {
-        for j in i + 1..m {
-            upper[upper_index(m, i, j)] *= 0.5;
-        }
-    }
-    let model = Volterra::from_upper(&upper, th[q..q + m].to_vec(), th[q + m])?;
+    Ok(th)
+}
 
-    // Residuals on every kept row.
-    let mut resid = vec![0.0; rows.len()];
-    for (r, out) in resid.iter_mut().enumerate() {
-        let pred: f64 = (0..p).map(|k| phi[(r, k)] * th[k]).sum();
-        *out = kept_y[r] - pred;
-    }
-    let scores = FitScores {
-        samples: rows.len(),
-        train_rows: n_tr,
-        validation_rows: n_val,
-        train_rel_rms: rel_rms(&resid[..n_tr], &kept_y[..n_tr], &kept_y),
-        validation_rel_rms: (n_val > 0).then(|| rel_rms(&resid[n_tr..], &kept_y[n_tr..], &kept_y)),
-    };
-
-    // Noise model: r² against the local mean of u² on the fitted rows.
+/// The noise model: the squared residuals `resid` of the fitted rows
+/// regressed on their local actuation `power`, r² ≈ σ₀² + β·p (both ≥ 0).
+fn noise_model(power: &[f64], resid: &[f64]) -> NoiseModel {
     let (mut sx, mut sy, mut sxx, mut sxy) = (0.0, 0.0, 0.0, 0.0);
-    for r in 0..n_tr {
+    for r in 0..resid.len() {
         let (x, e2) = (power[r], resid[r] * resid[r]);
         sx += x;
         sy += e2;
         sxx += x * x;
         sxy += x * e2;
     }
-    let nn = n_tr as f64;
+    let nn = resid.len() as f64;
     let var = sxx - sx * sx / nn;
     let beta = if var > 1e-12 * sxx.max(f64::MIN_POSITIVE) { (sxy - sx * sy / nn) / var } else { 0.0 };
     let beta = beta.max(0.0);
     let floor = ((sy - beta * sx) / nn).max(0.0);
-    let kept_u: Vec<f64> = rows.iter().map(|&n| u[n]).collect();
-    let spectrum = noise_spectrum(&resid, &kept_u, cfg.rate);
-    Ok(Fitted { model, noise: NoiseModel { floor_n2: floor, per_u2_n2: beta }, spectrum, scores })
+    NoiseModel { floor_n2: floor, per_u2_n2: beta }
 }
 
 /// ‖resid‖ / ‖y‖: the relative RMS error of rows whose force is `y` and

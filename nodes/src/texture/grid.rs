@@ -302,42 +302,10 @@ impl Grid {
         }
         let loads = axis(cells.iter().map(|c| c.load));
         let velocities = axis(cells.iter().map(|c| c.velocity));
-        let index = |axis: &[f64], x: f64| axis.iter().position(|a| same(*a, x)).unwrap_or(0);
-        let mut at: Vec<Option<usize>> = vec![None; loads.len() * velocities.len()];
-        for (k, c) in cells.iter().enumerate() {
-            let slot = index(&loads, c.load) * velocities.len() + index(&velocities, c.velocity);
-            if let Some(prev) = at[slot] {
-                return Err(GridError::Duplicate {
-                    a: cells[prev].path.clone(),
-                    b: c.path.clone(),
-                    load: c.load,
-                    velocity: c.velocity,
-                });
-            }
-            at[slot] = Some(k);
-        }
+        let at = slots(&cells, &loads, &velocities)?;
         let (i0, i1) = reachable(&loads, src.load_range);
         let (j0, j1) = reachable(&velocities, src.velocity_range);
-        let total = (i1 - i0 + 1) * (j1 - j0 + 1);
-        let found = (i0..=i1)
-            .flat_map(|i| (j0..=j1).map(move |j| (i, j)))
-            .filter(|(i, j)| at[i * velocities.len() + j].is_some())
-            .count();
-        for i in i0..=i1 {
-            for j in j0..=j1 {
-                if at[i * velocities.len() + j].is_none() {
-                    return Err(GridError::MissingCell {
-                        where_,
-                        load: loads[i],
-                        velocity: velocities[j],
-                        loads: loads.clone(),
-                        velocities: velocities.clone(),
-                        found,
-                        total,
-                    });
-                }
-            }
-        }
+        check_complete(&at, &loads, &velocities, (i0, i1), (j0, j1), where_)?;
         let mut grid = Grid {
             loads: loads[i0..=i1].to_vec(),
             velocities: velocities[j0..=j1].to_vec(),
@@ -353,41 +321,9 @@ impl Grid {
                 let c = &cells[k];
                 match first {
                     None => first = Some(c),
-                    Some(f) if !same(f.rate, c.rate) => {
-                        return Err(GridError::Rate {
-                            path: c.path.clone(),
-                            rate: c.rate,
-                            first_path: f.path.clone(),
-                            first: f.rate,
-                        })
-                    }
-                    Some(f) if f.carrier != c.carrier => {
-                        let says = |x: bool| if x { "rides a Nyquist-rate carrier" } else { "has no carrier" };
-                        return Err(GridError::Carrier {
-                            path: RecordingPaths::new(&c.path).json,
-                            message: format!(
-                                "{} but {} {}; every cell of a grid must agree (condition.carrier)",
-                                says(c.carrier),
-                                f.path.display(),
-                                says(f.carrier)
-                            ),
-                        });
-                    }
-                    Some(_) => {}
+                    Some(f) => check_agrees(c, f)?,
                 }
-                let channel = pick_channel(c, &src.channel)?;
-                let rec = Recording::open_channels(&c.path, &[channel.as_str()])
-                    .map_err(|e| GridError::Recording(e.to_string()))?;
-                rec.require_complete().map_err(|e| GridError::Recording(e.to_string()))?;
-                let mut samples = rec.into_channels().remove(0);
-                if src.expect == Expect::Force {
-                    let unit = c.channels.iter().position(|n| *n == channel).map_or("", |k| c.units[k].as_str());
-                    check_force(&c.path, &channel, unit, &samples, c.rate)?;
-                }
-                if src.apply_gain {
-                    samples.iter_mut().for_each(|x| *x *= c.gain);
-                }
-                grid.cells.push(samples);
+                grid.cells.push(cell_samples(c, src)?);
                 grid.paths.push(c.path.clone());
             }
         }
@@ -395,6 +331,103 @@ impl Grid {
         grid.carrier = first.is_some_and(|c| c.carrier);
         Ok(grid)
     }
+}
+
+/// Where each cell sits on the (load, velocity) axes: `slots[i · velocities + j]`
+/// is the index in `cells` of the cell at load i and velocity j; two cells
+/// at one condition are an error.
+fn slots(cells: &[CellInfo], loads: &[f64], velocities: &[f64]) -> Result<Vec<Option<usize>>, GridError> {
+    let index = |axis: &[f64], x: f64| axis.iter().position(|a| same(*a, x)).unwrap_or(0);
+    let mut at: Vec<Option<usize>> = vec![None; loads.len() * velocities.len()];
+    for (k, c) in cells.iter().enumerate() {
+        let slot = index(loads, c.load) * velocities.len() + index(velocities, c.velocity);
+        if let Some(prev) = at[slot] {
+            return Err(GridError::Duplicate {
+                a: cells[prev].path.clone(),
+                b: c.path.clone(),
+                load: c.load,
+                velocity: c.velocity,
+            });
+        }
+        at[slot] = Some(k);
+    }
+    Ok(at)
+}
+
+/// Every cell of the reachable rectangle (loads `i0..=i1`, velocities
+/// `j0..=j1`) is there; the error names the first missing one.
+fn check_complete(
+    at: &[Option<usize>],
+    loads: &[f64],
+    velocities: &[f64],
+    (i0, i1): (usize, usize),
+    (j0, j1): (usize, usize),
+    where_: String,
+) -> Result<(), GridError> {
+    let total = (i1 - i0 + 1) * (j1 - j0 + 1);
+    let found = (i0..=i1)
+        .flat_map(|i| (j0..=j1).map(move |j| (i, j)))
+        .filter(|(i, j)| at[i * velocities.len() + j].is_some())
+        .count();
+    for i in i0..=i1 {
+        for j in j0..=j1 {
+            if at[i * velocities.len() + j].is_none() {
+                return Err(GridError::MissingCell {
+                    where_,
+                    load: loads[i],
+                    velocity: velocities[j],
+                    loads: loads.to_vec(),
+                    velocities: velocities.to_vec(),
+                    found,
+                    total,
+                });
+            }
+        }
+    }
+    Ok(())
+}
+
+/// Cell `c` agrees with the grid's `first` cell on its rate and carrier.
+fn check_agrees(c: &CellInfo, first: &CellInfo) -> Result<(), GridError> {
+    if !same(first.rate, c.rate) {
+        return Err(GridError::Rate {
+            path: c.path.clone(),
+            rate: c.rate,
+            first_path: first.path.clone(),
+            first: first.rate,
+        });
+    }
+    if first.carrier != c.carrier {
+        let says = |x: bool| if x { "rides a Nyquist-rate carrier" } else { "has no carrier" };
+        return Err(GridError::Carrier {
+            path: RecordingPaths::new(&c.path).json,
+            message: format!(
+                "{} but {} {}; every cell of a grid must agree (condition.carrier)",
+                says(c.carrier),
+                first.path.display(),
+                says(first.carrier)
+            ),
+        });
+    }
+    Ok(())
+}
+
+/// The samples of cell `c`'s channel: checked as a force when `src`
+/// expects one, times the condition's gain when it applies it.
+fn cell_samples(c: &CellInfo, src: &GridSource) -> Result<Vec<f64>, GridError> {
+    let channel = pick_channel(c, &src.channel)?;
+    let rec =
+        Recording::open_channels(&c.path, &[channel.as_str()]).map_err(|e| GridError::Recording(e.to_string()))?;
+    rec.require_complete().map_err(|e| GridError::Recording(e.to_string()))?;
+    let mut samples = rec.into_channels().remove(0);
+    if src.expect == Expect::Force {
+        let unit = c.channels.iter().position(|n| *n == channel).map_or("", |k| c.units[k].as_str());
+        check_force(&c.path, &channel, unit, &samples, c.rate)?;
+    }
+    if src.apply_gain {
+        samples.iter_mut().for_each(|x| *x *= c.gain);
+    }
+    Ok(samples)
 }
 
 /// Equal within 1e-9 relative (conditions written by different tools).

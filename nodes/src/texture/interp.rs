@@ -8,6 +8,7 @@ use super::kernel::SincKernel;
 use super::scheme::{Geometry, Mix, Scheme};
 use crate::rate::clock::Clock;
 use evflow_engine::ports::{InPort, OutPort};
+use evflow_engine::spec::Scene;
 use evflow_engine::typed_params::{Choice, Flag, Float, Floats, Int, Text, Words};
 use evflow_engine::{
     BuildContext, Change, Io, Node, NodeError, NodeSpec, Params, PortSpec, PrepareContext, RateSpec, Refused, Role,
@@ -115,12 +116,13 @@ single-column grids, a velocity ratio of 10, missing and duplicate cells, envelo
     EXPECT.spec(),
     ALIGN.spec(),
 ])
+.scene(Scene::TextureGrid)
 .example("folder = \"recordings/grid\"\nscheme = \"improved\"\nupdate_rate = 10.0\nstream_rate = 20000.0");
 
 /// The ports: the user's load and velocity in, table frames out.
 const PORTS: &[PortSpec] = &[
-    PortSpec::input("load", "g", "user's normal load m_u"),
-    PortSpec::input("velocity", "cm/s", "user's scanning velocity v_u (its magnitude is used)"),
+    PortSpec::input("load", "g", "user's normal load m_u").view(),
+    PortSpec::input("velocity", "cm/s", "user's scanning velocity v_u (its magnitude is used)").view(),
     PortSpec::output("table", "frame", "table frames for `playback` (header + U_uu)")
         .at(RateSpec::Param(STREAM_RATE.name())),
 ];

@@ -128,6 +128,51 @@ pub fn read(stroke: &Path, actuation: &Path, real: &Path, sample: Option<&str>) 
     let s = open(stroke, &STROKE_CHANNELS, "a recorded stroke (the IR frame and the load cell)")?;
     let a = open(actuation, &ACTUATION_CHANNELS, "the chain's actuation (graphs/texture-live-recorded.toml's output)")?;
     let r = open(real, &REAL_CHANNELS, "the real force along the stroke (the path and the force)")?;
+    let (rate, frame_rate) = check_timing((stroke, &s), (actuation, &a), (real, &r))?;
+    let ch = |rec: &Recording, name: &str| rec.channel(name).expect("opened by name").to_vec();
+    let (velocity, load, force) = (ch(&r, "velocity"), ch(&r, "load"), ch(&r, "force"));
+    check_same_path(stroke, &ch(&s, "ir_x"), frame_rate, real, &r, rate)?;
+    let material = match sample {
+        Some(name) => name.to_string(),
+        None => r.meta().condition.material.clone().unwrap_or_default(),
+    };
+    let (base_force, base) = base_friction(&material, sample, real, (&velocity, &load, &force))?;
+    let modulation = force.iter().zip(&base_force).map(|(f, b)| f - b).collect();
+    // The path's position is not needed to play a display (it takes the
+    // load and the velocity); it is integrated from the IR frame's first reading.
+    let mut x = s.channel("ir_x").expect("opened").first().copied().unwrap_or(0.0);
+    let position = velocity
+        .iter()
+        .map(|v| {
+            let here = x;
+            x += v / rate;
+            here
+        })
+        .collect();
+    let path = Stroke { rate, position, velocity, load, real: force, modulation };
+    Ok(Inputs {
+        stroke_file: stroke.to_path_buf(),
+        actuation_file: actuation.to_path_buf(),
+        real_file: real.to_path_buf(),
+        frame_rate,
+        frames: s.frames(),
+        path,
+        u: ch(&a, "u"),
+        target: ch(&a, "target"),
+        material,
+        base,
+    })
+}
+
+/// The three recordings cover one stroke: the real force at the
+/// actuation's rate, sample for sample; the stroke (slower, at the
+/// frame's rate) as long; both long enough to score. Returns the
+/// actuation's rate and the stroke's frame rate.
+fn check_timing(
+    (stroke, s): (&Path, &Recording),
+    (actuation, a): (&Path, &Recording),
+    (real, r): (&Path, &Recording),
+) -> Result<(f64, f64), StudyError> {
     let rate = a.rate();
     if r.rate() != rate {
         return Err(bad(
@@ -194,54 +239,35 @@ pub fn read(stroke: &Path, actuation: &Path, real: &Path, sample: Option<&str>) 
             ),
         ));
     }
-    let ch = |rec: &Recording, name: &str| rec.channel(name).expect("opened by name").to_vec();
-    let (velocity, load, force) = (ch(&r, "velocity"), ch(&r, "load"), ch(&r, "force"));
-    check_same_path(stroke, &ch(&s, "ir_x"), frame_rate, real, &r, rate)?;
-    let material = match sample {
-        Some(name) => name.to_string(),
-        None => r.meta().condition.material.clone().unwrap_or_default(),
-    };
-    let surface = samples::lookup(&material);
-    let (base_force, base): (Vec<f64>, Base) = match (&surface, sample) {
+    Ok((rate, frame_rate))
+}
+
+/// The base friction under the path — (`velocity`, `load`), with the real
+/// `force` — that the display floor takes off the real force: lab sample
+/// `material`'s, or where it is none (and no `sample` was named) one
+/// μ·load·tanh(v/v₀) fitted to the force.
+fn base_friction(
+    material: &str,
+    sample: Option<&str>,
+    real: &Path,
+    (velocity, load, force): (&[f64], &[f64], &[f64]),
+) -> Result<(Vec<f64>, Base), StudyError> {
+    let surface = samples::lookup(material);
+    Ok(match (&surface, sample) {
         (Ok(surface), _) => (
-            velocity.iter().zip(&load).map(|(v, l)| surface.base_force(*v, *l)).collect(),
-            Base::Sample(material.clone()),
+            velocity.iter().zip(load).map(|(v, l)| surface.base_force(*v, *l)).collect(),
+            Base::Sample(material.to_string()),
         ),
         (Err(e), Some(_)) => return Err(StudyError::Config(format!("--sample: {e}"))),
         (Err(_), None) => {
-            let b: Vec<f64> = velocity.iter().zip(&load).map(|(v, l)| l.max(0.0) * (v / V_SIGN).tanh()).collect();
+            let b: Vec<f64> = velocity.iter().zip(load).map(|(v, l)| l.max(0.0) * (v / V_SIGN).tanh()).collect();
             let bb: f64 = b.iter().map(|x| x * x).sum();
             if bb <= 0.0 {
                 return Err(bad(real, "the finger never moves under load: there is no friction to score"));
             }
-            let mu = b.iter().zip(&force).map(|(x, f)| x * f).sum::<f64>() / bb;
+            let mu = b.iter().zip(force).map(|(x, f)| x * f).sum::<f64>() / bb;
             (b.iter().map(|x| mu * x).collect(), Base::Fitted { mu })
         }
-    };
-    let modulation = force.iter().zip(&base_force).map(|(f, b)| f - b).collect();
-    // The path's position is not needed to play a display (it takes the
-    // load and the velocity); it is integrated from the IR frame's first reading.
-    let mut x = s.channel("ir_x").expect("opened").first().copied().unwrap_or(0.0);
-    let position = velocity
-        .iter()
-        .map(|v| {
-            let here = x;
-            x += v / rate;
-            here
-        })
-        .collect();
-    let path = Stroke { rate, position, velocity, load, real: force, modulation };
-    Ok(Inputs {
-        stroke_file: stroke.to_path_buf(),
-        actuation_file: actuation.to_path_buf(),
-        real_file: real.to_path_buf(),
-        frame_rate,
-        frames: s.frames(),
-        path,
-        u: ch(&a, "u"),
-        target: ch(&a, "target"),
-        material,
-        base,
     })
 }
 

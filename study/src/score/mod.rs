@@ -277,43 +277,8 @@ pub fn score(inputs: &Inputs, cfg: &ScoreConfig, progress: &mut dyn FnMut(Step<'
     }
     let chosen = choose(&sweep).ok_or_else(|| StudyError::Config("an empty gain sweep".into()))?;
     let chain = ChainResult { chain: Chain::Live, sweep, chosen, iterations_per_tick: 0.0 };
-    let seeds = vec![(Chain::Live.label().to_string(), inputs.u.clone())];
-    let (mut achievable, mut target_floor, mut floor_spectrum) = (None, None, None);
-    if cfg.floors {
-        let starts = seeds.len() + floor::START_OFFSETS.len();
-        // The target's floor: towards the chain's own target.
-        progress(Step::Optimizing("the target's floor", starts));
-        let t = Instant::now();
-        let goal = Goal::chain_target(path, &inputs.target)?;
-        let candidates = player.optimize(path, &goal, &seeds, cfg.floor_iterations)?;
-        let secs = t.elapsed().as_secs_f64();
-        progress(Step::Optimized("the target's floor", secs));
-        progress(Step::Playing("the target's floor", candidates.len() * cfg.gains.len()));
-        let (sweep, reached, best) = play_best(player, &candidates, "target-floor", &cfg.gains)?;
-        let c = &candidates[best];
-        target_floor =
-            Some(TargetFloor { sweep, reached, start: c.start.clone(), objective: c.objective, seconds: secs });
-        // The stroke's floor: towards the real force.
-        progress(Step::Optimizing("the stroke's floor", starts));
-        let t = Instant::now();
-        let candidates = player.optimize(path, &Goal::real(path)?, &seeds, cfg.floor_iterations)?;
-        let secs = t.elapsed().as_secs_f64();
-        progress(Step::Optimized("the stroke's floor", secs));
-        progress(Step::Playing("the stroke's floor", (candidates.len() + 1) * cfg.gains.len() + 1));
-        let (sweep, reached, best) = play_best(player, &candidates, "floor", &cfg.gains)?;
-        let c = &candidates[best];
-        let sliding = player.sweep("floor-sliding", &floor::sliding_only(&c.u, path), &zeros, &cfg.gains)?;
-        let s = choose(&sliding).ok_or_else(|| StudyError::Config("an empty gain sweep".into()))?;
-        floor_spectrum = Some(metric::amplitude(&player.play("floor-best", &c.u, &zeros)?.rendered, rate)?);
-        achievable = Some(StrokeFloor {
-            sweep,
-            reached,
-            start: c.start.clone(),
-            objective: c.objective,
-            sliding_only: Reading { rect: s.best_rect.rect, welch: s.best_welch.welch },
-            seconds: secs,
-        });
-    }
+    let (achievable, target_floor, floor_spectrum) =
+        if cfg.floors { floors(player, inputs, cfg, &zeros, progress)? } else { (None, None, None) };
     let spectra = Spectra {
         real: metric::amplitude(&rendered.real, rate)?,
         rendered: metric::amplitude(&rendered.rendered, rate)?,
@@ -340,6 +305,59 @@ pub fn score(inputs: &Inputs, cfg: &ScoreConfig, progress: &mut dyn FnMut(Step<'
         row,
         spectra,
     })
+}
+
+/// The stroke's floor, the target's floor and the amplitude spectrum of
+/// the stroke floor's best actuation.
+type Floors = (Option<StrokeFloor>, Option<TargetFloor>, Option<Vec<(f64, f64)>>);
+
+/// The target's floor, the stroke's floor and the spectrum of the
+/// latter's best actuation, each optimized from the chain's actuation on
+/// `player` and swept over `cfg`'s gains.
+fn floors(
+    player: &mut dyn Player,
+    inputs: &Inputs,
+    cfg: &ScoreConfig,
+    zeros: &[f64],
+    progress: &mut dyn FnMut(Step<'_>),
+) -> Result<Floors, StudyError> {
+    let path = &inputs.path;
+    let rate = path.rate;
+    let seeds = vec![(Chain::Live.label().to_string(), inputs.u.clone())];
+    let starts = seeds.len() + floor::START_OFFSETS.len();
+    // The target's floor: towards the chain's own target.
+    progress(Step::Optimizing("the target's floor", starts));
+    let t = Instant::now();
+    let goal = Goal::chain_target(path, &inputs.target)?;
+    let candidates = player.optimize(path, &goal, &seeds, cfg.floor_iterations)?;
+    let secs = t.elapsed().as_secs_f64();
+    progress(Step::Optimized("the target's floor", secs));
+    progress(Step::Playing("the target's floor", candidates.len() * cfg.gains.len()));
+    let (sweep, reached, best) = play_best(player, &candidates, "target-floor", &cfg.gains)?;
+    let c = &candidates[best];
+    let target_floor =
+        Some(TargetFloor { sweep, reached, start: c.start.clone(), objective: c.objective, seconds: secs });
+    // The stroke's floor: towards the real force.
+    progress(Step::Optimizing("the stroke's floor", starts));
+    let t = Instant::now();
+    let candidates = player.optimize(path, &Goal::real(path)?, &seeds, cfg.floor_iterations)?;
+    let secs = t.elapsed().as_secs_f64();
+    progress(Step::Optimized("the stroke's floor", secs));
+    progress(Step::Playing("the stroke's floor", (candidates.len() + 1) * cfg.gains.len() + 1));
+    let (sweep, reached, best) = play_best(player, &candidates, "floor", &cfg.gains)?;
+    let c = &candidates[best];
+    let sliding = player.sweep("floor-sliding", &floor::sliding_only(&c.u, path), zeros, &cfg.gains)?;
+    let s = choose(&sliding).ok_or_else(|| StudyError::Config("an empty gain sweep".into()))?;
+    let floor_spectrum = Some(metric::amplitude(&player.play("floor-best", &c.u, zeros)?.rendered, rate)?);
+    let achievable = Some(StrokeFloor {
+        sweep,
+        reached,
+        start: c.start.clone(),
+        objective: c.objective,
+        sliding_only: Reading { rect: s.best_rect.rect, welch: s.best_welch.welch },
+        seconds: secs,
+    });
+    Ok((achievable, target_floor, floor_spectrum))
 }
 
 #[cfg(test)]

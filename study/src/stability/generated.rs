@@ -73,13 +73,13 @@ fn as_f64(v: &Value) -> f64 {
     }
 }
 
-/// Watches variant `o`'s largest |output| over `node`'s bound for its
+/// Watches variant `o`'s largest |output| over the bound of `spec` for its
 /// parameters `p` and inputs up to `input_max`, as the pseudo-port [`RATIO`].
-fn watch_ratio(o: &mut Observed, node: &str, p: &Table, input_max: f64) {
+fn watch_ratio(o: &mut Observed, spec: &NodeSpec, p: &Table, input_max: f64) {
     if o.error.is_some() {
         return;
     }
-    if let Some((port, b, _)) = bound(node, &from_table(p), input_max) {
+    if let Some((port, b, _)) = bound(spec, &from_table(p), input_max) {
         let seen = o.ports.iter().find(|(n, _)| n == port).map(|(_, m)| *m).unwrap_or(0.0);
         let ratio = if seen <= b {
             if b > 0.0 {
@@ -119,7 +119,7 @@ fn parameter_case(spec: &'static NodeSpec, size: Size) -> Case {
             if size.steps_inside() { " and one step inside" } else { "" }
         )
     };
-    let bounded = bound(spec.name, &from_table(&base), 1.0).is_some();
+    let bounded = bound(spec, &from_table(&base), 1.0).is_some();
     let invariant = if bounded {
         Invariant::Bound { bound: 1.0, port: Some(RATIO.into()), why: "every variant within its own bound".into() }
     } else {
@@ -131,13 +131,13 @@ fn parameter_case(spec: &'static NodeSpec, size: Size) -> Case {
         let text = toml::to_string(&base).unwrap_or_default();
         // The example must run as declared; its error fails the case.
         let mut o = single::run(spec, &text, &input, ticks, BLOCK, &env.dir);
-        watch_ratio(&mut o, spec.name, &base, INPUT_MAX);
+        watch_ratio(&mut o, spec, &base, INPUT_MAX);
         let (mut tried, mut refused) = (0, 0);
         for p in &numeric {
             for value in limit_values(&p.kind, env.size) {
                 let mut table = base.clone();
                 let mut value = value;
-                if let Some((cap, why)) = capped(spec.name, p.name, as_f64(&value)) {
+                if let Some((cap, why)) = capped(spec, p.name, as_f64(&value)) {
                     o.notes.push(format!("{} capped at {cap} ({why})", p.name));
                     value =
                         if matches!(value, Value::Integer(_)) { Value::Integer(cap as i64) } else { Value::Float(cap) };
@@ -151,7 +151,7 @@ fn parameter_case(spec: &'static NodeSpec, size: Size) -> Case {
                     eprintln!("{} {} = {shown}: {:.2} s", spec.name, p.name, t0.elapsed().as_secs_f64());
                 }
                 tried += 1;
-                watch_ratio(&mut v, spec.name, &table, INPUT_MAX);
+                watch_ratio(&mut v, spec, &table, INPUT_MAX);
                 if let Some(e) = v.error.take() {
                     refused += 1;
                     v.notes.push(format!("{} = {shown} refused: {}", p.name, first_line(&e)));
@@ -189,7 +189,7 @@ fn input_case(spec: &'static NodeSpec, e: Extreme, size: Size) -> Case {
     let sample = e.samples(len, 0);
     let input_max = sample.iter().fold(0.0f64, |m, x| m.max(x.abs()));
     let sourced = !has_inputs(spec);
-    let (invariant, extreme) = match bound(spec.name, &from_table(&base), if sourced { 0.0 } else { input_max }) {
+    let (invariant, extreme) = match bound(spec, &from_table(&base), if sourced { 0.0 } else { input_max }) {
         Some((port, b, why)) => (
             Invariant::Bound { bound: b, port: Some(port.into()), why },
             if sourced { format!("a long run of {len} samples") } else { e.describe(len) },
@@ -248,6 +248,34 @@ mod tests {
         assert_eq!(v[1], Value::Float(f64::INFINITY));
         assert_eq!(v[3], Value::Float(1e300));
         assert!(limit_values(&ParamKind::Bool, Size::Full).is_empty());
+    }
+
+    /// A node type as the registry holds it, changed and kept for the test's run.
+    fn leak(spec: NodeSpec) -> &'static NodeSpec {
+        Box::leak(Box::new(spec))
+    }
+
+    #[test]
+    fn the_bound_a_node_type_declares_is_the_one_its_cases_check() {
+        let dir = tempfile::tempdir().unwrap();
+        let env = super::super::prepare(dir.path(), dir.path(), Size::Ci).unwrap();
+        let gain = *evflow_nodes::registry().get("gain").unwrap();
+        let row = super::super::run_case(&input_case(leak(gain), Extreme::ALL[0], Size::Ci), &env);
+        assert!(
+            row.invariant.contains("|gain|·max|in|") && row.verdict.passed(),
+            "{}: {}",
+            row.invariant,
+            row.verdict.text()
+        );
+        // The same node declaring a bound it cannot keep: its case fails.
+        fn tight(_: &evflow_engine::spec::BoundArgs<'_>) -> Option<evflow_engine::spec::PortBound> {
+            Some(("out", 1e-3, "too tight".into()))
+        }
+        let tight = leak(NodeSpec { bound: Some(tight), ..gain });
+        let row = super::super::run_case(&input_case(tight, Extreme::ALL[0], Size::Ci), &env);
+        assert!(row.invariant.contains("too tight") && !row.verdict.passed(), "{}", row.verdict.text());
+        let row = super::super::run_case(&parameter_case(tight, Size::Ci), &env);
+        assert!(!row.verdict.passed(), "every variant within its own bound: {}", row.verdict.text());
     }
 
     #[test]

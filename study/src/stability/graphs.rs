@@ -38,9 +38,9 @@ pub struct Running {
 }
 
 /// Builds and runs a checked graph, watching every output of every node
-/// after every step (and each node with a bound in [`super::bounds`]
-/// that holds whatever its inputs against that bound: a breach is a
-/// violation), then every value the nodes report.
+/// after every step (and each node whose type declares a bound that holds
+/// whatever its inputs, [`super::bounds::bound`], against that bound: a
+/// breach is a violation), then every value the nodes report.
 pub fn run_checked(checked: &Checked, r: &Running) -> Observed {
     let mut o = Observed::default();
     let opts = PlanOptions {
@@ -64,8 +64,7 @@ pub fn run_checked(checked: &Checked, r: &Running) -> Observed {
     for k in 0..plan.len() {
         let name = plan.node_name(k).to_string();
         let spec = plan.spec(k);
-        let b =
-            checked.index(&name).and_then(|i| bound(spec.name, &from_params(&checked.nodes[i].params), f64::INFINITY));
+        let b = checked.index(&name).and_then(|i| bound(spec, &from_params(&checked.nodes[i].params), f64::INFINITY));
         for (j, port) in plan.output_names(k).iter().enumerate() {
             let limit = b.as_ref().filter(|(p, _, _)| p == port).map(|(_, v, _)| *v);
             watched.push((k, j, format!("{name}.{port}"), limit));

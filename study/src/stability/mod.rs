@@ -13,8 +13,9 @@
 //! The cases come from three places: [`generated`] (from every `NodeSpec`
 //! of the registry, so a new node type is covered without a line here),
 //! [`stiff`] (the named stiff cases of the issue) and [`graphs`] (one case
-//! per shipped graph family). [`bounds`] holds the node types whose
-//! outputs have a tighter bound than "finite".
+//! per shipped graph family). [`bounds`] reads what a node type declares
+//! beyond its ports and parameters: an output bound tighter than "finite",
+//! and the parameters whose largest values only cost time.
 
 pub mod bounds;
 pub mod generated;

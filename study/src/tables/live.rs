@@ -209,6 +209,51 @@ pub fn markdown(study: &LiveStudy, scope: &LiveScope) -> String {
     let chains = chains.as_slice();
     let live_k = chains.iter().position(|c| *c == Chain::Live);
     let mut md = String::new();
+    intro(&mut md, scope);
+    // Summary per profile: means over samples and users.
+    let _ = writeln!(md, "## Mean over samples and users\n");
+    header(&mut md, chains, "profile");
+    let per_profile = per_profile(study, scope, chains);
+    let mut summary = Vec::new();
+    for (name, cells) in &per_profile {
+        let m = mean_cell(cells, chains.len());
+        line(&mut md, name, &m, live_k);
+        summary.push((name.to_string(), m));
+    }
+    let _ = writeln!(md);
+    notes(&mut md, &summary.iter().map(|(n, c)| (n.as_str(), c)).collect::<Vec<_>>());
+    // Per profile, per sample.
+    for (p, _) in &per_profile {
+        let _ = writeln!(md, "## {p}\n");
+        header(&mut md, chains, "sample");
+        let mut rows = Vec::new();
+        for s in &scope.samples {
+            let c = cell(study, chains, p, s);
+            if c.users > 0 {
+                line(&mut md, s, &c, live_k);
+                rows.push((s.as_str(), c));
+            }
+        }
+        let _ = writeln!(md);
+        notes(&mut md, &rows.iter().map(|(s, c)| (*s, c)).collect::<Vec<_>>());
+    }
+    targets(&mut md, &per_profile, live_k);
+    if let Some(k) = live_k {
+        let all: Vec<&Cell> = per_profile.iter().flat_map(|(_, c)| c.iter()).collect();
+        held_out_targets(&mut md, &all, k);
+    }
+    if !study.failures.is_empty() {
+        let _ = writeln!(md, "## Steps that failed\n");
+        for (what, why) in &study.failures {
+            let _ = writeln!(md, "* {what}: {why}");
+        }
+        let _ = writeln!(md);
+    }
+    md
+}
+
+/// The title, how the chains are played and scored, and the users.
+fn intro(md: &mut String, scope: &LiveScope) {
     let _ = writeln!(md, "# Live texture rendering under virtual users\n");
     let _ = writeln!(
         md,
@@ -238,53 +283,58 @@ pub fn markdown(study: &LiveStudy, scope: &LiveScope) -> String {
         )
     });
     let _ = writeln!(md, "Users: {}.\n", users.collect::<Vec<_>>().join("; "));
-    let header = |md: &mut String, first: &str| {
-        let _ = write!(md, "| {first} | nothing |");
-        for c in chains {
-            let _ = write!(md, " {} |", c.label());
-        }
-        let _ = writeln!(
-            md,
-            " target's floor | stroke floor | its sliding only | display floor | best chain / floor | live / target's floor |"
-        );
-        let _ = write!(md, "|---|---:|");
-        for _ in chains {
-            let _ = write!(md, "---|");
-        }
-        let _ = writeln!(md, "---:|---:|---:|---:|---:|---:|");
+}
+
+/// A table's header: `first`, nothing, each chain, the floors and the ratios.
+fn header(md: &mut String, chains: &[Chain], first: &str) {
+    let _ = write!(md, "| {first} | nothing |");
+    for c in chains {
+        let _ = write!(md, " {} |", c.label());
+    }
+    let _ = writeln!(
+        md,
+        " target's floor | stroke floor | its sliding only | display floor | best chain / floor | live / target's floor |"
+    );
+    let _ = write!(md, "|---|---:|");
+    for _ in chains {
+        let _ = write!(md, "---|");
+    }
+    let _ = writeln!(md, "---:|---:|---:|---:|---:|---:|");
+}
+
+/// A table's row for `first`: cell `c`, the best chain in bold; `live_k`
+/// is the live synthesis' column, if it plays.
+fn line(md: &mut String, first: &str, c: &Cell, live_k: Option<usize>) {
+    let best = c.best();
+    let _ = write!(md, "| {first} | {} |", f3(c.nothing));
+    for (k, (rule, b)) in c.chains.iter().enumerate() {
+        let bold = best.is_some_and(|(i, _)| i == k);
+        let (o, e) = if bold { ("**", "**") } else { ("", "") };
+        let _ = write!(md, " {} / {o}{}{e} |", f3(*rule), f3(*b));
+    }
+    let ratio = best.map_or(f64::NAN, |(_, b)| b / c.floor);
+    let live = live_k.map_or(f64::NAN, |k| c.chains[k].1 / c.target);
+    let times = |r: f64| if r.is_finite() { format!("{r:.2}×") } else { "–".into() };
+    // Near the floor is no success where playing nothing does as well.
+    let ratio = match times(ratio) {
+        t if best.is_some() && !c.beaten() && ratio.is_finite() => format!("{t} (no chain beats nothing)"),
+        t => t,
     };
-    let line = |md: &mut String, first: &str, c: &Cell| {
-        let best = c.best();
-        let _ = write!(md, "| {first} | {} |", f3(c.nothing));
-        for (k, (rule, b)) in c.chains.iter().enumerate() {
-            let bold = best.is_some_and(|(i, _)| i == k);
-            let (o, e) = if bold { ("**", "**") } else { ("", "") };
-            let _ = write!(md, " {} / {o}{}{e} |", f3(*rule), f3(*b));
-        }
-        let ratio = best.map_or(f64::NAN, |(_, b)| b / c.floor);
-        let live = live_k.map_or(f64::NAN, |k| c.chains[k].1 / c.target);
-        let times = |r: f64| if r.is_finite() { format!("{r:.2}×") } else { "–".into() };
-        // Near the floor is no success where playing nothing does as well.
-        let ratio = match times(ratio) {
-            t if best.is_some() && !c.beaten() && ratio.is_finite() => format!("{t} (no chain beats nothing)"),
-            t => t,
-        };
-        let _ = writeln!(
-            md,
-            " {} | {} | {} | {} | {} | {} |",
-            f3(c.target),
-            f3(c.floor),
-            f3(c.sliding),
-            f3(c.display_floor),
-            ratio,
-            times(live)
-        );
-    };
-    // Summary per profile: means over samples and users.
-    let _ = writeln!(md, "## Mean over samples and users\n");
-    header(&mut md, "profile");
+    let _ = writeln!(
+        md,
+        " {} | {} | {} | {} | {} | {} |",
+        f3(c.target),
+        f3(c.floor),
+        f3(c.sliding),
+        f3(c.display_floor),
+        ratio,
+        times(live)
+    );
+}
+
+/// Each profile of the scope that has rows (by name), with its samples' cells.
+fn per_profile(study: &LiveStudy, scope: &LiveScope, chains: &[Chain]) -> Vec<(String, Vec<Cell>)> {
     let mut per_profile = Vec::new();
-    let mut summary = Vec::new();
     for p in &scope.profiles {
         let name = profile_name(p);
         let cells: Vec<Cell> =
@@ -292,42 +342,32 @@ pub fn markdown(study: &LiveStudy, scope: &LiveScope) -> String {
         if cells.is_empty() {
             continue;
         }
-        let m = Cell {
-            nothing: mean(cells.iter().map(|c| c.nothing)),
-            chains: (0..chains.len())
-                .map(|k| (mean(cells.iter().map(|c| c.chains[k].0)), mean(cells.iter().map(|c| c.chains[k].1))))
-                .collect(),
-            floor: mean(cells.iter().map(|c| c.floor)),
-            target: mean(cells.iter().map(|c| c.target)),
-            sliding: mean(cells.iter().map(|c| c.sliding)),
-            display_floor: mean(cells.iter().map(|c| c.display_floor)),
-            live_at_one: mean(cells.iter().map(|c| c.live_at_one)),
-            users: cells.iter().map(|c| c.users).sum(),
-        };
-        line(&mut md, name, &m);
-        summary.push((name.to_string(), m));
         per_profile.push((name.to_string(), cells));
     }
-    let _ = writeln!(md);
-    notes(&mut md, &summary.iter().map(|(n, c)| (n.as_str(), c)).collect::<Vec<_>>());
-    // Per profile, per sample.
-    for (p, _) in &per_profile {
-        let _ = writeln!(md, "## {p}\n");
-        header(&mut md, "sample");
-        let mut rows = Vec::new();
-        for s in &scope.samples {
-            let c = cell(study, chains, p, s);
-            if c.users > 0 {
-                line(&mut md, s, &c);
-                rows.push((s.as_str(), c));
-            }
-        }
-        let _ = writeln!(md);
-        notes(&mut md, &rows.iter().map(|(s, c)| (*s, c)).collect::<Vec<_>>());
+    per_profile
+}
+
+/// The mean of `cells` (of `chains` chains each), their users summed.
+fn mean_cell(cells: &[Cell], chains: usize) -> Cell {
+    Cell {
+        nothing: mean(cells.iter().map(|c| c.nothing)),
+        chains: (0..chains)
+            .map(|k| (mean(cells.iter().map(|c| c.chains[k].0)), mean(cells.iter().map(|c| c.chains[k].1))))
+            .collect(),
+        floor: mean(cells.iter().map(|c| c.floor)),
+        target: mean(cells.iter().map(|c| c.target)),
+        sliding: mean(cells.iter().map(|c| c.sliding)),
+        display_floor: mean(cells.iter().map(|c| c.display_floor)),
+        live_at_one: mean(cells.iter().map(|c| c.live_at_one)),
+        users: cells.iter().map(|c| c.users).sum(),
     }
-    // The targets.
+}
+
+/// Per profile: the best chain (and the live synthesis) against the
+/// stroke's floor and against nothing.
+fn targets(md: &mut String, per_profile: &[(String, Vec<Cell>)], live_k: Option<usize>) {
     let _ = writeln!(md, "## Targets: the best chain against the stroke's floor and against nothing\n");
-    for (p, cells) in &per_profile {
+    for (p, cells) in per_profile {
         let within = cells.iter().filter(|c| c.best().is_some_and(|(_, b)| b <= WITHIN * c.floor)).count();
         let hollow =
             cells.iter().filter(|c| c.best().is_some_and(|(_, b)| b <= WITHIN * c.floor) && !c.beaten()).count();
@@ -358,18 +398,6 @@ pub fn markdown(study: &LiveStudy, scope: &LiveScope) -> String {
         let _ = writeln!(md, ".");
     }
     let _ = writeln!(md);
-    if let Some(k) = live_k {
-        let all: Vec<&Cell> = per_profile.iter().flat_map(|(_, c)| c.iter()).collect();
-        held_out_targets(&mut md, &all, k);
-    }
-    if !study.failures.is_empty() {
-        let _ = writeln!(md, "## Steps that failed\n");
-        for (what, why) in &study.failures {
-            let _ = writeln!(md, "* {what}: {why}");
-        }
-        let _ = writeln!(md);
-    }
-    md
 }
 
 /// Every row and chain: profile, sample, user, chain, then Welch and rect

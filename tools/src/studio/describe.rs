@@ -44,10 +44,14 @@ pub struct Description {
 }
 
 /// Streams worth seeing by default on top of the sources and guards the
-/// session records anyway: the display's force, the mesh intensities, what
-/// feeds each limiter (its peak shows), each limiter's `state` (also a
-/// guard output, so normally tapped already), and the (load, velocity)
-/// point of each texture interpolator. Only nodes the plan kept.
+/// session records anyway: the ports each node type declares shown
+/// ([`evflow_engine::PortSpec::view`]) — an output's samples (the
+/// display's force, the mesh intensities, each limiter's `state`, which is
+/// also a guard output and so normally tapped already, the live
+/// synthesis' target beside what it expects to render and its running
+/// counts), or for an input, the stream that feeds it (what reaches each
+/// limiter, whose peak shows; the (load, velocity) point of each texture
+/// interpolator). Only nodes the plan kept.
 pub fn default_taps(checked: &Checked, plan: &evflow_engine::Plan) -> Vec<Tap> {
     wanted_taps(checked).into_iter().filter(|t| plan.index(&t.node).is_some()).collect()
 }
@@ -61,26 +65,14 @@ fn wanted_taps(checked: &Checked) -> Vec<Tap> {
         }
     };
     for n in &checked.nodes {
-        match n.spec.name {
-            "sim.display" => add(&n.name, "force"),
-            "mesh.gradient" | "mesh.edges" => add(&n.name, "intensity"),
-            "limit" => add(&n.name, "state"),
-            // The live synthesis: its target beside what it expects to render,
-            // and its running counts (the studio shows their rates).
-            "synth.live" => {
-                for port in ["target", "predicted", "iterations", "fallbacks"] {
-                    add(&n.name, port);
-                }
-            }
-            _ => {}
+        for port in n.spec.viewed(Direction::Out) {
+            add(&n.name, port);
         }
     }
     for e in &checked.edges {
         let to = &checked.nodes[e.to.0];
         let port = &to.ports[e.to.1].name;
-        let wanted =
-            matches!((to.spec.name, port.as_str()), ("limit", "in") | ("interp", "load") | ("interp", "velocity"));
-        if wanted {
+        if to.spec.viewed(Direction::In).any(|p| p == port) {
             let from = &checked.nodes[e.from.0];
             add(&from.name, &from.ports[e.from.1].name);
         }
@@ -263,6 +255,66 @@ type = "gain"
 [vars]
 gain = 2.0
 "#;
+
+    /// Every shipped graph's wanted taps, `graph: node.port …`, in order.
+    fn shipped_wanted_taps() -> Vec<String> {
+        let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).parent().unwrap().join("graphs");
+        let mut files: Vec<_> = std::fs::read_dir(&root)
+            .unwrap()
+            .map(|e| e.unwrap().path())
+            .filter(|p| p.extension().is_some_and(|x| x == "toml"))
+            .collect();
+        files.sort();
+        files
+            .iter()
+            .map(|f| {
+                let c = evflow_engine::load_file(f, &evflow_nodes::registry(), &[]).unwrap();
+                let taps: Vec<String> = wanted_taps(&c).iter().map(|t| format!("{}.{}", t.node, t.port)).collect();
+                format!("{}: {}", f.file_stem().unwrap().to_string_lossy(), taps.join(" "))
+            })
+            .collect()
+    }
+
+    /// The streams the studio showed by default in every shipped graph
+    /// when the node types' knowledge of them still lived in this file
+    /// (issue 35): the declarations must give the same.
+    const SHIPPED_TAPS: &[&str] = &[
+        "characterize: display.force",
+        "display-live: limit.state display.force gain.out",
+        "display-serial: limit.state gain.out",
+        "excitation: display.force",
+        "forces-recordings: ",
+        "forward-build-recordings: ",
+        "forward-build: display.force",
+        "lab-work-precision: display_ref.force display.force",
+        "mesh-live: surface.intensity edges.intensity limit.state display.force gain.out",
+        "mesh-scan: surface.intensity edges.intensity limit.state display.force gain.out",
+        "mesh-serial: surface.intensity edges.intensity limit.state gain.out",
+        "model-build-multilevel: display.force",
+        "model-build-recordings: ",
+        "model-build: display.force",
+        "model-validate-recordings: ",
+        "play-actuation: limit.state display.force gain.out",
+        "record-stroke: ",
+        "record-textures: ",
+        "synthesize-optimized: ",
+        "synthesize-recordings: ",
+        "synthesize: narx_limit.state narx_display.force narx_ml_limit.state narx_ml_display.force optimized_limit.state optimized_display.force playback_limit.state playback_display.force floor_display.force narx_gain.out narx_ml_gain.out optimized_gain.out playback_gain.out",
+        "texture-cross-validation: display.force playback_display.force ff_display.force cells_limit.state playback_limit.state ff_limit.state load.out speed.out playback.out playback_loop.out ff_gain.out",
+        "texture-forces-live: limit.state display.force velocity_cm_s.out load_g.out gain.out",
+        "texture-live-play: limit.state display.force gain.out",
+        "texture-live-quality: nothing_display.force playback_limit.state playback_display.force narx_limit.state narx_display.force optimized_limit.state optimized_display.force ff_limit.state ff_display.force live_synth.target live_synth.predicted live_synth.iterations live_synth.fallbacks live_limit.state live_display.force velocity_cm_s.out load_g.out playback_gain.out narx_gain.out optimized_gain.out ff_gain.out live_gain.out",
+        "texture-live-recorded: synth.target synth.predicted synth.iterations synth.fallbacks limit.state velocity_cm_s.out load_g.out gain.out",
+        "texture-live: synth.target synth.predicted synth.iterations synth.fallbacks limit.state display.force velocity_cm_s.out load_g.out gain.out",
+        "texture-quality: velocity_cm_s.out load_g.out",
+        "texture-render-quality: display.force forces_display.force limit.state forces_limit.state velocity_cm_s.out load_g.out gain.out forces_gain.out",
+        "texture-serial: synth.target synth.predicted synth.iterations synth.fallbacks limit.state velocity_cm_s.out load_g.out gain.out",
+    ];
+
+    #[test]
+    fn the_default_taps_of_every_shipped_graph_are_as_they_were() {
+        assert_eq!(shipped_wanted_taps(), SHIPPED_TAPS);
+    }
 
     #[test]
     fn the_page_is_told_the_graph_the_plan_left_out_the_limits_and_the_limiter() {

@@ -1,17 +1,28 @@
 //! What the finger moves over, for the page's finger view: the height map
-//! of each scene a `mesh.gradient` node can switch between (sampled by the
-//! node family's own ray caster, on a grid over the scene's footprint), or
-//! the (load, velocity) axes of each texture grid an `interp` node can
-//! switch between. Computed once, off the real-time thread, before the
+//! of each scene the first node declaring [`Scene::Mesh`] (`mesh.gradient`)
+//! can switch between (sampled by the node family's own ray caster, on a
+//! grid over the scene's footprint), or the (load, velocity) axes of each
+//! texture grid the first node declaring [`Scene::TextureGrid`] (`interp`)
+//! can switch between. Computed once, off the real-time thread, before the
 //! session starts.
 
+use evflow_engine::spec::Scene;
 use evflow_engine::{BuildContext, Checked};
 use serde_json::{json, Value};
 use std::path::Path;
 
+/// The scenes the finger view draws, in the order it looks for them.
+const SCENES: [Scene; 2] = [Scene::Mesh, Scene::TextureGrid];
+
 /// Height-map samples along the longer side of a scene's footprint.
 #[cfg(feature = "mesh")]
 const MAP_SAMPLES: usize = 96;
+
+/// The first node, in the plan's order, whose type draws `scene`.
+#[allow(dead_code)]
+fn first(checked: &Checked, scene: Scene) -> Option<usize> {
+    checked.order.iter().copied().find(|&k| checked.nodes[k].spec.scene == Some(scene))
+}
 
 #[allow(dead_code)]
 fn context(checked: &Checked, k: usize, base_dir: &Path) -> BuildContext {
@@ -30,11 +41,11 @@ fn context(checked: &Checked, k: usize, base_dir: &Path) -> BuildContext {
 }
 
 /// The height maps (mm, on a grid in touch coordinates, m) of the scenes
-/// of the first `mesh.gradient` node.
+/// of the first node that draws a [`Scene::Mesh`].
 #[cfg(feature = "mesh")]
 fn mesh_maps(checked: &Checked, base_dir: &Path) -> Option<Value> {
     use evflow_nodes::mesh::{place, raycast::RayCaster, source};
-    let k = checked.order.iter().copied().find(|&k| checked.nodes[k].spec.name == "mesh.gradient")?;
+    let k = first(checked, Scene::Mesh)?;
     let n = &checked.nodes[k];
     let placed = match source::load_scenes(&n.params, &context(checked, k, base_dir)) {
         Ok(p) => p,
@@ -71,12 +82,13 @@ fn mesh_maps(_: &Checked, _: &Path) -> Option<Value> {
     None
 }
 
-/// The (load, velocity) axes of every texture of the first `interp` node.
+/// The (load, velocity) axes of every texture of the first node that
+/// draws a [`Scene::TextureGrid`].
 #[cfg(feature = "texture")]
 fn texture_grids(checked: &Checked, base_dir: &Path) -> Option<Value> {
     use evflow_nodes::texture::grid::Grid;
     use evflow_nodes::texture::interp::grid_sources;
-    let k = checked.order.iter().copied().find(|&k| checked.nodes[k].spec.name == "interp")?;
+    let k = first(checked, Scene::TextureGrid)?;
     let n = &checked.nodes[k];
     let p = &n.params;
     let ctx = context(checked, k, base_dir);
@@ -103,11 +115,17 @@ fn texture_grids(_: &Checked, _: &Path) -> Option<Value> {
 
 /// The finger view's background for `checked` (relative paths from
 /// `base_dir`, the graph file's folder): a mesh scene's height maps, else a
-/// texture's (load, velocity) grid, else `{"kind": "none"}`.
+/// texture's (load, velocity) grid, else `{"kind": "none"}` naming the
+/// node types that would have drawn one.
 pub fn scene_json(checked: &Checked, base_dir: &Path) -> Value {
-    mesh_maps(checked, base_dir)
-        .or_else(|| texture_grids(checked, base_dir))
-        .unwrap_or_else(|| json!({ "kind": "none", "why": "no mesh.gradient or interp node" }))
+    mesh_maps(checked, base_dir).or_else(|| texture_grids(checked, base_dir)).unwrap_or_else(|| {
+        let drawers: Vec<&str> = SCENES
+            .iter()
+            .flat_map(|&s| evflow_nodes::all_specs().into_iter().filter(move |n| n.scene == Some(s)))
+            .map(|n| n.name)
+            .collect();
+        json!({ "kind": "none", "why": format!("no {} node", drawers.join(" or ")) })
+    })
 }
 
 #[cfg(all(test, feature = "mesh", feature = "texture"))]
@@ -118,6 +136,13 @@ mod tests {
         let root = Path::new(env!("CARGO_MANIFEST_DIR")).parent().unwrap().join("graphs");
         let c = evflow_engine::load_file(&root.join(name), &evflow_nodes::registry(), &[]).unwrap();
         (c, root)
+    }
+
+    #[test]
+    fn a_graph_without_a_scene_says_which_node_types_draw_one() {
+        let (c, dir) = load("excitation.toml");
+        let s = scene_json(&c, &dir);
+        assert_eq!(s, json!({ "kind": "none", "why": "no mesh.gradient or interp node" }));
     }
 
     #[test]

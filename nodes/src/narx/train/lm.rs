@@ -26,7 +26,7 @@
 
 use super::{mse, Data, EarlyStop, Epoch, Options, Report, StopReason};
 use crate::linalg::{add_lower_gram, Cholesky};
-use crate::narx::net::Mlp;
+use crate::narx::net::{Mlp, Workspace};
 use ndarray::linalg::general_mat_vec_mul;
 use ndarray::{s, Array1, Array2};
 use std::time::Instant;
@@ -44,20 +44,12 @@ pub fn train(
     progress: &mut dyn FnMut(&Epoch),
 ) -> Report {
     let start = Instant::now();
-    let p = net.n_params();
     let n = train.len();
     let mut ws = net.workspace();
     let mut perf = mse(net, train);
     let mut stop = EarlyStop::new(net.weights(), mse(net, val), perf, opts.max_fail);
     let mut mu = opts.mu;
-    // JᵀJ: only its lower triangle is formed and read (Cholesky of the lower half).
-    let mut jtj = Array2::<f64>::zeros((p, p));
-    let mut diag = vec![0.0; p];
-    let mut jte = Array1::<f64>::zeros(p);
-    // J of a block of rows: row i holds ∂y/∂w of row i, written in place.
-    let mut j_block = Array2::<f64>::zeros((BLOCK, p));
-    let mut eblock = Array1::<f64>::zeros(BLOCK);
-    let mut trial = vec![0.0; p];
+    let mut normal = Normal::new(net.n_params());
     let mut epochs = 0;
     let mut reason = StopReason::MaxEpochs;
     for epoch in 1..=opts.max_epochs {
@@ -68,59 +60,13 @@ pub fn train(
             reason = StopReason::Goal;
             break;
         }
-        // JᵀJ and Jᵀe, block by block.
-        let mut first = true;
-        let mut s = 0;
-        while s < n {
-            let m = BLOCK.min(n - s);
-            for i in 0..m {
-                let mut row = j_block.row_mut(i);
-                let row = row.as_slice_mut().expect("rows of a standard-layout array are contiguous");
-                let y = net.jacobian_row(train.row(s + i), &mut ws, row);
-                eblock[i] = y - train.target(s + i);
-            }
-            let (jb, eb) = (j_block.slice(s![0..m, ..]), eblock.slice(s![0..m]));
-            add_lower_gram(&mut jtj, jb, !first);
-            general_mat_vec_mul(1.0, &jb.t(), &eb, if first { 0.0 } else { 1.0 }, &mut jte);
-            first = false;
-            s += m;
-        }
-        let gradient = 2.0 * (0..p).map(|k| jte[k] * jte[k]).sum::<f64>().sqrt() / n as f64;
+        normal.form(net, train, &mut ws);
+        let gradient = normal.gradient(n);
         if gradient.is_nan() || gradient < opts.min_grad {
             reason = StopReason::MinGradient;
             break;
         }
-        // Raise μ until a step lowers the training error.
-        let mut improved = false;
-        for (k, d) in diag.iter_mut().enumerate() {
-            *d = jtj[(k, k)];
-        }
-        while mu <= opts.mu_max {
-            for (k, d) in diag.iter().enumerate() {
-                jtj[(k, k)] = d + mu;
-            }
-            if let Ok(llt) = Cholesky::factor(&jtj) {
-                let dx = llt.solve(jte.as_slice().expect("a vector is contiguous"));
-                let w = net.weights();
-                let ok = dx.iter().all(|d| d.is_finite());
-                if ok {
-                    for k in 0..p {
-                        trial[k] = w[k] - dx[k];
-                    }
-                    let saved: Vec<f64> = w.to_vec();
-                    net.weights_mut().copy_from_slice(&trial);
-                    let perf2 = mse(net, train);
-                    if perf2 < perf {
-                        perf = perf2;
-                        mu *= opts.mu_dec;
-                        improved = true;
-                        break;
-                    }
-                    net.weights_mut().copy_from_slice(&saved);
-                }
-            }
-            mu *= opts.mu_inc;
-        }
+        let improved = normal.step(net, train, &mut perf, &mut mu, opts);
         epochs = epoch;
         let vperf = mse(net, val);
         progress(&Epoch {
@@ -141,6 +87,99 @@ pub fn train(
         }
     }
     stop.finish(net.weights_mut(), epochs, reason, start)
+}
+
+/// The normal equations of an epoch, JᵀJ and Jᵀe, and the buffers they
+/// are formed and solved in (allocated once for the whole training).
+struct Normal {
+    /// JᵀJ: only its lower triangle is formed and read (Cholesky of the lower half).
+    jtj: Array2<f64>,
+    /// JᵀJ's diagonal, before μ is added.
+    diag: Vec<f64>,
+    /// Jᵀe.
+    jte: Array1<f64>,
+    /// J of a block of rows: row i holds ∂y/∂w of row i, written in place.
+    j_block: Array2<f64>,
+    /// The errors of a block of rows.
+    eblock: Array1<f64>,
+    /// The weights of a trial step.
+    trial: Vec<f64>,
+}
+
+impl Normal {
+    fn new(p: usize) -> Self {
+        Self {
+            jtj: Array2::<f64>::zeros((p, p)),
+            diag: vec![0.0; p],
+            jte: Array1::<f64>::zeros(p),
+            j_block: Array2::<f64>::zeros((BLOCK, p)),
+            eblock: Array1::<f64>::zeros(BLOCK),
+            trial: vec![0.0; p],
+        }
+    }
+
+    /// Forms JᵀJ and Jᵀe over `train`, block by block.
+    fn form(&mut self, net: &Mlp, train: &Data<'_>, ws: &mut Workspace) {
+        let n = train.len();
+        let mut first = true;
+        let mut s = 0;
+        while s < n {
+            let m = BLOCK.min(n - s);
+            for i in 0..m {
+                let mut row = self.j_block.row_mut(i);
+                let row = row.as_slice_mut().expect("rows of a standard-layout array are contiguous");
+                let y = net.jacobian_row(train.row(s + i), ws, row);
+                self.eblock[i] = y - train.target(s + i);
+            }
+            let (jb, eb) = (self.j_block.slice(s![0..m, ..]), self.eblock.slice(s![0..m]));
+            add_lower_gram(&mut self.jtj, jb, !first);
+            general_mat_vec_mul(1.0, &jb.t(), &eb, if first { 0.0 } else { 1.0 }, &mut self.jte);
+            first = false;
+            s += m;
+        }
+    }
+
+    /// The MSE gradient norm 2‖Jᵀe‖/N over `n` rows.
+    fn gradient(&self, n: usize) -> f64 {
+        let p = self.diag.len();
+        2.0 * (0..p).map(|k| self.jte[k] * self.jte[k]).sum::<f64>().sqrt() / n as f64
+    }
+
+    /// Raises μ until a step lowers the training error `perf`: true when
+    /// one did (the net holds its weights, `perf` and `mu` are updated),
+    /// false once μ passed `mu_max` (the net keeps its weights).
+    fn step(&mut self, net: &mut Mlp, train: &Data<'_>, perf: &mut f64, mu: &mut f64, opts: &Options) -> bool {
+        let p = self.diag.len();
+        for (k, d) in self.diag.iter_mut().enumerate() {
+            *d = self.jtj[(k, k)];
+        }
+        while *mu <= opts.mu_max {
+            for (k, d) in self.diag.iter().enumerate() {
+                self.jtj[(k, k)] = d + *mu;
+            }
+            if let Ok(llt) = Cholesky::factor(&self.jtj) {
+                let dx = llt.solve(self.jte.as_slice().expect("a vector is contiguous"));
+                let w = net.weights();
+                let ok = dx.iter().all(|d| d.is_finite());
+                if ok {
+                    for k in 0..p {
+                        self.trial[k] = w[k] - dx[k];
+                    }
+                    let saved: Vec<f64> = w.to_vec();
+                    net.weights_mut().copy_from_slice(&self.trial);
+                    let perf2 = mse(net, train);
+                    if perf2 < *perf {
+                        *perf = perf2;
+                        *mu *= opts.mu_dec;
+                        return true;
+                    }
+                    net.weights_mut().copy_from_slice(&saved);
+                }
+            }
+            *mu *= opts.mu_inc;
+        }
+        false
+    }
 }
 
 #[cfg(test)]

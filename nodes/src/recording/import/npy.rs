@@ -47,106 +47,13 @@ pub(super) struct NpyArray {
 /// Parses the bytes of an `.npy` file; `path` is only used in messages.
 pub(super) fn parse(bytes: &[u8], path: &Path) -> Result<NpyArray, ImportError> {
     let err = |message: String| ImportError::Npy { path: path.to_path_buf(), message };
-    if bytes.is_empty() {
-        return Err(err("the file is empty".into()));
-    }
-    if bytes.len() < 8 || &bytes[..6] != MAGIC {
-        return Err(err("it does not start with the .npy magic `\\x93NUMPY` (was it written by np.save?)".into()));
-    }
-    let (major, minor) = (bytes[6], bytes[7]);
-    let (len_bytes, utf8) = match (major, minor) {
-        (1, 0) => (2, false),
-        (2, 0) => (4, false),
-        (3, 0) => (4, true),
-        _ => {
-            return Err(err(format!("format version {major}.{minor} is not one this evflow reads (1.0, 2.0 and 3.0)")))
-        }
-    };
-    if bytes.len() < 8 + len_bytes {
-        return Err(err("the file ends inside the header length".into()));
-    }
-    let header_len = if len_bytes == 2 {
-        usize::from(u16::from_le_bytes([bytes[8], bytes[9]]))
-    } else {
-        u32::from_le_bytes([bytes[8], bytes[9], bytes[10], bytes[11]]) as usize
-    };
-    if header_len > MAX_HEADER {
-        return Err(err(format!("the header claims {header_len} bytes; headers longer than {MAX_HEADER} are refused")));
-    }
-    let start = 8 + len_bytes;
-    let data_at = start + header_len;
-    if bytes.len() < data_at {
-        return Err(err(format!(
-            "the header claims {header_len} bytes but the file ends after {} (cut short?)",
-            bytes.len() - start
-        )));
-    }
-    let raw = &bytes[start..data_at];
-    let text = if utf8 {
-        std::str::from_utf8(raw).map_err(|_| err("the header is not UTF-8".into()))?
-    } else {
-        if !raw.is_ascii() {
-            return Err(err("the header holds non-ASCII bytes (version 1.0/2.0 headers are ASCII)".into()));
-        }
-        // ASCII is valid UTF-8.
-        std::str::from_utf8(raw).map_err(|_| err("the header is not ASCII".into()))?
-    };
+    let (major, minor, text, data_at) = header_text(bytes).map_err(err)?;
     let header = Header::parse(text).map_err(|m| err(format!("header {m}")))?;
     let dtype = Dtype::parse(&header.descr).map_err(err)?;
-
-    let (frames, channels) = match header.shape.as_slice() {
-        [] => return Err(err("shape () is a single number, not a recording; save a 1-D or 2-D array".into())),
-        [n] => (*n, 1),
-        [n, c] => (*n, *c),
-        s => {
-            return Err(err(format!(
-                "shape {} has {} dimensions; a recording is 1-D (frames,) or 2-D (frames, channels)",
-                shape_text(s),
-                s.len()
-            )))
-        }
-    };
+    let (frames, channels) = frames_and_channels(&header).map_err(err)?;
     let shape = shape_text(&header.shape);
-    if frames == 0 || channels == 0 {
-        return Err(err(format!("shape {shape} holds no samples")));
-    }
-    if header.shape.len() == 2 && channels > frames {
-        return Err(err(format!(
-            "shape {shape} reads as {channels} channels of {frames} frames; a recording is (frames, channels): \
-             save the transpose (arr.T) or np.column_stack([...]) of the channels"
-        )));
-    }
-    let expected = frames
-        .checked_mul(channels)
-        .and_then(|n| n.checked_mul(dtype.size))
-        .ok_or_else(|| err(format!("shape {shape} of {} claims more bytes than any file can hold", header.descr)))?;
-    let present = bytes.len() - data_at;
-    if present < expected {
-        return Err(err(format!(
-            "truncated: shape {shape} of {} needs {expected} bytes of data but the file holds {present}",
-            header.descr
-        )));
-    }
-    if present > expected {
-        return Err(err(format!(
-            "{} bytes follow the {expected} bytes of data that shape {shape} of {} describes (the header does not \
-             describe the file)",
-            present - expected,
-            header.descr
-        )));
-    }
-
-    let data = &bytes[data_at..];
-    let mut samples = Vec::with_capacity(frames * channels);
-    samples.extend(data.chunks_exact(dtype.size).map(dtype.convert));
-    if header.fortran_order && channels > 1 {
-        // Column-major: element (frame i, channel j) is at j·frames + i.
-        let column_major = std::mem::take(&mut samples);
-        samples.reserve_exact(column_major.len());
-        for i in 0..frames {
-            samples.extend((0..channels).map(|j| column_major[j * frames + i]));
-        }
-    }
+    check_data_size(&header, &shape, (frames, channels), dtype.size, bytes.len() - data_at).map_err(err)?;
+    let samples = samples(&bytes[data_at..], &dtype, frames, channels, header.fortran_order);
     if let Some(k) = samples.iter().position(|x| !x.is_finite()) {
         return Err(ImportError::NonFinite {
             path: path.to_path_buf(),
@@ -168,6 +75,127 @@ pub(super) fn parse(bytes: &[u8], path: &Path) -> Result<NpyArray, ImportError> 
         samples,
         description: format!("NumPy {major}.{minor}, {}, shape {shape}{order}", header.descr),
     })
+}
+
+/// The format version, the header's text and where the data starts; the
+/// message says what is wrong.
+fn header_text(bytes: &[u8]) -> Result<(u8, u8, &str, usize), String> {
+    if bytes.is_empty() {
+        return Err("the file is empty".into());
+    }
+    if bytes.len() < 8 || &bytes[..6] != MAGIC {
+        return Err("it does not start with the .npy magic `\\x93NUMPY` (was it written by np.save?)".into());
+    }
+    let (major, minor) = (bytes[6], bytes[7]);
+    let (len_bytes, utf8) = match (major, minor) {
+        (1, 0) => (2, false),
+        (2, 0) => (4, false),
+        (3, 0) => (4, true),
+        _ => return Err(format!("format version {major}.{minor} is not one this evflow reads (1.0, 2.0 and 3.0)")),
+    };
+    if bytes.len() < 8 + len_bytes {
+        return Err("the file ends inside the header length".into());
+    }
+    let header_len = if len_bytes == 2 {
+        usize::from(u16::from_le_bytes([bytes[8], bytes[9]]))
+    } else {
+        u32::from_le_bytes([bytes[8], bytes[9], bytes[10], bytes[11]]) as usize
+    };
+    if header_len > MAX_HEADER {
+        return Err(format!("the header claims {header_len} bytes; headers longer than {MAX_HEADER} are refused"));
+    }
+    let start = 8 + len_bytes;
+    let data_at = start + header_len;
+    if bytes.len() < data_at {
+        return Err(format!(
+            "the header claims {header_len} bytes but the file ends after {} (cut short?)",
+            bytes.len() - start
+        ));
+    }
+    let raw = &bytes[start..data_at];
+    let text = if utf8 {
+        std::str::from_utf8(raw).map_err(|_| "the header is not UTF-8".to_string())?
+    } else {
+        if !raw.is_ascii() {
+            return Err("the header holds non-ASCII bytes (version 1.0/2.0 headers are ASCII)".into());
+        }
+        // ASCII is valid UTF-8.
+        std::str::from_utf8(raw).map_err(|_| "the header is not ASCII".to_string())?
+    };
+    Ok((major, minor, text, data_at))
+}
+
+/// The recording's frames and channels from the header's shape: (n,) or
+/// (n, c), with samples, and not more channels than frames.
+fn frames_and_channels(header: &Header) -> Result<(usize, usize), String> {
+    let (frames, channels) = match header.shape.as_slice() {
+        [] => return Err("shape () is a single number, not a recording; save a 1-D or 2-D array".into()),
+        [n] => (*n, 1),
+        [n, c] => (*n, *c),
+        s => {
+            return Err(format!(
+                "shape {} has {} dimensions; a recording is 1-D (frames,) or 2-D (frames, channels)",
+                shape_text(s),
+                s.len()
+            ))
+        }
+    };
+    let shape = shape_text(&header.shape);
+    if frames == 0 || channels == 0 {
+        return Err(format!("shape {shape} holds no samples"));
+    }
+    if header.shape.len() == 2 && channels > frames {
+        return Err(format!(
+            "shape {shape} reads as {channels} channels of {frames} frames; a recording is (frames, channels): \
+             save the transpose (arr.T) or np.column_stack([...]) of the channels"
+        ));
+    }
+    Ok((frames, channels))
+}
+
+/// The data holds exactly the `frames` × `channels` samples of `size`
+/// bytes the header describes (`present` bytes follow the header).
+fn check_data_size(
+    header: &Header,
+    shape: &str,
+    (frames, channels): (usize, usize),
+    size: usize,
+    present: usize,
+) -> Result<(), String> {
+    let expected = frames
+        .checked_mul(channels)
+        .and_then(|n| n.checked_mul(size))
+        .ok_or_else(|| format!("shape {shape} of {} claims more bytes than any file can hold", header.descr))?;
+    if present < expected {
+        return Err(format!(
+            "truncated: shape {shape} of {} needs {expected} bytes of data but the file holds {present}",
+            header.descr
+        ));
+    }
+    if present > expected {
+        return Err(format!(
+            "{} bytes follow the {expected} bytes of data that shape {shape} of {} describes (the header does not \
+             describe the file)",
+            present - expected,
+            header.descr
+        ));
+    }
+    Ok(())
+}
+
+/// The samples of `data`, interleaved frame after frame.
+fn samples(data: &[u8], dtype: &Dtype, frames: usize, channels: usize, fortran_order: bool) -> Vec<f64> {
+    let mut samples = Vec::with_capacity(frames * channels);
+    samples.extend(data.chunks_exact(dtype.size).map(dtype.convert));
+    if fortran_order && channels > 1 {
+        // Column-major: element (frame i, channel j) is at j·frames + i.
+        let column_major = std::mem::take(&mut samples);
+        samples.reserve_exact(column_major.len());
+        for i in 0..frames {
+            samples.extend((0..channels).map(|j| column_major[j * frames + i]));
+        }
+    }
+    samples
 }
 
 /// `(3000, 2)`, `(3000,)`, `()`: a shape as Python prints it.
@@ -295,107 +323,122 @@ impl Lexer<'_> {
             return Err("ends where a value was expected".into());
         };
         match c {
-            b'{' => {
+            b'{' => self.dict(depth),
+            b'(' | b'[' => self.sequence(c, depth),
+            b'\'' | b'"' => self.string(c),
+            b'0'..=b'9' | b'-' | b'+' => self.number(c),
+            _ => self.word(c),
+        }
+    }
+
+    /// A dict, at its `{`.
+    fn dict(&mut self, depth: usize) -> Result<Lit, String> {
+        self.pos += 1;
+        let mut entries = Vec::new();
+        loop {
+            if self.peek() == Some(b'}') {
                 self.pos += 1;
-                let mut entries = Vec::new();
-                loop {
-                    if self.peek() == Some(b'}') {
-                        self.pos += 1;
-                        return Ok(Lit::Dict(entries));
-                    }
-                    let k = self.value(depth + 1)?;
-                    if self.peek() != Some(b':') {
-                        return Err(format!("misses a `:` after a key at byte {}", self.pos));
-                    }
-                    self.pos += 1;
-                    let v = self.value(depth + 1)?;
-                    entries.push((k, v));
-                    match self.peek() {
-                        Some(b',') => self.pos += 1,
-                        Some(b'}') => {}
-                        _ => return Err(format!("misses a `,` or `}}` at byte {}", self.pos)),
-                    }
-                }
+                return Ok(Lit::Dict(entries));
             }
-            b'(' | b'[' => {
-                let close = if c == b'(' { b')' } else { b']' };
+            let k = self.value(depth + 1)?;
+            if self.peek() != Some(b':') {
+                return Err(format!("misses a `:` after a key at byte {}", self.pos));
+            }
+            self.pos += 1;
+            let v = self.value(depth + 1)?;
+            entries.push((k, v));
+            match self.peek() {
+                Some(b',') => self.pos += 1,
+                Some(b'}') => {}
+                _ => return Err(format!("misses a `,` or `}}` at byte {}", self.pos)),
+            }
+        }
+    }
+
+    /// A tuple or a list, at its `open`ing `(` or `[`.
+    fn sequence(&mut self, open: u8, depth: usize) -> Result<Lit, String> {
+        let close = if open == b'(' { b')' } else { b']' };
+        self.pos += 1;
+        let mut items = Vec::new();
+        let mut trailing_comma = false;
+        loop {
+            if self.peek() == Some(close) {
                 self.pos += 1;
-                let mut items = Vec::new();
-                let mut trailing_comma = false;
-                loop {
-                    if self.peek() == Some(close) {
-                        self.pos += 1;
-                        // `(5)` is the number 5 in Python; `(5,)` a tuple.
-                        if c == b'(' && items.len() == 1 && !trailing_comma {
-                            return Ok(items.pop().unwrap_or(Lit::None));
-                        }
-                        return Ok(if c == b'(' { Lit::Tuple(items) } else { Lit::List(items) });
-                    }
-                    items.push(self.value(depth + 1)?);
-                    trailing_comma = false;
-                    match self.peek() {
-                        Some(b',') => {
-                            self.pos += 1;
-                            trailing_comma = true;
-                        }
-                        Some(x) if x == close => {}
-                        _ => return Err(format!("misses a `,` or `{}` at byte {}", close as char, self.pos)),
-                    }
+                // `(5)` is the number 5 in Python; `(5,)` a tuple.
+                if open == b'(' && items.len() == 1 && !trailing_comma {
+                    return Ok(items.pop().unwrap_or(Lit::None));
                 }
+                return Ok(if open == b'(' { Lit::Tuple(items) } else { Lit::List(items) });
             }
-            b'\'' | b'"' => {
-                self.pos += 1;
-                let from = self.pos;
-                while self.pos < self.s.len() && self.s[self.pos] != c {
-                    if self.s[self.pos] == b'\\' {
-                        return Err(format!("holds an escape sequence in a string at byte {}", self.pos));
-                    }
+            items.push(self.value(depth + 1)?);
+            trailing_comma = false;
+            match self.peek() {
+                Some(b',') => {
                     self.pos += 1;
+                    trailing_comma = true;
                 }
-                if self.pos >= self.s.len() {
-                    return Err("ends inside a string".into());
-                }
-                let text = String::from_utf8_lossy(&self.s[from..self.pos]).into_owned();
-                self.pos += 1;
-                Ok(Lit::Str(text))
+                Some(x) if x == close => {}
+                _ => return Err(format!("misses a `,` or `{}` at byte {}", close as char, self.pos)),
             }
-            b'0'..=b'9' | b'-' | b'+' => {
-                let from = self.pos;
-                if c == b'-' || c == b'+' {
-                    self.pos += 1;
-                }
-                while self.pos < self.s.len() && self.s[self.pos].is_ascii_digit() {
-                    self.pos += 1;
-                }
-                let digits = std::str::from_utf8(&self.s[from..self.pos]).unwrap_or("");
-                // Python 2 wrote long integers as `3000L`.
-                if matches!(self.s.get(self.pos), Some(b'L') | Some(b'l')) {
-                    self.pos += 1;
-                }
-                if digits.starts_with('-') {
-                    return Err(format!("holds the negative number {digits}"));
-                }
-                digits.trim_start_matches('+').parse::<usize>().map(Lit::Int).map_err(|_| {
-                    if digits.trim_start_matches('+').is_empty() {
-                        format!("holds a lone sign at byte {from}")
-                    } else {
-                        format!("holds the number {digits}, too large for this machine")
-                    }
-                })
+        }
+    }
+
+    /// A string, at its `quote`.
+    fn string(&mut self, quote: u8) -> Result<Lit, String> {
+        self.pos += 1;
+        let from = self.pos;
+        while self.pos < self.s.len() && self.s[self.pos] != quote {
+            if self.s[self.pos] == b'\\' {
+                return Err(format!("holds an escape sequence in a string at byte {}", self.pos));
             }
-            _ => {
-                let from = self.pos;
-                while self.pos < self.s.len() && self.s[self.pos].is_ascii_alphanumeric() {
-                    self.pos += 1;
-                }
-                match &self.s[from..self.pos] {
-                    b"True" => Ok(Lit::Bool(true)),
-                    b"False" => Ok(Lit::Bool(false)),
-                    b"None" => Ok(Lit::None),
-                    b"" => Err(format!("holds an unexpected `{}` at byte {from}", char::from(c).escape_default())),
-                    w => Err(format!("holds an unexpected word `{}` at byte {from}", String::from_utf8_lossy(w))),
-                }
+            self.pos += 1;
+        }
+        if self.pos >= self.s.len() {
+            return Err("ends inside a string".into());
+        }
+        let text = String::from_utf8_lossy(&self.s[from..self.pos]).into_owned();
+        self.pos += 1;
+        Ok(Lit::Str(text))
+    }
+
+    /// A non-negative integer, at its first digit or sign `c`.
+    fn number(&mut self, c: u8) -> Result<Lit, String> {
+        let from = self.pos;
+        if c == b'-' || c == b'+' {
+            self.pos += 1;
+        }
+        while self.pos < self.s.len() && self.s[self.pos].is_ascii_digit() {
+            self.pos += 1;
+        }
+        let digits = std::str::from_utf8(&self.s[from..self.pos]).unwrap_or("");
+        // Python 2 wrote long integers as `3000L`.
+        if matches!(self.s.get(self.pos), Some(b'L') | Some(b'l')) {
+            self.pos += 1;
+        }
+        if digits.starts_with('-') {
+            return Err(format!("holds the negative number {digits}"));
+        }
+        digits.trim_start_matches('+').parse::<usize>().map(Lit::Int).map_err(|_| {
+            if digits.trim_start_matches('+').is_empty() {
+                format!("holds a lone sign at byte {from}")
+            } else {
+                format!("holds the number {digits}, too large for this machine")
             }
+        })
+    }
+
+    /// `True`, `False` or `None`, at its first character `c`.
+    fn word(&mut self, c: u8) -> Result<Lit, String> {
+        let from = self.pos;
+        while self.pos < self.s.len() && self.s[self.pos].is_ascii_alphanumeric() {
+            self.pos += 1;
+        }
+        match &self.s[from..self.pos] {
+            b"True" => Ok(Lit::Bool(true)),
+            b"False" => Ok(Lit::Bool(false)),
+            b"None" => Ok(Lit::None),
+            b"" => Err(format!("holds an unexpected `{}` at byte {from}", char::from(c).escape_default())),
+            w => Err(format!("holds an unexpected word `{}` at byte {from}", String::from_utf8_lossy(w))),
         }
     }
 }

@@ -2,6 +2,7 @@
 
 use super::envelope::Envelope;
 use evflow_engine::ports::{InPort, OutPort};
+use evflow_engine::spec::{BoundArgs, PortBound};
 use evflow_engine::typed_params::{Flag, Float, Words};
 use evflow_engine::{BuildContext, Change, Io, Node, NodeError, NodeSpec, Params, PortSpec, Refused, Role, Summary};
 
@@ -121,19 +122,21 @@ input and a disable; the latch and re-arm; the `state` code at each transition; 
 .ports(PORTS)
 .params(&[AMPLITUDE.spec(), SLEW.spec(), RAMP.spec(), FAULTS.spec(), ENABLE.spec()])
 .safety_guard(ENABLE.name())
+.bound(output_bound)
 .example("amplitude = 1.0\nslew = 4000.0\nramp = 0.01");
 
 /// The ports: the signal and one fault flag per `faults` entry in; the
 /// limited signal and the limiter's state out.
 const PORTS: &[PortSpec] = &[
-    PortSpec::input("in", "1", "actuation signal"),
+    PortSpec::input("in", "1", "actuation signal").view(),
     PortSpec::input("fault", "1", "fault flag: nonzero (or NaN) closes the gate and latches").per(FAULTS.name()),
     PortSpec::output("out", "1", "limited actuation signal"),
     PortSpec::output(
         "state",
         "1",
         "what the limiter did at each sample: 0 armed, 1 clamping, 2 fading, 3 faded, 4 faulted",
-    ),
+    )
+    .view(),
 ];
 /// `in`: the actuation signal.
 const IN: InPort = InPort::named(PORTS, "in");
@@ -182,6 +185,11 @@ struct Limit {
 
 /// Faults kept for the summary (more are counted, not listed).
 const FAULTS_LISTED: usize = 16;
+
+/// The output bound the stability suite checks: |out| ≤ `amplitude`.
+fn output_bound(b: &BoundArgs<'_>) -> Option<PortBound> {
+    Some(("out", b.num(&AMPLITUDE.spec()), "|out| ≤ amplitude".into()))
+}
 
 fn build(p: &Params, ctx: &BuildContext) -> Result<Box<dyn Node>, NodeError> {
     let ramp_steps = (RAMP.get(p) * ctx.rate).round().max(1.0);

@@ -10,6 +10,7 @@ use crate::filters::butterworth::design::{butterworth, Kind};
 use crate::filters::butterworth::sos::Cascade;
 use crate::synth::model_file::ForwardModel;
 use evflow_engine::ports::{InPort, OutPort};
+use evflow_engine::spec::{BoundArgs, PortBound};
 use evflow_engine::typed_params::{Float, Int, Words};
 use evflow_engine::{BuildContext, Io, Node, NodeError, NodeSpec, Params, PortSpec, Role, Summary};
 use std::time::{Duration, Instant};
@@ -79,6 +80,7 @@ pub static SPEC: NodeSpec = NodeSpec::new(
     UPDATE_RATE.spec(),
     BUDGET.spec(),
 ])
+.bound(output_bound)
 .example("models = [\"models/forward-60g-3cms.json\", \"models/forward-60g-7cms.json\", \"models/forward-110g-3cms.json\", \"models/forward-110g-7cms.json\"]\nlookahead = 15\niterations = 4");
 
 /// The ports: the target force and the finger's condition in; the
@@ -88,10 +90,10 @@ const PORTS: &[PortSpec] = &[
     PortSpec::input("load", "g", "finger's normal load"),
     PortSpec::input("velocity", "cm/s", "finger's signed velocity"),
     PortSpec::output("u", "1", "actuation: the envelope on a Nyquist-rate carrier"),
-    PortSpec::output("target", "N", "the target force at this tick"),
-    PortSpec::output("predicted", "N", "the force change the model expects from the actuation now"),
-    PortSpec::output("iterations", "1", "optimizer iterations made since the start (a running count)"),
-    PortSpec::output("fallbacks", "1", "ticks played from a fallback since the start (a running count)"),
+    PortSpec::output("target", "N", "the target force at this tick").view(),
+    PortSpec::output("predicted", "N", "the force change the model expects from the actuation now").view(),
+    PortSpec::output("iterations", "1", "optimizer iterations made since the start (a running count)").view(),
+    PortSpec::output("fallbacks", "1", "ticks played from a fallback since the start (a running count)").view(),
 ];
 /// The target force, `lookahead` samples ahead.
 const FORCE: InPort = InPort::named(PORTS, "force");
@@ -232,6 +234,11 @@ struct Live {
     bad_inputs: u64,
     reduction: f64,
     optimized_ticks: u64,
+}
+
+/// The output bound the stability suite checks: |u| ≤ `bound`.
+fn output_bound(b: &BoundArgs<'_>) -> Option<PortBound> {
+    Some(("u", b.num(&BOUND.spec()), "|u| ≤ bound".into()))
 }
 
 fn build(p: &Params, ctx: &BuildContext) -> Result<Box<dyn Node>, NodeError> {

@@ -14,6 +14,7 @@ mod fuzz_numbers;
 mod layers;
 mod library_from_recordings;
 mod live_chain;
+mod long_functions;
 mod prune;
 mod rate_mismatch;
 mod rig_recordings;

@@ -7,6 +7,7 @@
 pub mod batch;
 pub mod fit;
 pub mod floor_fit;
+pub mod plan_description;
 pub mod plot;
 #[cfg(feature = "studio")]
 pub mod studio;

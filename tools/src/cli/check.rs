@@ -3,12 +3,11 @@
 
 use super::graph_args::GraphArgs;
 use anyhow::{anyhow, bail, Result};
-use evflow_engine::batch::{check_outputs, output_files, Failures};
+use evflow_engine::batch::{check_outputs, output_files};
 use evflow_engine::check::prune::{Folded, Pruning};
 use evflow_engine::check::Pruned;
-use evflow_engine::sweep::{validate, Point};
-use evflow_engine::{Checked, Direction, Plan, PlanOptions};
-use evflow_tools::batch::sweep_runs::sweep_runs;
+use evflow_engine::graph::Axis;
+use evflow_tools::plan_description::{build_runs, validate_runs, Built, PlanDescription, PlanRole};
 
 /// Arguments of `evflow check`.
 #[derive(clap::Args, Debug)]
@@ -39,22 +38,9 @@ pub struct Args {
 /// exits 1.
 pub fn main(a: Args) -> Result<()> {
     let overrides = a.graph.overrides()?;
-    let (graph, swept, all) = sweep_runs(&a.graph.file, &overrides, &a.sweep).map_err(|e| anyhow!("{e}"))?;
-    let total = all.len();
-    let is_sweep = total > 1;
-    let registry = evflow_nodes::registry();
-    let mut failures = Failures::new();
-    let mut runs: Vec<(Point, Checked)> = Vec::with_capacity(total);
-    for v in validate(&graph, &registry, &overrides, all, 0..total) {
-        match v.checked {
-            Ok(c) => runs.push((v.point, c)),
-            Err(e) if !is_sweep => bail!("{e}"),
-            Err(e) => failures.push(v.point.label(), e),
-        }
-    }
-    let Some((first, c)) = runs.first() else {
-        bail!("no run of the sweep validates: {}", failures.summary_as(total, "sweep runs", "fail").trim_end());
-    };
+    let mut v = validate_runs(&a.graph.file, &overrides, &a.sweep).map_err(|e| anyhow!(e))?;
+    let (total, is_sweep) = (v.total, v.is_sweep());
+    let (first, c) = &v.runs[0];
     let g = &c.graph;
     println!("graph `{}` ({}), format {}, base rate {} Hz", g.name, a.graph.file.display(), g.format, g.rate);
     if !g.description.is_empty() {
@@ -62,57 +48,9 @@ pub fn main(a: Args) -> Result<()> {
     }
     // What an offline run leaves out before building anything.
     let pruning = Pruning::new(c, true, true).map_err(|(i, e)| anyhow!("node `{}`: {e}", c.nodes[i].name))?;
-    let order = pruning.order();
     let of_run = if is_sweep { format!(", the first run's: {}", first.label()) } else { String::new() };
-    println!("\nplan ({} of {} nodes, in execution order{of_run}):", order.len(), c.nodes.len());
-    for &i in &order {
-        let n = &c.nodes[i];
-        if let Some(k) = pruning.constant(i) {
-            println!("  {:<16} {:<16} constant: {}", n.name, n.spec.name, k.reason);
-            continue;
-        }
-        let ins: Vec<String> = c
-            .edges
-            .iter()
-            .filter(|e| e.to.0 == i)
-            .map(|e| {
-                format!(
-                    "{}←{}.{}",
-                    n.ports[e.to.1].name, c.nodes[e.from.0].name, c.nodes[e.from.0].ports[e.from.1].name
-                )
-            })
-            .collect();
-        let outs: Vec<String> = (n.ports.iter().enumerate())
-            .filter(|(_, p)| p.dir == Direction::Out)
-            .map(|(k, p)| format!("{} [{}]", p.name, evflow_engine::check::units::output_unit(c, i, k)))
-            .collect();
-        println!(
-            "  {:<16} {:<16} {:>9} Hz ({})  in: {}  out: {}",
-            n.name,
-            n.spec.name,
-            n.ratio.hz(g.rate),
-            n.ratio,
-            if ins.is_empty() { "-".into() } else { ins.join(", ") },
-            if outs.is_empty() { "-".into() } else { outs.join(", ") }
-        );
-    }
-    print_folded("replaced by constants (held, never run; docs/pruning.md):", &pruning.folded());
-    print_pruned("left out (never constructed, their files never opened):", &pruning.pruned(), true);
-    if !c.in_cycle.is_empty() {
-        let names: Vec<&str> = c.in_cycle.iter().map(|&i| c.nodes[i].name.as_str()).collect();
-        println!("\nfeedback cycles broken by: {}", names.join(", "));
-    }
-    if !swept.is_empty() {
-        let shown: Vec<String> = swept
-            .iter()
-            .map(|ax| match &ax.files {
-                Some(p) => format!("{} ({} files matching `{p}`)", ax.name, ax.values.len()),
-                None => format!("{} ({} values)", ax.name, ax.values.len()),
-            })
-            .collect();
-        let plural = if total == 1 { "" } else { "s" };
-        println!("\nsweep: {} → {total} run{plural} (`evflow run` runs them all)", shown.join(" × "));
-    }
+    print_plan(&PlanDescription::new(c, &pruning), &of_run);
+    print_sweep(&v.swept, total);
     for p in &g.plots {
         let fit =
             if p.fit == evflow_engine::graph::Fit::None { String::new() } else { format!(", {} fit", p.fit.name()) };
@@ -120,41 +58,14 @@ pub fn main(a: Args) -> Result<()> {
     }
     // Runs that would write one file would overwrite each other: `run`
     // refuses them before running anything, and so does check.
-    let outputs: Vec<_> = runs.iter().map(|(p, c)| (p.label(), output_files(c, std::path::Path::new("out")))).collect();
-    check_outputs(&outputs).map_err(|e| anyhow!("{}: {e}", graph.file.display()))?;
+    let outputs: Vec<_> =
+        v.runs.iter().map(|(p, c)| (p.label(), output_files(c, std::path::Path::new("out")))).collect();
+    check_outputs(&outputs).map_err(|e| anyhow!("{}: {e}", v.graph.file.display()))?;
     if !a.no_build {
-        let opts = PlanOptions { check_only: true, ..PlanOptions::default() };
-        let mut shown = false;
-        for (p, c) in &runs {
-            let plan = match Plan::build(c, &opts) {
-                Ok(plan) => plan,
-                Err(e) if !is_sweep => bail!("{e}"),
-                Err(e) => {
-                    failures.push(p.label(), e);
-                    continue;
-                }
-            };
-            if shown {
-                continue;
-            }
-            shown = true;
-            let whose = if is_sweep { format!(" (run {})", p.label()) } else { String::new() };
-            println!("\nbuilt{whose}: {} nodes, block {} base ticks", plan.schedule().len(), plan.max_block());
-            for (node, lines) in plan.notes() {
-                for l in lines {
-                    println!("  {node}: {l}");
-                }
-            }
-            let before = pruning.folded();
-            let folded: Vec<Folded> =
-                plan.folded().iter().filter(|f| !before.iter().any(|b| b.node == f.node)).cloned().collect();
-            let before = pruning.pruned();
-            let pruned: Vec<Pruned> =
-                plan.pruned().iter().filter(|p| !before.iter().any(|b| b.node == p.node)).cloned().collect();
-            print_folded("replaced by constants when built:", &folded);
-            print_pruned("left out when built (the nodes were built first, or never):", &pruned, false);
+        if let Some(b) = build_runs(&v.runs, &pruning, is_sweep, &mut v.failures).map_err(|e| anyhow!(e))? {
+            print_built(&b);
         }
-        if is_sweep && failures.is_empty() {
+        if is_sweep && v.failures.is_empty() {
             println!("\nbuilt every run of the sweep ({total})");
         }
     } else {
@@ -163,11 +74,65 @@ pub fn main(a: Args) -> Result<()> {
              without sharp edges: without `--no-build`, check builds the plan and says)"
         );
     }
-    if !failures.is_empty() {
-        bail!("{}", failures.summary_as(total, "sweep runs", "would fail (as `evflow run` runs them)").trim_end());
+    if !v.failures.is_empty() {
+        bail!("{}", v.failures.summary_as(total, "sweep runs", "would fail (as `evflow run` runs them)").trim_end());
     }
     println!("\nok");
     Ok(())
+}
+
+/// The plan (`of_run`: whose, in a sweep): each node in execution order,
+/// what replaces nodes, what is left out, what breaks feedback cycles.
+fn print_plan(plan: &PlanDescription, of_run: &str) {
+    println!("\nplan ({} of {} nodes, in execution order{of_run}):", plan.nodes.len(), plan.of);
+    for n in &plan.nodes {
+        match &n.role {
+            PlanRole::Constant(reason) => println!("  {:<16} {:<16} constant: {reason}", n.name, n.type_name),
+            PlanRole::Runs { hz, ratio, inputs, outputs } => println!(
+                "  {:<16} {:<16} {:>9} Hz ({})  in: {}  out: {}",
+                n.name,
+                n.type_name,
+                hz,
+                ratio,
+                if inputs.is_empty() { "-".into() } else { inputs.join(", ") },
+                if outputs.is_empty() { "-".into() } else { outputs.join(", ") }
+            ),
+        }
+    }
+    print_folded("replaced by constants (held, never run; docs/pruning.md):", &plan.folded);
+    print_pruned("left out (never constructed, their files never opened):", &plan.pruned, true);
+    if !plan.cycles.is_empty() {
+        println!("\nfeedback cycles broken by: {}", plan.cycles.join(", "));
+    }
+}
+
+/// The axes swept and the runs they make.
+fn print_sweep(swept: &[Axis], total: usize) {
+    if swept.is_empty() {
+        return;
+    }
+    let shown: Vec<String> = swept
+        .iter()
+        .map(|ax| match &ax.files {
+            Some(p) => format!("{} ({} files matching `{p}`)", ax.name, ax.values.len()),
+            None => format!("{} ({} values)", ax.name, ax.values.len()),
+        })
+        .collect();
+    let plural = if total == 1 { "" } else { "s" };
+    println!("\nsweep: {} → {total} run{plural} (`evflow run` runs them all)", shown.join(" × "));
+}
+
+/// What building the first run's plan found.
+fn print_built(b: &Built) {
+    let whose = if b.run.is_empty() { String::new() } else { format!(" (run {})", b.run) };
+    println!("\nbuilt{whose}: {} nodes, block {} base ticks", b.nodes, b.block);
+    for (node, lines) in &b.notes {
+        for l in lines {
+            println!("  {node}: {l}");
+        }
+    }
+    print_folded("replaced by constants when built:", &b.folded);
+    print_pruned("left out when built (the nodes were built first, or never):", &b.pruned, false);
 }
 
 /// Nodes replaced by constants, each with its outputs' values and why.

@@ -61,36 +61,32 @@ pub struct Args {
     csv: Option<std::path::PathBuf>,
 }
 
+/// A run of the slice: its sweep index, its values and its checked graph
+/// (or why it does not validate).
+type Item = (usize, Point, Result<Checked, String>);
+
+/// What the runs gave, in sweep order.
+#[derive(Default)]
+struct Done {
+    /// Each finished run's values and report.
+    reports: Vec<(Point, RunReport)>,
+    /// The sweep index of each report, for a shard's record.
+    indices: Vec<usize>,
+    /// The runs that failed, with why.
+    failures: Failures,
+    /// Runs whose outcome came back (fewer when interrupted).
+    received: usize,
+}
+
 /// Runs `evflow run`.
 pub fn main(a: Args) -> Result<()> {
     let overrides = a.graph.overrides()?;
     let (graph, _, all) = sweep_runs(&a.graph.file, &overrides, &a.sweep).map_err(|e| anyhow!("{e}"))?;
-    let registry = evflow_nodes::registry();
-
-    // Validate every run of the sweep before anything is built or written.
-    // A run that does not validate is a failure of that run only; when none
-    // validates, nothing is written.
     let total = all.len();
     let shard = a.batch.shard();
     let slice = shard.range(total);
     let is_sweep = total > 1;
-    let mut items: Vec<(usize, Point, Result<Checked, String>)> = Vec::with_capacity(slice.len());
-    for v in validate(&graph, &registry, &overrides, all, slice.clone()) {
-        match v.checked {
-            Ok(c) => items.push((v.index, v.point, Ok(c))),
-            Err(e) if !is_sweep => bail!("{e}"),
-            Err(e) => items.push((v.index, v.point, Err(e.to_string()))),
-        }
-    }
-    if is_sweep && !items.iter().any(|(_, _, c)| c.is_ok()) {
-        let mut f = Failures::new();
-        for (_, p, c) in &items {
-            if let Err(e) = c {
-                f.push(p.label(), e);
-            }
-        }
-        bail!("nothing was run: {}", f.summary(items.len(), "sweep runs").trim_end());
-    }
+    let items = validate_slice(&graph, &overrides, all, slice.clone(), is_sweep)?;
     // Runs (or nodes) that would write the same file would overwrite each
     // other, or race on `--jobs`: refused before anything runs.
     let outputs: Vec<_> =
@@ -103,7 +99,6 @@ pub fn main(a: Args) -> Result<()> {
         // leaves none and `evflow merge` does not take its files as done.
         remove_record(&a.out)?;
     }
-
     let stop = Arc::new(AtomicBool::new(false));
     {
         let stop = stop.clone();
@@ -112,78 +107,16 @@ pub fn main(a: Args) -> Result<()> {
     }
     let timings = if a.no_times { Timings::Leave } else { Timings::Show };
     let n = items.len();
-    let mut reports: Vec<(Point, RunReport)> = Vec::with_capacity(n);
-    // The sweep index of each report, for a shard's record.
-    let mut indices: Vec<usize> = Vec::with_capacity(n);
-    let mut failures = Failures::new();
-    let labels: Vec<(usize, Point)> = items.iter().map(|(i, p, _)| (*i, p.clone())).collect();
-    let received = if is_sweep {
-        let bar = progress_bar(n, "runs", a.quiet);
-        let work = |_: usize, (_, _, c): (usize, Point, Result<Checked, String>)| -> Result<RunReport, String> {
-            let report = run_one(&c?, &a, &stop, false).map_err(|e| format!("{e:#}"));
-            bar.inc(1);
-            report
-        };
-        let received = for_each_ordered(items, a.batch.jobs(), &stop, work, |k, outcome| {
-            let (i, point) = &labels[k];
-            if !a.quiet {
-                println!("── run {}/{total}: {} ──", i + 1, point.label());
-            }
-            match outcome.and_then(|r| r) {
-                Ok(report) => {
-                    print_report(&report, a.quiet, timings);
-                    reports.push((point.clone(), report));
-                    indices.push(*i);
-                }
-                Err(e) => {
-                    println!("run {} failed: {}", point.label(), e.lines().next().unwrap_or(""));
-                    failures.push(point.label(), e);
-                }
-            }
-            if !a.quiet {
-                println!();
-            }
-        });
-        evflow_tools::batch::finish(&bar);
-        received
-    } else if let Some((_, point, c)) = items.pop() {
-        let report = run_one(&c.map_err(|e| anyhow!(e))?, &a, &stop, true)?;
-        print_report(&report, a.quiet, timings);
-        reports.push((point, report));
-        indices.push(0);
-        1
+    let done = if is_sweep {
+        run_sweep(items, &a, &stop, total, timings)
     } else {
-        // An empty shard (more shards than runs, normal in a job array):
-        // nothing runs, and its record says so for `evflow merge`.
-        println!("shard {shard}: no run of the {total} falls in this slice; its record says so");
-        0
+        run_single(items, &a, &stop, timings, &shard.to_string(), total)?
     };
-    if received < n {
-        bail!("interrupted after {received} of {n} runs");
+    if done.received < n {
+        bail!("interrupted after {} of {n} runs", done.received);
     }
-    if is_sweep {
-        print!("{}", sweep_table(&reports, timings));
-    }
-    if let Some(path) = &a.json {
-        write(path, &report_json(&reports, is_sweep, timings), "results")?;
-    }
-    // A shard holds part of the sweep: its plots are drawn by `evflow merge`
-    // from every run, so that the merge equals one run, plots included.
-    if a.batch.shard.is_none() {
-        let (lines, errors) = evflow_tools::batch::sweep_plots::draw_plots(&graph, &reports, &overrides, &a.out);
-        for l in lines {
-            println!("{l}");
-        }
-        // A figure that cannot be drawn does not undo the runs: say why and go on.
-        for e in errors {
-            eprintln!("warning: {e}");
-        }
-    } else if !graph.plots.is_empty() {
-        println!("plots: drawn by `evflow merge` from the whole sweep");
-    }
-    if let Some(path) = &a.csv {
-        write(path, &sweep_csv(&reports, timings), "table")?;
-    }
+    let Done { reports, indices, failures, .. } = done;
+    write_results(&a, &graph, &overrides, &reports, is_sweep, timings)?;
     if a.batch.shard.is_some() {
         let record = ShardRecord {
             graph: graph.file.display().to_string(),
@@ -204,6 +137,131 @@ pub fn main(a: Args) -> Result<()> {
     }
     if !failures.is_empty() {
         bail!("{}", failures.summary(n, "sweep runs").trim_end());
+    }
+    Ok(())
+}
+
+/// Validates every run of the sweep's `slice` before anything is built
+/// or written. A run that does not validate is a failure of that run
+/// only; when none validates, nothing is written.
+fn validate_slice(
+    graph: &evflow_engine::Graph,
+    overrides: &[evflow_engine::Override],
+    all: Vec<Point>,
+    slice: std::ops::Range<usize>,
+    is_sweep: bool,
+) -> Result<Vec<Item>> {
+    let registry = evflow_nodes::registry();
+    let mut items: Vec<Item> = Vec::with_capacity(slice.len());
+    for v in validate(graph, &registry, overrides, all, slice) {
+        match v.checked {
+            Ok(c) => items.push((v.index, v.point, Ok(c))),
+            Err(e) if !is_sweep => bail!("{e}"),
+            Err(e) => items.push((v.index, v.point, Err(e.to_string()))),
+        }
+    }
+    if is_sweep && !items.iter().any(|(_, _, c)| c.is_ok()) {
+        let mut f = Failures::new();
+        for (_, p, c) in &items {
+            if let Err(e) = c {
+                f.push(p.label(), e);
+            }
+        }
+        bail!("nothing was run: {}", f.summary(items.len(), "sweep runs").trim_end());
+    }
+    Ok(items)
+}
+
+/// Runs a sweep's runs on `--jobs` threads, each printed in sweep order
+/// as it comes back.
+fn run_sweep(items: Vec<Item>, a: &Args, stop: &AtomicBool, total: usize, timings: Timings) -> Done {
+    let mut done = Done::default();
+    let labels: Vec<(usize, Point)> = items.iter().map(|(i, p, _)| (*i, p.clone())).collect();
+    let bar = progress_bar(items.len(), "runs", a.quiet);
+    let work = |_: usize, (_, _, c): Item| -> Result<RunReport, String> {
+        let report = run_one(&c?, a, stop, false).map_err(|e| format!("{e:#}"));
+        bar.inc(1);
+        report
+    };
+    done.received = for_each_ordered(items, a.batch.jobs(), stop, work, |k, outcome| {
+        let (i, point) = &labels[k];
+        if !a.quiet {
+            println!("── run {}/{total}: {} ──", i + 1, point.label());
+        }
+        match outcome.and_then(|r| r) {
+            Ok(report) => {
+                print_report(&report, a.quiet, timings);
+                done.reports.push((point.clone(), report));
+                done.indices.push(*i);
+            }
+            Err(e) => {
+                println!("run {} failed: {}", point.label(), e.lines().next().unwrap_or(""));
+                done.failures.push(point.label(), e);
+            }
+        }
+        if !a.quiet {
+            println!();
+        }
+    });
+    evflow_tools::batch::finish(&bar);
+    done
+}
+
+/// Runs the one run there is — or, in an empty shard (more shards than
+/// runs, normal in a job array), none, which its record says.
+fn run_single(
+    mut items: Vec<Item>,
+    a: &Args,
+    stop: &AtomicBool,
+    timings: Timings,
+    shard: &str,
+    total: usize,
+) -> Result<Done> {
+    let mut done = Done::default();
+    if let Some((_, point, c)) = items.pop() {
+        let report = run_one(&c.map_err(|e| anyhow!(e))?, a, stop, true)?;
+        print_report(&report, a.quiet, timings);
+        done.reports.push((point, report));
+        done.indices.push(0);
+        done.received = 1;
+    } else {
+        println!("shard {shard}: no run of the {total} falls in this slice; its record says so");
+    }
+    Ok(done)
+}
+
+/// A sweep's table, then the --json results, the graph's plots and the
+/// --csv table.
+fn write_results(
+    a: &Args,
+    graph: &evflow_engine::Graph,
+    overrides: &[evflow_engine::Override],
+    reports: &[(Point, RunReport)],
+    is_sweep: bool,
+    timings: Timings,
+) -> Result<()> {
+    if is_sweep {
+        print!("{}", sweep_table(reports, timings));
+    }
+    if let Some(path) = &a.json {
+        write(path, &report_json(reports, is_sweep, timings), "results")?;
+    }
+    // A shard holds part of the sweep: its plots are drawn by `evflow merge`
+    // from every run, so that the merge equals one run, plots included.
+    if a.batch.shard.is_none() {
+        let (lines, errors) = evflow_tools::batch::sweep_plots::draw_plots(graph, reports, overrides, &a.out);
+        for l in lines {
+            println!("{l}");
+        }
+        // A figure that cannot be drawn does not undo the runs: say why and go on.
+        for e in errors {
+            eprintln!("warning: {e}");
+        }
+    } else if !graph.plots.is_empty() {
+        println!("plots: drawn by `evflow merge` from the whole sweep");
+    }
+    if let Some(path) = &a.csv {
+        write(path, &sweep_csv(reports, timings), "table")?;
     }
     Ok(())
 }

@@ -98,10 +98,10 @@ pub fn main(a: Args) -> Result<()> {
         Some(p) => LabProfile::load(p).map_err(|e| anyhow!("{e}"))?,
         None => LabProfile::default(),
     };
-    let mut model =
+    let model =
         DisplayModel::new(&profile, 1000.0, Method::Exact, 4, 1.0, a.seed).map_err(|e| anyhow!("lab profile: {e}"))?;
     let (mut wire, name) = open(&a)?;
-    let mut log = a.log.as_deref().map(Log::create).transpose()?;
+    let log = a.log.as_deref().map(Log::create).transpose()?;
 
     let stop = Arc::new(AtomicBool::new(false));
     {
@@ -118,107 +118,177 @@ pub fn main(a: Args) -> Result<()> {
     );
     let _ = std::io::stdout().flush();
 
-    let finger = Finger { x0: 0.01, travel: a.travel * 0.01, speed: a.speed * 0.01, y: 0.03, load: a.load };
-    let caps = caps::TOUCH | if a.no_force { 0 } else { caps::FORCE };
     let t0 = Instant::now();
-    let mut dev = DeviceSession::new(DeviceConfig { version: a.protocol, caps, ..DeviceConfig::default() }, t0);
-    let mut corrupter = Corrupter::new(a.corrupt, a.seed);
-    let (mut buf, mut out, mut frame) = ([0u8; 4096], Vec::new(), Vec::with_capacity(MAX_FRAME));
-    let mut host = matches!(wire, Wire::Port(_));
-    let mut connects = 0u64;
-    let mut tick = 0u64;
-    let mut received = Vec::new();
+    let mut emu = Emulator::new(&a, model, log, matches!(wire, Wire::Port(_)), t0);
     let end = a.duration.map(|d| t0 + Duration::from_secs_f64(d.max(0.0)));
     while !stop.load(Ordering::SeqCst) && end.is_none_or(|e| Instant::now() < e) {
-        // Bytes from the host.
-        let (port, pty) = match &mut wire {
-            Wire::Pty(p) => (p, true),
-            Wire::Port(p) => (p, false),
-        };
-        match port.read(&mut buf) {
-            Ok(n) if n > 0 => {
-                if !host {
-                    connects += 1;
-                }
-                host = true;
-                dev.receive(Instant::now(), &buf[..n], &mut out, &mut |v| received.push(v));
-            }
-            Err(e) if matches!(e.kind(), ErrorKind::TimedOut | ErrorKind::WouldBlock | ErrorKind::Interrupted) => {
-                if pty && !host {
-                    connects += 1;
-                }
-                host = true;
-            }
-            _ if pty && host => {
-                // Nobody has the pty open (it hangs up): the host is gone.
-                dev.host_gone();
-                host = false;
-            }
-            _ => {}
-        }
-        // The device's 1 kHz clock.
-        let now = Instant::now();
-        let due = now.duration_since(t0).as_millis() as u64;
-        while tick < due {
-            tick += 1;
-            let u = dev.play(now, &mut out);
-            let f = finger.at(tick as f64 * 1e-3);
-            let force = model.step(u, f.load, f.velocity);
-            if dev.engaged() {
-                if !a.no_force {
-                    send(&mut dev, &mut corrupter, Message::Force(force as f32), &mut frame, &mut out);
-                }
-                if tick.is_multiple_of(25) {
-                    let t = Touch { x: f.x as f32, y: f.y as f32, load: f.load as f32, flags: 1 };
-                    send(&mut dev, &mut corrupter, Message::Touch(t), &mut frame, &mut out);
-                }
-                if tick.is_multiple_of(100) {
-                    frame.clear();
-                    dev.heartbeat(now, &mut frame);
-                    corrupter.append(&frame, &mut out);
-                }
-            }
-            if let Some(l) = &mut log {
-                l.tick([u, force, f.x, f.y, f.load, f.velocity])?;
-            }
-        }
-        if host && !out.is_empty() {
-            if let Err(e) = port.write_all(&out) {
-                if !pty {
-                    return Err(anyhow!("{name}: write error: {e}"));
-                }
-            }
-        }
-        out.clear();
-        if let Some(l) = &mut log {
-            for v in received.drain(..) {
-                l.actuation(v)?;
-            }
-            l.maybe_flush(&dev, &corrupter, connects)?;
-        } else {
-            received.clear();
-        }
+        emu.read(&mut wire);
+        emu.clock(Instant::now())?;
+        emu.write(&mut wire, &name)?;
+        emu.log_received()?;
         std::thread::sleep(Duration::from_micros(300));
     }
-    let c = dev.counters();
-    let i = corrupter.injected;
+    let c = emu.dev.counters();
+    let i = emu.corrupter.injected;
     println!(
         "evflow devsim: {:.1} s; actuation frames received {}, lost {}, host connects {}, watchdog {}, \
          FIFO underruns {}; damaged: {} bad CRC, {} truncated, {} garbage bursts",
         t0.elapsed().as_secs_f64(),
         c.actuation,
         c.lost,
-        connects,
+        emu.connects,
         c.watchdog,
         c.fifo_underruns,
         i.bad_crc,
         i.truncated,
         i.garbage_bursts
     );
-    if let Some(l) = log {
-        l.finish(&dev, &corrupter, connects)?;
+    if let Some(l) = emu.log {
+        l.finish(&emu.dev, &emu.corrupter, emu.connects)?;
     }
     Ok(())
+}
+
+/// The emulated device: its protocol session, the display model the
+/// virtual finger scans, and what passes between them and the host.
+struct Emulator {
+    dev: DeviceSession,
+    corrupter: Corrupter,
+    model: DisplayModel,
+    finger: Finger,
+    log: Option<Log>,
+    no_force: bool,
+    /// True while a host is attached.
+    host: bool,
+    /// Times a host attached.
+    connects: u64,
+    /// Milliseconds of the device's clock played.
+    tick: u64,
+    t0: Instant,
+    /// Actuation samples received since the log last took them.
+    received: Vec<i16>,
+    buf: [u8; 4096],
+    /// Bytes to send the host.
+    out: Vec<u8>,
+    frame: Vec<u8>,
+}
+
+impl Emulator {
+    fn new(a: &Args, model: DisplayModel, log: Option<Log>, host: bool, t0: Instant) -> Self {
+        let finger = Finger { x0: 0.01, travel: a.travel * 0.01, speed: a.speed * 0.01, y: 0.03, load: a.load };
+        let caps = caps::TOUCH | if a.no_force { 0 } else { caps::FORCE };
+        Emulator {
+            dev: DeviceSession::new(DeviceConfig { version: a.protocol, caps, ..DeviceConfig::default() }, t0),
+            corrupter: Corrupter::new(a.corrupt, a.seed),
+            model,
+            finger,
+            log,
+            no_force: a.no_force,
+            host,
+            connects: 0,
+            tick: 0,
+            t0,
+            received: Vec::new(),
+            buf: [0u8; 4096],
+            out: Vec::new(),
+            frame: Vec::with_capacity(MAX_FRAME),
+        }
+    }
+
+    /// Bytes from the host, and whether one is attached.
+    fn read(&mut self, wire: &mut Wire) {
+        let (port, pty) = match wire {
+            Wire::Pty(p) => (p, true),
+            Wire::Port(p) => (p, false),
+        };
+        match port.read(&mut self.buf) {
+            Ok(n) if n > 0 => {
+                if !self.host {
+                    self.connects += 1;
+                }
+                self.host = true;
+                let received = &mut self.received;
+                self.dev.receive(Instant::now(), &self.buf[..n], &mut self.out, &mut |v| received.push(v));
+            }
+            Err(e) if matches!(e.kind(), ErrorKind::TimedOut | ErrorKind::WouldBlock | ErrorKind::Interrupted) => {
+                if pty && !self.host {
+                    self.connects += 1;
+                }
+                self.host = true;
+            }
+            _ if pty && self.host => {
+                // Nobody has the pty open (it hangs up): the host is gone.
+                self.dev.host_gone();
+                self.host = false;
+            }
+            _ => {}
+        }
+    }
+
+    /// The device's 1 kHz clock up to `now`: each millisecond plays one
+    /// actuation sample on the display and, while a host is engaged, sends
+    /// the force (1 kHz), a touch frame (40 Hz) and a heartbeat (10 Hz).
+    fn clock(&mut self, now: Instant) -> Result<()> {
+        let due = now.duration_since(self.t0).as_millis() as u64;
+        while self.tick < due {
+            self.tick += 1;
+            let tick = self.tick;
+            let u = self.dev.play(now, &mut self.out);
+            let f = self.finger.at(tick as f64 * 1e-3);
+            let force = self.model.step(u, f.load, f.velocity);
+            if self.dev.engaged() {
+                let (dev, c, frame, out) = (&mut self.dev, &mut self.corrupter, &mut self.frame, &mut self.out);
+                if !self.no_force {
+                    send(dev, c, Message::Force(force as f32), frame, out);
+                }
+                if tick.is_multiple_of(25) {
+                    let t = Touch { x: f.x as f32, y: f.y as f32, load: f.load as f32, flags: 1 };
+                    send(dev, c, Message::Touch(t), frame, out);
+                }
+                if tick.is_multiple_of(100) {
+                    frame.clear();
+                    dev.heartbeat(now, frame);
+                    c.append(frame, out);
+                }
+            }
+            if let Some(l) = &mut self.log {
+                l.tick([u, force, f.x, f.y, f.load, f.velocity])?;
+            }
+        }
+        Ok(())
+    }
+
+    /// Sends what is due to an attached host (a write error ends a real
+    /// port's session; a pty's host may come back).
+    fn write(&mut self, wire: &mut Wire, name: &str) -> Result<()> {
+        let (port, pty) = match wire {
+            Wire::Pty(p) => (p, true),
+            Wire::Port(p) => (p, false),
+        };
+        if self.host && !self.out.is_empty() {
+            if let Err(e) = port.write_all(&self.out) {
+                if !pty {
+                    return Err(anyhow!("{name}: write error: {e}"));
+                }
+            }
+        }
+        self.out.clear();
+        Ok(())
+    }
+
+    /// Hands the actuation received to the log (and its counters, every
+    /// 100 ms); without a log, forgets it.
+    fn log_received(&mut self) -> Result<()> {
+        if let Some(l) = &mut self.log {
+            for v in self.received.drain(..) {
+                l.actuation(v)?;
+            }
+            l.maybe_flush(&self.dev, &self.corrupter, self.connects)?;
+        } else {
+            self.received.clear();
+        }
+        Ok(())
+    }
 }
 
 fn send(dev: &mut DeviceSession, c: &mut Corrupter, m: Message, frame: &mut Vec<u8>, out: &mut Vec<u8>) {

@@ -5,7 +5,7 @@
 //! edge detection on a CAD mesh against its dihedral angles.
 
 use anyhow::{Context, Result};
-use evflow_nodes::mesh::fidelity::{edge_fidelity, gradient_fidelity, line_trace, ScanPlan};
+use evflow_nodes::mesh::fidelity::{edge_fidelity, gradient_fidelity, line_trace, GradientRow, ScanPlan};
 use evflow_nodes::mesh::formats::load_file;
 use evflow_tools::plot::{write_png, Plot, Series};
 use std::path::PathBuf;
@@ -60,9 +60,21 @@ pub fn main(a: Args) -> Result<()> {
         plan.min_step
     );
     let rows = gradient_fidelity(&a.config, &a.resolutions, &plan);
+    print_gradient_table(&rows);
+    gradient_figures(&a, &rows, &plan)?;
+    if a.edges_mesh.exists() {
+        edge_report(&a)?;
+    } else {
+        println!("\n(no edge report: {} not found; pass --edges-mesh)", a.edges_mesh.display());
+    }
+    Ok(())
+}
+
+/// The gradient's fidelity and cost per resolution, as a Markdown table.
+fn print_gradient_table(rows: &[GradientRow]) {
     println!("\n| cells/side | triangles | BVH build ms | µs/tick secant | µs/tick normal | RMS F^sq secant | RMS F^sq normal | RMS tan α secant | RMS tan α normal |");
     println!("|---:|---:|---:|---:|---:|---:|---:|---:|---:|");
-    for r in &rows {
+    for r in rows {
         println!(
             "| {} | {} | {:.2} | {:.3} | {:.3} | {:.4} | {:.4} | {:.4} | {:.4} |",
             r.resolution,
@@ -76,6 +88,11 @@ pub fn main(a: Args) -> Result<()> {
             r.rms_slope_normal
         );
     }
+}
+
+/// The work-precision and resolution figures, and F^sq along one line
+/// through two bumps.
+fn gradient_figures(a: &Args, rows: &[GradientRow], plan: &ScanPlan) -> Result<()> {
     let wp = Plot {
         title: format!("Mesh gradient: error against run time (Gaussian {})", a.config),
         x_label: "ray cast + estimate per tick (µs)".into(),
@@ -109,7 +126,7 @@ pub fn main(a: Args) -> Result<()> {
     };
     report_png(&res, &a.out.join("mesh-gradient-resolution.png"))?;
     let coarse = a.resolutions.iter().copied().find(|&r| r >= 8).unwrap_or(8);
-    let t = line_trace("4B0H", coarse, 0.0, 3.0, &plan);
+    let t = line_trace("4B0H", coarse, 0.0, 3.0, plan);
     let line = Plot {
         title: format!("F^sq along y = 3 cm through two bumps, {coarse} cells/side"),
         x_label: "position along the line (cm)".into(),
@@ -124,46 +141,46 @@ pub fn main(a: Args) -> Result<()> {
         ..Default::default()
     };
     report_png(&line, &a.out.join("mesh-fsq-line.png"))?;
+    Ok(())
+}
 
-    if a.edges_mesh.exists() {
-        let m = load_file(&a.edges_mesh, 0.0).map_err(|e| anyhow::anyhow!("{e}"))?;
-        let turned: Vec<[f64; 3]> = m.vertices.iter().map(|&p| turn(p, &a.up)).collect::<Result<_>>()?;
-        let m = evflow_nodes::mesh::Mesh::new(turned, m.triangles.clone(), 0.0);
-        let b = m.bounds();
-        let ext = (b.max[0] - b.min[0]).max(b.max[1] - b.min[1]);
-        let plan = ScanPlan {
-            offsets: (-4..=4).map(|k| k as f64 * ext / 10.0).collect(),
-            length: 1.2 * ext,
-            ..ScanPlan::standard()
-        };
-        println!(
-            "\nEdges: {} (up: {}, {} triangles), {} directions × {} lines, sharp = θ < 135° (Fig. 4.4), max_angle 160°",
-            a.edges_mesh.display(),
-            a.up,
-            m.triangles.len(),
-            plan.directions.len(),
-            plan.offsets.len()
-        );
-        let f = edge_fidelity(&m, b.min[2], &plan, 135.0, 160.0);
-        println!("\n| quantity | value |\n|---|---:|");
-        for (k, v) in [
-            ("θ_min of the mesh (°)", format!("{:.2}", f.theta_min)),
-            ("consistently oriented interior edges", format!("{:.4}", f.oriented_fraction)),
-            ("ticks changing triangle, resolved to mesh edges", f.resolved_crossings.to_string()),
-            ("  of them skipping triangles (several edges in one tick)", f.multi_edge_crossings.to_string()),
-            ("ticks changing triangle, unresolved", f.unresolved_crossings.to_string()),
-            ("sharp crossings (truth, θ < 135°)", f.sharp_truth.to_string()),
-            ("true positives", f.true_positives.to_string()),
-            ("false positives", f.false_positives.to_string()),
-            ("false negatives", f.false_negatives.to_string()),
-            ("detections on unresolved ticks", f.unverified_detections.to_string()),
-            ("RMS θ error of true positives (°)", format!("{:.3}", f.theta_rms_error)),
-            ("max θ error of true positives (°)", format!("{:.3}", f.theta_max_error)),
-        ] {
-            println!("| {k} | {v} |");
-        }
-    } else {
-        println!("\n(no edge report: {} not found; pass --edges-mesh)", a.edges_mesh.display());
+/// Edge detection on the `--edges-mesh` against its dihedral angles.
+fn edge_report(a: &Args) -> Result<()> {
+    let m = load_file(&a.edges_mesh, 0.0).map_err(|e| anyhow::anyhow!("{e}"))?;
+    let turned: Vec<[f64; 3]> = m.vertices.iter().map(|&p| turn(p, &a.up)).collect::<Result<_>>()?;
+    let m = evflow_nodes::mesh::Mesh::new(turned, m.triangles.clone(), 0.0);
+    let b = m.bounds();
+    let ext = (b.max[0] - b.min[0]).max(b.max[1] - b.min[1]);
+    let plan = ScanPlan {
+        offsets: (-4..=4).map(|k| k as f64 * ext / 10.0).collect(),
+        length: 1.2 * ext,
+        ..ScanPlan::standard()
+    };
+    println!(
+        "\nEdges: {} (up: {}, {} triangles), {} directions × {} lines, sharp = θ < 135° (Fig. 4.4), max_angle 160°",
+        a.edges_mesh.display(),
+        a.up,
+        m.triangles.len(),
+        plan.directions.len(),
+        plan.offsets.len()
+    );
+    let f = edge_fidelity(&m, b.min[2], &plan, 135.0, 160.0);
+    println!("\n| quantity | value |\n|---|---:|");
+    for (k, v) in [
+        ("θ_min of the mesh (°)", format!("{:.2}", f.theta_min)),
+        ("consistently oriented interior edges", format!("{:.4}", f.oriented_fraction)),
+        ("ticks changing triangle, resolved to mesh edges", f.resolved_crossings.to_string()),
+        ("  of them skipping triangles (several edges in one tick)", f.multi_edge_crossings.to_string()),
+        ("ticks changing triangle, unresolved", f.unresolved_crossings.to_string()),
+        ("sharp crossings (truth, θ < 135°)", f.sharp_truth.to_string()),
+        ("true positives", f.true_positives.to_string()),
+        ("false positives", f.false_positives.to_string()),
+        ("false negatives", f.false_negatives.to_string()),
+        ("detections on unresolved ticks", f.unverified_detections.to_string()),
+        ("RMS θ error of true positives (°)", format!("{:.3}", f.theta_rms_error)),
+        ("max θ error of true positives (°)", format!("{:.3}", f.theta_max_error)),
+    ] {
+        println!("| {k} | {v} |");
     }
     Ok(())
 }

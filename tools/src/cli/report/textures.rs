@@ -9,7 +9,7 @@ use evflow_nodes::lab::texture::samples::{self, NAMES};
 use evflow_nodes::recording::format::Recording;
 use evflow_study::cells::write_actuation;
 use evflow_study::row::{Method, Row};
-use evflow_study::run::{run_on, Progress, StudyConfig};
+use evflow_study::run::{run_on, Progress, Study, StudyConfig};
 use evflow_study::saved::{SavedStudy, RECORD};
 use evflow_study::scope::Scope;
 use evflow_study::setup::Cond;
@@ -18,7 +18,7 @@ use evflow_study::tables::textures::Timings;
 use evflow_study::tables::textures::{csv, markdown};
 use evflow_tools::batch::{progress_bar, BatchArgs};
 use evflow_tools::plot::{Plot, Series};
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 
 /// Arguments of `evflow report textures`.
 #[derive(clap::Args, Debug)]
@@ -155,39 +155,52 @@ pub fn main(a: Args) -> Result<()> {
         println!("wrote {}", rows_csv.display());
     }
     if !a.no_plots {
-        for r in &study.rows {
-            let name = format!("textures-{}-{}-{}.png", r.profile, r.sample, r.cond.tag());
-            match spectra_plot(r) {
-                Ok(p) => super::save_png(&p, &a.out.join(name)),
-                Err(e) => eprintln!("warning: {name}: {e}"),
-            }
-        }
+        save_spectra(&study, &a.out);
     }
     if let Some(g) = &a.grid {
-        for r in study.rows.iter().filter(|r| r.profile == "nominal") {
-            for (m, channel, folder) in [
-                (Method::Optimized, "optimized_u", "optimized"),
-                (Method::NarxBinary, "u", "narx"),
-                (Method::Playback, "playback_u", "playback"),
-            ] {
-                let Some(res) = r.method(m) else { continue };
-                let gain = res.chosen.table51.gain;
-                write_actuation(
-                    &r.recording(gain),
-                    channel,
-                    &g.join(format!("{folder}-{}", r.sample)),
-                    &r.sample,
-                    &r.cond,
-                    gain,
-                    m.carrier(),
-                )?;
-            }
-        }
+        write_grids(&study, g)?;
         println!("wrote the grids under {}", g.display());
     }
     if !study.failures.is_empty() {
         let f = evflow_engine::batch::Failures { list: study.failures };
         anyhow::bail!("{}", f.summary(cells + cells * cfg.scope.samples.len(), "steps").trim_end());
+    }
+    Ok(())
+}
+
+/// Each row's spectra as a PNG in `out` (a figure that cannot be drawn
+/// is a warning).
+fn save_spectra(study: &Study, out: &Path) {
+    for r in &study.rows {
+        let name = format!("textures-{}-{}-{}.png", r.profile, r.sample, r.cond.tag());
+        match spectra_plot(r) {
+            Ok(p) => super::save_png(&p, &out.join(name)),
+            Err(e) => eprintln!("warning: {name}: {e}"),
+        }
+    }
+}
+
+/// Each nominal row's grid of actuation signals U_ij (the trained cells
+/// at their Table 5.1 gains) under `g`, one folder per method and texture.
+fn write_grids(study: &Study, g: &Path) -> Result<()> {
+    for r in study.rows.iter().filter(|r| r.profile == "nominal") {
+        for (m, channel, folder) in [
+            (Method::Optimized, "optimized_u", "optimized"),
+            (Method::NarxBinary, "u", "narx"),
+            (Method::Playback, "playback_u", "playback"),
+        ] {
+            let Some(res) = r.method(m) else { continue };
+            let gain = res.chosen.table51.gain;
+            write_actuation(
+                &r.recording(gain),
+                channel,
+                &g.join(format!("{folder}-{}", r.sample)),
+                &r.sample,
+                &r.cond,
+                gain,
+                m.carrier(),
+            )?;
+        }
     }
     Ok(())
 }

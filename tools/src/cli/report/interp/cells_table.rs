@@ -26,13 +26,21 @@ pub(super) fn table(
     rows: &[(bool, Run)],
     seconds: f64,
 ) -> String {
-    let (lo, hi) = (a.band[0], a.band[1]);
     let ff_how = match method {
         Method::Optimized => "the optimized synthesis through the nearest trained condition's forward model, offline",
         Method::Playback => "none: the playback cells are the forces",
         _ => "the nearest trained condition's inverse NARX model",
     };
     let mut md = String::new();
+    periods_line(&mut md, a, method, periods);
+    trained_cells(&mut md, a, ff_how, cells);
+    cross_validation(&mut md, a, rows);
+    means(&mut md, ff_how, rows, seconds);
+    md
+}
+
+/// The cells' method, lab profile and loop periods.
+fn periods_line(md: &mut String, a: &Args, method: Method, periods: &[(String, f64)]) {
     let _ = write!(
         md,
         "Cells: {}, lab profile {}. Loops of whole main periods (`interp`'s `period`, measured on the trained recordings):",
@@ -43,6 +51,12 @@ pub(super) fn table(
         let _ = write!(md, "{} {s} {:.4} mm", if k == 0 { "" } else { "," }, p * 10.0);
     }
     let _ = writeln!(md, ".\n");
+}
+
+/// The trained cells against their control; `ff_how`: how the forces
+/// first scheme makes its actuation.
+fn trained_cells(md: &mut String, a: &Args, ff_how: &str, cells: &[Cell]) {
+    let (lo, hi) = (a.band[0], a.band[1]);
     let _ = writeln!(
         md,
         "## Trained cells U_ij and the control\n\nE_s (Eq. 5.2, {lo}–{hi} Hz, constant-speed stretch) against \
@@ -78,6 +92,11 @@ pub(super) fn table(
             num(i.ff_es())
         );
     }
+}
+
+/// The grid interpolated to each untrained condition and played there.
+fn cross_validation(md: &mut String, a: &Args, rows: &[(bool, Run)]) {
+    let (lo, hi) = (a.band[0], a.band[1]);
     let _ = writeln!(
         md,
         "\n## Cross-validation on the display (Fig. 5.6, 5.9, 6.8)\n\nThe grid interpolated to each untrained \
@@ -120,6 +139,10 @@ pub(super) fn table(
             peak(i)
         );
     }
+}
+
+/// The means over the conditions, and how often the improved scheme wins.
+fn means(md: &mut String, ff_how: &str, rows: &[(bool, Run)], seconds: f64) {
     let mean = |f: &dyn Fn(&Run) -> f64| rows.iter().map(|(_, r)| f(r)).sum::<f64>() / rows.len().max(1) as f64;
     let velocity: Vec<&Run> = rows.iter().filter(|(v, _)| *v).map(|(_, r)| r).collect();
     let wins = velocity.iter().filter(|r| r.schemes[1].scores.cells < r.schemes[0].scores.cells).count();
@@ -141,5 +164,4 @@ pub(super) fn table(
         num(mean(&|r| r.schemes[1].ff_es())),
         velocity.len()
     );
-    md
 }

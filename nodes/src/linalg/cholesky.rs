@@ -1,6 +1,7 @@
 //! The Cholesky factorization A = LLᵀ of a symmetric positive definite
 //! matrix, read from its lower triangle, and the solves with it.
 
+use super::dot;
 use ndarray::linalg::general_mat_mul;
 use ndarray::{s, Array2, Axis};
 
@@ -115,24 +116,6 @@ fn factor_panel(l: &mut Array2<f64>, j0: usize, j1: usize) -> Result<(), NotPosi
         }
     }
     Ok(())
-}
-
-/// Σ x_k y_k with eight running sums (independent chains the compiler
-/// can vectorize; a single sum would wait on each addition).
-fn dot(x: &[f64], y: &[f64]) -> f64 {
-    let mut acc = [0.0; 8];
-    let (xc, yc) = (x.chunks_exact(8), y.chunks_exact(8));
-    let (xr, yr) = (xc.remainder(), yc.remainder());
-    for (a, b) in xc.zip(yc) {
-        for k in 0..8 {
-            acc[k] += a[k] * b[k];
-        }
-    }
-    let mut s = ((acc[0] + acc[4]) + (acc[1] + acc[5])) + ((acc[2] + acc[6]) + (acc[3] + acc[7]));
-    for (a, b) in xr.iter().zip(yr) {
-        s += a * b;
-    }
-    s
 }
 
 #[cfg(test)]

@@ -37,6 +37,7 @@
 //! carrier start. Nothing here allocates after [`Horizon::new`].
 
 use super::envelope::EnvelopeModel;
+use crate::linalg::dot;
 use std::time::Instant;
 
 /// How one tick's synthesis went.
@@ -57,25 +58,6 @@ pub struct TickOutcome {
     /// The model's expected force change now, y\[n\] − c − b (N): what the
     /// synthesis expects the display to render of the target.
     pub predicted: f64,
-}
-
-/// Σ a_i·b_i over two slices of one length, in four running sums (which a
-/// compiler turns into vector lanes).
-#[inline(always)]
-fn dot(a: &[f64], b: &[f64]) -> f64 {
-    let mut acc = [0.0f64; 4];
-    let (ca, cb) = (a.chunks_exact(4), b.chunks_exact(4));
-    let (ra, rb) = (ca.remainder(), cb.remainder());
-    for (x, y) in ca.zip(cb) {
-        for l in 0..4 {
-            acc[l] += x[l] * y[l];
-        }
-    }
-    let mut s = (acc[0] + acc[1]) + (acc[2] + acc[3]);
-    for (x, y) in ra.iter().zip(rb) {
-        s += x * y;
-    }
-    s
 }
 
 /// The solver's state and scratch, sized once.

@@ -1,6 +1,6 @@
 //! The house's rules, held against the code (docs/architecture.md):
 //!
-//! * **Layers.** engine < nodes < study < tools: a crate depends only on
+//! * **Layers.** dsp, engine < nodes < study < tools: a crate depends only on
 //!   crates below it (its `Cargo.toml`), so no arrow runs back up between
 //!   the layers.
 //! * **No circles.** Inside each crate, no two source files import each
@@ -21,8 +21,13 @@ use std::collections::{BTreeMap, BTreeSet};
 use std::path::{Path, PathBuf};
 
 /// The layers, bottom first, with the crate folders that form them.
-const LAYERS: &[(&str, &str)] =
-    &[("evflow-engine", "engine"), ("evflow-nodes", "nodes"), ("evflow-study", "study"), ("evflow", "tools")];
+const LAYERS: &[(&str, &str)] = &[
+    ("evflow-dsp", "dsp"),
+    ("evflow-engine", "engine"),
+    ("evflow-nodes", "nodes"),
+    ("evflow-study", "study"),
+    ("evflow", "tools"),
+];
 
 /// One crate root's module tree: module path → file, and the names each
 /// module hands on (`pub use path::Name`) with the path they name.
@@ -558,4 +563,54 @@ fn a_module_with_files_is_a_folder_with_mod_rs() {
     std::fs::write(d.path().join("a.rs"), "mod b;").unwrap();
     std::fs::write(d.path().join("a/b.rs"), "").unwrap();
     assert_eq!(file_and_folder_pairs(d.path()), [d.path().join("a.rs")]);
+}
+
+/// Every `.rs` file under `dir`, recursively.
+fn rust_files(dir: &Path) -> Vec<PathBuf> {
+    let mut found = Vec::new();
+    let Ok(entries) = std::fs::read_dir(dir) else { return found };
+    for e in entries.flatten() {
+        let p = e.path();
+        if p.is_dir() {
+            found.extend(rust_files(&p));
+        } else if p.extension().is_some_and(|x| x == "rs") {
+            found.push(p);
+        }
+    }
+    found
+}
+
+/// Where `text`, its `//` comments cut, names one of rustfft's or rubato's
+/// generic constructors: `(line number, line)`.
+fn generic_dsp_constructors(text: &str) -> Vec<(usize, String)> {
+    const NAMES: [&str; 5] = ["FftPlanner", "Async::<", "Async::new", "Fft::<f64>", "rubato::Fft"];
+    text.lines()
+        .enumerate()
+        .filter(|(_, l)| {
+            let code = l.split("//").next().unwrap_or("");
+            NAMES.iter().any(|n| code.contains(n))
+        })
+        .map(|(i, l)| (i + 1, l.trim().to_string()))
+        .collect()
+}
+
+#[test]
+fn rustfft_and_rubato_are_instantiated_only_in_dsp() {
+    // dsp/src/lib.rs: named anywhere else, the planner with all its
+    // butterflies is compiled again there (and again for its unit tests).
+    let root = evflow_tests::root();
+    let mut found = Vec::new();
+    for (_, dir) in LAYERS.iter().filter(|(_, d)| *d != "dsp").chain([&("evflow-tests", "tests")]) {
+        // This file names them to look for them.
+        for f in rust_files(&root.join(dir)).into_iter().filter(|f| !f.ends_with("tests/layers.rs")) {
+            let text = std::fs::read_to_string(&f).unwrap();
+            for (n, l) in generic_dsp_constructors(&text) {
+                found.push(format!("{}:{n}: {l}", f.strip_prefix(&root).unwrap_or(&f).display()));
+            }
+        }
+    }
+    assert!(found.is_empty(), "use evflow_dsp::fft / evflow_dsp::resamplers instead:\n{}", found.join("\n"));
+    // The reader sees a use, not a comment.
+    let made_up = "let p = FftPlanner::new();\n// FftPlanner in a comment\nlet r = Async::<f64>::new_poly(1.0);";
+    assert_eq!(generic_dsp_constructors(made_up).iter().map(|(n, _)| *n).collect::<Vec<_>>(), [1, 3]);
 }

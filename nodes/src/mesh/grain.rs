@@ -229,7 +229,7 @@ impl Node for Grain {
 mod tests {
     use super::*;
     use evflow_engine::harness::Single;
-    use rustfft::{num_complex::Complex, FftPlanner};
+    use rustfft::num_complex::Complex;
 
     fn run(params: &str, area: Vec<f64>, edge: Option<Vec<f64>>) -> Vec<f64> {
         let n = area.len() as u64;
@@ -242,7 +242,7 @@ mod tests {
 
     fn magnitudes(x: &[f64], n: usize) -> Vec<f64> {
         let mut buf: Vec<Complex<f64>> = (0..n).map(|i| Complex::new(x.get(i).copied().unwrap_or(0.0), 0.0)).collect();
-        FftPlanner::new().plan_fft_forward(n).process(&mut buf);
+        evflow_dsp::fft::forward(n).process(&mut buf);
         buf[..n / 2].iter().map(|c| c.norm()).collect()
     }
 

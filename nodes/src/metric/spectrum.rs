@@ -22,7 +22,7 @@
 //! the result does not depend on how the samples were split into blocks.
 
 use rustfft::num_complex::Complex;
-use rustfft::{Fft, FftPlanner};
+use rustfft::Fft;
 use std::f64::consts::PI;
 use std::sync::Arc;
 
@@ -225,7 +225,7 @@ impl SpectrumAccumulator {
     pub fn new(cfg: SpectrumConfig) -> Result<Self, SpectrumError> {
         cfg.validate()?;
         let n = cfg.nfft;
-        let fft = FftPlanner::new().plan_fft_forward(n);
+        let fft = evflow_dsp::fft::forward(n);
         let scratch = vec![Complex::new(0.0, 0.0); fft.get_inplace_scratch_len()];
         Ok(Self {
             cfg,

@@ -23,7 +23,6 @@
 //! [`measure`] and lengthens the filter until the figures hold.
 
 use rustfft::num_complex::Complex64;
-use rustfft::FftPlanner;
 use std::f64::consts::PI;
 
 /// The modified Bessel function of the first kind, order 0 (power series;
@@ -108,7 +107,7 @@ pub fn measure(taps: &[f64], pass_edge: f64, stop_edge: f64) -> Response {
     let n = (32 * taps.len()).next_power_of_two().max(4096);
     let mut buf: Vec<Complex64> = taps.iter().map(|&t| Complex64::new(t, 0.0)).collect();
     buf.resize(n, Complex64::new(0.0, 0.0));
-    FftPlanner::new().plan_fft_forward(n).process(&mut buf);
+    evflow_dsp::fft::forward(n).process(&mut buf);
     let (mut pass_deviation, mut stop_gain) = (0.0f64, 0.0f64);
     for (k, h) in buf.iter().take(n / 2 + 1).enumerate() {
         let f = k as f64 / n as f64;

@@ -44,8 +44,8 @@
 
 use rubato::audioadapter_buffers::direct::SequentialSlice;
 use rubato::{
-    calculate_cutoff, Async, FixedAsync, PolynomialDegree, Resampler, SincInterpolationParameters,
-    SincInterpolationType, WindowFunction,
+    calculate_cutoff, FixedAsync, PolynomialDegree, Resampler, SincInterpolationParameters, SincInterpolationType,
+    WindowFunction,
 };
 
 /// Inputs are multiplied by this on entry (and outputs divided by it).
@@ -135,7 +135,7 @@ pub enum ResampleError {
 
 /// One resampled stream.
 pub struct Stream {
-    inner: Async<f64>,
+    inner: Box<dyn Resampler<f64>>,
     ratio: f64,
     lag: f64,
     lookahead: f64,
@@ -166,7 +166,7 @@ impl Stream {
                 if step > MAX_STEP {
                     return Err(ResampleError::StepTooLarge { step, quality: quality.name(), taps: 4 });
                 }
-                let inner = Async::<f64>::new_poly(ratio, 1.0, PolynomialDegree::Cubic, 1, 1, FixedAsync::Output)
+                let inner = evflow_dsp::resamplers::async_poly(ratio, PolynomialDegree::Cubic, 1, FixedAsync::Output)
                     .map_err(|e| rub(&e))?;
                 (inner, 2.0, 2.0)
             }
@@ -186,7 +186,7 @@ impl Stream {
                     .interpolation(SincInterpolationType::Cubic)
                     .f_cutoff(cutoff);
                 let inner =
-                    Async::<f64>::new_sinc(ratio, 1.0, &params, 1, 1, FixedAsync::Output).map_err(|e| rub(&e))?;
+                    evflow_dsp::resamplers::async_sinc(ratio, &params, 1, FixedAsync::Output).map_err(|e| rub(&e))?;
                 (inner, taps as f64 / 2.0 - 1.0 / phases as f64, 1.0)
             }
         };

@@ -224,7 +224,6 @@ mod tests {
     use evflow_engine::harness::Single;
     use evflow_engine::{run_offline, RunOptions};
     use rustfft::num_complex::Complex;
-    use rustfft::FftPlanner;
 
     /// MATLAB `idinput(511,'prbs',[0 1],[-1 1])`, first 32 samples.
     const MATLAB_PRBS9_START: &str = "---------++++----+---++++-+--++-";
@@ -296,7 +295,7 @@ mod tests {
         let c = 1.5;
         let y = run("order = 9\nperiods = 1\nlevel = 1.5", 511, 100);
         let mut x: Vec<Complex<f64>> = y.iter().map(|&v| Complex::new(v, 0.0)).collect();
-        FftPlanner::new().plan_fft_forward(511).process(&mut x);
+        evflow_dsp::fft::forward(511).process(&mut x);
         // Sum of one period: 255·c − 256·c = −c. Every other bin: |X|² = (N + 1)·c².
         assert!((x[0].re + c).abs() < 1e-9 && x[0].im.abs() < 1e-9, "DC {}", x[0]);
         for (k, v) in x.iter().enumerate().skip(1) {

@@ -20,7 +20,7 @@ use super::error::SynthError;
 use crate::metric::spectral_error::Band;
 use crate::metric::spectrum::{averaged_spectrum, SpectrumConfig, ROUNDING_LEVEL};
 use rustfft::num_complex::Complex;
-use rustfft::{Fft, FftPlanner};
+use rustfft::Fft;
 use std::sync::Arc;
 
 /// A noise power spectrum that grows with the actuation: the expected
@@ -114,7 +114,7 @@ impl SpectralTarget {
         }
         let hop = cfg.hop();
         let starts: Vec<usize> = (0..).map(|p| p * hop).take_while(|s| s + nfft <= real.len()).collect();
-        let fft = FftPlanner::new().plan_fft_forward(nfft);
+        let fft = evflow_dsp::fft::forward(nfft);
         let scratch = vec![Complex::default(); fft.get_inplace_scratch_len()];
         Ok(Self {
             cfg,

@@ -370,7 +370,7 @@ pub fn noise_spectrum(r: &[f64], u: &[f64], rate: f64) -> Option<NoiseSpectrum> 
     let hop = nfft / 2;
     let w = crate::metric::spectrum::Window::Hann.coefficients(nfft);
     let energy: f64 = w.iter().map(|v| v * v).sum();
-    let fft = rustfft::FftPlanner::<f64>::new().plan_fft_forward(nfft);
+    let fft = evflow_dsp::fft::forward(nfft);
     let bins = nfft / 2 + 1;
     let (mut powers, mut ps) = (Vec::new(), Vec::new());
     let mut buf = vec![Complex::default(); nfft];

@@ -16,7 +16,7 @@ use super::kernel::SincKernel;
 use crate::rate::resampler::{Quality, ResampleError, Stream};
 use rubato::audioadapter_buffers::direct::SequentialSlice;
 use rubato::{
-    Async, Fft, FixedAsync, FixedSync, PolynomialDegree, Resampler, SincInterpolationParameters, SincInterpolationType,
+    FixedAsync, FixedSync, PolynomialDegree, Resampler, SincInterpolationParameters, SincInterpolationType,
     WindowFunction,
 };
 
@@ -137,14 +137,14 @@ pub fn rs(y: &[f64], p: f64, q: f64, method: RsMethod) -> Result<Vec<f64>, RsErr
             let params = SincInterpolationParameters::new(len.max(8), WindowFunction::BlackmanHarris2)
                 .oversampling_factor(256)
                 .interpolation(SincInterpolationType::Cubic);
-            Box::new(Async::<f64>::new_sinc(ratio, 1.0, &params, 1024, 1, FixedAsync::Input).map_err(|e| rub(&e))?)
+            evflow_dsp::resamplers::async_sinc(ratio, &params, 1024, FixedAsync::Input).map_err(|e| rub(&e))?
         }
         RsMethod::RubatoPoly(d) => {
-            Box::new(Async::<f64>::new_poly(ratio, 1.0, d, 1024, 1, FixedAsync::Input).map_err(|e| rub(&e))?)
+            evflow_dsp::resamplers::async_poly(ratio, d, 1024, FixedAsync::Input).map_err(|e| rub(&e))?
         }
         RsMethod::RubatoFft => {
             let (a, b) = rational(p, q).ok_or(RsError::NotRational { p, q })?;
-            Box::new(Fft::<f64>::new(b, a, 1024, 1, FixedSync::Input).map_err(|e| rub(&e))?)
+            evflow_dsp::resamplers::fft(b, a, 1024, FixedSync::Input).map_err(|e| rub(&e))?
         }
     };
     let input = SequentialSlice::new(y, 1, y.len()).map_err(|e| rub(&e))?;

@@ -1,18 +1,14 @@
 //! `evflow live FILE`: run a graph in real time, recording the session.
 
-mod disk;
 mod ending;
-pub mod integrity;
-mod recorder;
-pub mod session;
 mod setup;
-mod steal;
 mod threads;
 
 use super::graph_args::GraphArgs;
 use anyhow::{anyhow, Context, Result};
 use evflow_engine::live;
-use recorder::Recorder;
+use evflow_tools::live_session::recorder::Recorder;
+use evflow_tools::live_session::{disk, integrity, recorder, session, steal};
 #[cfg(feature = "studio")]
 use std::path::Path;
 use std::path::PathBuf;
@@ -95,16 +91,6 @@ pub struct Args {
     #[cfg(feature = "studio")]
     #[arg(long, requires = "studio")]
     studio_public: bool,
-}
-
-#[cfg(feature = "studio")]
-impl recorder::Tee for evflow_tools::studio::Ingest {
-    fn samples(&mut self, tap: usize, samples: &[f64]) {
-        evflow_tools::studio::Ingest::samples(self, tap, samples);
-    }
-    fn event(&mut self, e: &evflow_engine::live::Event) {
-        evflow_tools::studio::Ingest::event(self, e);
-    }
 }
 
 /// Runs `evflow live`.

@@ -106,7 +106,6 @@ impl Recorder {
     }
 
     /// Hands every drained sample and event to `tee` as well.
-    #[cfg_attr(not(feature = "studio"), allow(dead_code))]
     pub fn tee(mut self, tee: Box<dyn Tee>) -> Self {
         self.tee = Some(tee);
         self
@@ -233,6 +232,17 @@ impl Recorder {
             .map(|(sink, err)| (sink.spec.file.clone(), sink.frames, sink.gap_frames, err))
             .collect();
         RecorderReport { files, events: self.events_logged, event_error: disk.event_error }
+    }
+}
+
+/// The studio sees what the recorder drains.
+#[cfg(feature = "studio")]
+impl Tee for crate::studio::Ingest {
+    fn samples(&mut self, tap: usize, samples: &[f64]) {
+        crate::studio::Ingest::samples(self, tap, samples);
+    }
+    fn event(&mut self, e: &Event) {
+        crate::studio::Ingest::event(self, e);
     }
 }
 

@@ -106,6 +106,7 @@ impl Recorder {
     }
 
     /// Hands every drained sample and event to `tee` as well.
+    #[cfg_attr(not(feature = "studio"), allow(dead_code))]
     pub fn tee(mut self, tee: Box<dyn Tee>) -> Self {
         self.tee = Some(tee);
         self

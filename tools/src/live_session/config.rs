@@ -14,7 +14,7 @@ pub struct SessionConfig {
     /// named in the manifest (`graph_source`) and in errors.
     pub graph_file: PathBuf,
     /// The `--set` overrides as typed (`name=value`, `node.param=value`),
-    /// recorded in the manifest; the graph given to [`run`](super::run)
+    /// recorded in the manifest; the graph given to [`run`](fn@super::run)
     /// must have been loaded with them.
     pub overrides: Vec<String>,
     /// The session length in seconds (`None`: the graph's `duration`).

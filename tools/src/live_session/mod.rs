@@ -2,7 +2,7 @@
 //! sources, safety guards and taps are recorded to a session folder that
 //! `evflow replay` and `evflow studio` read back.
 //!
-//! [`run`] runs one as a [`SessionConfig`] says and returns it [`Ended`];
+//! [`run()`] runs one as a [`SessionConfig`] says and returns it [`Ended`];
 //! [`session`] and [`integrity`] read and check what it recorded. Inside:
 //! `setup` (the live plan, the folder and its manifest, the pacing),
 //! `threads` (Ctrl-C, the console, the metrics display, the recorder's

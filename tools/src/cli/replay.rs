@@ -7,7 +7,7 @@
 //! outputs are compared with the recorded ones: with the session's own
 //! graph they are identical bit for bit, because the live tick and the
 //! offline step are the same code. With the session's own graph the folder
-//! is also held to what the session recorded of itself (`live::integrity`):
+//! is also held to what the session recorded of itself (`live_session::integrity`):
 //! its graph file, seed and files, each as long and as written as when it
 //! ended — or the replay says what it could not check, and `--check`
 //! ends with exit status [`UNPROVEN_EXIT`] ([`Unproven`]).
@@ -16,14 +16,14 @@
 //! threads, each into its own folder under `--out`, printed in the order
 //! given; one that fails does not stop the others.
 
-use super::live::integrity::Verdict;
-use super::live::session::{read_events, FileSpec, LoggedEvent, Manifest};
 use anyhow::{anyhow, bail, Context, Result};
 use evflow_engine::batch::{for_each_ordered, Failures};
 use evflow_engine::graph::{parse_graph, ParamDecl};
 use evflow_engine::{check, Override, Plan, PlanOptions, Value};
 use evflow_nodes::recording::format::Recording;
 use evflow_tools::batch::{progress_bar, JobsArg};
+use evflow_tools::live_session::integrity::Verdict;
+use evflow_tools::live_session::session::{read_events, FileSpec, LoggedEvent, Manifest};
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
 use std::sync::atomic::AtomicBool;
@@ -263,7 +263,7 @@ fn replay_one(session: &Path, graph: Option<&Path>, out: &Path, a: &Args) -> Res
     // The folder held to what the session recorded of itself: its graph,
     // seed and files, every file as long and as written as it ended.
     if own {
-        for f in super::live::integrity::check(&session_dir, &m, &raw) {
+        for f in evflow_tools::live_session::integrity::check(&session_dir, &m, &raw) {
             match f.verdict {
                 Verdict::Fails => {
                     let _ = writeln!(shown, "not the session's: {}", f.what);

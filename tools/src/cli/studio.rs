@@ -1,9 +1,9 @@
 //! `evflow studio SESSION`: the studio page for a recorded session.
 
 use super::graph_args::load_with;
-use super::live::session::Manifest;
 use anyhow::{anyhow, Context, Result};
 use evflow_nodes::recording::format::Recording;
+use evflow_tools::live_session::session::Manifest;
 use evflow_tools::studio::{publish_replay, serve_recorded, RecordedSession, RecordedTap, StudioConfig};
 use serde_json::Value;
 use std::path::{Path, PathBuf};

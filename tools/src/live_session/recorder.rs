@@ -236,6 +236,17 @@ impl Recorder {
     }
 }
 
+/// The studio sees what the recorder drains.
+#[cfg(feature = "studio")]
+impl Tee for crate::studio::Ingest {
+    fn samples(&mut self, tap: usize, samples: &[f64]) {
+        crate::studio::Ingest::samples(self, tap, samples);
+    }
+    fn event(&mut self, e: &Event) {
+        crate::studio::Ingest::event(self, e);
+    }
+}
+
 /// The console's line for a change that landed (none for other events).
 fn echo_line(e: &Event, names: &[String], base_rate: f64) -> Option<String> {
     let name = |k: u32| names.get(k as usize).map_or_else(|| format!("#{k}"), String::clone);

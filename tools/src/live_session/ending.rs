@@ -1,14 +1,16 @@
 //! The session's end: waiting for its threads, the record of how it ended
-//! (in the manifest and `--json`) and the printed report.
+//! (in the manifest and `--json`) and the report to print.
 
+use super::config::SessionConfig;
+use super::integrity;
 use super::recorder::RecorderReport;
 use super::session::Manifest;
-use super::{integrity, Args};
 use anyhow::{anyhow, Result};
 use evflow_engine::live::{Metrics, MetricsSummary, Percentiles, RtExit, RtThread, Shared};
 use evflow_engine::Summary;
 use serde_json::json;
-use std::path::Path;
+use std::fmt;
+use std::path::{Path, PathBuf};
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::Arc;
 use std::thread::JoinHandle;
@@ -48,17 +50,16 @@ impl Ran {
         Ok(Ran { exit, wall, stolen, rec, metrics })
     }
 
-    /// Finishes the plan's nodes, writes how the session ended to the
-    /// manifest (and `--json`), prints the report, and fails when a node
-    /// or a fault stopped the session.
+    /// Finishes the plan's nodes and writes how the session ended to the
+    /// manifest (and `--json`); the session's report and outcome.
     pub(super) fn finish(
         self,
-        a: &Args,
+        c: &SessionConfig,
         dir: &Path,
         manifest: &Manifest,
         shared: &Arc<Shared>,
         base_rate: f64,
-    ) -> Result<()> {
+    ) -> Result<Ended> {
         let summary = self.metrics.summary(shared, base_rate);
         let mut exit = self.exit;
         let sums = exit.plan.plan_mut().finish().map_err(|e| anyhow!("{e}"))?;
@@ -68,77 +69,98 @@ impl Ran {
             (None, Some(r)) => r.as_str().to_string(),
             (None, None) => "unknown".into(),
         };
-        let end = End { exit: &exit, wall: self.wall, stolen: self.stolen, rec: &self.rec, summary: &summary };
-        let record = end.record(dir, base_rate, &reason);
-        manifest.write(dir, if exit.failure.is_some() { "failed" } else { "ended" }, Some(record.clone()))?;
-        if let Some(path) = &a.json {
+        let (wall, stolen, rec) = (self.wall, self.stolen, self.rec);
+        let ended = Ended { dir: dir.to_path_buf(), base_rate, reason, exit, wall, stolen, rec, summary, sums };
+        let record = ended.record();
+        manifest.write(dir, if ended.exit.failure.is_some() { "failed" } else { "ended" }, Some(record.clone()))?;
+        if let Some(path) = &c.json {
             std::fs::write(path, serde_json::to_string_pretty(&record)?)
                 .map_err(|e| anyhow!("{}: cannot write results: {e}", path.display()))?;
         }
-        end.print(dir, base_rate, &reason, &sums);
-        match exit.failure {
-            Some(f) => Err(anyhow!("{f}")),
-            None if exit.reason.is_some_and(|r| r.is_fault()) => Err(anyhow!("session stopped by a fault: {reason}")),
-            None => Ok(()),
-        }
+        Ok(ended)
     }
 }
 
-/// What a session's end is told from.
-struct End<'a> {
-    exit: &'a RtExit,
+/// A session that has ended, its end recorded in its folder: the report
+/// to print (its `Display`) and its outcome.
+pub struct Ended {
+    dir: PathBuf,
+    base_rate: f64,
+    /// Why it stopped, for people.
+    reason: String,
+    exit: RtExit,
+    /// Wall-clock time of the real-time thread.
     wall: Duration,
+    /// Host steal during the session (seconds), where the system tells it.
     stolen: Option<f64>,
-    rec: &'a RecorderReport,
-    summary: &'a MetricsSummary,
+    rec: RecorderReport,
+    summary: MetricsSummary,
+    /// The nodes' summaries.
+    sums: Vec<(String, Summary)>,
 }
 
-impl End<'_> {
+impl Ended {
+    /// Fails when a node or a fault stopped the session.
+    pub fn outcome(self) -> Result<()> {
+        match self.exit.failure {
+            Some(f) => Err(anyhow!("{f}")),
+            None if self.exit.reason.is_some_and(|r| r.is_fault()) => {
+                Err(anyhow!("session stopped by a fault: {}", self.reason))
+            }
+            None => Ok(()),
+        }
+    }
+
     /// The record of the session's end: ticks, times, why it stopped, the
     /// metrics and each recorded file with its fingerprint.
-    fn record(&self, dir: &Path, base_rate: f64, reason: &str) -> serde_json::Value {
+    fn record(&self) -> serde_json::Value {
         let files: Vec<_> = self
             .rec
             .files
             .iter()
             .map(|(f, n, gap, err)| {
                 // The fingerprint of the samples as written: `evflow replay --check` holds the file to it.
-                let hash = integrity::file_hash(&dir.join(format!("{f}.wav"))).ok();
+                let hash = integrity::file_hash(&self.dir.join(format!("{f}.wav"))).ok();
                 json!({ "file": f, "frames": n, "gap_frames": gap, "error": err, "hash": hash })
             })
             .collect();
         json!({
             "ticks": self.exit.ticks,
-            "seconds": self.exit.ticks as f64 / base_rate,
+            "seconds": self.exit.ticks as f64 / self.base_rate,
             "wall_seconds": self.wall.as_secs_f64(),
-            "stopped": reason,
+            "stopped": self.reason,
             "realtime": self.exit.realtime.to_string(),
-            "metrics": metrics_json(self.summary),
+            "metrics": metrics_json(&self.summary),
             "host_steal_seconds": self.stolen,
             "files": files,
             "events": self.rec.events,
         })
     }
+}
 
-    /// Prints the report: ticks and why it stopped, the real-time grant,
-    /// host steal, the metrics, the recorded files and the nodes' summaries.
-    fn print(&self, dir: &Path, base_rate: f64, reason: &str, sums: &[(String, Summary)]) {
-        let exit = self.exit;
-        println!(
-            "session {}: {} ticks ({:.3} s), stopped: {reason}",
-            dir.display(),
+/// The report: ticks and why it stopped, the real-time grant, host steal,
+/// the metrics, the recorded files and the nodes' summaries.
+impl fmt::Display for Ended {
+    fn fmt(&self, out: &mut fmt::Formatter<'_>) -> fmt::Result {
+        let exit = &self.exit;
+        writeln!(
+            out,
+            "session {}: {} ticks ({:.3} s), stopped: {}",
+            self.dir.display(),
             exit.ticks,
-            exit.ticks as f64 / base_rate
-        );
-        println!("real-time thread: {}", exit.realtime);
+            exit.ticks as f64 / self.base_rate,
+            self.reason
+        )?;
+        writeln!(out, "real-time thread: {}", exit.realtime)?;
         if let Some(st) = self.stolen.filter(|&st| st > 0.0) {
-            println!(
+            writeln!(
+                out,
                 "host steal: {:.0} ms of CPU time taken from this virtual machine by its host during the session \
                  (stalls no setting inside the machine prevents; see docs/live.md)",
                 st * 1e3
-            );
+            )?;
         }
-        println!("{}", self.summary);
+        writeln!(out, "{}", self.summary)?;
         for (f, n, gap, err) in &self.rec.files {
             let gap = if *gap > 0 {
                 format!(", {gap} lost to a full tap ring: the recorder fell behind (zero-filled, see events.jsonl)")
@@ -146,31 +168,33 @@ impl End<'_> {
                 String::new()
             };
             match err {
-                None => println!("recorded {f} ({n} frames{gap})"),
-                Some(e) => println!("recorded {f}: FAILED: {e}"),
+                None => writeln!(out, "recorded {f} ({n} frames{gap})")?,
+                Some(e) => writeln!(out, "recorded {f}: FAILED: {e}")?,
             }
         }
         if let Some(e) = &self.rec.event_error {
-            println!("event log: FAILED: {e}");
+            writeln!(out, "event log: FAILED: {e}")?;
         }
-        println!("{RECORDED}");
-        for (node, s) in sums {
+        writeln!(out, "{RECORDED}")?;
+        for (node, s) in &self.sums {
             for l in &s.lines {
-                println!("{node}: {l}");
+                writeln!(out, "{node}: {l}")?;
             }
             for (k, v, unit) in &s.values {
-                println!(
+                writeln!(
+                    out,
                     "{node}: {k} = {}{}",
-                    evflow_tools::batch::tables::number(*v),
-                    evflow_tools::batch::tables::unit_suffix(unit)
-                );
+                    crate::batch::tables::number(*v),
+                    crate::batch::tables::unit_suffix(unit)
+                )?;
             }
         }
+        Ok(())
     }
 }
 
 /// What a session records, said after the list of its files.
-pub(super) const RECORDED: &str = "(a session records what its replay needs: every source's outputs and every safety \
+const RECORDED: &str = "(a session records what its replay needs: every source's outputs and every safety \
      guard's; `--tap NODE.PORT` records another output too, to see it in `evflow studio` or read it later — \
      `evflow check FILE` lists the outputs there are)";
 

@@ -2,8 +2,9 @@
 //! and its taps, the session folder with its manifest, the pacing and the
 //! scripted changes.
 
+use super::config::{SessionConfig, DEFAULT_MISS_STREAK};
+use super::integrity;
 use super::session::{FileSpec, Manifest};
-use super::{integrity, Args, DEFAULT_MISS_STREAK};
 use anyhow::{anyhow, Result};
 use evflow_engine::live::{Control, LiveConfig, LivePlan, LiveVar, RealtimeRequest, Tap};
 use evflow_engine::{Checked, Plan, PlanOptions};
@@ -13,28 +14,26 @@ use std::time::Duration;
 /// Builds the graph's plan for one-sample ticks and the live plan that
 /// records its sources, guards, `--tap`s (and, with the studio, what its
 /// page shows by default); also returns how many of the taps are inputs.
-pub(super) fn live_plan(a: &Args, checked: &Checked, seed: u64) -> Result<(LivePlan, usize)> {
+pub(super) fn live_plan(c: &SessionConfig, checked: &Checked, seed: u64) -> Result<(LivePlan, usize)> {
     let opts = PlanOptions {
         max_block: 1,
         seed: Some(seed),
         base_dir: None,
-        out_dir: Some(a.out.clone()),
+        out_dir: Some(c.out.clone()),
         timing: false,
         mode: evflow_engine::RunMode::Live,
         check_only: false,
     };
     let plan = Plan::build(checked, &opts).map_err(|e| anyhow!("{e}"))?;
     #[allow(unused_mut)]
-    let mut extra = a.taps.clone();
+    let mut extra = c.taps.clone();
     #[cfg(feature = "studio")]
-    if a.studio.is_some() {
+    if c.studio.is_some() {
         // What the page shows by default is recorded too.
-        extra.extend(
-            evflow_tools::studio::default_taps(checked, &plan).into_iter().map(|t| format!("{}.{}", t.node, t.port)),
-        );
+        extra.extend(crate::studio::default_taps(checked, &plan).into_iter().map(|t| format!("{}.{}", t.node, t.port)));
     }
     let (taps, n_inputs) = taps_of(&plan, &extra)?;
-    let lp = LivePlan::new(plan, &taps).map_err(|e| anyhow!("{}: {e}", a.graph.file.display()))?;
+    let lp = LivePlan::new(plan, &taps).map_err(|e| anyhow!("{}: {e}", c.graph_file.display()))?;
     Ok((lp, n_inputs))
 }
 
@@ -54,8 +53,8 @@ impl Folder<'_> {
     /// Creates the session folder (refusing one that holds a session), copies
     /// the graph into it and writes the manifest as `running`, before
     /// anything runs. Returns the folder and its manifest.
-    pub(super) fn open(&self, a: &Args, checked: &Checked, lp: &LivePlan) -> Result<(PathBuf, Manifest)> {
-        let dir = a.session.clone().unwrap_or_else(|| a.out.join("sessions").join(session_name(&checked.graph.name)));
+    pub(super) fn open(&self, c: &SessionConfig, checked: &Checked, lp: &LivePlan) -> Result<(PathBuf, Manifest)> {
+        let dir = c.session.clone().unwrap_or_else(|| c.out.join("sessions").join(session_name(&checked.graph.name)));
         if dir.join("session.json").exists() {
             return Err(anyhow!("{}: a session is already recorded there; choose another --session", dir.display()));
         }
@@ -64,13 +63,13 @@ impl Folder<'_> {
         std::fs::write(dir.join("graph.toml"), self.graph_text)?;
         let graph_hash = integrity::file_hash(&dir.join("graph.toml"))
             .map_err(|e| anyhow!("{}: cannot read back: {e}", dir.join("graph.toml").display()))?;
-        let graph_path = std::fs::canonicalize(&a.graph.file).unwrap_or_else(|_| a.graph.file.clone());
+        let graph_path = std::fs::canonicalize(&c.graph_file).unwrap_or_else(|_| c.graph_file.clone());
         let base_rate = lp.plan().base_rate();
         let manifest = Manifest {
             identity: Some(integrity::identity(
                 &graph_hash,
                 self.seed,
-                &a.graph.set,
+                &c.overrides,
                 base_rate,
                 self.inputs,
                 self.outputs,
@@ -79,7 +78,7 @@ impl Folder<'_> {
             name: checked.graph.name.clone(),
             base_dir: graph_path.parent().map(Path::to_path_buf).unwrap_or_default(),
             graph_source: graph_path,
-            overrides: a.graph.set.clone(),
+            overrides: c.overrides.clone(),
             seed: self.seed,
             base_rate,
             inputs: self.inputs.to_vec(),
@@ -109,20 +108,20 @@ pub(super) struct Pacing {
 impl Pacing {
     /// The session length, real-time request and miss streak from the
     /// arguments and the graph.
-    pub(super) fn of(a: &Args, checked: &Checked) -> Self {
-        let duration = if a.endless { None } else { a.duration.or(checked.graph.duration) };
+    pub(super) fn of(c: &SessionConfig, checked: &Checked) -> Self {
+        let duration = if c.endless { None } else { c.duration.or(checked.graph.duration) };
         let last_cpu = std::thread::available_parallelism().map(|n| n.get() - 1).unwrap_or(0);
-        let realtime = if a.no_realtime {
+        let realtime = if !c.realtime {
             RealtimeRequest::default()
         } else {
-            RealtimeRequest { priority: Some(a.priority), lock_memory: true, cpu: Some(a.cpu.unwrap_or(last_cpu)) }
+            RealtimeRequest { priority: Some(c.priority), lock_memory: true, cpu: Some(c.cpu.unwrap_or(last_cpu)) }
         };
         let hardware = checked.nodes.iter().any(|n| n.spec.hardware);
-        let miss_streak = a.miss_streak.unwrap_or(if hardware { DEFAULT_MISS_STREAK } else { 0 });
+        let miss_streak = c.miss_streak.unwrap_or(if hardware { DEFAULT_MISS_STREAK } else { 0 });
         let config = LiveConfig {
             duration,
             realtime,
-            spin: Duration::from_micros(a.spin_us),
+            spin: Duration::from_micros(c.spin_us),
             miss_streak,
             ..LiveConfig::default()
         };

@@ -14,7 +14,7 @@ use std::time::{Duration, Instant};
 /// What the metrics thread hands tick timings and steal to: the studio's
 /// ingest, or nothing in a build without the studio.
 #[cfg(feature = "studio")]
-pub(super) type StudioFeed = evflow_tools::studio::Ingest;
+pub(super) type StudioFeed = crate::studio::Ingest;
 /// What the metrics thread hands tick timings and steal to: the studio's
 /// ingest, or nothing in a build without the studio.
 #[cfg(not(feature = "studio"))]
@@ -112,7 +112,7 @@ impl Display {
 
 /// Hands the tick timings to the studio as well, then counts them.
 #[cfg(feature = "studio")]
-fn drain_to_studio(m: &mut Metrics, ring: &mut rtrb::Consumer<TickStat>, studio: &evflow_tools::studio::Ingest) {
+fn drain_to_studio(m: &mut Metrics, ring: &mut rtrb::Consumer<TickStat>, studio: &crate::studio::Ingest) {
     let n = ring.slots();
     if let Ok(chunk) = ring.read_chunk(n) {
         let (a, b) = chunk.as_slices();

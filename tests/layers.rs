@@ -531,22 +531,12 @@ fn a_dependency_on_a_higher_layer_is_named() {
 /// Rust files: a module with files of its own is written one way only,
 /// as `X/mod.rs`.
 fn file_and_folder_pairs(dir: &Path) -> Vec<PathBuf> {
-    let mut found = Vec::new();
-    let Ok(entries) = std::fs::read_dir(dir) else { return found };
-    for e in entries.flatten() {
-        let p = e.path();
-        if p.is_dir() {
-            found.extend(file_and_folder_pairs(&p));
-        } else if p.extension().is_some_and(|x| x == "rs") {
-            let folder = p.with_extension("");
-            let holds_rust = std::fs::read_dir(&folder)
-                .map(|es| es.flatten().any(|e| e.path().extension().is_some_and(|x| x == "rs")))
-                .unwrap_or(false);
-            if holds_rust {
-                found.push(p);
-            }
-        }
-    }
+    let holds_rust = |folder: &Path| {
+        std::fs::read_dir(folder)
+            .map(|es| es.flatten().any(|e| e.path().extension().is_some_and(|x| x == "rs")))
+            .unwrap_or(false)
+    };
+    let mut found: Vec<PathBuf> = rust_files(dir).into_iter().filter(|p| holds_rust(&p.with_extension(""))).collect();
     found.sort();
     found
 }

@@ -3,7 +3,7 @@
 use super::graph_args::load_with;
 use anyhow::{anyhow, Context, Result};
 use evflow_nodes::recording::format::Recording;
-use evflow_tools::live_session::session::Manifest;
+use evflow_tools::live_session::session::{read_event_values, Manifest};
 use evflow_tools::studio::{publish_replay, serve_recorded, RecordedSession, RecordedTap, StudioConfig};
 use serde_json::Value;
 use std::path::{Path, PathBuf};
@@ -37,27 +37,6 @@ pub fn studio_addr(text: &str) -> Result<std::net::SocketAddr> {
         .ok()
         .and_then(|mut a| a.next())
         .ok_or_else(|| anyhow!("studio address `{text}`: expected PORT or HOST:PORT (e.g. 127.0.0.1:8737)"))
-}
-
-/// Every line of `events.jsonl` as JSON; a last line cut short by a crash
-/// is left out.
-fn events(path: &Path) -> Result<Vec<Value>> {
-    let text = match evflow_engine::files::read_regular_to_string(path) {
-        Ok(t) => t,
-        Err(e) if e.kind() == std::io::ErrorKind::NotFound => return Ok(Vec::new()),
-        Err(e) => return Err(anyhow!("{}: {e}", path.display())),
-    };
-    let lines: Vec<&str> = text.lines().collect();
-    let mut out = Vec::new();
-    for (i, line) in lines.iter().enumerate() {
-        match serde_json::from_str::<Value>(line) {
-            Ok(v) if v["tick"].is_u64() => out.push(v),
-            Ok(_) => return Err(anyhow!("{}:{}: event without a tick", path.display(), i + 1)),
-            Err(_) if i + 1 == lines.len() && !text.ends_with('\n') => break,
-            Err(e) => return Err(anyhow!("{}:{}: not a JSON event: {e}", path.display(), i + 1)),
-        }
-    }
-    Ok(out)
 }
 
 /// Reads a session folder.
@@ -102,7 +81,7 @@ fn read(dir: &Path) -> Result<RecordedSession> {
             .map(str::to_string)
             .unwrap_or_else(|| format!("did not end cleanly (status {})", raw["status"].as_str().unwrap_or("unknown"))),
         taps,
-        events: events(&dir.join("events.jsonl"))?,
+        events: read_event_values(&dir.join("events.jsonl"))?,
         metrics: end["metrics"].clone(),
         steal_s: end["host_steal_seconds"].as_f64(),
         checked,

@@ -259,9 +259,10 @@ pub enum LoggedEvent {
     Other,
 }
 
-/// Reads `events.jsonl`; a last line cut short by a crash is ignored.
-pub fn read_events(path: &Path) -> Result<Vec<LoggedEvent>> {
-    let text = match std::fs::read_to_string(path) {
+/// Every line of `events.jsonl` as JSON, each with a tick; a last line cut
+/// short by a crash is left out. A file that is not there holds no events.
+pub fn read_event_values(path: &Path) -> Result<Vec<Value>> {
+    let text = match evflow_engine::files::read_regular_to_string(path) {
         Ok(t) => t,
         Err(e) if e.kind() == std::io::ErrorKind::NotFound => return Ok(Vec::new()),
         Err(e) => return Err(anyhow!("{}: {e}", path.display())),
@@ -269,12 +270,22 @@ pub fn read_events(path: &Path) -> Result<Vec<LoggedEvent>> {
     let lines: Vec<&str> = text.lines().collect();
     let mut out = Vec::new();
     for (i, line) in lines.iter().enumerate() {
-        let v: Value = match serde_json::from_str(line) {
-            Ok(v) => v,
+        match serde_json::from_str::<Value>(line) {
+            Ok(v) if v["tick"].is_u64() => out.push(v),
+            Ok(_) => return Err(anyhow!("{}:{}: event without a tick", path.display(), i + 1)),
             Err(_) if i + 1 == lines.len() && !text.ends_with('\n') => break,
             Err(e) => return Err(anyhow!("{}:{}: not a JSON event: {e}", path.display(), i + 1)),
-        };
-        let tick = v["tick"].as_u64().ok_or_else(|| anyhow!("{}:{}: event without a tick", path.display(), i + 1))?;
+        }
+    }
+    Ok(out)
+}
+
+/// Reads `events.jsonl` ([`read_event_values`]) into the events a replay
+/// acts on.
+pub fn read_events(path: &Path) -> Result<Vec<LoggedEvent>> {
+    let mut out = Vec::new();
+    for (i, v) in read_event_values(path)?.into_iter().enumerate() {
+        let tick = v["tick"].as_u64().unwrap_or_default();
         out.push(match v["event"].as_str() {
             Some("set") => LoggedEvent::Set {
                 tick,

@@ -107,35 +107,42 @@ fn one_bad_run_does_not_lose_the_others_and_fails_the_batch() {
 }
 
 /// A shard beyond the batch's runs is empty, not a failure (a job array
-/// of N tasks over a graph without a sweep): it runs nothing, exits 0,
-/// writes a record saying so, and `merge` of it with the shard that ran is
-/// the one run's output, byte for byte.
-#[test]
-fn an_empty_shard_writes_its_record_and_merges() {
+/// of N tasks over a graph without a sweep, or over a sweep of fewer runs
+/// than tasks): it runs nothing, exits 0, writes a record saying so, and
+/// `merge` of it with the shards that ran is the one run's output, byte
+/// for byte.
+fn an_empty_shard_merges(extra: &[&str], shards: usize) {
     let base = tempfile::tempdir().unwrap();
     let dir = |n: &str| base.path().join(n).to_str().unwrap().to_string();
-    let one = evflow(&["run", "graphs/excitation.toml", "-q", "--no-times", "--out", &dir("one")]);
+    let with = |args: &[&str]| evflow(&[args, extra].concat());
+    let one = with(&["run", "graphs/excitation.toml", "-q", "--no-times", "--out", &dir("one")]);
     assert!(one.status.success(), "{}", String::from_utf8_lossy(&one.stderr));
-    for (k, n) in [(1, 3), (2, 3), (3, 3)] {
-        let o = evflow(&[
-            "run",
-            "graphs/excitation.toml",
-            "-q",
-            "--no-times",
-            "--shard",
-            &format!("{k}/{n}"),
-            "--out",
-            &dir(&format!("s{k}")),
-        ]);
-        assert!(o.status.success(), "shard {k}/{n}: {}", String::from_utf8_lossy(&o.stderr));
+    let mut parts = Vec::new();
+    for k in 1..=shards {
+        let shard = format!("{k}/{shards}");
+        let part = dir(&format!("s{k}"));
+        let o = with(&["run", "graphs/excitation.toml", "-q", "--no-times", "--shard", &shard, "--out", &part]);
+        assert!(o.status.success(), "shard {shard}: {}", String::from_utf8_lossy(&o.stderr));
+        parts.push(part);
     }
-    let empty = std::fs::read_to_string(base.path().join("s3/shard.json")).unwrap();
+    let empty = std::fs::read_to_string(base.path().join(format!("s{shards}/shard.json"))).unwrap();
     assert!(empty.contains("\"runs\": []") || empty.contains("\"runs\":[]"), "{empty}");
-    let o = evflow(&["merge", &dir("merged"), &dir("s2"), &dir("s1"), &dir("s3")]);
+    parts.reverse();
+    let o = evflow(&[&["merge", &dir("merged")][..], &parts.iter().map(String::as_str).collect::<Vec<_>>()].concat());
     assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
     let (a, b) = (tree(&base.path().join("one")), tree(&base.path().join("merged")));
     assert_eq!(a.iter().map(|t| &t.0).collect::<Vec<_>>(), b.iter().map(|t| &t.0).collect::<Vec<_>>());
     assert!(a == b, "the merged empty shards differ from one run");
+}
+
+#[test]
+fn an_empty_shard_writes_its_record_and_merges() {
+    an_empty_shard_merges(&[], 3);
+}
+
+#[test]
+fn an_empty_shard_of_a_sweep_writes_its_record_and_merges() {
+    an_empty_shard_merges(&["--sweep", "mass=60,85"], 3);
 }
 
 #[test]

@@ -15,9 +15,7 @@ use super::row::Row;
 use super::run::{Study, StudyConfig};
 use super::scope::Scope;
 use super::setup::Cond;
-use super::shard_file::{self, SavedFailure};
-use super::StudyError;
-use evflow_engine::batch::Shard;
+use super::shard_file::{self, SavedFailure, StudyRecord};
 use serde::{Deserialize, Serialize};
 use std::path::{Path, PathBuf};
 
@@ -93,30 +91,6 @@ impl SavedStudy {
         }
     }
 
-    /// Writes the record into `dir` (through a temporary file, so a record
-    /// is whole or absent).
-    pub fn write(&self, dir: &Path) -> Result<(), StudyError> {
-        shard_file::write(dir, RECORD, self)
-    }
-
-    /// Reads the record in `dir`; errors name the file and, for a malformed
-    /// record, the line and column.
-    pub fn read(dir: &Path) -> Result<Self, StudyError> {
-        let saved: Self = shard_file::read(dir, RECORD, "evflow report textures --shard", "a study shard's record")?;
-        shard_file::slice(dir, RECORD, &saved.shard, saved.cells, saved.range, "cells")?;
-        Ok(saved)
-    }
-
-    /// The record's K/N.
-    pub fn slice(&self) -> Result<Shard, evflow_engine::batch::ShardError> {
-        Shard::parse(&self.shard)
-    }
-
-    /// Whether `dir` holds a study shard's record.
-    pub fn is_in(dir: &Path) -> bool {
-        dir.join(RECORD).is_file()
-    }
-
     /// The study of several shards' records (in K order), with every path
     /// put under `base`: rows and models one after another, the failures
     /// labelled with their shard, the times added up.
@@ -133,12 +107,32 @@ impl SavedStudy {
     }
 }
 
+impl StudyRecord for SavedStudy {
+    const RECORD: &'static str = RECORD;
+    const COMMAND: &'static str = "evflow report textures";
+    const WHAT: &'static str = "a study shard's record";
+    const UNIT: &'static str = "cells";
+
+    fn shard(&self) -> &str {
+        &self.shard
+    }
+
+    fn total(&self) -> usize {
+        self.cells
+    }
+
+    fn range(&self) -> [usize; 2] {
+        self.range
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::super::gains::{AtGain, Chosen};
     use super::super::row::{Achievable, Method, MethodResult, Reading};
     use super::super::setup::Profile;
     use super::*;
+    use evflow_engine::batch::Shard;
 
     fn config(shard: Shard) -> StudyConfig {
         StudyConfig {

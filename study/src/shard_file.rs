@@ -1,11 +1,13 @@
 //! A study shard's record as a file: written as JSON through a temporary
 //! file (whole or absent), read back with the file named in every error,
-//! and its slice checked against the range it says it holds. The texture
-//! study's ([`super::saved`]) and the live study's
-//! ([`super::live::saved`]) records share it.
+//! and its slice checked against the range it says it holds. Every sharded
+//! study's record is a [`StudyRecord`]: the texture study's
+//! ([`super::saved`]), the live study's ([`super::live::saved`]) and
+//! `report narx`'s ([`super::narx::saved`]); `evflow merge` reads them
+//! through it.
 
 use super::StudyError;
-use evflow_engine::batch::Shard;
+use evflow_engine::batch::{Shard, ShardError};
 use serde::de::DeserializeOwned;
 use serde::{Deserialize, Serialize};
 use std::path::{Path, PathBuf};
@@ -73,4 +75,55 @@ pub fn slice(
         return Err(bad(format!("shard {s} of {total} {unit} should hold {unit} {expected:?}, not {range:?}")));
     }
     Ok(s)
+}
+
+/// The record a shard of a study (`evflow report … --shard K/N`) writes
+/// last into its output folder: which slice of the study's units it ran,
+/// and what it found. One implementation per sharded study; writing,
+/// reading (checked against its slice) and finding it are shared.
+pub trait StudyRecord: Serialize + DeserializeOwned + Sized {
+    /// The record's file name in the shard's output folder.
+    const RECORD: &'static str;
+    /// The command whose shards write it, as a person types it
+    /// (`evflow report live`).
+    const COMMAND: &'static str;
+    /// What a record is, named when a file is not one.
+    const WHAT: &'static str;
+    /// What the study's slices count (`cells`, `items`).
+    const UNIT: &'static str;
+
+    /// Which slice, `K/N`, as saved.
+    fn shard(&self) -> &str;
+    /// The study's units in all.
+    fn total(&self) -> usize;
+    /// The slice's units among them, `[start, end)`.
+    fn range(&self) -> [usize; 2];
+    /// Writes the record into `dir` (through a temporary file: whole or absent).
+    fn write(&self, dir: &Path) -> Result<(), StudyError> {
+        write(dir, Self::RECORD, self)
+    }
+
+    /// Reads the record in `dir`, checked: its range is its `K/N`'s slice
+    /// (a study whose record holds more checks them too). Errors name the
+    /// file and what is wrong.
+    fn read(dir: &Path) -> Result<Self, StudyError> {
+        let saved: Self = Self::read_unchecked(dir)?;
+        slice(dir, Self::RECORD, saved.shard(), saved.total(), saved.range(), Self::UNIT)?;
+        Ok(saved)
+    }
+
+    /// Reads the record in `dir` as JSON, nothing checked.
+    fn read_unchecked(dir: &Path) -> Result<Self, StudyError> {
+        read(dir, Self::RECORD, &format!("{} --shard", Self::COMMAND), Self::WHAT)
+    }
+
+    /// The record's K/N.
+    fn slice(&self) -> Result<Shard, ShardError> {
+        Shard::parse(self.shard())
+    }
+
+    /// Whether `dir` holds such a record.
+    fn is_in(dir: &Path) -> bool {
+        dir.join(Self::RECORD).is_file()
+    }
 }

@@ -8,9 +8,7 @@
 use super::row::LiveRow;
 use super::run::{LiveConfig, LiveStudy};
 use super::scope::LiveScope;
-use crate::shard_file::{self, SavedFailure};
-use crate::StudyError;
-use evflow_engine::batch::Shard;
+use crate::shard_file::{self, SavedFailure, StudyRecord};
 use serde::{Deserialize, Serialize};
 use std::path::Path;
 
@@ -57,28 +55,6 @@ impl LiveRecord {
         }
     }
 
-    /// Writes the record into `dir` (through a temporary file: whole or absent).
-    pub fn write(&self, dir: &Path) -> Result<(), StudyError> {
-        shard_file::write(dir, RECORD, self)
-    }
-
-    /// Reads the record in `dir`; errors name the file and what is wrong.
-    pub fn read(dir: &Path) -> Result<Self, StudyError> {
-        let saved: Self = shard_file::read(dir, RECORD, "evflow report live --shard", "a live study shard's record")?;
-        shard_file::slice(dir, RECORD, &saved.shard, saved.items, saved.range, "items")?;
-        Ok(saved)
-    }
-
-    /// The record's K/N.
-    pub fn slice(&self) -> Result<Shard, evflow_engine::batch::ShardError> {
-        Shard::parse(&self.shard)
-    }
-
-    /// Whether `dir` holds a live study shard's record.
-    pub fn is_in(dir: &Path) -> bool {
-        dir.join(RECORD).is_file()
-    }
-
     /// The study of several shards' records (in K order), every row's
     /// folder put under `base`, the failures labelled with their shard, the
     /// times added up.
@@ -93,10 +69,30 @@ impl LiveRecord {
     }
 }
 
+impl StudyRecord for LiveRecord {
+    const RECORD: &'static str = RECORD;
+    const COMMAND: &'static str = "evflow report live";
+    const WHAT: &'static str = "a live study shard's record";
+    const UNIT: &'static str = "items";
+
+    fn shard(&self) -> &str {
+        &self.shard
+    }
+
+    fn total(&self) -> usize {
+        self.items
+    }
+
+    fn range(&self) -> [usize; 2] {
+        self.range
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::super::row::{Chain, ChainResult, StrokeFloor, TargetFloor};
     use super::*;
+    use evflow_engine::batch::Shard;
     use crate::gains::{AtGain, Chosen};
     use crate::row::Reading;
     use std::path::PathBuf;

@@ -9,9 +9,8 @@
 
 use super::run::{Item, NarxConfig, NarxStudy, SeedScore};
 use super::scope::NarxScope;
-use crate::shard_file;
+use crate::shard_file::{self, StudyRecord};
 use crate::StudyError;
-use evflow_engine::batch::Shard;
 use serde::{Deserialize, Serialize};
 use std::path::Path;
 
@@ -80,36 +79,6 @@ impl NarxRecord {
         }
     }
 
-    /// Writes the record into `dir` (through a temporary file: whole or absent).
-    pub fn write(&self, dir: &Path) -> Result<(), StudyError> {
-        shard_file::write(dir, NARX_RECORD, self)
-    }
-
-    /// Reads the record in `dir`, checked: its slice is its `K/N`'s, its
-    /// total the scope's, its items that slice in order, each naming a
-    /// setting of the scope and either scored or failed. Errors name the
-    /// file and what is wrong.
-    pub fn read(dir: &Path) -> Result<Self, StudyError> {
-        let saved: Self =
-            shard_file::read(dir, NARX_RECORD, "evflow report narx --shard", "a narx report shard's record")?;
-        let bad = |m: String| StudyError::Io { path: dir.join(NARX_RECORD), message: m };
-        if saved.total != saved.scope.total() {
-            let s = &saved.scope;
-            return Err(bad(format!("`total` is not {} settings × {} seeds", s.settings.len(), s.seeds)));
-        }
-        shard_file::slice(dir, NARX_RECORD, &saved.shard, saved.total, saved.range, "items")?;
-        if !saved.items.iter().map(|i| i.index).eq(saved.range[0]..saved.range[1]) {
-            return Err(bad(format!("the items are not items {:?} in order", saved.range[0]..saved.range[1])));
-        }
-        saved.items().map_err(|e| bad(e.to_string()))?;
-        Ok(saved)
-    }
-
-    /// The record's K/N.
-    pub fn slice(&self) -> Result<Shard, evflow_engine::batch::ShardError> {
-        Shard::parse(&self.shard)
-    }
-
     /// The items, their settings as indices into the scope's.
     pub fn items(&self) -> Result<Vec<Item>, StudyError> {
         let settings = &self.scope.settings;
@@ -133,10 +102,49 @@ impl NarxRecord {
     }
 }
 
+impl StudyRecord for NarxRecord {
+    const RECORD: &'static str = NARX_RECORD;
+    const COMMAND: &'static str = "evflow report narx";
+    const WHAT: &'static str = "a narx report shard's record";
+    const UNIT: &'static str = "items";
+
+    fn shard(&self) -> &str {
+        &self.shard
+    }
+
+    fn total(&self) -> usize {
+        self.total
+    }
+
+    fn range(&self) -> [usize; 2] {
+        self.range
+    }
+
+    /// Reads the record in `dir`, checked: its total is the scope's, its
+    /// slice its `K/N`'s, its items that slice in order, each naming a
+    /// setting of the scope and either scored or failed. Errors name the
+    /// file and what is wrong.
+    fn read(dir: &Path) -> Result<Self, StudyError> {
+        let saved = Self::read_unchecked(dir)?;
+        let bad = |m: String| StudyError::Io { path: dir.join(NARX_RECORD), message: m };
+        if saved.total != saved.scope.total() {
+            let s = &saved.scope;
+            return Err(bad(format!("`total` is not {} settings × {} seeds", s.settings.len(), s.seeds)));
+        }
+        shard_file::slice(dir, NARX_RECORD, &saved.shard, saved.total, saved.range, "items")?;
+        if !saved.items.iter().map(|i| i.index).eq(saved.range[0]..saved.range[1]) {
+            return Err(bad(format!("the items are not items {:?} in order", saved.range[0]..saved.range[1])));
+        }
+        saved.items().map_err(|e| bad(e.to_string()))?;
+        Ok(saved)
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::super::setting::Setting;
     use super::*;
+    use evflow_engine::batch::Shard;
     use crate::setup::Cond;
     use serde_json::{json, Value as Json};
 

@@ -1,6 +1,6 @@
 //! `evflow merge OUT SHARD_DIRS...`: joins the outputs of the shards of a
 //! sweep (`evflow run --shard K/N`), of a model library (`evflow library
-//! build --shard K/N`) or of a report (`evflow report textures|narx
+//! build --shard K/N`) or of a report (`evflow report textures|live|narx
 //! --shard K/N`) into what one run would have written. The merge is
 //! library code (`evflow_tools::batch::merge`); this parses, calls and prints.
 //!
@@ -75,53 +75,18 @@ fn print(merged: Merged) -> Result<()> {
             );
         }
         #[cfg(feature = "synth")]
-        Merged::Textures(m) => {
+        Merged::Study(m) => {
             print!("{}", m.markdown);
-            for table in &m.tables {
-                println!("wrote {}", table.display());
+            for line in &m.written {
+                println!("{line}");
             }
-            println!(
-                "merged {} shards of a texture report: {} rows, {} files the shards wrote",
-                m.shards, m.rows, m.files
-            );
+            // A figure that cannot be drawn does not undo the merge: say why and go on.
+            for w in &m.warnings {
+                eprintln!("warning: {w}");
+            }
+            println!("{}", m.summary);
             if !m.failures.is_empty() {
                 bail!("{}", m.failures.summary(m.steps, "steps").trim_end());
-            }
-        }
-        #[cfg(feature = "synth")]
-        Merged::Narx(m) => {
-            println!("wrote {}", m.table.display());
-            match &m.figure {
-                Some(Ok(w)) => {
-                    println!(
-                        "wrote {}{}",
-                        w.path.display(),
-                        if w.labelled { "" } else { " (no font found: unlabelled)" }
-                    )
-                }
-                Some(Err(e)) => eprintln!("warning: {e}"),
-                None => {}
-            }
-            println!(
-                "merged {} shards of report narx: {} of {} models scored, {} files copied",
-                m.shards, m.scored, m.total, m.files
-            );
-            if !m.failures.is_empty() {
-                bail!("{}", m.failures.summary(m.samples + m.total, "steps").trim_end());
-            }
-        }
-        #[cfg(feature = "synth")]
-        Merged::Live(m) => {
-            print!("{}", m.markdown);
-            for f in &m.written {
-                println!("wrote {}", f.display());
-            }
-            println!(
-                "merged {} shards of a live report: {} rows of {} items, {} files the shards wrote",
-                m.shards, m.rows, m.items, m.files
-            );
-            if !m.failures.is_empty() {
-                bail!("{}", m.failures.summary(m.items, "steps").trim_end());
             }
         }
         Merged::Sweep(m) => {

@@ -127,13 +127,17 @@ pub enum MergeError {
         #[source]
         source: std::io::Error,
     },
-    /// A folder among the shards of `evflow report narx` that is not one of them.
-    #[error("{}: not a shard of `evflow report narx` as {} is (it holds no narx-shard.json)", dir.display(), narx.display())]
-    NotNarx {
+    /// A folder among the shards of a study report that is not one of them.
+    #[error("{}: not a shard of `{command}` as {} is (it holds no {record})", dir.display(), first.display())]
+    NotOfReport {
         /// The folder without the record.
         dir: PathBuf,
         /// A folder with it.
-        narx: PathBuf,
+        first: PathBuf,
+        /// The report's command.
+        command: &'static str,
+        /// Its record's file name.
+        record: &'static str,
     },
     /// The shards of a model library or of a texture report could not be
     /// read, or their indexes joined.

@@ -22,38 +22,37 @@ use std::path::{Path, PathBuf};
 pub const PARTIAL_NOTE: &str = "PARTIAL.txt";
 
 /// Which command wrote a shard, known by its record.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[derive(Clone, Copy)]
 pub enum Kind {
     /// `evflow run --shard` (`shard.json`).
     Sweep,
     /// `evflow library build --shard` (`index.json`).
     #[cfg(feature = "synth")]
     Library,
-    /// `evflow report textures --shard`.
+    /// A study report's (`evflow report textures|live|narx --shard`), one of
+    /// [`super::STUDIES`].
     #[cfg(feature = "synth")]
-    Textures,
-    /// `evflow report live --shard`.
-    #[cfg(feature = "synth")]
-    Live,
-    /// `evflow report narx --shard`.
-    #[cfg(feature = "synth")]
-    Narx,
+    Study(&'static dyn super::StudyKind),
+}
+
+impl PartialEq for Kind {
+    fn eq(&self, other: &Kind) -> bool {
+        self.record() == other.record()
+    }
+}
+
+impl std::fmt::Debug for Kind {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        write!(f, "Kind({})", self.record())
+    }
 }
 
 impl Kind {
     /// The kind of shard whose record `dir` holds, if it holds one.
     pub fn of(dir: &Path) -> Option<Kind> {
         #[cfg(feature = "synth")]
-        {
-            if evflow_study::saved::SavedStudy::is_in(dir) {
-                return Some(Kind::Textures);
-            }
-            if evflow_study::live::saved::LiveRecord::is_in(dir) {
-                return Some(Kind::Live);
-            }
-            if dir.join(evflow_study::narx::saved::NARX_RECORD).is_file() {
-                return Some(Kind::Narx);
-            }
+        if let Some(kind) = super::STUDIES.iter().find(|k| k.holds(dir)) {
+            return Some(Kind::Study(*kind));
         }
         if dir.join(RECORD).is_file() {
             return Some(Kind::Sweep);
@@ -72,11 +71,7 @@ impl Kind {
             #[cfg(feature = "synth")]
             Kind::Library => "index.json",
             #[cfg(feature = "synth")]
-            Kind::Textures => evflow_study::saved::RECORD,
-            #[cfg(feature = "synth")]
-            Kind::Live => evflow_study::live::saved::RECORD,
-            #[cfg(feature = "synth")]
-            Kind::Narx => evflow_study::narx::saved::NARX_RECORD,
+            Kind::Study(k) => k.record(),
         }
     }
 
@@ -87,11 +82,7 @@ impl Kind {
             #[cfg(feature = "synth")]
             Kind::Library => "evflow library build",
             #[cfg(feature = "synth")]
-            Kind::Textures => "evflow report textures",
-            #[cfg(feature = "synth")]
-            Kind::Live => "evflow report live",
-            #[cfg(feature = "synth")]
-            Kind::Narx => "evflow report narx",
+            Kind::Study(k) => k.command(),
         }
     }
 
@@ -102,30 +93,18 @@ impl Kind {
             #[cfg(feature = "synth")]
             Kind::Library => "<the array's script>",
             #[cfg(feature = "synth")]
-            Kind::Textures => "<the array's script, e.g. contrib/slurm/textures.sbatch>",
-            #[cfg(feature = "synth")]
-            Kind::Live => "<the array's script, e.g. contrib/slurm/live.sbatch>",
-            #[cfg(feature = "synth")]
-            Kind::Narx => "<the array's script, e.g. contrib/slurm/narx.sbatch>",
+            Kind::Study(k) => k.script(),
         }
     }
 
     /// The K/N of the shard in `dir`, read from its record.
     fn slice(self, dir: &Path) -> Result<Shard, MergeError> {
-        #[cfg(feature = "synth")]
-        let config = |e: evflow_engine::batch::ShardError| {
-            MergeError::Study(evflow_study::StudyError::Config(format!("{}: {e}", dir.display())))
-        };
         match self {
             Kind::Sweep => Ok(ShardRecord::read(dir)?.shard),
             #[cfg(feature = "synth")]
             Kind::Library => Ok(evflow_study::library::read_shard(dir)?.shard),
             #[cfg(feature = "synth")]
-            Kind::Textures => evflow_study::saved::SavedStudy::read(dir)?.slice().map_err(config),
-            #[cfg(feature = "synth")]
-            Kind::Live => evflow_study::live::saved::LiveRecord::read(dir)?.slice().map_err(config),
-            #[cfg(feature = "synth")]
-            Kind::Narx => evflow_study::narx::saved::NarxRecord::read(dir)?.slice().map_err(config),
+            Kind::Study(k) => k.slice(dir),
         }
     }
 }

@@ -12,9 +12,10 @@
 //! --shard K/N`) merge the same way: their files copied, their indexes
 //! joined in the library's order.
 //!
-//! A texture report run in shards (`evflow report textures --shard K/N`)
-//! merges into its tables ([`textures`]), a live report's into its own
-//! ([`live`]).
+//! A study report run in shards (`evflow report textures|live|narx --shard
+//! K/N`) merges into its tables through one merge ([`study`]); each report
+//! is its few lines ([`textures`], [`live`], [`narx`]) listed in
+//! [`STUDIES`].
 //!
 //! A shard writes its record last; a folder without one is a task that did
 //! not end ([`gaps`]). A merge refuses missing shards, naming each and
@@ -22,7 +23,8 @@
 //! the shards there are ([`Coverage::Partial`]): its output then holds
 //! [`gaps::PARTIAL_NOTE`], which says what is missing.
 //!
-//! One file per kind of shard; [`error`] and [`files`] are what they share.
+//! One file per kind of shard; [`error`], [`files`] and [`study`] are what
+//! they share.
 
 pub mod error;
 pub mod files;
@@ -34,6 +36,8 @@ pub mod live;
 #[cfg(feature = "synth")]
 pub mod narx;
 pub mod rerun;
+#[cfg(feature = "synth")]
+pub mod study;
 pub mod sweep;
 #[cfg(feature = "synth")]
 pub mod textures;
@@ -43,7 +47,14 @@ pub use files::Coverage;
 pub use gaps::{Gaps, PARTIAL_NOTE};
 #[cfg(feature = "synth")]
 pub use library::{merge_library, LibraryMerge};
+#[cfg(feature = "synth")]
+pub use study::{StudyKind, StudyMerge};
 pub use sweep::{merge_sweep, SweepMerge};
+
+/// Every study report that runs in shards, in the order a folder's record
+/// is looked for.
+#[cfg(feature = "synth")]
+pub static STUDIES: &[&dyn StudyKind] = &[&textures::Textures, &live::Live, &narx::Narx];
 
 use std::path::{Path, PathBuf};
 
@@ -55,15 +66,9 @@ pub enum Merged {
     /// The shards of `evflow library build --shard`.
     #[cfg(feature = "synth")]
     Library(LibraryMerge),
-    /// The shards of `evflow report textures --shard`.
+    /// The shards of a study report (`evflow report textures|live|narx --shard`).
     #[cfg(feature = "synth")]
-    Textures(textures::TexturesMerge),
-    /// The shards of `evflow report narx --shard`.
-    #[cfg(feature = "synth")]
-    Narx(narx::NarxMerge),
-    /// The shards of `evflow report live --shard`.
-    #[cfg(feature = "synth")]
-    Live(live::LiveMerge),
+    Study(StudyMerge),
 }
 
 /// What `evflow merge` did, and what it left out.
@@ -105,8 +110,7 @@ pub fn merge(out: &Path, dirs: &[PathBuf], coverage: Coverage) -> Result<Outcome
 }
 
 /// Merges the folders `dirs`, each holding a shard's record, into `out`:
-/// a texture report's when a folder holds a study shard's record, a
-/// `report narx`'s when a folder holds its record ([`narx`]), a model
+/// a study report's when a folder holds one of [`STUDIES`]' records, a model
 /// library's when every folder is one (and none holds a sweep's shard
 /// record), else a sweep's.
 fn merge_shards(out: &Path, dirs: &[PathBuf], coverage: Coverage) -> Result<Merged, MergeError> {
@@ -114,16 +118,10 @@ fn merge_shards(out: &Path, dirs: &[PathBuf], coverage: Coverage) -> Result<Merg
         return Err(MergeError::NoShards);
     }
     #[cfg(feature = "synth")]
-    if dirs.iter().any(|d| evflow_study::saved::SavedStudy::is_in(d)) {
-        return textures::merge_textures(out, dirs, coverage).map(Merged::Textures);
-    }
-    #[cfg(feature = "synth")]
-    if dirs.iter().any(|d| live::is_live_shard(d)) {
-        return live::merge_live(out, dirs, coverage).map(Merged::Live);
-    }
-    #[cfg(feature = "synth")]
-    if dirs.iter().any(|d| narx::is_narx_shard(d)) {
-        return narx::merge_narx(out, dirs, coverage).map(Merged::Narx);
+    for kind in STUDIES {
+        if dirs.iter().any(|d| kind.holds(d)) {
+            return kind.merge(out, dirs, coverage).map(Merged::Study);
+        }
     }
     #[cfg(feature = "synth")]
     if dirs.iter().all(|d| !d.join(super::shard_record::RECORD).exists() && evflow_study::library::is_library(d)) {

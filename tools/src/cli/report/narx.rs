@@ -14,6 +14,7 @@ use evflow_study::narx::scope::NarxScope;
 use evflow_study::narx::setting::{Setting, DEFAULT_SETTINGS};
 use evflow_study::setup::Cond;
 use evflow_study::tables::narx::{figure, markdown, Table};
+use evflow_study::shard_file::StudyRecord;
 use evflow_tools::batch::merge::narx::{NARX_FIGURE, NARX_TABLE};
 use evflow_tools::batch::{progress_bar, BatchArgs};
 use std::path::PathBuf;

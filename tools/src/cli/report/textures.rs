@@ -16,6 +16,7 @@ use evflow_study::setup::Cond;
 use evflow_study::spectrum::gated;
 use evflow_study::tables::textures::Timings;
 use evflow_study::tables::textures::{csv, markdown};
+use evflow_study::shard_file::StudyRecord;
 use evflow_tools::batch::{progress_bar, BatchArgs};
 use evflow_tools::plot::{Plot, Series};
 use std::path::{Path, PathBuf};

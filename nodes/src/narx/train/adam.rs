@@ -5,10 +5,10 @@
 //! epoch (seeded); one epoch is one pass over the training block; early
 //! stopping on the validation block as for LM.
 
-use super::{mse, Data, EarlyStop, Epoch, Options, Report, StopReason};
+use super::epochs::{self, Stepped};
+use super::{mse, Data, Epoch, Options, Report, StopReason};
 use crate::narx::net::Mlp;
 use crate::rng::Rng;
-use std::time::Instant;
 
 const BETA1: f64 = 0.9;
 const BETA2: f64 = 0.999;
@@ -22,27 +22,15 @@ pub fn train(
     opts: &Options,
     progress: &mut dyn FnMut(&Epoch),
 ) -> Report {
-    let start = Instant::now();
     let p = net.n_params();
     let n = train.len();
     let mut ws = net.workspace();
-    let mut perf = mse(net, train);
-    let mut stop = EarlyStop::new(net.weights(), mse(net, val), perf, opts.max_fail);
     let (mut m, mut v, mut g, mut row) = (vec![0.0; p], vec![0.0; p], vec![0.0; p], vec![0.0; p]);
     let mut order: Vec<usize> = (0..n).collect();
     let mut rng = Rng::new(opts.seed);
     let batch = opts.batch.max(1);
     let mut t = 0i32;
-    let mut epochs = 0;
-    let mut reason = StopReason::MaxEpochs;
-    for epoch in 1..=opts.max_epochs {
-        if n == 0 {
-            break;
-        }
-        if perf == 0.0 {
-            reason = StopReason::Goal;
-            break;
-        }
+    epochs::run(net, train, val, opts, progress, |net, perf| {
         // Fisher–Yates shuffle.
         for i in (1..n).rev() {
             let j = (rng.uniform() * (i + 1) as f64) as usize;
@@ -67,31 +55,16 @@ pub fn train(
                 *w -= opts.learning_rate * (m[k] / c1) / ((v[k] / c2).sqrt() + EPS);
             }
         }
-        perf = mse(net, train);
-        let vperf = mse(net, val);
-        epochs = epoch;
-        progress(&Epoch {
-            epoch,
-            train_mse: perf,
-            val_mse: vperf,
-            gradient: gnorm,
-            mu: 0.0,
-            seconds: start.elapsed().as_secs_f64(),
-        });
-        if !perf.is_finite() {
-            reason = StopReason::MuMax;
-            break;
-        }
-        if gnorm < opts.min_grad {
-            reason = StopReason::MinGradient;
-            break;
-        }
-        if stop.update(epoch, net.weights(), vperf, perf) {
-            reason = StopReason::ValidationStop;
-            break;
-        }
-    }
-    stop.finish(net.weights_mut(), epochs, reason, start)
+        *perf = mse(net, train);
+        let stop = if !perf.is_finite() {
+            Some(StopReason::MuMax)
+        } else if gnorm < opts.min_grad {
+            Some(StopReason::MinGradient)
+        } else {
+            None
+        };
+        Ok(Stepped { gradient: gnorm, mu: 0.0, stop })
+    })
 }
 
 #[cfg(test)]

@@ -24,12 +24,12 @@
 //! the symmetric JᵀJ — the half the Cholesky factorization reads — is
 //! formed (half the multiply-adds of the full product).
 
-use super::{mse, Data, EarlyStop, Epoch, Options, Report, StopReason};
+use super::epochs::{self, Stepped};
+use super::{mse, Data, Epoch, Options, Report, StopReason};
 use crate::linalg::{add_lower_gram, Cholesky};
 use crate::narx::net::{Mlp, Workspace};
 use ndarray::linalg::general_mat_vec_mul;
 use ndarray::{s, Array1, Array2};
-use std::time::Instant;
 
 /// Rows of the Jacobian formed at once.
 const BLOCK: usize = 512;
@@ -43,50 +43,19 @@ pub fn train(
     opts: &Options,
     progress: &mut dyn FnMut(&Epoch),
 ) -> Report {
-    let start = Instant::now();
     let n = train.len();
     let mut ws = net.workspace();
-    let mut perf = mse(net, train);
-    let mut stop = EarlyStop::new(net.weights(), mse(net, val), perf, opts.max_fail);
     let mut mu = opts.mu;
     let mut normal = Normal::new(net.n_params());
-    let mut epochs = 0;
-    let mut reason = StopReason::MaxEpochs;
-    for epoch in 1..=opts.max_epochs {
-        if n == 0 {
-            break;
-        }
-        if perf == 0.0 {
-            reason = StopReason::Goal;
-            break;
-        }
+    epochs::run(net, train, val, opts, progress, |net, perf| {
         normal.form(net, train, &mut ws);
         let gradient = normal.gradient(n);
         if gradient.is_nan() || gradient < opts.min_grad {
-            reason = StopReason::MinGradient;
-            break;
+            return Err(StopReason::MinGradient);
         }
-        let improved = normal.step(net, train, &mut perf, &mut mu, opts);
-        epochs = epoch;
-        let vperf = mse(net, val);
-        progress(&Epoch {
-            epoch,
-            train_mse: perf,
-            val_mse: vperf,
-            gradient,
-            mu,
-            seconds: start.elapsed().as_secs_f64(),
-        });
-        if !improved {
-            reason = StopReason::MuMax;
-            break;
-        }
-        if stop.update(epoch, net.weights(), vperf, perf) {
-            reason = StopReason::ValidationStop;
-            break;
-        }
-    }
-    stop.finish(net.weights_mut(), epochs, reason, start)
+        let improved = normal.step(net, train, perf, &mut mu, opts);
+        Ok(Stepped { gradient, mu, stop: (!improved).then_some(StopReason::MuMax) })
+    })
 }
 
 /// The normal equations of an epoch, JᵀJ and Jᵀe, and the buffers they

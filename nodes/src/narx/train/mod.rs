@@ -5,6 +5,7 @@
 //! Both stop early on a contiguous validation block.
 
 pub mod adam;
+mod epochs;
 pub mod lm;
 
 use super::net::Mlp;

@@ -72,7 +72,7 @@ impl fmt::Display for RealtimeReport {
 }
 
 /// Applies `req` to the calling thread and reports what was granted.
-#[cfg(target_os = "linux")]
+#[cfg(all(target_os = "linux", not(miri)))]
 pub fn apply(req: &RealtimeRequest) -> RealtimeReport {
     let errno = || std::io::Error::last_os_error().to_string();
     // Each block below is a plain system call on the calling thread; a
@@ -113,14 +113,15 @@ pub fn apply(req: &RealtimeRequest) -> RealtimeReport {
     r
 }
 
-/// Applies `req` (unsupported outside Linux: everything is reported refused).
-#[cfg(not(target_os = "linux"))]
+/// Applies `req` (unsupported outside Linux, and under Miri, which runs no
+/// system call of these: everything is reported refused).
+#[cfg(any(not(target_os = "linux"), miri))]
 pub fn apply(req: &RealtimeRequest) -> RealtimeReport {
-    let no = || Err("not supported on this system".to_string());
+    let no = || "not supported on this system".to_string();
     RealtimeReport {
-        timer_slack: Some(no()),
-        fifo: req.priority.map(|_| no()),
-        memory_locked: req.lock_memory.then(|| no()),
-        cpu: req.cpu.map(|_| no()),
+        timer_slack: Some(Err(no())),
+        fifo: req.priority.map(|_| Err(no())),
+        memory_locked: req.lock_memory.then(|| Err(no())),
+        cpu: req.cpu.map(|_| Err(no())),
     }
 }

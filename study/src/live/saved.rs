@@ -92,9 +92,9 @@ impl StudyRecord for LiveRecord {
 mod tests {
     use super::super::row::{Chain, ChainResult, StrokeFloor, TargetFloor};
     use super::*;
-    use evflow_engine::batch::Shard;
     use crate::gains::{AtGain, Chosen};
     use crate::row::Reading;
+    use evflow_engine::batch::Shard;
     use std::path::PathBuf;
 
     fn row(k: usize) -> LiveRow {

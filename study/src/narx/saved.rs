@@ -144,8 +144,8 @@ impl StudyRecord for NarxRecord {
 mod tests {
     use super::super::setting::Setting;
     use super::*;
-    use evflow_engine::batch::Shard;
     use crate::setup::Cond;
+    use evflow_engine::batch::Shard;
     use serde_json::{json, Value as Json};
 
     /// Shard `shard` of 2 settings × 2 seeds, with awkward floats and a failure.

@@ -87,7 +87,7 @@ pub fn main(a: Args) -> Result<()> {
     let checked = a.graph.load()?;
     let ended = live_session::run(&config(a)?, &checked)?;
     print!("{ended}");
-    ended.outcome()
+    Ok(ended.outcome()?)
 }
 
 /// The session's settings from the command line.

@@ -6,6 +6,7 @@
 //! the real-time thread counts the lost ticks as a gap — the same outcome
 //! as before, only seconds later and with memory still bounded.
 
+use super::error::SessionError;
 use super::session::FileSpec;
 use evflow_nodes::recording::format::{Channel, RecordingMeta, RecordingWriter};
 use std::fs::File;
@@ -78,23 +79,24 @@ impl Files {
     /// log in the session folder `dir`. Each file is synced to disk once
     /// here, which can take seconds on a loaded machine: call it before the
     /// real-time thread starts filling its rings.
-    pub fn create(dir: &Path, specs: &[FileSpec], source: &str) -> anyhow::Result<Self> {
+    pub fn create(dir: &Path, specs: &[FileSpec], source: &str) -> Result<Self, SessionError> {
         let mut writers = Vec::new();
         for spec in specs {
             let path = dir.join(&spec.file);
             if let Some(parent) = path.parent() {
-                std::fs::create_dir_all(parent)?;
+                std::fs::create_dir_all(parent).map_err(SessionError::file(parent, "cannot create"))?;
             }
             let channels = spec.ports.iter().map(|p| Channel::new(p.clone(), "")).collect();
             let mut meta = RecordingMeta::new(spec.rate, channels);
             meta.source = format!("{source}: `{}` ({})", spec.node, spec.ports.join(", "));
             let mut writer = RecordingWriter::create_live(&path, meta)
-                .map_err(|e| anyhow::anyhow!("cannot start the session recording: {e}"))?;
+                .map_err(|e| SessionError::Run(format!("cannot start the session recording: {e}")))?;
             writer.reserve_frames(8192);
-            writer.flush().map_err(|e| anyhow::anyhow!("{e}"))?;
+            writer.flush().map_err(|e| SessionError::Run(e.to_string()))?;
             writers.push((Some(writer), None));
         }
-        let log = File::create(dir.join("events.jsonl"))?;
+        let events = dir.join("events.jsonl");
+        let log = File::create(&events).map_err(SessionError::file(&events, "cannot create"))?;
         Ok(Self { specs: specs.to_vec(), writers, log: Some(std::io::BufWriter::new(log)), event_error: None })
     }
 

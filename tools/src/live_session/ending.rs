@@ -2,10 +2,10 @@
 //! (in the manifest and `--json`) and the report to print.
 
 use super::config::SessionConfig;
+use super::error::SessionError;
 use super::integrity;
 use super::recorder::RecorderReport;
 use super::session::Manifest;
-use anyhow::{anyhow, Result};
 use evflow_engine::live::{Metrics, MetricsSummary, Percentiles, RtExit, RtThread, Shared};
 use evflow_engine::Summary;
 use serde_json::json;
@@ -38,15 +38,15 @@ impl Ran {
         done: &AtomicBool,
         rec_thread: JoinHandle<RecorderReport>,
         metrics_thread: JoinHandle<Metrics>,
-    ) -> Result<Self> {
+    ) -> Result<Self, SessionError> {
         let started = Instant::now();
         let steal_before = super::steal::steal_seconds();
         let exit = thread.join();
         let wall = started.elapsed();
         let stolen = super::steal::steal_seconds().zip(steal_before).map(|(b, a)| (b - a).max(0.0));
         done.store(true, Ordering::Release);
-        let rec = rec_thread.join().map_err(|_| anyhow!("the recorder thread panicked"))?;
-        let metrics = metrics_thread.join().map_err(|_| anyhow!("the metrics thread panicked"))?;
+        let rec = rec_thread.join().map_err(|_| SessionError::Thread("the recorder thread panicked".into()))?;
+        let metrics = metrics_thread.join().map_err(|_| SessionError::Thread("the metrics thread panicked".into()))?;
         Ok(Ran { exit, wall, stolen, rec, metrics })
     }
 
@@ -59,10 +59,10 @@ impl Ran {
         manifest: &Manifest,
         shared: &Arc<Shared>,
         base_rate: f64,
-    ) -> Result<Ended> {
+    ) -> Result<Ended, SessionError> {
         let summary = self.metrics.summary(shared, base_rate);
         let mut exit = self.exit;
-        let sums = exit.plan.plan_mut().finish().map_err(|e| anyhow!("{e}"))?;
+        let sums = exit.plan.plan_mut().finish().map_err(|e| SessionError::Run(e.to_string()))?;
 
         let reason = match (&exit.failure, exit.reason) {
             (Some(f), _) => format!("node failure: {f}"),
@@ -74,8 +74,9 @@ impl Ran {
         let record = ended.record();
         manifest.write(dir, if ended.exit.failure.is_some() { "failed" } else { "ended" }, Some(record.clone()))?;
         if let Some(path) = &c.json {
-            std::fs::write(path, serde_json::to_string_pretty(&record)?)
-                .map_err(|e| anyhow!("{}: cannot write results: {e}", path.display()))?;
+            let text =
+                serde_json::to_string_pretty(&record).map_err(SessionError::json(path, "cannot write results"))?;
+            std::fs::write(path, text).map_err(SessionError::file(path, "cannot write results"))?;
         }
         Ok(ended)
     }
@@ -101,11 +102,11 @@ pub struct Ended {
 
 impl Ended {
     /// Fails when a node or a fault stopped the session.
-    pub fn outcome(self) -> Result<()> {
+    pub fn outcome(self) -> Result<(), SessionError> {
         match self.exit.failure {
-            Some(f) => Err(anyhow!("{f}")),
+            Some(f) => Err(SessionError::Run(f.to_string())),
             None if self.exit.reason.is_some_and(|r| r.is_fault()) => {
-                Err(anyhow!("session stopped by a fault: {}", self.reason))
+                Err(SessionError::Run(format!("session stopped by a fault: {}", self.reason)))
             }
             None => Ok(()),
         }

@@ -3,7 +3,8 @@
 //! `evflow replay` and `evflow studio` read back.
 //!
 //! [`run()`] runs one as a [`SessionConfig`] says and returns it [`Ended`];
-//! [`session`] and [`integrity`] read and check what it recorded. Inside:
+//! [`session`] and [`integrity`] read and check what it recorded; every
+//! failure is a [`SessionError`]. Inside:
 //! `setup` (the live plan, the folder and its manifest, the pacing),
 //! `threads` (Ctrl-C, the console, the metrics display, the recorder's
 //! thread), `recorder` (drains the real-time thread's rings), `disk`
@@ -17,6 +18,7 @@
 mod config;
 mod disk;
 mod ending;
+pub mod error;
 pub mod integrity;
 mod recorder;
 mod run;
@@ -27,4 +29,5 @@ mod threads;
 
 pub use config::{SessionConfig, DEFAULT_MISS_STREAK};
 pub use ending::Ended;
+pub use error::SessionError;
 pub use run::run;

@@ -5,6 +5,7 @@
 //! itself never waits on the disk.
 
 use super::disk::{Disk, DiskQueue, Files, Op, QUEUE_SECONDS};
+use super::error::SessionError;
 use super::session::{event_json, FileSpec};
 use evflow_engine::live::{rtrb, Event, EventKind, TapInfo};
 use std::io::IsTerminal;
@@ -70,7 +71,7 @@ impl Recorder {
         events: rtrb::Consumer<Event>,
         names: Vec<String>,
         flush_every: Duration,
-    ) -> anyhow::Result<Self> {
+    ) -> Result<Self, SessionError> {
         let infos: Vec<TapInfo> = taps.iter().map(|(i, _)| i.clone()).collect();
         let rings = taps.into_iter().map(|(_, r)| r).collect();
         let mut used = vec![false; infos.len()];
@@ -80,7 +81,7 @@ impl Recorder {
             for port in &spec.ports {
                 let i = (0..infos.len())
                     .find(|&i| !used[i] && infos[i].node == spec.node && infos[i].port == *port)
-                    .ok_or_else(|| anyhow::anyhow!("no tap for {}.{port}", spec.node))?;
+                    .ok_or_else(|| SessionError::Setup(format!("no tap for {}.{port}", spec.node)))?;
                 used[i] = true;
                 idx.push(i);
             }
@@ -97,11 +98,12 @@ impl Recorder {
         events: rtrb::Consumer<Event>,
         names: Vec<String>,
         flush_every: Duration,
-    ) -> anyhow::Result<Self> {
+    ) -> Result<Self, SessionError> {
         // The budget: QUEUE_SECONDS of every recording's samples.
         let per_second: f64 = sinks.iter().map(|s| s.spec.rate * s.spec.ports.len() as f64).sum();
         let budget = (QUEUE_SECONDS * per_second * std::mem::size_of::<f64>() as f64) as usize;
-        let disk = DiskQueue::start(disk, sinks.len(), budget.max(1 << 16), flush_every)?;
+        let disk =
+            DiskQueue::start(disk, sinks.len(), budget.max(1 << 16), flush_every).map_err(SessionError::spawn)?;
         Ok(Self { tee: None, sinks, rings, events, disk, names, events_logged: 0, echo: None })
     }
 

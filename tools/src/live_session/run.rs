@@ -4,9 +4,9 @@
 
 use super::config::SessionConfig;
 use super::ending::{Ended, Ran};
+use super::error::SessionError;
 use super::recorder::Recorder;
 use super::{disk, session, setup, threads};
-use anyhow::{anyhow, Context, Result};
 use evflow_engine::live;
 use evflow_engine::Checked;
 #[cfg(feature = "studio")]
@@ -24,14 +24,14 @@ use std::time::Duration;
 /// and each change as it lands, on stderr. Returns the ended session, its
 /// end recorded in the folder; a failure to set it up or to record its end
 /// is an error.
-pub fn run(c: &SessionConfig, checked: &Checked) -> Result<Ended> {
+pub fn run(c: &SessionConfig, checked: &Checked) -> Result<Ended, SessionError> {
     // Bound before the session (and its folder) starts: a taken port stops
     // nothing that runs.
     #[cfg(feature = "studio")]
     let bound = bind_studio(c)?;
     let graph_text =
-        std::fs::read_to_string(&c.graph_file).with_context(|| format!("{}: cannot read", c.graph_file.display()))?;
-    std::fs::create_dir_all(&c.out).map_err(|e| anyhow!("{}: cannot create output folder: {e}", c.out.display()))?;
+        std::fs::read_to_string(&c.graph_file).map_err(SessionError::file(&c.graph_file, "cannot read"))?;
+    std::fs::create_dir_all(&c.out).map_err(SessionError::file(&c.out, "cannot create output folder"))?;
     let seed = c.seed.unwrap_or(checked.graph.seed);
     let (lp, n_inputs) = setup::live_plan(c, checked, seed)?;
     let (inputs, outputs) = session::files(lp.taps(), n_inputs)?;
@@ -47,7 +47,7 @@ pub fn run(c: &SessionConfig, checked: &Checked) -> Result<Ended> {
     // The files first: creating them syncs each to disk, which must not
     // happen while the real-time thread fills its rings.
     let files = disk::Files::create(&dir, &[inputs, outputs].concat(), "evflow live")?;
-    let mut session = live::start(lp, &pacing.config).map_err(|e| anyhow!("{e}"))?;
+    let mut session = live::start(lp, &pacing.config).map_err(|e| SessionError::Setup(e.to_string()))?;
     let vars_line = setup::vars_line(&vars);
     session.control.bind_vars(vars);
     setup::schedule_changes(&mut session.control, &c.changes)?;
@@ -93,7 +93,7 @@ pub fn run(c: &SessionConfig, checked: &Checked) -> Result<Ended> {
 
 /// Binds the studio's address when the session is to serve it.
 #[cfg(feature = "studio")]
-fn bind_studio(c: &SessionConfig) -> Result<Option<crate::studio::Bound>> {
+fn bind_studio(c: &SessionConfig) -> Result<Option<crate::studio::Bound>, SessionError> {
     Ok(match &c.studio {
         Some(cfg) => Some(crate::studio::Bound::bind(cfg)?),
         None => None,
@@ -108,7 +108,7 @@ fn start_studio(
     description: Option<crate::studio::Description>,
     control: &Arc<std::sync::Mutex<live::Control>>,
     shared: &Arc<live::Shared>,
-) -> Result<Option<(crate::studio::Studio, crate::studio::Ingest)>> {
+) -> Result<Option<(crate::studio::Studio, crate::studio::Ingest)>, SessionError> {
     Ok(match (bound, description) {
         (Some(bound), Some(d)) => {
             let (studio, ingest) = bound.start_live(&d, control.clone(), shared.clone())?;

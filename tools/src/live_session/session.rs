@@ -13,7 +13,9 @@
 //! the manifest and event log are rewritten/appended so a process killed at
 //! any moment leaves a session `evflow replay` can read up to the last flush.
 
-use anyhow::{anyhow, Context, Result};
+use super::error::SessionError;
+
+type Result<T> = std::result::Result<T, SessionError>;
 use evflow_engine::live::{Event, EventKind, TapInfo};
 use evflow_engine::rate::Ratio;
 use serde_json::{json, Value};
@@ -135,48 +137,59 @@ impl Manifest {
 
     /// Writes `session.json` atomically (temporary file, then rename).
     pub fn write(&self, dir: &Path, status: &str, end: Option<Value>) -> Result<()> {
-        let text = serde_json::to_string_pretty(&self.json(status, end))? + "\n";
         let path = dir.join("session.json");
-        evflow_engine::atomic_file::write_atomically(&path, text)
-            .with_context(|| format!("{}: cannot write", path.display()))
+        let text =
+            serde_json::to_string_pretty(&self.json(status, end)).map_err(SessionError::json(&path, "cannot write"))?;
+        evflow_engine::atomic_file::write_atomically(&path, text + "\n")
+            .map_err(SessionError::file(&path, "cannot write"))
     }
 
     /// Reads `SESSION/session.json`, and the JSON as it is.
     pub fn read_raw(dir: &Path) -> Result<(Manifest, Value)> {
         let m = Self::read(dir)?;
         let path = dir.join("session.json");
-        let text = std::fs::read_to_string(&path).with_context(|| format!("{}: cannot read", path.display()))?;
-        let v: Value = serde_json::from_str(&text).with_context(|| format!("{}: not valid JSON", path.display()))?;
+        let text = std::fs::read_to_string(&path).map_err(SessionError::file(&path, "cannot read"))?;
+        let v: Value = serde_json::from_str(&text).map_err(SessionError::json(&path, "not valid JSON"))?;
         Ok((m, v))
     }
 
     /// Reads `SESSION/session.json`.
     pub fn read(dir: &Path) -> Result<Manifest> {
         let path = dir.join("session.json");
-        let text = std::fs::read_to_string(&path).with_context(|| {
-            format!("{}: not a session folder (no session.json; `evflow live` writes one)", dir.display())
-        })?;
-        let v: Value = serde_json::from_str(&text).with_context(|| format!("{}: not valid JSON", path.display()))?;
+        let text = std::fs::read_to_string(&path)
+            .map_err(SessionError::file(dir, "not a session folder (no session.json; `evflow live` writes one)"))?;
+        let v: Value = serde_json::from_str(&text).map_err(SessionError::json(&path, "not valid JSON"))?;
         if v["format"] != FORMAT {
-            return Err(anyhow!("{}: `format` is {}, not \"{FORMAT}\"", path.display(), v["format"]));
+            return Err(SessionError::Recording(format!(
+                "{}: `format` is {}, not \"{FORMAT}\"",
+                path.display(),
+                v["format"]
+            )));
         }
         let version = v["version"].as_u64().unwrap_or(0);
         if version > VERSION {
-            return Err(anyhow!(
+            return Err(SessionError::Recording(format!(
                 "{}: session format version {version} is newer than this evflow reads ({VERSION}); update evflow",
                 path.display()
-            ));
+            )));
         }
-        let base_rate = v["base_rate"].as_f64().ok_or_else(|| anyhow!("{}: `base_rate` missing", path.display()))?;
+        let base_rate = v["base_rate"]
+            .as_f64()
+            .ok_or_else(|| SessionError::Recording(format!("{}: `base_rate` missing", path.display())))?;
         let files = |key: &str| -> Result<Vec<FileSpec>> {
-            let list = v[key].as_array().ok_or_else(|| anyhow!("{}: `{key}` missing", path.display()))?;
+            let list = v[key]
+                .as_array()
+                .ok_or_else(|| SessionError::Recording(format!("{}: `{key}` missing", path.display())))?;
             list.iter()
                 .map(|f| {
-                    let rate = f["rate"]
-                        .as_f64()
-                        .ok_or_else(|| anyhow!("{}: a file in `{key}` has no rate", path.display()))?;
+                    let rate = f["rate"].as_f64().ok_or_else(|| {
+                        SessionError::Recording(format!("{}: a file in `{key}` has no rate", path.display()))
+                    })?;
                     let ratio = Ratio::of(rate, base_rate).ok_or_else(|| {
-                        anyhow!("{}: rate {rate} Hz is not a multiple or divisor of {base_rate} Hz", path.display())
+                        SessionError::Recording(format!(
+                            "{}: rate {rate} Hz is not a multiple or divisor of {base_rate} Hz",
+                            path.display()
+                        ))
                     })?;
                     Ok(FileSpec {
                         file: f["file"].as_str().unwrap_or_default().to_string(),
@@ -265,16 +278,20 @@ pub fn read_event_values(path: &Path) -> Result<Vec<Value>> {
     let text = match evflow_engine::files::read_regular_to_string(path) {
         Ok(t) => t,
         Err(e) if e.kind() == std::io::ErrorKind::NotFound => return Ok(Vec::new()),
-        Err(e) => return Err(anyhow!("{}: {e}", path.display())),
+        Err(e) => return Err(SessionError::Recording(format!("{}: {e}", path.display()))),
     };
     let lines: Vec<&str> = text.lines().collect();
     let mut out = Vec::new();
     for (i, line) in lines.iter().enumerate() {
         match serde_json::from_str::<Value>(line) {
             Ok(v) if v["tick"].is_u64() => out.push(v),
-            Ok(_) => return Err(anyhow!("{}:{}: event without a tick", path.display(), i + 1)),
+            Ok(_) => {
+                return Err(SessionError::Recording(format!("{}:{}: event without a tick", path.display(), i + 1)))
+            }
             Err(_) if i + 1 == lines.len() && !text.ends_with('\n') => break,
-            Err(e) => return Err(anyhow!("{}:{}: not a JSON event: {e}", path.display(), i + 1)),
+            Err(e) => {
+                return Err(SessionError::Recording(format!("{}:{}: not a JSON event: {e}", path.display(), i + 1)))
+            }
         }
     }
     Ok(out)
@@ -291,9 +308,9 @@ pub fn read_events(path: &Path) -> Result<Vec<LoggedEvent>> {
                 tick,
                 node: v["node"].as_str().unwrap_or_default().to_string(),
                 param: v["param"].as_str().unwrap_or_default().to_string(),
-                value: v["value"]
-                    .as_f64()
-                    .ok_or_else(|| anyhow!("{}:{}: `set` without a value", path.display(), i + 1))?,
+                value: v["value"].as_f64().ok_or_else(|| {
+                    SessionError::Recording(format!("{}:{}: `set` without a value", path.display(), i + 1))
+                })?,
             },
             Some("gap") => LoggedEvent::Gap { tick, ticks: v["ticks"].as_u64().unwrap_or(0) },
             Some("replaced") => LoggedEvent::Replaced { tick },

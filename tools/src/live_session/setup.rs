@@ -3,9 +3,11 @@
 //! scripted changes.
 
 use super::config::{SessionConfig, DEFAULT_MISS_STREAK};
+use super::error::SessionError;
 use super::integrity;
 use super::session::{FileSpec, Manifest};
-use anyhow::{anyhow, Result};
+
+type Result<T> = std::result::Result<T, SessionError>;
 use evflow_engine::live::{Control, LiveConfig, LivePlan, LiveVar, RealtimeRequest, Tap};
 use evflow_engine::{Checked, Plan, PlanOptions};
 use std::path::{Path, PathBuf};
@@ -24,7 +26,7 @@ pub(super) fn live_plan(c: &SessionConfig, checked: &Checked, seed: u64) -> Resu
         mode: evflow_engine::RunMode::Live,
         check_only: false,
     };
-    let plan = Plan::build(checked, &opts).map_err(|e| anyhow!("{e}"))?;
+    let plan = Plan::build(checked, &opts).map_err(|e| SessionError::Setup(format!("{e}")))?;
     #[allow(unused_mut)]
     let mut extra = c.taps.clone();
     #[cfg(feature = "studio")]
@@ -33,7 +35,7 @@ pub(super) fn live_plan(c: &SessionConfig, checked: &Checked, seed: u64) -> Resu
         extra.extend(crate::studio::default_taps(checked, &plan).into_iter().map(|t| format!("{}.{}", t.node, t.port)));
     }
     let (taps, n_inputs) = taps_of(&plan, &extra)?;
-    let lp = LivePlan::new(plan, &taps).map_err(|e| anyhow!("{}: {e}", c.graph_file.display()))?;
+    let lp = LivePlan::new(plan, &taps).map_err(|e| SessionError::Setup(format!("{}: {e}", c.graph_file.display())))?;
     Ok((lp, n_inputs))
 }
 
@@ -56,13 +58,16 @@ impl Folder<'_> {
     pub(super) fn open(&self, c: &SessionConfig, checked: &Checked, lp: &LivePlan) -> Result<(PathBuf, Manifest)> {
         let dir = c.session.clone().unwrap_or_else(|| c.out.join("sessions").join(session_name(&checked.graph.name)));
         if dir.join("session.json").exists() {
-            return Err(anyhow!("{}: a session is already recorded there; choose another --session", dir.display()));
+            return Err(SessionError::Setup(format!(
+                "{}: a session is already recorded there; choose another --session",
+                dir.display()
+            )));
         }
-        std::fs::create_dir_all(&dir)
-            .map_err(|e| anyhow!("{}: cannot create the session folder: {e}", dir.display()))?;
-        std::fs::write(dir.join("graph.toml"), self.graph_text)?;
+        std::fs::create_dir_all(&dir).map_err(SessionError::file(&dir, "cannot create the session folder"))?;
+        std::fs::write(dir.join("graph.toml"), self.graph_text)
+            .map_err(SessionError::file(dir.join("graph.toml"), "cannot write"))?;
         let graph_hash = integrity::file_hash(&dir.join("graph.toml"))
-            .map_err(|e| anyhow!("{}: cannot read back: {e}", dir.join("graph.toml").display()))?;
+            .map_err(SessionError::file(dir.join("graph.toml"), "cannot read back"))?;
         let graph_path = std::fs::canonicalize(&c.graph_file).unwrap_or_else(|_| c.graph_file.clone());
         let base_rate = lp.plan().base_rate();
         let manifest = Manifest {
@@ -168,12 +173,15 @@ pub(super) fn vars_line(vars: &[LiveVar]) -> String {
 /// Queues the `--change SECONDS:…` changes at their ticks.
 pub(super) fn schedule_changes(control: &mut Control, changes: &[String]) -> Result<()> {
     for c in changes {
-        let (t, change) = c
-            .split_once(':')
-            .ok_or_else(|| anyhow!("--change {c}: expected SECONDS:node.param=value or SECONDS:variable=value"))?;
-        let t: f64 = t.trim().parse().map_err(|_| anyhow!("--change {c}: `{t}` is not a number of seconds"))?;
+        let (t, change) = c.split_once(':').ok_or_else(|| {
+            SessionError::Setup(format!("--change {c}: expected SECONDS:node.param=value or SECONDS:variable=value"))
+        })?;
+        let t: f64 = t
+            .trim()
+            .parse()
+            .map_err(|_| SessionError::Setup(format!("--change {c}: `{t}` is not a number of seconds")))?;
         let at = control.tick_at(t);
-        control.set_text(change, Some(at)).map_err(|e| anyhow!("--change {c}: {e}"))?;
+        control.set_text(change, Some(at)).map_err(|e| SessionError::Setup(format!("--change {c}: {e}")))?;
     }
     Ok(())
 }
@@ -188,7 +196,8 @@ fn taps_of(plan: &Plan, extra: &[String]) -> Result<(Vec<Tap>, usize)> {
         }
     }
     for e in extra {
-        let (node, port) = e.split_once('.').ok_or_else(|| anyhow!("--tap {e}: expected node.port"))?;
+        let (node, port) =
+            e.split_once('.').ok_or_else(|| SessionError::Setup(format!("--tap {e}: expected node.port")))?;
         let t = Tap::new(node, port);
         if !taps[n_inputs..].contains(&t) {
             taps.push(t);

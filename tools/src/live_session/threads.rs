@@ -1,9 +1,9 @@
 //! The ordinary threads around the real-time one: Ctrl-C, the recorder,
 //! the metrics display and the console.
 
+use super::error::SessionError;
 use super::recorder::{Recorder, RecorderReport};
 use super::steal;
-use anyhow::Result;
 use evflow_engine::live::{rtrb, Control, Metrics, Shared, StopReason, TickStat};
 use std::io::{BufRead, IsTerminal};
 use std::sync::atomic::{AtomicBool, AtomicU32, Ordering};
@@ -42,9 +42,15 @@ pub(super) const FLUSH_EVERY: Duration = Duration::from_millis(200);
 
 /// Starts the recorder's thread, which drains the taps and events until
 /// `done` and hands them to its disk thread.
-pub(super) fn spawn_recorder(recorder: Recorder, done: &Arc<AtomicBool>) -> Result<JoinHandle<RecorderReport>> {
+pub(super) fn spawn_recorder(
+    recorder: Recorder,
+    done: &Arc<AtomicBool>,
+) -> Result<JoinHandle<RecorderReport>, SessionError> {
     let done = done.clone();
-    Ok(std::thread::Builder::new().name("evflow-recorder".into()).spawn(move || recorder.run(done, DRAIN_EVERY))?)
+    std::thread::Builder::new()
+        .name("evflow-recorder".into())
+        .spawn(move || recorder.run(done, DRAIN_EVERY))
+        .map_err(SessionError::spawn)
 }
 
 /// The metrics display: drains the tick timings until `done` and, unless
@@ -67,8 +73,11 @@ impl Display {
         self,
         stats: rtrb::Consumer<TickStat>,
         ingest: Option<StudioFeed>,
-    ) -> Result<JoinHandle<Metrics>> {
-        Ok(std::thread::Builder::new().name("evflow-metrics".into()).spawn(move || self.run(stats, ingest))?)
+    ) -> Result<JoinHandle<Metrics>, SessionError> {
+        std::thread::Builder::new()
+            .name("evflow-metrics".into())
+            .spawn(move || self.run(stats, ingest))
+            .map_err(SessionError::spawn)
     }
 
     /// The metrics thread's loop.
@@ -127,22 +136,25 @@ fn drain_to_studio(m: &mut Metrics, ring: &mut rtrb::Consumer<TickStat>, studio:
 
 /// Starts the console thread: each line of stdin is a change queued on the
 /// control, or `stop`.
-pub(super) fn spawn_console(control: Arc<Mutex<Control>>) -> Result<()> {
-    std::thread::Builder::new().name("evflow-console".into()).spawn(move || {
-        let stdin = std::io::stdin();
-        for line in stdin.lock().lines() {
-            let Ok(line) = line else { break };
-            let line = line.trim();
-            match line {
-                "" => {}
-                "stop" | "q" | "quit" => control.lock().unwrap_or_else(|e| e.into_inner()).stop(),
-                _ => match control.lock().unwrap_or_else(|e| e.into_inner()).set_text(line, None) {
-                    Ok(()) => eprintln!("queued {line}"),
-                    Err(e) => eprintln!("{e}"),
-                },
+pub(super) fn spawn_console(control: Arc<Mutex<Control>>) -> Result<(), SessionError> {
+    std::thread::Builder::new()
+        .name("evflow-console".into())
+        .spawn(move || {
+            let stdin = std::io::stdin();
+            for line in stdin.lock().lines() {
+                let Ok(line) = line else { break };
+                let line = line.trim();
+                match line {
+                    "" => {}
+                    "stop" | "q" | "quit" => control.lock().unwrap_or_else(|e| e.into_inner()).stop(),
+                    _ => match control.lock().unwrap_or_else(|e| e.into_inner()).set_text(line, None) {
+                        Ok(()) => eprintln!("queued {line}"),
+                        Err(e) => eprintln!("{e}"),
+                    },
+                }
+                control.lock().unwrap_or_else(|e| e.into_inner()).collect_retired();
             }
-            control.lock().unwrap_or_else(|e| e.into_inner()).collect_retired();
-        }
-    })?;
+        })
+        .map_err(SessionError::spawn)?;
     Ok(())
 }

@@ -99,13 +99,13 @@ mod tests {
     use super::super::study::merge_study;
     use super::*;
     use evflow_engine::batch::Shard;
-    use evflow_study::narx::saved::NARX_RECORD;
-    use evflow_study::shard_file::StudyRecord;
-    use std::path::PathBuf;
     use evflow_study::narx::run::{NarxConfig, NarxStudy, SeedScore};
+    use evflow_study::narx::saved::NARX_RECORD;
     use evflow_study::narx::scope::NarxScope;
     use evflow_study::narx::setting::Setting;
     use evflow_study::setup::Cond;
+    use evflow_study::shard_file::StudyRecord;
+    use std::path::PathBuf;
 
     /// Shard `shard` of 2 settings × 2 seeds, item 1 failed, felt-fabric left out.
     fn record(shard: Shard) -> (NarxRecord, Vec<Item>) {

@@ -97,7 +97,8 @@ pub fn merge_study<S: StudyReport>(out: &Path, dirs: &[PathBuf], coverage: Cover
     }
     let shards = k_order(shards, coverage)?;
     let folders: Vec<&Path> = shards.iter().map(|(d, _, _)| d.as_path()).collect();
-    let skip: Vec<PathBuf> = std::iter::once(R::<S>::RECORD).chain(S::TABLES.iter().copied()).map(PathBuf::from).collect();
+    let skip: Vec<PathBuf> =
+        std::iter::once(R::<S>::RECORD).chain(S::TABLES.iter().copied()).map(PathBuf::from).collect();
     let files = copy_files(out, &folders, &skip)?;
     std::fs::create_dir_all(out).map_err(|source| MergeError::Create { dir: out.to_path_buf(), source })?;
     let base = std::fs::canonicalize(out).map_err(|source| MergeError::Create { dir: out.to_path_buf(), source })?;

@@ -9,8 +9,8 @@ use evflow_study::live::row::Chain;
 use evflow_study::live::run::{run, LiveConfig, Progress};
 use evflow_study::live::saved::{LiveRecord, RECORD};
 use evflow_study::live::scope::{LiveScope, LiveSettings, User};
-use evflow_study::tables::live::{csv, figures, markdown};
 use evflow_study::shard_file::StudyRecord;
+use evflow_study::tables::live::{csv, figures, markdown};
 use evflow_tools::batch::{progress_bar, BatchArgs};
 use std::path::PathBuf;
 

@@ -39,13 +39,13 @@ pub fn k_order<T>(
 
 /// Reads every shard folder of `dirs` with `read` (its slice and record),
 /// puts them in K order and checks that they are the N slices of one batch:
-/// the same N, and records `same` as the first's (else `what` differs);
-/// every K of N, or those there are ([`Coverage`]).
+/// the same N, and nothing `differs` between the first's record and
+/// another's (else what differs is named); every K of N, or those there
+/// are ([`Coverage`]).
 pub fn one_batch<T>(
     dirs: &[PathBuf],
     read: impl Fn(&Path) -> Result<(Shard, T), MergeError>,
-    same: impl Fn(&T, &T) -> bool,
-    what: &'static str,
+    differs: impl Fn(&T, &T) -> Option<&'static str>,
     coverage: Coverage,
 ) -> Result<Vec<(PathBuf, Shard, T)>, MergeError> {
     if dirs.is_empty() {
@@ -59,12 +59,12 @@ pub fn one_batch<T>(
     shards.sort_by_key(|(_, s, _)| s.k);
     let (first_dir, first_shard, first) = &shards[0];
     for (dir, shard, s) in &shards {
-        let differs = |what| MergeError::NotOneBatch { first: first_dir.clone(), other: dir.clone(), what };
+        let not_one = |what| MergeError::NotOneBatch { first: first_dir.clone(), other: dir.clone(), what };
         if shard.n != first_shard.n {
-            return Err(differs("the shard counts N"));
+            return Err(not_one("the shard counts N"));
         }
-        if !same(s, first) {
-            return Err(differs(what));
+        if let Some(what) = differs(first, s) {
+            return Err(not_one(what));
         }
     }
     k_order(shards, coverage)

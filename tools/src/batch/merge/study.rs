@@ -12,7 +12,7 @@
 //! printing the merge (`evflow merge`) come with it.
 
 use super::error::MergeError;
-use super::files::{copy_files, k_order, Coverage};
+use super::files::{copy_files, one_batch, Coverage};
 use evflow_engine::batch::{Failures, Shard};
 use evflow_study::shard_file::StudyRecord;
 use evflow_study::StudyError;
@@ -65,9 +65,6 @@ pub struct StudyMerge {
 /// Merges the shards of `S`'s report in `dirs` (in any order) into `out`.
 pub fn merge_study<S: StudyReport>(out: &Path, dirs: &[PathBuf], coverage: Coverage) -> Result<StudyMerge, MergeError> {
     type R<S> = <S as StudyReport>::Record;
-    if dirs.is_empty() {
-        return Err(MergeError::NoShards);
-    }
     // A folder of another kind of shard among them: named, not "cannot read".
     let ours = |d: &&PathBuf| R::<S>::is_in(d);
     if let (Some(first), Some(other)) = (dirs.iter().find(ours), dirs.iter().find(|d| !ours(d))) {
@@ -78,24 +75,12 @@ pub fn merge_study<S: StudyReport>(out: &Path, dirs: &[PathBuf], coverage: Cover
             record: R::<S>::RECORD,
         });
     }
-    let mut shards = Vec::with_capacity(dirs.len());
-    for d in dirs {
+    let read = |d: &Path| -> Result<(Shard, R<S>), MergeError> {
         let record = R::<S>::read(d)?;
         let shard = record.slice().map_err(|e| StudyError::Config(format!("{}: {e}", d.display())))?;
-        shards.push((d.clone(), shard, record));
-    }
-    shards.sort_by_key(|(_, s, _)| s.k);
-    let (first_dir, first_shard, first) = &shards[0];
-    for (dir, shard, r) in &shards {
-        let differs = |what| MergeError::NotOneBatch { first: first_dir.clone(), other: dir.clone(), what };
-        if shard.n != first_shard.n {
-            return Err(differs("the shard counts N"));
-        }
-        if let Some(what) = S::differs(first, r) {
-            return Err(differs(what));
-        }
-    }
-    let shards = k_order(shards, coverage)?;
+        Ok((shard, record))
+    };
+    let shards = one_batch(dirs, read, S::differs, coverage)?;
     let folders: Vec<&Path> = shards.iter().map(|(d, _, _)| d.as_path()).collect();
     let skip: Vec<PathBuf> =
         std::iter::once(R::<S>::RECORD).chain(S::TABLES.iter().copied()).map(PathBuf::from).collect();

@@ -94,7 +94,7 @@ impl SavedStudy {
     /// The study of several shards' records (in K order), with every path
     /// put under `base`: rows and models one after another, the failures
     /// labelled with their shard, the times added up.
-    pub fn join(shards: &[SavedStudy], base: &Path) -> Study {
+    pub fn join<'a>(shards: impl IntoIterator<Item = &'a SavedStudy>, base: &Path) -> Study {
         let under = |p: &Path| shard_file::under(base, p);
         let mut study = Study { rows: Vec::new(), models: Vec::new(), seconds: 0.0, failures: Vec::new() };
         for s in shards {

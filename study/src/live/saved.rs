@@ -58,7 +58,7 @@ impl LiveRecord {
     /// The study of several shards' records (in K order), every row's
     /// folder put under `base`, the failures labelled with their shard, the
     /// times added up.
-    pub fn join(shards: &[LiveRecord], base: &Path) -> LiveStudy {
+    pub fn join<'a>(shards: impl IntoIterator<Item = &'a LiveRecord>, base: &Path) -> LiveStudy {
         let mut study = LiveStudy { rows: Vec::new(), failures: Vec::new(), seconds: 0.0 };
         for s in shards {
             study.rows.extend(s.rows.iter().map(|r| LiveRow { dir: shard_file::under(base, &r.dir), ..r.clone() }));

@@ -27,9 +27,9 @@ impl StudyReport for Live {
     }
 
     fn tables(out: &Path, base: &Path, shards: &[Slice<LiveRecord>], files: usize) -> Result<StudyMerge, MergeError> {
-        let saved: Vec<LiveRecord> = shards.iter().map(|(_, _, s)| s.clone()).collect();
-        let study = LiveRecord::join(&saved, base);
-        let scope = &saved[0].scope;
+        let first = &shards[0].2;
+        let study = LiveRecord::join(shards.iter().map(|(_, _, s)| s), base);
+        let scope = &first.scope;
         let md = markdown(&study, scope);
         let (md_path, csv_path) = (out.join("live.md"), out.join("rows.csv"));
         write(&md_path, &md)?;
@@ -41,15 +41,15 @@ impl StudyReport for Live {
                 written.push(w.path);
             }
         }
-        let items = saved[0].items;
+        let items = first.items;
         Ok(StudyMerge {
-            shards: saved.len(),
+            shards: shards.len(),
             markdown: md,
             written: written.iter().map(|p| format!("wrote {}", p.display())).collect(),
             warnings: Vec::new(),
             summary: format!(
                 "merged {} shards of a live report: {} rows of {items} items, {files} files the shards wrote",
-                saved.len(),
+                shards.len(),
                 study.rows.len()
             ),
             steps: items,

@@ -75,12 +75,7 @@ pub fn merge_study<S: StudyReport>(out: &Path, dirs: &[PathBuf], coverage: Cover
             record: R::<S>::RECORD,
         });
     }
-    let read = |d: &Path| -> Result<(Shard, R<S>), MergeError> {
-        let record = R::<S>::read(d)?;
-        let shard = record.slice().map_err(|e| StudyError::Config(format!("{}: {e}", d.display())))?;
-        Ok((shard, record))
-    };
-    let shards = one_batch(dirs, read, S::differs, coverage)?;
+    let shards = one_batch(dirs, read_slice::<R<S>>, S::differs, coverage)?;
     let folders: Vec<&Path> = shards.iter().map(|(d, _, _)| d.as_path()).collect();
     let skip: Vec<PathBuf> =
         std::iter::once(R::<S>::RECORD).chain(S::TABLES.iter().copied()).map(PathBuf::from).collect();
@@ -88,6 +83,13 @@ pub fn merge_study<S: StudyReport>(out: &Path, dirs: &[PathBuf], coverage: Cover
     std::fs::create_dir_all(out).map_err(|source| MergeError::Create { dir: out.to_path_buf(), source })?;
     let base = std::fs::canonicalize(out).map_err(|source| MergeError::Create { dir: out.to_path_buf(), source })?;
     S::tables(out, &base, &shards, files)
+}
+
+/// The record of a study shard in `dir`, checked, and its K/N.
+fn read_slice<R: StudyRecord>(dir: &Path) -> Result<(Shard, R), MergeError> {
+    let record = R::read(dir)?;
+    let shard = record.slice().map_err(|e| StudyError::Config(format!("{}: {e}", dir.display())))?;
+    Ok((shard, record))
 }
 
 /// A sharded study report seen through one interface, whatever its record
@@ -125,9 +127,7 @@ impl<S: StudyReport> StudyKind for S {
     }
 
     fn slice(&self, dir: &Path) -> Result<Shard, MergeError> {
-        S::Record::read(dir)?
-            .slice()
-            .map_err(|e| MergeError::Study(StudyError::Config(format!("{}: {e}", dir.display()))))
+        read_slice::<S::Record>(dir).map(|(shard, _)| shard)
     }
 
     fn merge(&self, out: &Path, dirs: &[PathBuf], coverage: Coverage) -> Result<StudyMerge, MergeError> {

@@ -29,24 +29,24 @@ impl StudyReport for Textures {
     }
 
     fn tables(out: &Path, base: &Path, shards: &[Slice<SavedStudy>], files: usize) -> Result<StudyMerge, MergeError> {
-        let saved: Vec<SavedStudy> = shards.iter().map(|(_, _, s)| s.clone()).collect();
-        let study = SavedStudy::join(&saved, base);
-        let scope = &saved[0].scope;
+        let first = &shards[0].2;
+        let study = SavedStudy::join(shards.iter().map(|(_, _, s)| s), base);
+        let scope = &first.scope;
         let cfg = StudyConfig::merged(scope.clone(), base, Shard::ALL);
         let timings = if scope.times { Timings::Show } else { Timings::Leave };
         let md = markdown(&study, &cfg, timings);
         let (md_path, csv_path) = (out.join("textures.md"), out.join("rows.csv"));
         write(&md_path, &md)?;
         write(&csv_path, &csv(&study, timings))?;
-        let cells = saved[0].cells;
+        let cells = first.cells;
         Ok(StudyMerge {
-            shards: saved.len(),
+            shards: shards.len(),
             markdown: md,
             written: [md_path, csv_path].iter().map(|p| format!("wrote {}", p.display())).collect(),
             warnings: Vec::new(),
             summary: format!(
                 "merged {} shards of a texture report: {} rows, {files} files the shards wrote",
-                saved.len(),
+                shards.len(),
                 study.rows.len()
             ),
             steps: cells + cells * scope.samples.len(),

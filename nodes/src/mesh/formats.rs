@@ -20,7 +20,7 @@ pub enum Format {
     Stl,
     /// PLY, ASCII or binary (ply-rs-bw).
     Ply,
-    /// glTF 2.0 JSON (gltf).
+    /// glTF 2.0 JSON (`.gltf`).
     Gltf,
     /// glTF 2.0 binary container.
     Glb,

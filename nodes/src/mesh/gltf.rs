@@ -1,13 +1,14 @@
 //! glTF 2.0 loading, `.gltf` (JSON, buffers as base64 data URIs or files
-//! beside it) and `.glb` (binary container), through the `gltf` crate for
-//! the JSON document, its validation and its scene graph.
+//! beside it) and `.glb` (binary container). The JSON document is read by
+//! our own serde types and checked in [`super::gltf_doc`] (every index in
+//! range, known enum codes, no required extension); this module walks its
+//! scene graph.
 //!
 //! The GLB container (12-byte header, JSON chunk, BIN chunk) is split
 //! here so that a wrong magic, version or length names its byte; the
-//! buffers are fetched here (the crate's `import` feature would also pull
-//! in an image decoder), and the accessors are read here, after checking
-//! that each lies inside its buffer view and buffer, so a bad index or a
-//! non-finite coordinate names its byte.
+//! buffers are fetched here, and the accessors are read here, after
+//! checking that each lies inside its buffer view and buffer, so a bad
+//! index or a non-finite coordinate names its byte.
 //!
 //! **What is read.** The default scene (else the first; without scenes,
 //! every mesh once, untransformed), each node's mesh placed by the
@@ -19,9 +20,8 @@
 //! by its specification. [`Mesh::new`] welds the vertices.
 
 use super::error::MeshError;
+use super::gltf_doc::{self, DataType, Dimensions, DocError, Document, Mode, Transform};
 use super::trimesh::Mesh;
-use ::gltf::accessor::{DataType, Dimensions};
-use ::gltf::mesh::Mode;
 use base64::Engine;
 use std::borrow::Cow;
 use std::path::{Path, PathBuf};
@@ -42,41 +42,42 @@ pub fn load_gltf(path: &Path, weld: f64) -> Result<Mesh, MeshError> {
     parse_gltf(path, &bytes, glb, weld)
 }
 
-/// Parses glTF bytes: a GLB when `glb` (the magic is then required),
-/// else JSON. External buffer files are looked up beside `path`.
+/// Parses glTF bytes: a GLB when `glb` (the magic is then required) or
+/// when they start with the GLB magic `glTF`, else JSON. External buffer
+/// files are looked up beside `path`.
 pub fn parse_gltf(path: &Path, bytes: &[u8], glb: bool, weld: f64) -> Result<Mesh, MeshError> {
-    let (json, bin, json_at) = if glb {
+    let (json, bin, json_at) = if glb || bytes.starts_with(b"glTF") {
         let c = split_glb(path, bytes)?;
         (c.json, c.bin, Some(c.json_at))
     } else {
         (bytes, None, None)
     };
-    let doc = ::gltf::Gltf::from_slice(json).map_err(|e| gltf_error(path, e, json_at))?;
+    let doc = gltf_doc::parse(json).map_err(|e| gltf_error(path, e, json_at))?;
     let buffers = fetch_buffers(path, &doc, bin)?;
     let mut vertices: Vec<[f64; 3]> = Vec::new();
     let mut triangles: Vec<[u32; 3]> = Vec::new();
-    let mut add = |mesh: ::gltf::Mesh, m: &Mat| -> Result<(), MeshError> {
-        for prim in mesh.primitives() {
-            let what = format!("meshes[{}].primitives[{}]", mesh.index(), prim.index());
-            let Some(pos) = prim.get(&::gltf::Semantic::Positions) else { continue };
-            if matches!(prim.mode(), Mode::Points | Mode::Lines | Mode::LineLoop | Mode::LineStrip) {
+    let mut add = |mesh: usize, m: &Mat| -> Result<(), MeshError> {
+        for (k, prim) in doc.meshes[mesh].iter().enumerate() {
+            let what = format!("meshes[{mesh}].primitives[{k}]");
+            let Some(pos) = prim.position else { continue };
+            if matches!(prim.mode, Mode::Points | Mode::Lines | Mode::LineLoop | Mode::LineStrip) {
                 continue;
             }
             let base = vertices.len() as u64;
-            for p in read_positions(path, &buffers, &pos, &what)? {
+            for p in read_positions(path, &buffers, &doc, pos, &what)? {
                 let q = m.apply(p);
                 if !q.iter().all(|x| x.is_finite()) {
                     return Err(gltf_msg(path, format!("{what}: a node transform takes {p:?} to {q:?}")));
                 }
                 vertices.push(q);
             }
-            let n = pos.count();
-            let idx: Vec<u32> = match prim.indices() {
-                Some(a) => read_indices(path, &buffers, &a, &what, n)?,
+            let n = doc.accessors[pos].count;
+            let idx: Vec<u32> = match prim.indices {
+                Some(a) => read_indices(path, &buffers, &doc, a, &what, n)?,
                 None => (0..n as u32).collect(),
             };
             let tri = |a: u32, b: u32, c: u32| [a, b, c].map(|i| (base + i as u64) as u32);
-            match prim.mode() {
+            match prim.mode {
                 Mode::TriangleStrip => {
                     for k in 2..idx.len() {
                         let (a, b, c) = (idx[k - 2], idx[k - 1], idx[k]);
@@ -104,26 +105,28 @@ pub fn parse_gltf(path: &Path, bytes: &[u8], glb: bool, weld: f64) -> Result<Mes
         }
         Ok(())
     };
-    let scene = doc.default_scene().or_else(|| doc.scenes().next());
+    let scene = doc.scene.or(if doc.scenes.is_empty() { None } else { Some(0) });
     match scene {
         Some(scene) => {
-            let mut stack: Vec<(::gltf::Node, Mat, usize)> = scene.nodes().map(|n| (n, Mat::IDENTITY, 0)).collect();
-            while let Some((node, parent, depth)) = stack.pop() {
+            let mut stack: Vec<(usize, Mat, usize)> =
+                doc.scenes[scene].iter().map(|&n| (n, Mat::IDENTITY, 0)).collect();
+            while let Some((k, parent, depth)) = stack.pop() {
                 if depth > MAX_DEPTH {
                     return Err(gltf_msg(
                         path,
-                        format!("nodes[{}]: node hierarchy deeper than {MAX_DEPTH} (a cycle?)", node.index()),
+                        format!("nodes[{k}]: node hierarchy deeper than {MAX_DEPTH} (a cycle?)"),
                     ));
                 }
-                let m = parent.then(&Mat::of(node.transform()));
-                if let Some(mesh) = node.mesh() {
+                let node = &doc.nodes[k];
+                let m = parent.then(&Mat::of(node.transform));
+                if let Some(mesh) = node.mesh {
                     add(mesh, &m)?;
                 }
-                stack.extend(node.children().map(|c| (c, m, depth + 1)));
+                stack.extend(node.children.iter().map(|&c| (c, m, depth + 1)));
             }
         }
         None => {
-            for mesh in doc.meshes() {
+            for mesh in 0..doc.meshes.len() {
                 add(mesh, &Mat::IDENTITY)?;
             }
         }
@@ -136,11 +139,11 @@ fn gltf_msg(path: &Path, message: String) -> MeshError {
     MeshError::Gltf { path: path.into(), message }
 }
 
-/// The crate's error as a mesh error: JSON errors by line (of the file,
+/// A document error as a mesh error: JSON errors by line (of the file,
 /// or of the GLB's JSON chunk), validation errors by JSON path.
-fn gltf_error(path: &Path, e: ::gltf::Error, json_at: Option<u64>) -> MeshError {
+fn gltf_error(path: &Path, e: DocError, json_at: Option<u64>) -> MeshError {
     match e {
-        ::gltf::Error::Deserialize(j) => {
+        DocError::Syntax(j) => {
             let inside = json_at.map_or(String::new(), |at| format!(" of the JSON chunk (from byte {at})"));
             MeshError::Syntax {
                 path: path.into(),
@@ -148,11 +151,7 @@ fn gltf_error(path: &Path, e: ::gltf::Error, json_at: Option<u64>) -> MeshError 
                 message: format!("column {}{inside}: {j}", j.column()),
             }
         }
-        ::gltf::Error::Validation(list) => {
-            let all: Vec<String> = list.iter().map(|(p, e)| format!("{p}: {e}")).collect();
-            gltf_msg(path, format!("invalid document: {}", all.join("; ")))
-        }
-        other => gltf_msg(path, other.to_string()),
+        DocError::Invalid(all) => gltf_msg(path, format!("invalid document: {}", all.join("; "))),
     }
 }
 
@@ -258,22 +257,17 @@ struct Buffer<'a> {
 
 /// Fetches every buffer: the GLB's BIN chunk, a base64 data URI or a
 /// file relative to the glTF file.
-fn fetch_buffers<'a>(
-    path: &Path,
-    doc: &::gltf::Gltf,
-    bin: Option<(&'a [u8], u64)>,
-) -> Result<Vec<Buffer<'a>>, MeshError> {
+fn fetch_buffers<'a>(path: &Path, doc: &Document, bin: Option<(&'a [u8], u64)>) -> Result<Vec<Buffer<'a>>, MeshError> {
     let mut out = Vec::new();
-    for b in doc.buffers() {
-        let k = b.index();
-        let buf = match b.source() {
-            ::gltf::buffer::Source::Bin => {
+    for (k, b) in doc.buffers.iter().enumerate() {
+        let buf = match b.uri.as_deref() {
+            None => {
                 let (data, at) = bin.ok_or_else(|| {
                     gltf_msg(path, format!("buffers[{k}] refers to the GLB's BIN chunk, which is missing"))
                 })?;
                 Buffer { data: Cow::Borrowed(data), file: Some((path.into(), at)) }
             }
-            ::gltf::buffer::Source::Uri(uri) if uri.starts_with("data:") => {
+            Some(uri) if uri.starts_with("data:") => {
                 let (head, payload) = uri
                     .split_once(',')
                     .ok_or_else(|| gltf_msg(path, format!("buffers[{k}]: a data URI without `,`")))?;
@@ -285,7 +279,7 @@ fn fetch_buffers<'a>(
                     .map_err(|e| gltf_msg(path, format!("buffers[{k}]: data URI: {e}")))?;
                 Buffer { data: Cow::Owned(data), file: None }
             }
-            ::gltf::buffer::Source::Uri(uri) => {
+            Some(uri) => {
                 let file = path.parent().unwrap_or(Path::new("")).join(percent_decode(uri));
                 let data = evflow_engine::files::read_regular(&file).map_err(|e| MeshError::Io {
                     path: file.clone(),
@@ -294,8 +288,8 @@ fn fetch_buffers<'a>(
                 Buffer { data: Cow::Owned(data), file: Some((file, 0)) }
             }
         };
-        if buf.data.len() < b.length() {
-            let message = format!("buffers[{k}] declares {} bytes, its data has {}", b.length(), buf.data.len());
+        if buf.data.len() < b.length {
+            let message = format!("buffers[{k}] declares {} bytes, its data has {}", b.length, buf.data.len());
             return Err(match &buf.file {
                 Some((file, at)) => MeshError::Truncated {
                     path: file.clone(),
@@ -344,58 +338,65 @@ fn at_byte(path: &Path, buffers: &[Buffer], buffer: usize, at: usize, message: S
 fn layout(
     path: &Path,
     buffers: &[Buffer],
-    a: &::gltf::Accessor,
+    doc: &Document,
+    k: usize,
     what: &str,
     elem: usize,
 ) -> Result<(usize, usize, usize), MeshError> {
-    let name = format!("{what}: accessors[{}]", a.index());
-    if a.sparse().is_some() {
+    let a = &doc.accessors[k];
+    let name = format!("{what}: accessors[{k}]");
+    if a.sparse {
         return Err(gltf_msg(path, format!("{name} is sparse, which this loader does not read")));
     }
-    let view = a.view().ok_or_else(|| gltf_msg(path, format!("{name} has no buffer view")))?;
-    let stride = view.stride().unwrap_or(elem);
-    let buffer = view.buffer().index();
+    let v = a.view.ok_or_else(|| gltf_msg(path, format!("{name} has no buffer view")))?;
+    let view = &doc.views[v];
+    let stride = view.stride.unwrap_or(elem);
+    let buffer = view.buffer;
     let len = buffers[buffer].data.len();
-    let view_end = view.offset().checked_add(view.length()).filter(|&e| e <= len).ok_or_else(|| {
+    let view_end = view.offset.checked_add(view.length).filter(|&e| e <= len).ok_or_else(|| {
         gltf_msg(
             path,
             format!(
-                "{name}: bufferViews[{}] ({} bytes from byte {}) runs past the end of buffers[{buffer}] ({len} bytes)",
-                view.index(),
-                view.length(),
-                view.offset()
+                "{name}: bufferViews[{v}] ({} bytes from byte {}) runs past the end of buffers[{buffer}] ({len} bytes)",
+                view.length, view.offset
             ),
         )
     })?;
-    let start = view.offset() + a.offset();
-    let need =
-        if a.count() == 0 { Some(0) } else { (a.count() - 1).checked_mul(stride).and_then(|b| b.checked_add(elem)) };
-    if need.and_then(|n| start.checked_add(n)).is_none_or(|e| e > view_end) {
-        return Err(gltf_msg(path, format!("{name}: {} elements of {elem} bytes (stride {stride}) from byte {} run past the end of bufferViews[{}]", a.count(), a.offset(), view.index())));
+    let start = view.offset.checked_add(a.offset);
+    let need = if a.count == 0 { Some(0) } else { (a.count - 1).checked_mul(stride).and_then(|b| b.checked_add(elem)) };
+    match start.zip(need).and_then(|(s, n)| s.checked_add(n).map(|e| (s, e))) {
+        Some((start, end)) if end <= view_end => Ok((buffer, start, stride)),
+        _ => Err(gltf_msg(
+            path,
+            format!(
+                "{name}: {} elements of {elem} bytes (stride {stride}) from byte {} run past the end of bufferViews[{v}]",
+                a.count, a.offset
+            ),
+        )),
     }
-    Ok((buffer, start, stride))
 }
 
 /// The positions of an accessor (float VEC3), each finite.
 fn read_positions(
     path: &Path,
     buffers: &[Buffer],
-    a: &::gltf::Accessor,
+    doc: &Document,
+    k: usize,
     what: &str,
 ) -> Result<Vec<[f64; 3]>, MeshError> {
-    if a.dimensions() != Dimensions::Vec3 || a.data_type() != DataType::F32 {
+    let a = &doc.accessors[k];
+    if a.dimensions != Dimensions::Vec3 || a.data_type != DataType::F32 {
         return Err(gltf_msg(
             path,
             format!(
                 "{what}: POSITION is {:?} {:?}; float VEC3 is read (quantized positions are not)",
-                a.data_type(),
-                a.dimensions()
+                a.data_type, a.dimensions
             ),
         ));
     }
-    let (buffer, start, stride) = layout(path, buffers, a, what, 12)?;
+    let (buffer, start, stride) = layout(path, buffers, doc, k, what, 12)?;
     let data = &buffers[buffer].data;
-    (0..a.count())
+    (0..a.count)
         .map(|k| {
             let mut p = [0.0; 3];
             for (i, x) in p.iter_mut().enumerate() {
@@ -421,19 +422,21 @@ fn read_positions(
 fn read_indices(
     path: &Path,
     buffers: &[Buffer],
-    a: &::gltf::Accessor,
+    doc: &Document,
+    k: usize,
     what: &str,
     n: usize,
 ) -> Result<Vec<u32>, MeshError> {
-    let size = match (a.dimensions(), a.data_type()) {
+    let a = &doc.accessors[k];
+    let size = match (a.dimensions, a.data_type) {
         (Dimensions::Scalar, DataType::U8) => 1,
         (Dimensions::Scalar, DataType::U16) => 2,
         (Dimensions::Scalar, DataType::U32) => 4,
         (d, t) => return Err(gltf_msg(path, format!("{what}: indices are {t:?} {d:?}; unsigned SCALAR is read"))),
     };
-    let (buffer, start, stride) = layout(path, buffers, a, what, size)?;
+    let (buffer, start, stride) = layout(path, buffers, doc, k, what, size)?;
     let data = &buffers[buffer].data;
-    (0..a.count())
+    (0..a.count)
         .map(|k| {
             let at = start + k * stride;
             let i = match size {
@@ -470,13 +473,13 @@ impl Mat {
 
     /// A node's transform (glTF: column-major matrix, or T·R·S with R a
     /// unit quaternion x, y, z, w).
-    fn of(t: ::gltf::scene::Transform) -> Mat {
+    fn of(t: Transform) -> Mat {
         match t {
-            ::gltf::scene::Transform::Matrix { matrix: c } => Mat {
-                m: [0, 1, 2].map(|r| [0, 1, 2].map(|k| c[k][r] as f64)),
-                t: [c[3][0] as f64, c[3][1] as f64, c[3][2] as f64],
+            Transform::Matrix(c) => Mat {
+                m: [0, 1, 2].map(|r| [0, 1, 2].map(|k| c[4 * k + r] as f64)),
+                t: [c[12] as f64, c[13] as f64, c[14] as f64],
             },
-            ::gltf::scene::Transform::Decomposed { translation, rotation, scale } => {
+            Transform::Decomposed { translation, rotation, scale } => {
                 let [x, y, z, w] = rotation.map(|v| v as f64);
                 let n = (x * x + y * y + z * z + w * w).sqrt();
                 let (x, y, z, w) = if n > 0.0 { (x / n, y / n, z / n, w / n) } else { (0.0, 0.0, 0.0, 1.0) };
@@ -608,6 +611,22 @@ mod tests {
                 .sum();
             assert!((area - 1.0).abs() < 1e-12, "mode {mode}: {area}");
         }
+    }
+
+    #[test]
+    fn glb_bytes_under_any_name_and_primitives_without_positions() {
+        // GLB bytes are a GLB whatever the file is called.
+        let a = parse_gltf(Path::new("t.gltf"), &glb(&json(None, ""), &buffer()), false, 0.0).unwrap();
+        assert_eq!((a.vertices.len(), a.triangles.len()), (5, 3));
+        // A primitive without POSITION adds nothing; the others are read.
+        let two = r#""primitives":[{"attributes":{"NORMAL":0}},{"attributes":{"POSITION":0},"indices":1}]"#;
+        let text = embedded("").replace(r#""primitives":[{"attributes":{"POSITION":0},"indices":1}]"#, two);
+        let b = parse_gltf(Path::new("t.gltf"), text.as_bytes(), false, 0.0).unwrap();
+        assert_eq!(a, b);
+        // A node matrix (column-major): x doubled, then moved by (10, 0, 0).
+        let m = r#","matrix":[2,0,0,0,0,1,0,0,0,0,1,0,10,0,0,1]"#;
+        let c = parse_gltf(Path::new("t.gltf"), embedded(m).as_bytes(), false, 0.0).unwrap();
+        assert!(c.vertices.contains(&[14.0, 1.0, 0.0]), "{:?}", c.vertices);
     }
 
     #[test]

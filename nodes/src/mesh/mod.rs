@@ -10,6 +10,8 @@ pub mod edges;
 pub mod error;
 pub mod formats;
 pub mod gltf;
+pub mod gltf_doc;
+mod gltf_json;
 pub mod gradient;
 pub mod obj;
 pub mod ply;

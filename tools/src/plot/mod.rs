@@ -193,13 +193,20 @@ pub fn write_png(plot: &Plot, path: &Path) -> Result<Written, PlotError> {
     Ok(Written { path: path.to_path_buf(), labelled })
 }
 
-/// Writes `pixels` (RGB, [`SIZE`]) to `out` as PNG with the encoder and
-/// settings plotters' own file output uses: the same bytes.
+/// Writes `pixels` (RGB, [`SIZE`]) to `out` as PNG with the settings
+/// plotters' own file output uses (through the image crate's encoder:
+/// fast compression, adaptive filtering starting from Sub): the same bytes.
 fn encode_png(pixels: &[u8], out: &mut impl std::io::Write) -> std::io::Result<()> {
     let mut w = std::io::BufWriter::new(out);
-    let png = image::codecs::png::PngEncoder::new(&mut w);
-    image::ImageEncoder::write_image(png, pixels, SIZE.0, SIZE.1, image::ColorType::Rgb8)
-        .map_err(std::io::Error::other)?;
+    let mut encoder = png::Encoder::new(&mut w, SIZE.0, SIZE.1);
+    encoder.set_color(png::ColorType::Rgb);
+    encoder.set_depth(png::BitDepth::Eight);
+    encoder.set_compression(png::Compression::Fast);
+    encoder.set_filter(png::FilterType::Sub);
+    encoder.set_adaptive_filter(png::AdaptiveFilterType::Adaptive);
+    let mut writer = encoder.write_header().map_err(std::io::Error::other)?;
+    writer.write_image_data(pixels).map_err(std::io::Error::other)?;
+    writer.finish().map_err(std::io::Error::other)?;
     std::io::Write::flush(&mut w)
 }
 
@@ -372,21 +379,28 @@ mod tests {
     #[test]
     fn the_png_is_byte_for_byte_what_plotters_writes_to_a_file() {
         // Plots are drawn in memory and written through a new temporary
-        // (issue 37, point 2); the bytes are those plotters' file output wrote.
-        let dir = tempfile::tempdir().unwrap();
-        let scene = |root: DrawingArea<BitMapBackend<'_>, plotters::coord::Shift>| {
+        // (issue 37, point 2); the bytes are those plotters' file output
+        // (`BitMapBackend::new`, plotters 0.3.7 through image 0.24.9) wrote
+        // for this scene: its length and FNV-1a hash were taken from that
+        // output before the image crate was dropped.
+        let mut pixels = vec![0u8; SIZE.0 as usize * SIZE.1 as usize * 3];
+        {
+            let root = BitMapBackend::with_buffer(&mut pixels, SIZE).into_drawing_area();
             root.fill(&WHITE).unwrap();
             let pts = (0..900).map(|x| (x + 30, 320 + ((x as f64 / 40.0).sin() * 250.0) as i32));
             root.draw(&PathElement::new(pts.collect::<Vec<_>>(), colour(1).stroke_width(2))).unwrap();
             root.present().unwrap();
-        };
-        let by_plotters = dir.path().join("plotters.png");
-        scene(BitMapBackend::new(&by_plotters, SIZE).into_drawing_area());
-        let mut pixels = vec![0u8; SIZE.0 as usize * SIZE.1 as usize * 3];
-        scene(BitMapBackend::with_buffer(&mut pixels, SIZE).into_drawing_area());
+        }
         let mut ours = Vec::new();
         encode_png(&pixels, &mut ours).unwrap();
-        assert_eq!(ours, std::fs::read(&by_plotters).unwrap());
+        let fnv = ours.iter().fold(0xcbf2_9ce4_8422_2325u64, |h, &b| (h ^ b as u64).wrapping_mul(0x100_0000_01b3));
+        assert_eq!((ours.len(), fnv), (18164, 0x8835_29ac_ec80_cdb5));
+        // And it decodes to the pixels drawn.
+        let mut reader = png::Decoder::new(std::io::Cursor::new(&ours)).read_info().unwrap();
+        let mut back = vec![0u8; reader.output_buffer_size()];
+        let info = reader.next_frame(&mut back).unwrap();
+        assert_eq!((info.width, info.height, info.color_type), (SIZE.0, SIZE.1, png::ColorType::Rgb));
+        assert_eq!(back, pixels);
     }
 
     #[test]

@@ -176,27 +176,10 @@ impl Mesh {
 /// Which triangles to flip so each connected piece is consistently
 /// oriented with its seed facing up (see the module doc).
 fn orientation(v: &[[f64; 3]], tris: &[[u32; 3]], normals: &[[f64; 3]]) -> Vec<bool> {
-    // Edge → (triangle, runs low→high) for every triangle on it.
-    let mut edges: HashMap<(u32, u32), Vec<(u32, bool)>> = HashMap::with_capacity(tris.len() * 3 / 2);
-    for (t, tri) in tris.iter().enumerate() {
-        for k in 0..3 {
-            let (a, b) = (tri[k], tri[(k + 1) % 3]);
-            edges.entry((a.min(b), a.max(b))).or_default().push((t as u32, a < b));
-        }
-    }
+    let across = edge_neighbours(tris);
     let neighbours = |t: usize, out: &mut Vec<(usize, bool)>| {
         out.clear();
-        let tri = tris[t];
-        for k in 0..3 {
-            let (a, b) = (tri[k], tri[(k + 1) % 3]);
-            if let Some(f) = edges.get(&(a.min(b), a.max(b))) {
-                if f.len() == 2 {
-                    let (me, other) = if f[0].0 as usize == t { (f[0], f[1]) } else { (f[1], f[0]) };
-                    // Same direction on the shared edge: inconsistent winding.
-                    out.push((other.0 as usize, me.1 == other.1));
-                }
-            }
-        }
+        out.extend(across[t].iter().flatten().map(|&(n, inconsistent)| (n as usize, inconsistent)));
     };
     let mut flip = vec![false; tris.len()];
     let mut component = vec![usize::MAX; tris.len()];
@@ -244,6 +227,44 @@ fn orientation(v: &[[f64; 3]], tris: &[[u32; 3]], normals: &[[f64; 3]]) -> Vec<b
         }
     }
     flip
+}
+
+/// For each triangle and each of its edges k (corner k to corner k + 1),
+/// the triangle across that edge and whether the two run the same way
+/// along it (inconsistent winding), where exactly two triangles share the
+/// edge; `None` on a boundary edge or one shared by three or more.
+///
+/// The edges of every triangle are sorted by their vertex pair, ties in
+/// the order (triangle, k) they were listed in, so the two of an edge are
+/// taken in that order — as the map from each edge to the list of its
+/// triangles, filled in that order, that this replaces (the test keeps it
+/// as the reference), took them; without one allocation per edge.
+fn edge_neighbours(tris: &[[u32; 3]]) -> Vec<[Option<(u32, bool)>; 3]> {
+    // (low << 32 | high, triangle << 2 | k, runs low → high).
+    let mut list: Vec<(u64, u64, bool)> = Vec::with_capacity(tris.len() * 3);
+    for (t, tri) in tris.iter().enumerate() {
+        for k in 0..3 {
+            let (a, b) = (tri[k], tri[(k + 1) % 3]);
+            list.push((((a.min(b) as u64) << 32) | a.max(b) as u64, ((t as u64) << 2) | k as u64, a < b));
+        }
+    }
+    list.sort_unstable_by_key(|e| (e.0, e.1));
+    let mut across = vec![[None; 3]; tris.len()];
+    let mut i = 0;
+    while i < list.len() {
+        let mut j = i + 1;
+        while j < list.len() && list[j].0 == list[i].0 {
+            j += 1;
+        }
+        if j - i == 2 {
+            let (p, q) = (list[i], list[i + 1]);
+            let inconsistent = p.2 == q.2;
+            across[(p.1 >> 2) as usize][(p.1 & 3) as usize] = Some(((q.1 >> 2) as u32, inconsistent));
+            across[(q.1 >> 2) as usize][(q.1 & 3) as usize] = Some(((p.1 >> 2) as u32, inconsistent));
+        }
+        i = j;
+    }
+    across
 }
 
 /// FNV-1a, 64 bits.
@@ -354,6 +375,65 @@ fn weld_vertices(v: &[[f64; 3]], tol: f64) -> (Vec<[f64; 3]>, Vec<u32>) {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// The edge map `orientation` used before `edge_neighbours`: each edge
+    /// to the list of its triangles, in the order they were listed.
+    fn neighbours_by_map(tris: &[[u32; 3]], t: usize) -> Vec<(usize, bool)> {
+        let mut edges: HashMap<(u32, u32), Vec<(u32, bool)>> = HashMap::new();
+        for (t, tri) in tris.iter().enumerate() {
+            for k in 0..3 {
+                let (a, b) = (tri[k], tri[(k + 1) % 3]);
+                edges.entry((a.min(b), a.max(b))).or_default().push((t as u32, a < b));
+            }
+        }
+        let mut out = Vec::new();
+        let tri = tris[t];
+        for k in 0..3 {
+            let (a, b) = (tri[k], tri[(k + 1) % 3]);
+            if let Some(f) = edges.get(&(a.min(b), a.max(b))) {
+                if f.len() == 2 {
+                    let (me, other) = if f[0].0 as usize == t { (f[0], f[1]) } else { (f[1], f[0]) };
+                    out.push((other.0 as usize, me.1 == other.1));
+                }
+            }
+        }
+        out
+    }
+
+    #[test]
+    fn edge_neighbours_are_those_of_the_edge_map() {
+        // A grid of quads split in two, every third triangle wound the
+        // other way, plus a fin (a third triangle on an edge), a
+        // degenerate triangle with a repeated vertex and a lone triangle.
+        let n = 9u32;
+        let at = |i: u32, j: u32| i * (n + 1) + j;
+        let mut tris = Vec::new();
+        for i in 0..n {
+            for j in 0..n {
+                let (a, b, c, d) = (at(i, j), at(i + 1, j), at(i + 1, j + 1), at(i, j + 1));
+                tris.push([a, b, c]);
+                tris.push([a, c, d]);
+            }
+        }
+        for (k, t) in tris.iter_mut().enumerate() {
+            if k % 3 == 0 {
+                t.swap(1, 2);
+            }
+        }
+        let extra = (n + 1) * (n + 1);
+        tris.push([at(0, 0), at(1, 0), extra]);
+        tris.push([at(2, 2), at(2, 3), at(2, 2)]);
+        tris.push([extra + 1, extra + 2, extra + 3]);
+        let across = edge_neighbours(&tris);
+        let mut shared = 0;
+        for (t, edges) in across.iter().enumerate() {
+            let ours: Vec<(usize, bool)> = edges.iter().flatten().map(|&(o, i)| (o as usize, i)).collect();
+            assert_eq!(ours, neighbours_by_map(&tris, t), "triangle {t}");
+            shared += ours.len();
+        }
+        // Inner edges of the grid are shared by two; the fin's edge by three (none).
+        assert_eq!(shared as u32, 2 * (2 * n * (n - 1) + n * n) - 2 + 2);
+    }
 
     #[test]
     fn seams_are_welded_and_collapsed_triangles_dropped() {

@@ -51,6 +51,11 @@ struct Step {
     npre: f64,
     branch: Branch,
     req_sign: f64,
+    /// On a sliding step (`Slide`, `Clipped`), the sliding friction at the
+    /// step's speed and load and its exp(−(speed/v_s)²), kept so that the
+    /// backward pass does not evaluate them again (0 when stuck).
+    slide: f64,
+    slide_exp: f64,
 }
 
 /// What the forward pass of the display keeps for the backward pass.
@@ -60,6 +65,11 @@ pub struct Tape {
     /// Per sample: the lag factor a and whether V_cmd was clamped.
     samples: Vec<(f64, bool)>,
     velocity: Vec<f64>,
+    /// Per sample, the velocity and the lag factor of the last forward
+    /// pass: an optimization passes the same velocity in every
+    /// evaluation, so the factor (an `exp`) is reused where the velocity
+    /// is bit for bit the same.
+    lag: Vec<(f64, f64)>,
 }
 
 /// The display's twin.
@@ -150,15 +160,18 @@ impl DisplayTwin {
         })
     }
 
-    fn slide(&self, speed: f64, n: f64) -> f64 {
-        let r = speed / self.v_s;
-        (self.mu_k + (self.mu_s - self.mu_k) * (-r * r).exp()) * n + self.viscous * speed
-    }
-
-    /// ∂slide/∂speed and ∂slide/∂n.
-    fn slide_grad(&self, speed: f64, n: f64) -> (f64, f64) {
+    /// The sliding friction at `speed` and load `n`, and the
+    /// exp(−(speed/v_s)²) it is made of (for [`Self::slide_grad`]).
+    fn slide(&self, speed: f64, n: f64) -> (f64, f64) {
         let r = speed / self.v_s;
         let e = (-r * r).exp();
+        ((self.mu_k + (self.mu_s - self.mu_k) * e) * n + self.viscous * speed, e)
+    }
+
+    /// ∂slide/∂speed and ∂slide/∂n, given `e` = exp(−(speed/v_s)²) as
+    /// [`Self::slide`] returned it.
+    fn slide_grad(&self, speed: f64, n: f64, e: f64) -> (f64, f64) {
+        let r = speed / self.v_s;
         (
             (self.mu_s - self.mu_k) * e * (-2.0 * r / self.v_s) * n + self.viscous,
             self.mu_k + (self.mu_s - self.mu_k) * e,
@@ -172,6 +185,7 @@ impl DisplayTwin {
         tape.steps.clear();
         tape.samples.clear();
         tape.velocity.clear();
+        tape.lag.truncate(u.len());
         let mut xe = self.x0;
         let vr0 = electrical::force_voltage(&self.x0);
         let mut fl = self.ke * vr0 * vr0;
@@ -186,8 +200,19 @@ impl DisplayTwin {
             let v = if velocity[n].is_finite() { velocity[n] } else { 0.0 };
             let raw = self.gain * uu + self.offset;
             let vcmd = raw.clamp(-self.vmax, self.vmax);
-            let wc = self.lag0 + self.lag_slope * v.abs();
-            let a = (-wc * self.hs).exp();
+            let a = match tape.lag.get(n) {
+                Some(&(vk, ak)) if vk.to_bits() == v.to_bits() => ak,
+                _ => {
+                    let wc = self.lag0 + self.lag_slope * v.abs();
+                    let a = (-wc * self.hs).exp();
+                    if n < tape.lag.len() {
+                        tape.lag[n] = (v, a);
+                    } else {
+                        tape.lag.push((v, a));
+                    }
+                    a
+                }
+            };
             tape.samples.push((a, vcmd != raw));
             tape.velocity.push(v);
             for _ in 0..self.sub {
@@ -202,7 +227,13 @@ impl DisplayTwin {
                 fl = a * fl + (1.0 - a) * fe;
                 let npre = ld + fl;
                 let nf = npre.max(0.0);
-                let limit = if stuck { self.mu_s * nf } else { self.slide(xm[1].abs(), nf) };
+                // The sliding friction at this speed and load, when the
+                // contact was sliding (the limit) or starts to (the force).
+                let mut sliding = if stuck { None } else { Some(self.slide(xm[1].abs(), nf)) };
+                let limit = match sliding {
+                    Some((fs, _)) => fs,
+                    None => self.mu_s * nf,
+                };
                 let xa = [xm[0], xm[1], 0.0];
                 let mut free = [0.0; 3];
                 matvec(&self.phi_m, &xa, 3, 3, &mut free);
@@ -214,13 +245,15 @@ impl DisplayTwin {
                 let required = if ds_df != 0.0 { -free[2] / ds_df } else { 0.0 };
                 let xm0 = xm;
                 let branch;
+                let mut kept = (0.0, 0.0);
                 if required.abs() <= limit.max(0.0) {
                     branch = Branch::Stuck;
                     xm[0] += v * self.hs;
                     xm[1] = 0.0;
                     stuck = true;
                 } else {
-                    let fs = self.slide(xm[1].abs(), nf).max(0.0);
+                    kept = *sliding.get_or_insert_with(|| self.slide(xm[1].abs(), nf));
+                    let fs = kept.0.max(0.0);
                     let force = fs.min(required.abs()) * required.signum();
                     branch = if fs < required.abs() { Branch::Slide } else { Branch::Clipped };
                     for i in 0..2 {
@@ -228,7 +261,8 @@ impl DisplayTwin {
                     }
                     stuck = false;
                 }
-                tape.steps.push(Step { xe0, xm0, vr, npre, branch, req_sign: required.signum() });
+                let (slide, slide_exp) = kept;
+                tape.steps.push(Step { xe0, xm0, vr, npre, branch, req_sign: required.signum(), slide, slide_exp });
             }
             out.push(self.k * xm[0] + self.c * (v - xm[1]));
         }
@@ -264,8 +298,8 @@ impl DisplayTwin {
                         } else {
                             let w = s.xm0[1].abs();
                             let nf = s.npre.max(0.0);
-                            if self.slide(w, nf) > 0.0 {
-                                let (dw, dn) = self.slide_grad(w, nf);
+                            if s.slide > 0.0 {
+                                let (dw, dn) = self.slide_grad(w, nf, s.slide_exp);
                                 bn += bforce * s.req_sign * dn;
                                 bxm0[1] += bforce * s.req_sign * dw * s.xm0[1].signum();
                             }
@@ -489,6 +523,38 @@ mod tests {
                 assert!((fd - g[k]).abs() < 1e-4 * (fd.abs() + 1e-3), "{name} u[{k}]: {} vs {fd}", g[k]);
             }
         }
+    }
+
+    #[test]
+    fn a_reused_tape_gives_the_fresh_tapes_values_bit_for_bit() {
+        // The lag factors kept from the last pass (same velocity) and the
+        // sliding friction kept for the backward pass are the values a
+        // fresh tape computes: force and gradient identical to the bit,
+        // also after the velocity changes under a kept tape.
+        let profile = LabProfile::default();
+        let twin = DisplayTwin::new(&profile, 1000.0, 4).unwrap();
+        let (load, vel) = pass(&profile, 85.0, 5.0);
+        let n = 1500;
+        let (load, mut vel) = (&load[..n], vel[..n].to_vec());
+        let u = actuation(n);
+        let fbar: Vec<f64> = (0..n).map(|k| ((k * 7 % 13) as f64 - 6.0) * 0.1).collect();
+        let run = |tape: &mut Tape, vel: &[f64]| {
+            let f = twin.forward(&u, load, vel, tape);
+            let mut g = vec![0.0; n];
+            twin.backward(tape, &fbar, &mut g);
+            (f, g)
+        };
+        let bits = |v: &[f64]| v.iter().map(|x| x.to_bits()).collect::<Vec<_>>();
+        let mut kept = Tape::default();
+        for round in 0..3 {
+            if round == 2 {
+                vel.iter_mut().skip(400).step_by(3).for_each(|v| *v *= 1.5);
+            }
+            let (f, g) = run(&mut kept, &vel);
+            let (f0, g0) = run(&mut Tape::default(), &vel);
+            assert_eq!((bits(&f), bits(&g)), (bits(&f0), bits(&g0)), "round {round}");
+        }
+        assert!(kept.steps.iter().any(|s| s.branch == Branch::Slide), "no sliding step exercised");
     }
 
     #[test]

@@ -64,12 +64,11 @@ pub struct Tape {
     steps: Vec<Step>,
     /// Per sample: the lag factor a and whether V_cmd was clamped.
     samples: Vec<(f64, bool)>,
-    velocity: Vec<f64>,
-    /// Per sample, the velocity and the lag factor of the last forward
-    /// pass: an optimization passes the same velocity in every
-    /// evaluation, so the factor (an `exp`) is reused where the velocity
+    /// Per sample, the velocity the lag factor was computed for. An
+    /// optimization passes the same velocity in every evaluation, so the
+    /// next forward pass reuses the factor (an `exp`) wherever the velocity
     /// is bit for bit the same.
-    lag: Vec<(f64, f64)>,
+    velocity: Vec<f64>,
 }
 
 /// The display's twin.
@@ -183,9 +182,8 @@ impl DisplayTwin {
     /// initial state, keeping the tape.
     pub fn forward(&self, u: &[f64], load: &[f64], velocity: &[f64], tape: &mut Tape) -> Vec<f64> {
         tape.steps.clear();
-        tape.samples.clear();
-        tape.velocity.clear();
-        tape.lag.truncate(u.len());
+        tape.samples.truncate(u.len());
+        tape.velocity.truncate(u.len());
         let mut xe = self.x0;
         let vr0 = electrical::force_voltage(&self.x0);
         let mut fl = self.ke * vr0 * vr0;
@@ -200,21 +198,26 @@ impl DisplayTwin {
             let v = if velocity[n].is_finite() { velocity[n] } else { 0.0 };
             let raw = self.gain * uu + self.offset;
             let vcmd = raw.clamp(-self.vmax, self.vmax);
-            let a = match tape.lag.get(n) {
-                Some(&(vk, ak)) if vk.to_bits() == v.to_bits() => ak,
+            let clamped = vcmd != raw;
+            let a = match tape.velocity.get(n) {
+                Some(&vk) if vk.to_bits() == v.to_bits() => {
+                    let a = tape.samples[n].0;
+                    tape.samples[n] = (a, clamped);
+                    a
+                }
                 _ => {
                     let wc = self.lag0 + self.lag_slope * v.abs();
                     let a = (-wc * self.hs).exp();
-                    if n < tape.lag.len() {
-                        tape.lag[n] = (v, a);
+                    if n < tape.velocity.len() {
+                        tape.samples[n] = (a, clamped);
+                        tape.velocity[n] = v;
                     } else {
-                        tape.lag.push((v, a));
+                        tape.samples.push((a, clamped));
+                        tape.velocity.push(v);
                     }
                     a
                 }
             };
-            tape.samples.push((a, vcmd != raw));
-            tape.velocity.push(v);
             for _ in 0..self.sub {
                 let xe0 = xe;
                 let mut y = [0.0; NE];
@@ -276,8 +279,6 @@ impl DisplayTwin {
         let ds_df = self.gam_m[2 * 2 + 1];
         for n in (0..tape.samples.len()).rev() {
             let (a, clamped) = tape.samples[n];
-            let v = tape.velocity[n];
-            let _ = v;
             bxm[0] += self.k * fbar[n];
             bxm[1] -= self.c * fbar[n];
             let mut bvcmd = 0.0;

@@ -431,7 +431,10 @@ mod tests {
             assert_eq!(ours, neighbours_by_map(&tris, t), "triangle {t}");
             shared += ours.len();
         }
-        // Inner edges of the grid are shared by two; the fin's edge by three (none).
+        // The grid's inner edges (2n(n − 1) between cells, n² diagonals)
+        // are each seen from two triangles; the fin's edge, now on three,
+        // from none (−2); the degenerate triangle's edge, which it runs
+        // along twice, from both of its sides (+2).
         assert_eq!(shared as u32, 2 * (2 * n * (n - 1) + n * n) - 2 + 2);
     }
 

@@ -117,6 +117,13 @@ impl<A: Accumulator> WideSum<A> {
         self.acc.add(if self.scaled { x * pow2(-WIDE_SHIFT) } else { x });
     }
 
+    /// The running sum itself, while no sample has been scaled: then adding
+    /// an [`ordinary`] sample is adding it to this, bit for bit (for block
+    /// loops that keep the sum in a register).
+    pub fn plain_mut(&mut self) -> Option<&mut A> {
+        (!self.scaled).then_some(&mut self.acc)
+    }
+
     /// The sum divided by `n`, as m·2^e (e = 0, m the plain sum / n, until
     /// the sum was scaled).
     pub fn mean_scaled(&self, n: f64) -> Scaled {
@@ -142,6 +149,15 @@ const SQ_LO: f64 = f64::from_bits((1023 - 448) << 52);
 const SQ_HI: f64 = f64::from_bits((1023 + 448) << 52);
 /// The smallest scale exponent (so that 2^−e stays a finite f64).
 const SQ_MIN_E: i32 = -1000;
+
+/// Whether `x` is 0 or 2⁻⁴⁴⁸ ≤ |x| ≤ 2⁴⁴⁸: a sample both sums add plainly
+/// while they are unscaled ([`WideSum::plain_mut`], [`SumSq::plain_mut`]).
+/// False for NaN and ±∞.
+#[inline]
+pub fn ordinary(x: f64) -> bool {
+    let a = x.abs();
+    (SQ_LO..=SQ_HI).contains(&a) | (x == 0.0)
+}
 
 /// A running sum of squares Σx² = sum·4^e, with 2^e the binary exponent
 /// of the largest |x| once that leaves [2⁻⁴⁴⁸, 2⁴⁴⁸] (and 1 while it does
@@ -187,6 +203,20 @@ impl<A: Accumulator> SumSq<A> {
         }
         let y = x * self.inv - r * self.inv;
         self.acc.add(y * y);
+    }
+
+    /// The running sum of squares itself, while it is unscaled, for adding
+    /// a block of [`ordinary`] samples whose largest |x| is `peak`: then
+    /// adding x² to this is [`SumSq::add`] of each, bit for bit (the scale
+    /// stays 1, as every new largest |x| is within [2⁻⁴⁴⁸, 2⁴⁴⁸]); the
+    /// largest |x| is raised to `peak` here. `None` once scaled.
+    pub fn plain_mut(&mut self, peak: f64) -> Option<&mut A> {
+        if self.e != 0 {
+            return None;
+        }
+        debug_assert!(ordinary(peak));
+        self.max = self.max.max(peak);
+        Some(&mut self.acc)
     }
 
     /// The largest |x| so far is `a` (finite): the scale follows it.

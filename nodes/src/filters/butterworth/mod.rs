@@ -95,6 +95,13 @@ impl Node for Butterworth {
     fn process(&mut self, io: &mut Io<'_>) -> Result<(), NodeError> {
         let start = io.start();
         let (x, y) = io.io(IN, OUT);
+        self.cascade.process(x, y);
+        // One check of the output, which a non-finite input always makes
+        // non-finite (every section adds b0·x to its finite state); only
+        // then are the input and the output searched for the sample to name.
+        if y.iter().fold(true, |ok, v| ok & v.is_finite()) {
+            return Ok(());
+        }
         if let Some(i) = x.iter().position(|v| !v.is_finite()) {
             return Err(NodeError::Data(format!(
                 "input sample {} is {}; a recursive filter cannot recover from a non-finite value \
@@ -103,7 +110,6 @@ impl Node for Butterworth {
                 x[i]
             )));
         }
-        self.cascade.process(x, y);
         // Finite inputs near ±f64::MAX overflow the sections' state (found
         // by `evflow report stability`): stop, naming the sample, rather
         // than let ±∞ or NaN out.

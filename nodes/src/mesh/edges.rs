@@ -46,8 +46,7 @@
 //! θ_min (Fig. 4.4 marks θ < 135° as relatively sharp).
 
 use super::raycast::vertical_hit;
-use super::trimesh::{dot, sub, Mesh};
-use std::collections::HashMap;
+use super::trimesh::{dot, sorted_edges, sub, Mesh};
 
 /// Faces with n_z at or below this are vertical walls.
 const VERTICAL: f64 = 1e-12;
@@ -147,58 +146,79 @@ fn pair_angle(m: &Mesh, a: u32, b: u32, v0: u32, v1: u32) -> Option<f64> {
 
 /// The census and θ_min of a mesh whose floor (screen plane) is at `floor`.
 pub fn census(m: &Mesh, floor: f64, max_angle: f64) -> EdgeCensus {
-    let mut map: HashMap<(u32, u32), Vec<u32>> = HashMap::with_capacity(m.triangles.len() * 3 / 2);
-    for (t, tri) in m.triangles.iter().enumerate() {
-        for k in 0..3 {
-            let (a, b) = (tri[k], tri[(k + 1) % 3]);
-            map.entry((a.min(b), a.max(b))).or_default().push(t as u32);
-        }
+    // Each edge with its triangles in the order they are listed (every
+    // count and the minimum angle are the same in any order of the edges).
+    let mut tally = Tally::new(m, floor, max_angle);
+    let mut faces = Vec::new();
+    for run in sorted_edges(&m.triangles).chunk_by(|a, b| a.same_edge(*b)) {
+        faces.clear();
+        faces.extend(run.iter().map(|e| e.triangle()));
+        let (v0, v1) = run[0].vertices();
+        tally.edge(v0, v1, &faces);
     }
-    let ext = m.bounds().extent().max(1e-300);
-    let mut c = EdgeCensus { edges: map.len(), theta_min: 180.0, ..Default::default() };
-    let take = |th: f64, c: &mut EdgeCensus| {
-        if th < max_angle {
-            c.convex += 1;
-            c.theta_min = c.theta_min.min(th);
+    tally.c
+}
+
+/// A census being taken, one edge at a time.
+struct Tally<'a> {
+    m: &'a Mesh,
+    floor: f64,
+    max_angle: f64,
+    ext: f64,
+    c: EdgeCensus,
+}
+
+impl<'a> Tally<'a> {
+    fn new(m: &'a Mesh, floor: f64, max_angle: f64) -> Self {
+        let ext = m.bounds().extent().max(1e-300);
+        Self { m, floor, max_angle, ext, c: EdgeCensus { theta_min: 180.0, ..Default::default() } }
+    }
+
+    /// A convex angle `th`, counted when sharper than `max_angle`; true if it was.
+    fn take(&mut self, th: f64) -> bool {
+        let sharp = th < self.max_angle;
+        if sharp {
+            self.c.convex += 1;
+            self.c.theta_min = self.c.theta_min.min(th);
         }
-    };
-    for (&(v0, v1), faces) in &map {
-        match faces.len() {
-            1 => {
-                c.boundary += 1;
-                let t = faces[0];
-                let n = up(m.normals[t as usize]);
-                let (p0, p1) = (m.vertices[v0 as usize], m.vertices[v1 as usize]);
-                let drop = p0[2].min(p1[2]) - floor;
-                let o = m.triangles[t as usize].into_iter().find(|&k| k != v0 && k != v1);
-                if n[2] > VERTICAL && drop > 1e-9 * ext {
-                    let o = o.map(|o| m.vertices[o as usize]);
-                    // A step lower than the face beside it is wide × tan(180° − max_angle)
-                    // bends no more than a facet would: not a cliff.
-                    let turn = (180.0 - max_angle).clamp(0.0, 89.0).to_radians().tan();
-                    let tall = o.is_some_and(|o| drop > turn * across(p0, p1, o));
-                    if let Some(th) = o.filter(|_| tall).and_then(|o| wall_angle(n, p0, p1, o)) {
-                        let before = c.convex;
-                        take(th, &mut c);
-                        c.cliffs += c.convex - before;
+        sharp
+    }
+
+    /// The edge from vertex `v0` to `v1` and the triangles on it, in order.
+    fn edge(&mut self, v0: u32, v1: u32, faces: &[u32]) {
+        let m = self.m;
+        self.c.edges += 1;
+        if let [t] = *faces {
+            self.c.boundary += 1;
+            let n = up(m.normals[t as usize]);
+            let (p0, p1) = (m.vertices[v0 as usize], m.vertices[v1 as usize]);
+            let drop = p0[2].min(p1[2]) - self.floor;
+            let o = m.triangles[t as usize].into_iter().find(|&k| k != v0 && k != v1);
+            if n[2] > VERTICAL && drop > 1e-9 * self.ext {
+                let o = o.map(|o| m.vertices[o as usize]);
+                // A step lower than the face beside it is wide × tan(180° − max_angle)
+                // bends no more than a facet would: not a cliff.
+                let turn = (180.0 - self.max_angle).clamp(0.0, 89.0).to_radians().tan();
+                let tall = o.is_some_and(|o| drop > turn * across(p0, p1, o));
+                if let Some(th) = o.filter(|_| tall).and_then(|o| wall_angle(n, p0, p1, o)) {
+                    if self.take(th) {
+                        self.c.cliffs += 1;
                     }
                 }
             }
-            k => {
-                if k > 2 {
-                    c.non_manifold += 1;
-                }
-                for i in 0..k {
-                    for j in i + 1..k {
-                        if let Some(th) = pair_angle(m, faces[i], faces[j], v0, v1) {
-                            take(th, &mut c);
-                        }
-                    }
+            return;
+        }
+        if faces.len() > 2 {
+            self.c.non_manifold += 1;
+        }
+        for (i, &a) in faces.iter().enumerate() {
+            for &b in &faces[i + 1..] {
+                if let Some(th) = pair_angle(m, a, b, v0, v1) {
+                    self.take(th);
                 }
             }
         }
     }
-    c
 }
 
 /// Eq. 4.8, clamped to [0, 1]; 0 when the mesh has no convex edge.
@@ -344,6 +364,45 @@ mod tests {
     use super::*;
     use crate::mesh::raycast::RayCaster;
     use crate::mesh::scenes::{grid, scene, Shape};
+
+    /// The census as it was taken before the sorted edge list: a SipHash
+    /// map from each vertex pair to its triangles, visited in the map's
+    /// (random) order.
+    fn census_by_map(m: &Mesh, floor: f64, max_angle: f64) -> EdgeCensus {
+        let mut map: std::collections::HashMap<(u32, u32), Vec<u32>> = Default::default();
+        for (t, tri) in m.triangles.iter().enumerate() {
+            for k in 0..3 {
+                let (a, b) = (tri[k], tri[(k + 1) % 3]);
+                map.entry((a.min(b), a.max(b))).or_default().push(t as u32);
+            }
+        }
+        let mut tally = Tally::new(m, floor, max_angle);
+        for (&(v0, v1), faces) in &map {
+            tally.edge(v0, v1, faces);
+        }
+        tally.c
+    }
+
+    #[test]
+    fn the_census_is_that_of_the_edge_map() {
+        let mut meshes = vec![scene(Shape::Gaussian, "2B2H", 12).unwrap(), scene(Shape::Frustum, "1B3H", 9).unwrap()];
+        // A cube with a fin (a third triangle on one edge) and an open flap.
+        let c = cube(0.3, 0.2, true);
+        let (mut v, mut t) = (c.vertices.clone(), c.triangles.clone());
+        v.extend([[2.0, 2.0, 3.0], [0.9, -0.7, 0.1]]);
+        let n = v.len() as u32;
+        t.push([t[0][0], t[0][1], n - 2]);
+        t.push([t[5][1], t[5][2], n - 1]);
+        meshes.push(Mesh::new(v, t, 0.0));
+        for m in &meshes {
+            for (floor, max_angle) in [(m.bounds().min[2], 160.0), (m.bounds().min[2] - 0.5, 175.0)] {
+                let c = census(m, floor, max_angle);
+                assert_eq!(c, census_by_map(m, floor, max_angle));
+                assert!(c.edges > 0 && c.convex > 0, "{c:?}");
+            }
+        }
+        assert!(census(&meshes[2], 0.0, 175.0).non_manifold > 0);
+    }
 
     /// A unit cube rotated by `rx` about x then `ry` about y, 12 triangles
     /// in the given winding (true = outward).

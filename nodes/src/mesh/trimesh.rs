@@ -14,6 +14,7 @@
 
 use super::error::MeshError;
 use std::collections::{HashMap, HashSet};
+use std::hash::{BuildHasherDefault, Hasher};
 
 /// A triangle mesh in mesh units (the scenes of §4.2 are in cm).
 #[derive(Debug, Clone, PartialEq)]
@@ -89,7 +90,7 @@ impl Mesh {
         let (vertices, remap) = weld_vertices(&vertices, weld);
         let mut tris = Vec::with_capacity(triangles.len());
         let mut normals: Vec<[f64; 3]> = Vec::with_capacity(triangles.len());
-        let mut seen: HashSet<[u32; 3]> = HashSet::with_capacity(triangles.len());
+        let mut seen: KeySet<[u32; 3]> = KeySet::with_capacity_and_hasher(triangles.len(), Default::default());
         for t in triangles {
             let t = t.map(|i| remap[i as usize]);
             let n = raw_normal(vertices[t[0] as usize], vertices[t[1] as usize], vertices[t[2] as usize]);
@@ -229,40 +230,70 @@ fn orientation(v: &[[f64; 3]], tris: &[[u32; 3]], normals: &[[f64; 3]]) -> Vec<b
     flip
 }
 
+/// One triangle's edge, packed so that sorting the numbers sorts the edges
+/// by their vertex pair (low, high), then by triangle, then by corner.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, PartialOrd, Ord)]
+pub(crate) struct EdgeEntry(u128);
+
+impl EdgeEntry {
+    /// Edge `k` (corner k to corner k + 1) of triangle `t`, from vertex `a` to `b`.
+    fn new(a: u32, b: u32, t: usize, k: usize) -> Self {
+        let pair = ((a.min(b) as u128) << 32) | a.max(b) as u128;
+        Self((pair << 64) | ((t as u128) << 3) | ((k as u128) << 1) | u128::from(a < b))
+    }
+    /// The vertex pair, lower index first.
+    pub(crate) fn vertices(self) -> (u32, u32) {
+        ((self.0 >> 96) as u32, (self.0 >> 64) as u32)
+    }
+    /// The triangle.
+    pub(crate) fn triangle(self) -> u32 {
+        (self.0 >> 3) as u32
+    }
+    /// Which of the triangle's edges (0, 1, 2).
+    fn corner(self) -> usize {
+        (self.0 >> 1 & 3) as usize
+    }
+    /// True when the triangle runs along it from the lower vertex index to the higher.
+    fn low_to_high(self) -> bool {
+        self.0 & 1 == 1
+    }
+    /// True when `other` joins the same two vertices.
+    pub(crate) fn same_edge(self, other: EdgeEntry) -> bool {
+        self.0 >> 64 == other.0 >> 64
+    }
+}
+
+/// Every triangle's edges, sorted by their vertex pair, ties in the order
+/// (triangle, corner) they were listed in: the edges shared by the same
+/// triangles are neighbours, in the order a map from each vertex pair to
+/// the list of its triangles, filled triangle by triangle, would hold
+/// them — without one allocation per edge.
+pub(crate) fn sorted_edges(tris: &[[u32; 3]]) -> Vec<EdgeEntry> {
+    let mut list = Vec::with_capacity(tris.len() * 3);
+    for (t, tri) in tris.iter().enumerate() {
+        for k in 0..3 {
+            list.push(EdgeEntry::new(tri[k], tri[(k + 1) % 3], t, k));
+        }
+    }
+    list.sort_unstable();
+    list
+}
+
 /// For each triangle and each of its edges k (corner k to corner k + 1),
 /// the triangle across that edge and whether the two run the same way
 /// along it (inconsistent winding), where exactly two triangles share the
-/// edge; `None` on a boundary edge or one shared by three or more.
-///
-/// The edges of every triangle are sorted by their vertex pair, ties in
-/// the order (triangle, k) they were listed in, so the two of an edge are
-/// taken in that order — as the map from each edge to the list of its
-/// triangles, filled in that order, that this replaces (the test keeps it
-/// as the reference), took them; without one allocation per edge.
+/// edge; `None` on a boundary edge or one shared by three or more. The two
+/// of an edge are taken in [`sorted_edges`]' order — as the map from each
+/// edge to the list of its triangles that this replaces (the test keeps it
+/// as the reference) took them.
 fn edge_neighbours(tris: &[[u32; 3]]) -> Vec<[Option<(u32, bool)>; 3]> {
-    // (low << 32 | high, triangle << 2 | k, runs low → high).
-    let mut list: Vec<(u64, u64, bool)> = Vec::with_capacity(tris.len() * 3);
-    for (t, tri) in tris.iter().enumerate() {
-        for k in 0..3 {
-            let (a, b) = (tri[k], tri[(k + 1) % 3]);
-            list.push((((a.min(b) as u64) << 32) | a.max(b) as u64, ((t as u64) << 2) | k as u64, a < b));
-        }
-    }
-    list.sort_unstable_by_key(|e| (e.0, e.1));
     let mut across = vec![[None; 3]; tris.len()];
-    let mut i = 0;
-    while i < list.len() {
-        let mut j = i + 1;
-        while j < list.len() && list[j].0 == list[i].0 {
-            j += 1;
+    for run in sorted_edges(tris).chunk_by(|a, b| a.same_edge(*b)) {
+        if let [p, q] = *run {
+            let inconsistent = p.low_to_high() == q.low_to_high();
+            across[p.triangle() as usize][p.corner()] = Some((q.triangle(), inconsistent));
+            across[q.triangle() as usize][q.corner()] = Some((p.triangle(), inconsistent));
         }
-        if j - i == 2 {
-            let (p, q) = (list[i], list[i + 1]);
-            let inconsistent = p.2 == q.2;
-            across[(p.1 >> 2) as usize][(p.1 & 3) as usize] = Some(((q.1 >> 2) as u32, inconsistent));
-            across[(q.1 >> 2) as usize][(q.1 & 3) as usize] = Some(((p.1 >> 2) as u32, inconsistent));
-        }
-        i = j;
     }
     across
 }
@@ -317,6 +348,53 @@ fn drop_unused(vertices: Vec<[f64; 3]>, tris: &mut [[u32; 3]]) -> Vec<[f64; 3]> 
     kept
 }
 
+/// A hasher for the integer keys of [`Mesh::new`]'s look-ups (grid cells,
+/// exact coordinates, sorted corner triples): one multiply per word and a
+/// final mix (MurmurHash3's `fmix64`) so that the low and the top bits a
+/// hash table reads both depend on every word. It replaces std's SipHash,
+/// whose per-key cost was most of building a million-triangle mesh; only
+/// look-ups use it (no map is iterated), so what is built does not change.
+#[derive(Debug, Default, Clone, Copy)]
+struct KeyHasher(u64);
+
+impl Hasher for KeyHasher {
+    fn write(&mut self, bytes: &[u8]) {
+        for &b in bytes {
+            self.write_u64(u64::from(b));
+        }
+    }
+    #[inline]
+    fn write_u64(&mut self, x: u64) {
+        self.0 = (self.0.rotate_left(23) ^ x).wrapping_mul(0x9e37_79b9_7f4a_7c15);
+    }
+    #[inline]
+    fn write_u32(&mut self, x: u32) {
+        self.write_u64(u64::from(x));
+    }
+    #[inline]
+    fn write_i64(&mut self, x: i64) {
+        self.write_u64(x as u64);
+    }
+    #[inline]
+    fn write_usize(&mut self, x: usize) {
+        self.write_u64(x as u64);
+    }
+    #[inline]
+    fn finish(&self) -> u64 {
+        let mut z = self.0;
+        z ^= z >> 33;
+        z = z.wrapping_mul(0xff51_afd7_ed55_8ccd);
+        z ^= z >> 33;
+        z = z.wrapping_mul(0xc4ce_b9fe_1a85_ec53);
+        z ^ (z >> 33)
+    }
+}
+
+/// The hash maps and sets of mesh building, keyed through [`KeyHasher`].
+type KeyMap<K, V> = HashMap<K, V, BuildHasherDefault<KeyHasher>>;
+/// See [`KeyMap`].
+type KeySet<K> = HashSet<K, BuildHasherDefault<KeyHasher>>;
+
 /// Merges vertices closer than `tol` (exactly equal when `tol` = 0): the
 /// merged list and, for each input vertex, its index in it. With a
 /// tolerance the vertices are hashed on a grid of cell `tol` and compared
@@ -325,7 +403,7 @@ fn weld_vertices(v: &[[f64; 3]], tol: f64) -> (Vec<[f64; 3]>, Vec<u32>) {
     let mut out = Vec::with_capacity(v.len());
     let mut remap = Vec::with_capacity(v.len());
     if tol <= 0.0 {
-        let mut seen: HashMap<[u64; 3], u32> = HashMap::with_capacity(v.len());
+        let mut seen: KeyMap<[u64; 3], u32> = KeyMap::with_capacity_and_hasher(v.len(), Default::default());
         for p in v {
             // +0.0 and −0.0 are the same point.
             let key = p.map(|x| (x + 0.0).to_bits());
@@ -337,7 +415,7 @@ fn weld_vertices(v: &[[f64; 3]], tol: f64) -> (Vec<[f64; 3]>, Vec<u32>) {
         }
         return (out, remap);
     }
-    let mut grid: HashMap<[i64; 3], Vec<u32>> = HashMap::with_capacity(v.len());
+    let mut grid: KeyMap<[i64; 3], Vec<u32>> = KeyMap::with_capacity_and_hasher(v.len(), Default::default());
     let cell = |p: &[f64; 3]| p.map(|x| (x / tol).floor() as i64);
     for p in v {
         let c = cell(p);

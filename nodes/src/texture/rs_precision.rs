@@ -83,11 +83,16 @@ pub fn score(out: &[f64], tones: &[(f64, f64, f64)], step: f64) -> (f64, f64) {
         }
         (e.sqrt() / r.sqrt().max(f64::MIN_POSITIVE), n)
     };
-    // Coarse scan of the delay over ±1.5 output samples, then golden-section refinement.
+    // Coarse scan of the delay over ±1.5 output samples, then golden-section
+    // refinement. Each error is a sum of sines over the whole body, the
+    // same whichever thread takes it: the scan's two halves, and the two
+    // points of each golden step, are computed side by side.
     let mut best = (0.0, rms_of(0.0).0);
-    for i in -30..=30 {
-        let d = i as f64 * 0.05;
-        let e = rms_of(d).0;
+    let scan = |range: std::ops::RangeInclusive<i32>| -> Vec<(f64, f64)> {
+        range.map(|i| i as f64 * 0.05).map(|d| (d, rms_of(d).0)).collect()
+    };
+    let (low, high) = side_by_side(|| scan(-30..=0), || scan(1..=30));
+    for (d, e) in low.into_iter().chain(high) {
         if e < best.1 {
             best = (d, e);
         }
@@ -96,7 +101,8 @@ pub fn score(out: &[f64], tones: &[(f64, f64, f64)], step: f64) -> (f64, f64) {
     let g = 0.618_033_988_749_894_9;
     for _ in 0..40 {
         let (c, d) = (b - g * (b - a), a + g * (b - a));
-        if rms_of(c).0 < rms_of(d).0 {
+        let (at_c, at_d) = side_by_side(|| rms_of(c).0, || rms_of(d).0);
+        if at_c < at_d {
             b = d;
         } else {
             a = c;
@@ -107,11 +113,30 @@ pub fn score(out: &[f64], tones: &[(f64, f64, f64)], step: f64) -> (f64, f64) {
     (error, delay)
 }
 
+/// `a()` on a second thread while `b()` runs on this one (a panic in
+/// `a` goes on in the caller, as it would have without the thread).
+fn side_by_side<A: Send, B>(a: impl FnOnce() -> A + Send, b: impl FnOnce() -> B) -> (A, B) {
+    std::thread::scope(|s| {
+        let other = s.spawn(a);
+        let rb = b();
+        (other.join().unwrap_or_else(|e| std::panic::resume_unwind(e)), rb)
+    })
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
     use crate::rate::resampler::Quality;
     use rubato::PolynomialDegree;
+
+    #[test]
+    fn side_by_side_returns_both_in_order_and_passes_a_panic_on() {
+        let t = tones(5, 0.2, 3);
+        let (a, b) = side_by_side(|| eval(&t, 0.25), || eval(&t, 7.5));
+        assert_eq!((a.to_bits(), b.to_bits()), (eval(&t, 0.25).to_bits(), eval(&t, 7.5).to_bits()));
+        let caught = std::panic::catch_unwind(|| side_by_side(|| -> f64 { panic!("in the other thread") }, || 1.0));
+        assert!(caught.is_err());
+    }
 
     #[test]
     fn the_exact_kernel_and_long_sincs_are_accurate_and_errors_fall_with_length() {

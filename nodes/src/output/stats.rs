@@ -54,14 +54,12 @@ impl Stats {
             bad: None,
         }
     }
-}
 
-impl Stats {
     /// Adds a block whose samples are all [`ordinary`] while both sums are
-    /// unscaled, with the sums and extremes in registers: the same
-    /// operations, in the same order, as the sample-by-sample loop (which
-    /// keeps them in memory, as it may rescale). False, having added
-    /// nothing, where that does not hold.
+    /// unscaled: the sums in registers, with the same operations in the
+    /// same order as the sample-by-sample loop (which keeps them in
+    /// memory, as it may rescale), and the extremes from a vectorized
+    /// pass. False, having added nothing, where that does not hold.
     fn add_ordinary(&mut self, x: &[f64]) -> bool {
         let Some((peak, lo, hi)) = ordinary_extremes(x, self.min, self.max) else {
             return false;

@@ -18,6 +18,7 @@ mod long_functions;
 mod prune;
 mod rate_mismatch;
 mod rig_recordings;
+mod shared_sweep;
 mod shipped_graphs;
 mod stability;
 mod studio_server;

@@ -30,6 +30,7 @@ pub mod spec;
 pub mod suggest;
 pub mod sweep;
 pub mod sweep_files;
+pub mod sweep_shared;
 pub mod typed_params;
 
 pub use check::{check, Checked, Override};

@@ -7,8 +7,9 @@
 //! reference node and an `error` sink) before running it, and run it with no
 //! output folder at all when it writes nothing.
 
+use evflow_engine::sweep_shared;
 use evflow_engine::{
-    check, read_graph, run_offline, Graph, Override, Plan, PlanOptions, RunMode, RunOptions, RunReport, Value,
+    check, read_graph, run_offline, Checked, Graph, Override, Plan, PlanOptions, RunMode, RunOptions, RunReport, Value,
 };
 use std::path::{Path, PathBuf};
 
@@ -107,6 +108,32 @@ pub fn run_graph_for(file: &Path, sets: &Sets, out: &Path, duration: Option<f64>
     run(&read(file)?, sets, Some(out), duration)
 }
 
+/// Runs the graph `file` once for each of `points` (the values each point
+/// sets), for `duration` seconds (its own length if `None`), its outputs
+/// under `out`: as [`run_graph_for`] at each point, with every node that
+/// is the same at every point run once for all of them
+/// ([`evflow_engine::sweep_shared`]) — the same results, one report per
+/// point. Points that differ in structure run one by one.
+pub fn run_sweep_for(
+    file: &Path,
+    points: &[Sets],
+    out: &Path,
+    duration: Option<f64>,
+) -> Result<Vec<RunReport>, GraphError> {
+    let graph = read(file)?;
+    let err = |e: String| GraphError::new(file, e);
+    let registry = evflow_nodes::registry();
+    let checked = points
+        .iter()
+        .map(|p| check(&graph, &registry, p.overrides()).map_err(|e| err(e.to_string())))
+        .collect::<Result<Vec<_>, _>>()?;
+    let Ok(merged) = sweep_shared::merge(&checked) else {
+        return points.iter().map(|p| run(&graph, p, Some(out), duration)).collect();
+    };
+    let report = run_checked(&merged.checked, Some(out), duration).map_err(err)?;
+    Ok((0..merged.points()).map(|k| merged.report(&report, k)).collect())
+}
+
 /// Reads and parses the graph file `file` (to add probes to it before [`run`]).
 pub fn read(file: &Path) -> Result<Graph, GraphError> {
     read_graph(file).map_err(|e| GraphError::new(file, e.to_string()))
@@ -128,8 +155,13 @@ pub fn run(graph: &Graph, sets: &Sets, out: Option<&Path>, duration: Option<f64>
     let file = graph.file.as_path();
     let err = |e: String| GraphError::new(file, e);
     let checked = check(graph, &evflow_nodes::registry(), sets.overrides()).map_err(|e| err(e.to_string()))?;
+    run_checked(&checked, out, duration).map_err(err)
+}
+
+/// Plans the checked graph with node timing on and runs it offline (see [`run`]).
+fn run_checked(checked: &Checked, out: Option<&Path>, duration: Option<f64>) -> Result<RunReport, String> {
     if let Some(out) = out {
-        std::fs::create_dir_all(out).map_err(|e| err(format!("{}: {e}", out.display())))?;
+        std::fs::create_dir_all(out).map_err(|e| format!("{}: {e}", out.display()))?;
     }
     let opts = PlanOptions {
         max_block: 1024,
@@ -140,8 +172,8 @@ pub fn run(graph: &Graph, sets: &Sets, out: Option<&Path>, duration: Option<f64>
         mode: RunMode::Offline,
         check_only: false,
     };
-    let mut plan = Plan::build(&checked, &opts).map_err(|e| err(e.to_string()))?;
-    run_offline(&mut plan, RunOptions { duration, ..RunOptions::default() }).map_err(|e| err(e.to_string()))
+    let mut plan = Plan::build(checked, &opts).map_err(|e| e.to_string())?;
+    run_offline(&mut plan, RunOptions { duration, ..RunOptions::default() }).map_err(|e| e.to_string())
 }
 
 /// The value `name` that node `node` reported in run `r` of the graph `file`.

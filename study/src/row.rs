@@ -2,7 +2,7 @@
 //! every method synthesized and scored the same way.
 
 use super::gains::{choose, AtGain, Chosen};
-use super::graphs::{run_graph, value, Sets};
+use super::graphs::{run_graph, run_sweep_for, value, Sets};
 use super::models::Models;
 use super::recordings::{self, playback_range};
 use super::setup::{Cond, Profile};
@@ -194,7 +194,7 @@ pub fn run(i: &RowInputs<'_>) -> Result<Row, StudyError> {
     };
     // Every method over the gain sweep.
     let graph = i.graphs.join("synthesize.toml");
-    let mut runs = Vec::new();
+    let mut points = Vec::new();
     for &gain in i.gains {
         // Without a multilevel model its chain plays the binary one (and is not reported).
         let ml = i.models.narx_multilevel.as_ref().unwrap_or(&i.models.narx);
@@ -209,8 +209,11 @@ pub fn run(i: &RowInputs<'_>) -> Result<Row, StudyError> {
             .num("playback_max", hi)
             .and(i.profile.sets())
             .path("model_ml", ml);
-        runs.push((gain, run_graph(&graph, &sets, &i.dir)?));
+        points.push(sets);
     }
+    // One run for the whole sweep: the syntheses and the baselines before the gains are the same at every gain.
+    let reports = run_sweep_for(&graph, &points, &i.dir, None)?;
+    let runs: Vec<(f64, RunReport)> = i.gains.iter().copied().zip(reports).collect();
     let first = &runs[0].1;
     let reading = |node: &str| -> Result<Reading, StudyError> {
         Ok(Reading {

@@ -41,6 +41,11 @@ pub struct ResolvedPort {
 pub struct CheckedNode {
     /// Name in the graph.
     pub name: String,
+    /// The name it is built under ([`crate::node::BuildContext::node`]):
+    /// its own, or for a shared sweep's copy of a node
+    /// ([`crate::sweep_shared`]) its original's — so the copy seeds,
+    /// labels and writes exactly as that node would.
+    pub origin: String,
     /// Its declaration.
     pub spec: &'static NodeSpec,
     /// Validated parameters (defaults filled, variables substituted).
@@ -213,6 +218,7 @@ fn check_nodes(graph: &Graph, registry: &Registry, sink: &mut Sink) -> Vec<Optio
         let ports = params.as_ref().map(|p| params::resolve_ports(decl, spec, p, sink)).unwrap_or_default();
         nodes.push(params.map(|params| CheckedNode {
             name: decl.name.clone(),
+            origin: decl.name.clone(),
             spec,
             params,
             ports,

@@ -104,7 +104,7 @@ impl Builder<'_> {
             }
             let n = &checked.nodes[i];
             let ctx = BuildContext {
-                node: n.name.clone(),
+                node: n.origin.clone(),
                 base_rate: g.rate,
                 rate: n.ratio.hz(g.rate),
                 input_rates: n.inputs().map(|p| n.ports[p].ratio.hz(g.rate)).collect(),

@@ -1,12 +1,14 @@
 //! Every live chain under one user on one sample: graphs/texture-live-quality.toml
-//! run over the gain sweep, each chain's scores read per gain, and every
+//! run over the gain sweep (as one shared sweep: each chain computed once,
+//! its gain, limiter, display and metrics once per gain), each chain's
+//! scores read per gain, and every
 //! chain's actuation as played at gain 1 (the stroke's floor starts from
 //! them).
 
 use super::play::Stage;
 use super::row::{Chain, ChainResult};
 use crate::gains::{choose, AtGain};
-use crate::graphs::{run_graph_for, value, Sets};
+use crate::graphs::{run_sweep_for, value, Sets};
 use crate::row::Reading;
 use crate::StudyError;
 use evflow_nodes::recording::format::Recording;
@@ -35,7 +37,7 @@ pub fn run(at: &Stage<'_>, library: &Path) -> Result<ChainsRun, StudyError> {
     let (scope, profile, sample, user, dir) = (at.scope, at.profile, at.sample, at.user, at.dir);
     let graph = at.graphs.join(GRAPH);
     let record_gain = if scope.gains.contains(&1.0) { 1.0 } else { scope.gains[0] };
-    let mut runs = Vec::new();
+    let mut points = Vec::new();
     for &gain in &scope.gains {
         // A chain left out plays nothing: its gain is 0, and what fed only it is pruned (never built).
         let out = Chain::ALL.iter().filter(|c| !scope.chains.contains(c));
@@ -50,8 +52,11 @@ pub fn run(at: &Stage<'_>, library: &Path) -> Result<ChainsRun, StudyError> {
             .num("offset", scope.live.offset)
             .text("record", &format!("actuations-g{gain:?}"))
             .and(user.sets());
-        runs.push((gain, run_graph_for(&graph, &sets, dir, Some(scope.seconds))?));
+        points.push(sets);
     }
+    // One run for the whole sweep: what comes before each chain's gain is the same at every gain.
+    let reports = run_sweep_for(&graph, &points, dir, Some(scope.seconds))?;
+    let runs: Vec<(f64, _)> = scope.gains.iter().copied().zip(reports).collect();
     let first = &runs[0].1;
     let nothing = Reading {
         rect: value(first, &graph, "nothing_es", "E_s")?,

@@ -6,7 +6,7 @@
 use super::scope::{LiveScope, User};
 use super::stroke::Stroke;
 use crate::gains::AtGain;
-use crate::graphs::{run_graph_for, value, Sets};
+use crate::graphs::{run_sweep_for, value, Sets};
 use crate::row::Reading;
 use crate::setup::Profile;
 use crate::StudyError;
@@ -54,20 +54,26 @@ pub struct Stage<'a> {
 pub fn sweep(at: &Stage<'_>, file: &Path, gains: &[f64]) -> Result<Vec<AtGain>, StudyError> {
     let (scope, profile, sample, user, dir) = (at.scope, at.profile, at.sample, at.user, at.dir);
     let graph = at.graphs.join(GRAPH);
+    let points: Vec<Sets> = gains
+        .iter()
+        .map(|&gain| {
+            Sets::new()
+                .text("sample", sample)
+                .path("actuation", file)
+                .and(profile.sets())
+                .num("gain", gain)
+                .and(user.sets())
+        })
+        .collect();
+    // One run for the whole sweep: the user, the sample and the actuation read once.
+    let reports = run_sweep_for(&graph, &points, dir, Some(scope.seconds))?;
     let mut out = Vec::new();
-    for &gain in gains {
-        let sets = Sets::new()
-            .text("sample", sample)
-            .path("actuation", file)
-            .and(profile.sets())
-            .num("gain", gain)
-            .and(user.sets());
-        let r = run_graph_for(&graph, &sets, dir, Some(scope.seconds))?;
+    for (&gain, r) in gains.iter().zip(&reports) {
         out.push(AtGain {
             gain,
-            rect: value(&r, &graph, "es", "E_s")?,
-            welch: value(&r, &graph, "welch", "E_s")?,
-            peak_ratio: value(&r, &graph, "es", "peak_psd_ratio")?,
+            rect: value(r, &graph, "es", "E_s")?,
+            welch: value(r, &graph, "welch", "E_s")?,
+            peak_ratio: value(r, &graph, "es", "peak_psd_ratio")?,
         });
     }
     Ok(out)

@@ -28,7 +28,7 @@ fn first(checked: &Checked, scene: Scene) -> Option<usize> {
 fn context(checked: &Checked, k: usize, base_dir: &Path) -> BuildContext {
     let n = &checked.nodes[k];
     BuildContext {
-        node: n.name.clone(),
+        node: n.origin.clone(),
         base_rate: checked.graph.rate,
         rate: n.ratio.hz(checked.graph.rate),
         input_rates: n.inputs().map(|p| n.ports[p].ratio.hz(checked.graph.rate)).collect(),

@@ -109,8 +109,8 @@ pub fn merge(points: &[Checked]) -> Result<Merged, MergeError> {
     let mut nodes = Vec::new();
     let mut at: Vec<Vec<usize>> = Vec::with_capacity(n);
     let mut copies = Vec::new();
-    for i in 0..n {
-        if copied[i] {
+    for (i, &copy) in copied.iter().enumerate() {
+        if copy {
             let mut names = Vec::with_capacity(points.len());
             let mut idx = Vec::with_capacity(points.len());
             for (k, c) in points.iter().enumerate() {

@@ -71,6 +71,33 @@ fn a_sweep_on_two_jobs_prints_and_writes_what_one_job_does() {
 }
 
 #[test]
+fn a_shared_sweep_prints_and_writes_what_separate_runs_do() {
+    // The 3×3 grid changes the lab's first node: nothing is shared, every node copied.
+    let (one, shared) = (tempfile::tempdir().unwrap(), tempfile::tempdir().unwrap());
+    let a = run(&sweep_args(one.path()), &["--jobs", "1"]);
+    let b = run(&sweep_args(shared.path()), &["--shared"]);
+    assert!(a.status.success() && b.status.success(), "{}", String::from_utf8_lossy(&b.stderr));
+    assert_eq!(a.stdout, b.stdout, "stdout differs with --shared");
+    assert_eq!(tree(one.path()), tree(shared.path()), "files differ with --shared");
+    // A gain sweep of the live chains: everything before the gains runs once.
+    let (one, shared) = (tempfile::tempdir().unwrap(), tempfile::tempdir().unwrap());
+    let gains = |dir: &Path, extra: &str| {
+        let d = dir.to_str().unwrap();
+        let mut args = vec!["run", "graphs/texture-live-quality.toml", "--sweep", "gain=0.5,1.0", "--duration", "2"];
+        args.extend(["--set", "record=actuations-g${gain}", "--no-times", "--out", d, extra]);
+        evflow(&args)
+    };
+    let (a, b) = (gains(one.path(), "--jobs=1"), gains(shared.path(), "--shared"));
+    assert!(a.status.success() && b.status.success(), "{}", String::from_utf8_lossy(&b.stderr));
+    assert_eq!(a.stdout, b.stdout, "stdout differs with --shared");
+    assert_eq!(tree(one.path()).len(), 4, "a recording (wav + json) per gain");
+    assert_eq!(tree(one.path()), tree(shared.path()), "files differ with --shared");
+    let err = String::from_utf8_lossy(&b.stderr);
+    assert!(err.contains("nodes run once for the 2 runs") && err.contains("live_gain"), "{err}");
+    assert!(!err.split("once per run:").nth(1).unwrap_or("").contains("live_synth"), "{err}");
+}
+
+#[test]
 fn one_bad_run_does_not_lose_the_others_and_fails_the_batch() {
     let dir = tempfile::tempdir().unwrap();
     let d = dir.path().to_str().unwrap();

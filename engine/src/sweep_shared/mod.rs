@@ -164,8 +164,9 @@ impl Merged {
     }
 
     /// Point `k`'s share of the merged run `r`: the shared nodes and point
-    /// `k`'s copies under their original names, in run order; the other
-    /// points' copies left out.
+    /// `k`'s copies under their original names, in run order (their times,
+    /// summaries and what the plan left out); the other points' copies
+    /// left out.
     pub fn report(&self, r: &RunReport, k: usize) -> RunReport {
         let name = |node: &str| -> Option<String> {
             match self.copies.iter().find(|(_, names)| names.iter().any(|m| m == node)) {
@@ -179,14 +180,20 @@ impl Merged {
             .filter_map(|t| name(&t.node).map(|node| crate::plan::NodeTime { node, ..t.clone() }))
             .collect();
         let summaries = r.summaries.iter().filter_map(|(n, s)| name(n).map(|n| (n, s.clone()))).collect();
-        RunReport {
-            ticks: r.ticks,
-            base_rate: r.base_rate,
-            elapsed: r.elapsed,
-            times,
-            summaries,
-            left_out: r.left_out.clone(),
-        }
+        // The lines name their node first, in backticks: another point's copies' lines go.
+        let left_out = r
+            .left_out
+            .iter()
+            .filter(|line| line.split('`').nth(1).is_none_or(|node| name(node).is_some()))
+            .map(|line| {
+                let mut line = line.clone();
+                for (orig, names) in &self.copies {
+                    line = line.replace(&format!("`{}`", names[k]), &format!("`{orig}`"));
+                }
+                line
+            })
+            .collect();
+        RunReport { ticks: r.ticks, base_rate: r.base_rate, elapsed: r.elapsed, times, summaries, left_out }
     }
 }
 

@@ -182,3 +182,25 @@ fn points_of_another_structure_are_refused_with_the_reason() {
     assert!(e.to_string().contains("its connections"), "{e}");
     assert!(merge(&[]).is_err());
 }
+
+#[test]
+fn each_point_reads_what_was_left_out_of_its_own_copies() {
+    let m = merge(&[at(1.0), at(2.0)]).unwrap();
+    let r = RunReport {
+        ticks: 0,
+        base_rate: 1000.0,
+        elapsed: std::time::Duration::ZERO,
+        times: Vec::new(),
+        summaries: Vec::new(),
+        left_out: vec![
+            "held constant `pre` (out = 0): k = 0".into(),
+            "held constant `g@0` (out = 0): k = 0".into(),
+            "left out `post@1`: feeds only `sum@1`".into(),
+        ],
+    };
+    assert_eq!(
+        m.report(&r, 0).left_out,
+        ["held constant `pre` (out = 0): k = 0", "held constant `g` (out = 0): k = 0"]
+    );
+    assert_eq!(m.report(&r, 1).left_out, ["held constant `pre` (out = 0): k = 0", "left out `post`: feeds only `sum`"]);
+}

@@ -7,6 +7,7 @@ use super::run_report::print_report;
 use anyhow::{anyhow, bail, Result};
 use evflow_engine::batch::{check_outputs, for_each_ordered, output_files, Failures};
 use evflow_engine::sweep::{validate, Point};
+use evflow_engine::sweep_shared;
 use evflow_engine::{run_offline, Checked, Plan, PlanOptions, RunOptions, RunReport};
 use evflow_tools::batch::shard_record::{relative_to, ShardRecord};
 use evflow_tools::batch::sweep_runs::sweep_runs;
@@ -28,6 +29,16 @@ pub struct Args {
     /// variable instead.
     #[arg(long = "sweep", value_name = "NAME=V1,V2,…")]
     sweep: Vec<String>,
+    /// Run a sweep's points as one plan: every node that is the same at
+    /// every point (same type, parameters and ports, fed only by such
+    /// nodes) runs once for all of them, the rest once per point — the
+    /// same results as separate runs, without repeating what the swept
+    /// values do not change (e.g. every synthesis before a swept `gain`).
+    /// One thread (--jobs is not used); each run's times count the shared
+    /// nodes' in full. Points whose graphs differ in structure run one by
+    /// one, as without it.
+    #[arg(long)]
+    shared: bool,
     #[command(flatten)]
     batch: BatchArgs,
     /// Seed for every random stream (overrides the graph's `seed`).
@@ -107,7 +118,9 @@ pub fn main(a: Args) -> Result<()> {
     }
     let timings = if a.no_times { Timings::Leave } else { Timings::Show };
     let n = items.len();
-    let done = if is_sweep {
+    let done = if is_sweep && a.shared {
+        run_shared(items, &a, &stop, total, timings)?
+    } else if is_sweep {
         run_sweep(items, &a, &stop, total, timings)
     } else {
         run_single(items, &a, &stop, timings, &shard.to_string(), total)?
@@ -207,6 +220,68 @@ fn run_sweep(items: Vec<Item>, a: &Args, stop: &AtomicBool, total: usize, timing
     });
     evflow_tools::batch::finish(&bar);
     done
+}
+
+/// Runs a sweep's runs as one plan (`--shared`), printed in sweep order;
+/// a run that did not validate is a failure of its own. Points that
+/// cannot share a plan run as [`run_sweep`] runs them.
+fn run_shared(items: Vec<Item>, a: &Args, stop: &AtomicBool, total: usize, timings: Timings) -> Result<Done> {
+    let (valid, invalid): (Vec<Item>, Vec<Item>) = items.into_iter().partition(|(_, _, c)| c.is_ok());
+    let checked: Vec<Checked> = valid.iter().filter_map(|(_, _, c)| c.as_ref().ok().cloned()).collect();
+    let merged = match sweep_shared::merge(&checked) {
+        Ok(m) => m,
+        Err(e) => {
+            eprintln!("--shared: {e}; running them one by one");
+            let mut all = valid;
+            all.extend(invalid);
+            all.sort_by_key(|(i, _, _)| *i);
+            return Ok(run_sweep(all, a, stop, total, timings));
+        }
+    };
+    if !a.quiet {
+        let copied: Vec<&str> = merged.copied().collect();
+        eprintln!(
+            "--shared: {} of {} nodes run once for the {} runs; once per run: {}",
+            checked[0].nodes.len() - copied.len(),
+            checked[0].nodes.len(),
+            valid.len(),
+            if copied.is_empty() { "none".to_string() } else { copied.join(", ") }
+        );
+    }
+    // A node that fails fails every run it was shared by; an interruption stops them all.
+    let report = run_one(&merged.checked, a, stop, true).map_err(|e| format!("{e:#}"));
+    if stop.load(Ordering::Relaxed) {
+        return Ok(Done::default());
+    }
+    let mut done = Done::default();
+    let mut outcomes: Vec<(usize, Point, Result<RunReport, String>)> = valid
+        .into_iter()
+        .enumerate()
+        .map(|(k, (i, p, _))| (i, p, report.as_ref().map(|r| merged.report(r, k)).map_err(Clone::clone)))
+        .chain(invalid.into_iter().map(|(i, p, c)| (i, p, Err(c.err().unwrap_or_default()))))
+        .collect();
+    outcomes.sort_by_key(|(i, _, _)| *i);
+    for (i, point, outcome) in outcomes {
+        if !a.quiet {
+            println!("── run {}/{total}: {} ──", i + 1, point.label());
+        }
+        match outcome {
+            Ok(report) => {
+                print_report(&report, a.quiet, timings);
+                done.reports.push((point, report));
+                done.indices.push(i);
+            }
+            Err(e) => {
+                println!("run {} failed: {}", point.label(), e.lines().next().unwrap_or(""));
+                done.failures.push(point.label(), e);
+            }
+        }
+        if !a.quiet {
+            println!();
+        }
+        done.received += 1;
+    }
+    Ok(done)
 }
 
 /// Runs the one run there is — or, in an empty shard (more shards than

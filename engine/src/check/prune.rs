@@ -234,4 +234,4 @@ impl<'a> Pruning<'a> {
 
 #[cfg(test)]
 #[path = "prune_tests.rs"]
-mod tests;
+pub(crate) mod tests;

@@ -49,8 +49,9 @@ fn build_file(p: &Params, ctx: &BuildContext) -> Result<Box<dyn Node>, NodeError
     Ok(Box::new(Ramp(0.0)))
 }
 
-/// y = k·x, `k` live; folds when k = 0 or x is constant.
-static SCALE: NodeSpec = NodeSpec::new("t.scale", "test", Role::Filter, "y = k x", build_scale)
+/// y = k·x, `k` live; folds when k = 0 or x is constant (the shared
+/// sweeps' tests use it too).
+pub(crate) static SCALE: NodeSpec = NodeSpec::new("t.scale", "test", Role::Filter, "y = k x", build_scale)
     .ports(&[PortSpec::input("in", "1", "x"), PortSpec::output("out", "1", "k x")])
     .params(&[ParamSpec::float("k", -10.0, 10.0, 1.0, "1", "factor").live()])
     .fold(fold_scale);

@@ -2,38 +2,18 @@
 //! to the separate runs, each point's report, and points that cannot merge.
 
 use super::{copy_name, merge};
+use crate::check::prune::tests::SCALE;
 use crate::check::{check, Checked, Override};
 use crate::graph::parse_graph;
 use crate::harness::FEED;
 use crate::node::{BuildContext, Io, Node, NodeError, Summary};
 use crate::params::{Params, Value};
 use crate::plan::{Plan, PlanOptions};
-use crate::ports::{InPort, OutPort};
+use crate::ports::InPort;
 use crate::registry::Registry;
 use crate::run::{run_offline, RunOptions, RunReport};
-use crate::spec::{NodeSpec, ParamSpec, PortSpec, Role};
+use crate::spec::{NodeSpec, PortSpec, Role};
 use std::path::Path;
-
-/// y = k·x.
-static SCALE: NodeSpec = NodeSpec::new("t.scale", "test", Role::Filter, "y = k x", build_scale)
-    .ports(&[PortSpec::input("in", "1", "x"), PortSpec::output("out", "1", "k x")])
-    .params(&[ParamSpec::float("k", -10.0, 10.0, 1.0, "1", "factor")]);
-
-struct Scale(f64);
-impl Node for Scale {
-    fn process(&mut self, io: &mut Io<'_>) -> Result<(), NodeError> {
-        let (x, y) = io.io(InPort::at(0), OutPort::at(0));
-        for (y, x) in y.iter_mut().zip(x) {
-            *y = self.0 * x;
-        }
-        Ok(())
-    }
-    fn reset(&mut self) {}
-}
-
-fn build_scale(p: &Params, _: &BuildContext) -> Result<Box<dyn Node>, NodeError> {
-    Ok(Box::new(Scale(p.f64("k"))))
-}
 
 /// Sums its input; reports the sum and the name it was built under.
 static TOTAL: NodeSpec =

@@ -42,7 +42,8 @@ pub struct Merged {
 #[error("the sweep's points cannot share one run: {0}")]
 pub struct MergeError(pub String);
 
-/// The name of node `name`'s copy for point `k`.
+/// The name of node `name`'s copy for point `k` (a graph's node names
+/// hold letters, digits, `_` and `-` only, so no copy's name is a node's).
 pub fn copy_name(name: &str, k: usize) -> String {
     format!("{name}@{k}")
 }

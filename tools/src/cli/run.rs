@@ -89,6 +89,38 @@ struct Done {
     received: usize,
 }
 
+impl Done {
+    /// Prints run `i` of the sweep (of `total`) and keeps its report, or
+    /// its failure.
+    fn take(
+        &mut self,
+        i: usize,
+        point: Point,
+        outcome: Result<RunReport, String>,
+        a: &Args,
+        total: usize,
+        timings: Timings,
+    ) {
+        if !a.quiet {
+            println!("── run {}/{total}: {} ──", i + 1, point.label());
+        }
+        match outcome {
+            Ok(report) => {
+                print_report(&report, a.quiet, timings);
+                self.reports.push((point, report));
+                self.indices.push(i);
+            }
+            Err(e) => {
+                println!("run {} failed: {}", point.label(), e.lines().next().unwrap_or(""));
+                self.failures.push(point.label(), e);
+            }
+        }
+        if !a.quiet {
+            println!();
+        }
+    }
+}
+
 /// Runs `evflow run`.
 pub fn main(a: Args) -> Result<()> {
     let overrides = a.graph.overrides()?;
@@ -200,23 +232,7 @@ fn run_sweep(items: Vec<Item>, a: &Args, stop: &AtomicBool, total: usize, timing
     };
     done.received = for_each_ordered(items, a.batch.jobs(), stop, work, |k, outcome| {
         let (i, point) = &labels[k];
-        if !a.quiet {
-            println!("── run {}/{total}: {} ──", i + 1, point.label());
-        }
-        match outcome.and_then(|r| r) {
-            Ok(report) => {
-                print_report(&report, a.quiet, timings);
-                done.reports.push((point.clone(), report));
-                done.indices.push(*i);
-            }
-            Err(e) => {
-                println!("run {} failed: {}", point.label(), e.lines().next().unwrap_or(""));
-                done.failures.push(point.label(), e);
-            }
-        }
-        if !a.quiet {
-            println!();
-        }
+        done.take(*i, point.clone(), outcome.and_then(|r| r), a, total, timings);
     });
     evflow_tools::batch::finish(&bar);
     done
@@ -262,23 +278,7 @@ fn run_shared(items: Vec<Item>, a: &Args, stop: &AtomicBool, total: usize, timin
         .collect();
     outcomes.sort_by_key(|(i, _, _)| *i);
     for (i, point, outcome) in outcomes {
-        if !a.quiet {
-            println!("── run {}/{total}: {} ──", i + 1, point.label());
-        }
-        match outcome {
-            Ok(report) => {
-                print_report(&report, a.quiet, timings);
-                done.reports.push((point, report));
-                done.indices.push(i);
-            }
-            Err(e) => {
-                println!("run {} failed: {}", point.label(), e.lines().next().unwrap_or(""));
-                done.failures.push(point.label(), e);
-            }
-        }
-        if !a.quiet {
-            println!();
-        }
+        done.take(i, point, outcome, a, total, timings);
         done.received += 1;
     }
     Ok(done)

@@ -280,4 +280,9 @@ fn bad_arguments_are_named() {
     assert!(!ok && err.contains("--rate"), "{err}");
     let (ok, _, err) = evflow(&["bench", "mesh", "--config", "9B9H", "--sizes", "300"]);
     assert!(!ok && err.contains("9B9H"), "{err}");
+    let (ok, _, err) = evflow(&["bench", "mesh", "--queries", "0", "--sizes", "300"]);
+    assert!(!ok && err.contains("--queries") && !err.contains("panicked"), "{err}");
+    // Fewer ray casts than the brute-force loop's least (20) is not a panic: it casts them all.
+    let (ok, out, err) = evflow(&["bench", "mesh", "--queries", "5", "--ticks", "20", "--sizes", "300"]);
+    assert!(ok && !err.contains("panicked") && out.contains("hit mismatches"), "{err}");
 }

@@ -21,10 +21,10 @@ pub struct Args {
     #[arg(long, value_delimiter = ',', default_value = "1000,100000,1000000")]
     sizes: Vec<usize>,
     /// Ticks of the live chain timed per size (after 1000 warm-up ticks).
-    #[arg(long, default_value_t = 20_000)]
+    #[arg(long, default_value_t = 20_000, value_parser = clap::builder::RangedU64ValueParser::<usize>::new().range(1..))]
     ticks: usize,
     /// Ray casts timed per size (the brute-force loop gets fewer on big meshes).
-    #[arg(long, default_value_t = 20_000)]
+    #[arg(long, default_value_t = 20_000, value_parser = clap::builder::RangedU64ValueParser::<usize>::new().range(1..))]
     queries: usize,
     /// The live chain to time; its `surface` and `edges` nodes get the scene.
     #[arg(long, default_value = "graphs/mesh-live.toml")]
@@ -107,7 +107,7 @@ fn measure(a: &Args, resolution: usize) -> Result<Row> {
     let points = touch_points(&mesh, a.queries);
     let cast_ns = time_casts(&points, |x, y| rc.cast(x, y).map(|h| h.tri));
     // Brute force visits every triangle: keep its total near a second.
-    let n_brute = (2_000_000_000 / triangles.max(1)).clamp(20, points.len());
+    let n_brute = (2_000_000_000 / triangles.max(1)).max(20).min(points.len());
     let brute_ns = time_casts(&points[..n_brute], |x, y| rc.cast_brute(x, y).map(|h| h.tri));
     let mismatches = points[..n_brute]
         .iter()

@@ -242,14 +242,22 @@ fn run_sweep(items: Vec<Item>, a: &Args, stop: &AtomicBool, total: usize, timing
 /// a run that did not validate is a failure of its own. Points that
 /// cannot share a plan run as [`run_sweep`] runs them.
 fn run_shared(items: Vec<Item>, a: &Args, stop: &AtomicBool, total: usize, timings: Timings) -> Result<Done> {
-    let (valid, invalid): (Vec<Item>, Vec<Item>) = items.into_iter().partition(|(_, _, c)| c.is_ok());
-    let checked: Vec<Checked> = valid.iter().filter_map(|(_, _, c)| c.as_ref().ok().cloned()).collect();
+    let (mut valid, mut checked, mut invalid) = (Vec::new(), Vec::new(), Vec::new());
+    for (i, p, c) in items {
+        match c {
+            Ok(c) => {
+                valid.push((i, p));
+                checked.push(c);
+            }
+            Err(e) => invalid.push((i, p, e)),
+        }
+    }
     let merged = match sweep_shared::merge(&checked) {
         Ok(m) => m,
         Err(e) => {
             eprintln!("--shared: {e}; running them one by one");
-            let mut all = valid;
-            all.extend(invalid);
+            let mut all: Vec<Item> = valid.into_iter().zip(checked).map(|((i, p), c)| (i, p, Ok(c))).collect();
+            all.extend(invalid.into_iter().map(|(i, p, e)| (i, p, Err(e))));
             all.sort_by_key(|(i, _, _)| *i);
             return Ok(run_sweep(all, a, stop, total, timings));
         }
@@ -273,8 +281,8 @@ fn run_shared(items: Vec<Item>, a: &Args, stop: &AtomicBool, total: usize, timin
     let mut outcomes: Vec<(usize, Point, Result<RunReport, String>)> = valid
         .into_iter()
         .enumerate()
-        .map(|(k, (i, p, _))| (i, p, report.as_ref().map(|r| merged.report(r, k)).map_err(Clone::clone)))
-        .chain(invalid.into_iter().map(|(i, p, c)| (i, p, Err(c.err().unwrap_or_default()))))
+        .map(|(k, (i, p))| (i, p, report.as_ref().map(|r| merged.report(r, k)).map_err(Clone::clone)))
+        .chain(invalid.into_iter().map(|(i, p, e)| (i, p, Err(e))))
         .collect();
     outcomes.sort_by_key(|(i, _, _)| *i);
     for (i, point, outcome) in outcomes {

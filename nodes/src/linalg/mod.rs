@@ -7,9 +7,11 @@
 //! "gaxpy" Cholesky).
 
 pub mod cholesky;
+pub mod dot_columns;
 pub mod gram;
 
 pub use cholesky::{Cholesky, NotPositiveDefinite};
+pub use dot_columns::dot_columns;
 pub use gram::add_lower_gram;
 
 /// Σ a_i·b_i over two slices of one length, in four running sums (which a

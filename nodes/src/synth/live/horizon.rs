@@ -37,7 +37,13 @@
 //! free i, the row sum Σ_{j past} Q_ij·a_j. An evaluation then multiplies
 //! only the free part, Σ_k min(k + 1, M)² multiply-adds (M = 20, H = 16:
 //! 1 496, against H·M² = 6 400 for the whole windows). The worst case is
-//! fixed: one preparation and `iterations` + 2 evaluations.
+//! fixed: one preparation and `iterations` + 2 evaluations. Each tick lays
+//! the model's Q out transposed, so that a window's row products run four
+//! rows at a time ([`dot_columns`]: each row summed as the row dot
+//! product, the same bits), and on CPUs with AVX2 the evaluations run
+//! compiled for it (Rust never fuses a multiply and an add on its own, so
+//! the portable and AVX2 builds give the same bits; a test checks both
+//! against the row-by-row evaluation).
 //!
 //! **Fallback.** When the budget runs out (the iterations, or the optional
 //! deadline) the best point found is played: never worse than the better

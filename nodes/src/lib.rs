@@ -11,6 +11,7 @@
 #![deny(missing_docs)]
 
 pub mod analysis;
+pub mod cpu;
 pub mod example_files;
 pub mod families;
 pub mod filters;

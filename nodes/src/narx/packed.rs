@@ -117,7 +117,14 @@ impl PackedMlp {
             layers.push(Layer { r, sp, w: pw, b: pb });
             off += s * r + s;
         }
-        Self { inputs: net.inputs(), layers, tanh, avx2: has_avx2(), a: vec![0.0; widest], b: vec![0.0; widest] }
+        Self {
+            inputs: net.inputs(),
+            layers,
+            tanh,
+            avx2: crate::cpu::has_avx2_fma(),
+            a: vec![0.0; widest],
+            b: vec![0.0; widest],
+        }
     }
 
     /// Number of inputs.
@@ -143,7 +150,7 @@ impl PackedMlp {
         debug_assert_eq!(head.len() + tail.len(), self.inputs);
         #[cfg(target_arch = "x86_64")]
         if self.avx2 {
-            // SAFETY: `has_avx2` found AVX2 and FMA on this CPU when `self`
+            // SAFETY: `cpu::has_avx2_fma` found AVX2 and FMA on this CPU when `self`
             // was built; the function only needs those.
             return unsafe { self.forward_avx2(head, tail) };
         }
@@ -179,18 +186,6 @@ impl PackedMlp {
             std::mem::swap(&mut cur, &mut next);
         }
         cur[0]
-    }
-}
-
-/// Whether this CPU runs the AVX2 build.
-pub(crate) fn has_avx2() -> bool {
-    #[cfg(target_arch = "x86_64")]
-    {
-        std::arch::is_x86_feature_detected!("avx2") && std::arch::is_x86_feature_detected!("fma")
-    }
-    #[cfg(not(target_arch = "x86_64"))]
-    {
-        false
     }
 }
 
@@ -293,7 +288,7 @@ fn group<const B: usize, const FUSED: bool>(
             Act::Linear => z,
             Act::Exact => z.map(f64::tanh),
             // SAFETY: FUSED is instantiated only by `forward_avx2`, which
-            // runs after `has_avx2` found AVX2 and FMA.
+            // runs after `cpu::has_avx2_fma` found AVX2 and FMA.
             Act::Fast if FUSED => unsafe { fast_tanh_avx2::tanh4_fused(z) },
             Act::Fast => fast_tanh::tanh_lanes(z),
         };

@@ -157,7 +157,7 @@ impl Volterra {
     /// `y` (same length).
     pub fn eval(&self, u: &[f64], y: &mut [f64]) {
         #[cfg(target_arch = "x86_64")]
-        if avx2() {
+        if crate::cpu::has_avx2_fma() {
             // SAFETY: the CPU has AVX2 and FMA (checked just above), all
             // that `eval_avx2` needs.
             return unsafe { self.eval_avx2(u, y) };
@@ -219,7 +219,7 @@ impl Volterra {
     /// sensitivity 2·H·w + l scattered back onto the samples it read).
     pub fn eval_grad(&self, u: &[f64], ybar: &[f64], y: &mut [f64], du: &mut [f64]) {
         #[cfg(target_arch = "x86_64")]
-        if avx2() {
+        if crate::cpu::has_avx2_fma() {
             // SAFETY: as in `eval`.
             return unsafe { self.eval_grad_avx2(u, ybar, y, du) };
         }
@@ -253,12 +253,6 @@ impl Volterra {
             }
         }
     }
-}
-
-/// Whether this CPU runs the AVX2 builds (the answer is cached by std).
-#[cfg(target_arch = "x86_64")]
-fn avx2() -> bool {
-    std::arch::is_x86_feature_detected!("avx2") && std::arch::is_x86_feature_detected!("fma")
 }
 
 /// z[c0 .. c0 + L] = Σ_j w_j·Hᵀ[j][c0 .. c0 + L], the L sums in registers,

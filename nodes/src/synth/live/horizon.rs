@@ -145,7 +145,7 @@ impl Horizon {
             qt: vec![0.0; m * mp],
             mp,
             rows: vec![0.0; mp],
-            avx2: crate::narx::packed::has_avx2(),
+            avx2: crate::cpu::has_avx2_fma(),
             m,
             h,
             buf: vec![0.0; m - 1],

@@ -108,11 +108,6 @@ pub struct Horizon {
     carrier: Vec<f64>,
     warm: Vec<f64>,
     z: Vec<f64>,
-    /// Per row of a window, its term of y (scratch, M).
-    terms: Vec<f64>,
-    /// The gradient being summed, last sample first: `grev[h − 1 − k]`
-    /// collects ∂J/∂x_k, so that a window's contributions run forwards.
-    grev: Vec<f64>,
     has_warm: bool,
 }
 
@@ -159,8 +154,6 @@ impl Horizon {
             carrier: vec![0.0; h],
             warm: vec![0.0; h],
             z: vec![0.0; m],
-            terms: vec![0.0; m],
-            grev: vec![0.0; h],
             win: vec![0.0; m],
             has_warm: false,
         }
@@ -260,9 +253,9 @@ impl Horizon {
             Point::Current => (&self.x, &mut self.g),
             Point::Trial => (&self.xt, &mut self.gt),
         };
-        let (win, z, rows, terms, grev) = (&mut self.win, &mut self.z, &mut self.rows, &mut self.terms, &mut self.grev);
+        let (win, z, rows) = (&mut self.win, &mut self.z, &mut self.rows);
         let h = x.len();
-        grev.iter_mut().for_each(|v| *v = 0.0);
+        g.iter_mut().for_each(|v| *v = 0.0);
         let mut j = 0.0;
         let mut first = 0.0;
         let lt = &model.lt[..m];
@@ -280,31 +273,22 @@ impl Horizon {
             let rows = &mut rows[..len.div_ceil(ROWS) * ROWS];
             dot_columns(&self.qt, self.mp, win, rows);
             let cross = &self.cross[k * m..k * m + len];
-            let (z, terms) = (&mut z[..len], &mut terms[..len]);
-            for ((((zi, t), r), c), (w, l)) in
-                z.iter_mut().zip(terms.iter_mut()).zip(&rows[..len]).zip(cross).zip(win.iter().zip(lt))
-            {
+            let z = &mut z[..len];
+            let mut y = self.fixed[k];
+            for (((zi, r), c), (w, l)) in z.iter_mut().zip(&rows[..len]).zip(cross).zip(win.iter().zip(lt)) {
                 // z_i = Σ_j Q_ij w_j over the whole window (Q symmetric).
                 *zi = r + c;
-                *t = w * (*zi + c + s * l);
-            }
-            // y's terms added in order (each row's term computed above).
-            let mut y = self.fixed[k];
-            for t in terms.iter() {
-                y += t;
+                y += w * (*zi + c + s * l);
             }
             if k == 0 {
                 first = y;
             }
             let e = y - b - f[k];
             j += e * e;
-            // x_{k−i} for i = 0 … kf sits at grev[h − 1 − k + i].
-            for ((gi, zi), l) in grev[h - 1 - k..h - 1 - k + len].iter_mut().zip(&*z).zip(lt) {
+            // Row i of the window is sample k − i.
+            for ((gi, zi), l) in g[k - kf..=k].iter_mut().rev().zip(&*z).zip(lt) {
                 *gi += 2.0 * e * (2.0 * zi + s * l);
             }
-        }
-        for (gk, gr) in g.iter_mut().zip(grev.iter().rev()) {
-            *gk = *gr;
         }
         for (gk, xk) in g.iter_mut().zip(x) {
             j += model.beta * xk * xk;

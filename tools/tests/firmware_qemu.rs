@@ -260,7 +260,7 @@ fn live_texture_rendering_drives_the_emulated_board_sample_for_sample() {
     let unread = arrived_in_order(&sent, &got, &stats, &text);
     assert!(unread < 3000, "{unread} samples not taken");
     let loud = sent.iter().filter(|v| v.unsigned_abs() > 3000).count();
-    assert!(loud > 200, "the texture was rendered: {loud} samples above 0.09");
+    assert!(loud > 200, "the texture was rendered: {loud} samples above 0.09\n{text}");
     // The DAC applied what arrived, in order: each run of equal samples it
     // played is a received sample (a sample held while the FIFO was empty
     // repeats; the watchdog's and the stop's ramps end at zero).

@@ -4,11 +4,13 @@
 use super::calibrate::{calibrate, CacheStatus, Range, ScanSettings};
 use super::gradient::{intensity, Gradient, GradientSettings, SlopeMode};
 use super::raycast::RayCaster;
+use super::shared;
 use super::source::{self, Fit, Placed};
 use evflow_engine::ports::{InPort, OutPort};
 use evflow_engine::spec::Scene;
 use evflow_engine::typed_params::{Choice, Float, Floats, Int, Text};
 use evflow_engine::{BuildContext, Change, Io, Node, NodeError, NodeSpec, Params, PortSpec, Refused, Role, Summary};
+use std::sync::Arc;
 
 /// Declaration of `mesh.gradient`.
 pub static SPEC: NodeSpec = NodeSpec::new(
@@ -190,8 +192,8 @@ pub const DEFAULT_SPEEDS: [f64; 3] = [0.02, 0.05, 0.1];
 pub struct MeshGradient {
     /// The mesh and its placement.
     pub placed: Placed,
-    /// The ray caster (BVH).
-    pub rc: RayCaster,
+    /// The ray caster (BVH), shared with the other holders of the mesh.
+    pub rc: Arc<RayCaster>,
     /// The estimator.
     pub est: Gradient,
     /// The F^sq range.
@@ -208,7 +210,7 @@ pub struct MeshGradient {
 
 /// Builds one mesh's state from the node's parameters.
 pub fn build_state(p: &Params, ctx: &BuildContext, placed: Placed) -> Result<MeshGradient, NodeError> {
-    let rc = RayCaster::new(&placed.mesh);
+    let rc = shared::ray_caster(&placed.mesh);
     let unit = placed.unit;
     let gs = GradientSettings {
         mode: SLOPE.get(p),

@@ -17,6 +17,7 @@ pub mod obj;
 pub mod ply;
 pub mod raycast;
 pub mod scenes;
+pub mod shared;
 pub mod trimesh;
 
 pub use error::MeshError;

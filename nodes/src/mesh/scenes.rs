@@ -9,7 +9,7 @@ use super::error::MeshError;
 use super::trimesh::Mesh;
 
 /// Object profile of a scene.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
 pub enum Shape {
     /// z = 8/(1.4π)·exp(−(x²+y²)/1.4) (Fig. 4.5a).
     Gaussian,

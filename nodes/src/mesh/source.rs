@@ -7,10 +7,12 @@
 
 use super::formats::{Format, EXTENSIONS};
 use super::place::{self, Up};
-use super::scenes::{scene, Shape, CONFIGS};
+use super::scenes::{Shape, CONFIGS};
+use super::shared;
 use super::trimesh::Mesh;
 use evflow_engine::typed_params::{Choice, Float, Int, Text, Words};
 use evflow_engine::{BuildContext, NodeError, Params};
+use std::sync::Arc;
 
 /// The parameters of a node that loads its scenes here (`file`, `shape`,
 /// `config`, `resolution`, `unit`, `offset_x`, `offset_y`, `up`, `fit`,
@@ -153,8 +155,9 @@ pub const WELD: Float = Float::new(
 /// A loaded mesh with its placement.
 #[derive(Debug, Clone)]
 pub struct Placed {
-    /// The mesh, turned so that `up` is +z.
-    pub mesh: Mesh,
+    /// The mesh, turned so that `up` is +z; a generated scene shared with
+    /// the other nodes that hold it ([`shared`]).
+    pub mesh: Arc<Mesh>,
     /// The file's axis that was turned to +z.
     pub up: Up,
     /// Height of the screen plane in mesh units: 0 for scenes (objects
@@ -320,7 +323,7 @@ pub fn placement_warnings(placed: &Placed, auto: Option<Format>, fitted: bool) -
 
 /// The mesh of one entry turned so that its up axis is +z, with its floor
 /// (mesh units), name and the axis turned.
-fn load_mesh(p: &Params, ctx: &BuildContext, entry: &str) -> Result<(Mesh, f64, String, Up), NodeError> {
+fn load_mesh(p: &Params, ctx: &BuildContext, entry: &str) -> Result<(Arc<Mesh>, f64, String, Up), NodeError> {
     let format = Format::of(entry);
     let up = match (UP.get(p), format) {
         (Some(up), _) => up,
@@ -332,7 +335,7 @@ fn load_mesh(p: &Params, ctx: &BuildContext, entry: &str) -> Result<(Mesh, f64, 
         let mesh = format.load(&path, WELD.get(p)).map_err(|e| NodeError::Other(e.to_string()))?;
         let mesh = place::reorient(mesh, up);
         let floor = mesh.bounds().min[2];
-        return Ok((mesh, floor, path.display().to_string(), up));
+        return Ok((Arc::new(mesh), floor, path.display().to_string(), up));
     }
     let shape = SHAPE.get(p);
     if !CONFIGS.contains(&entry) && (entry.contains('.') || entry.contains('/')) {
@@ -349,14 +352,16 @@ fn load_mesh(p: &Params, ctx: &BuildContext, entry: &str) -> Result<(Mesh, f64, 
             format!("unknown scene `{entry}` (one of {}, or a mesh file); {help}", CONFIGS.join(", ")),
         ));
     }
-    let mesh = scene(shape, entry, RESOLUTION.count(p)).map_err(|e| NodeError::param(CONFIG.name(), e.to_string()))?;
-    // Scenes stand on the screen plane z = 0; turned, on their lowest point.
+    let mesh = shared::scene(shape, entry, RESOLUTION.count(p))
+        .map_err(|e| NodeError::param(CONFIG.name(), e.to_string()))?;
+    // Scenes stand on the screen plane z = 0; turned, on their lowest point
+    // (a turned scene is a copy of its own).
     let (mesh, floor) = match up {
         Up::PlusZ => (mesh, 0.0),
         _ => {
-            let mesh = place::reorient(mesh, up);
+            let mesh = place::reorient(Arc::unwrap_or_clone(mesh), up);
             let floor = mesh.bounds().min[2];
-            (mesh, floor)
+            (Arc::new(mesh), floor)
         }
     };
     Ok((mesh, floor, format!("{} {entry}", shape.word()), up))

@@ -100,6 +100,9 @@ pub fn curve(graphs: &Path, size: Size) -> Result<Curve, PrecisionError> {
         Size::Ci => (2.0, &[8, 16, DEFAULT_RESOLUTION], 192),
         Size::Full => (10.0, &[4, 8, 16, 32, DEFAULT_RESOLUTION, 64, 96], 512),
     };
+    // The reference mesh (and its BVH) is the same in every run and in the check: built once, kept
+    // until the curve is done.
+    let _keep = evflow_nodes::mesh::shared::Keep::new();
     let mut points = Vec::new();
     for &c in cells {
         let r = graphs::run(&graph, &sets(c, reference), None, Some(seconds))?;

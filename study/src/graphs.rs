@@ -120,17 +120,28 @@ pub fn run_sweep_for(
     out: &Path,
     duration: Option<f64>,
 ) -> Result<Vec<RunReport>, GraphError> {
-    let graph = read(file)?;
+    run_sweep(&read(file)?, points, Some(out), duration)
+}
+
+/// [`run_sweep_for`] of a graph already read (and perhaps probed, as
+/// [`run`] takes it), its outputs under `out` if given.
+pub fn run_sweep(
+    graph: &Graph,
+    points: &[Sets],
+    out: Option<&Path>,
+    duration: Option<f64>,
+) -> Result<Vec<RunReport>, GraphError> {
+    let file = graph.file.as_path();
     let err = |e: String| GraphError::new(file, e);
     let registry = evflow_nodes::registry();
     let checked = points
         .iter()
-        .map(|p| check(&graph, &registry, p.overrides()).map_err(|e| err(e.to_string())))
+        .map(|p| check(graph, &registry, p.overrides()).map_err(|e| err(e.to_string())))
         .collect::<Result<Vec<_>, _>>()?;
     let Ok(merged) = sweep_shared::merge(&checked) else {
-        return points.iter().map(|p| run(&graph, p, Some(out), duration)).collect();
+        return points.iter().map(|p| run(graph, p, out, duration)).collect();
     };
-    let report = run_checked(&merged.checked, Some(out), duration).map_err(err)?;
+    let report = run_checked(&merged.checked, out, duration).map_err(err)?;
     Ok((0..merged.points()).map(|k| merged.report(&report, k)).collect())
 }
 

@@ -46,21 +46,28 @@ pub fn curves(graphs: &Path, size: Size) -> Result<Vec<Curve>, PrecisionError> {
         Size::Ci => (Some(0.6), &[1, 4, 16, 64], 1024),
         Size::Full => (None, &[1, 4, 16, 64, 256], 4096),
     };
+    // One shared sweep over every setting: the sources and the three references (the same at every
+    // setting) run once for all of them, each setting's lab nodes and error sinks once per setting.
+    let settings: Vec<(&str, usize)> =
+        ["exact", "rk4", "euler"].into_iter().flat_map(|i| substeps.iter().map(move |&s| (i, s))).collect();
+    let sweep: Vec<Sets> = settings
+        .iter()
+        .map(|&(integrator, s)| {
+            Sets::new().text("integrator", integrator).int("substeps", s as i64).and(ref_sets(reference))
+        })
+        .collect();
+    let reports = graphs::run_sweep(&graph, &sweep, None, duration)?;
     let mut points: Vec<Vec<WorkPoint>> = vec![Vec::new(); NODES.len()];
-    for integrator in ["exact", "rk4", "euler"] {
-        for &s in substeps {
-            let sets = Sets::new().text("integrator", integrator).int("substeps", s as i64).and(ref_sets(reference));
-            let r = graphs::run(&graph, &sets, None, duration)?;
-            for (k, &(node, sink, _, _)) in NODES.iter().enumerate() {
-                points[k].push(WorkPoint {
-                    setting: setting(integrator, s),
-                    series: integrator.into(),
-                    error: value(&r, &file, sink, "rel_rms")?,
-                    cost: seconds_per_tick(&r, &file, &[node])?,
-                    // RK4 evaluates four stages per sub-step.
-                    work: (s * if integrator == "rk4" { 4 } else { 1 }) as f64,
-                });
-            }
+    for (&(integrator, s), r) in settings.iter().zip(&reports) {
+        for (k, &(node, sink, _, _)) in NODES.iter().enumerate() {
+            points[k].push(WorkPoint {
+                setting: setting(integrator, s),
+                series: integrator.into(),
+                error: value(r, &file, sink, "rel_rms")?,
+                cost: seconds_per_tick(r, &file, &[node])?,
+                // RK4 evaluates four stages per sub-step.
+                work: (s * if integrator == "rk4" { 4 } else { 1 }) as f64,
+            });
         }
     }
     let sets = Sets::new().text("integrator", "exact").int("substeps", reference as i64).and(ref_sets(10_000));

@@ -352,8 +352,8 @@ fn load_mesh(p: &Params, ctx: &BuildContext, entry: &str) -> Result<(Arc<Mesh>, 
             format!("unknown scene `{entry}` (one of {}, or a mesh file); {help}", CONFIGS.join(", ")),
         ));
     }
-    let mesh = shared::scene(shape, entry, RESOLUTION.count(p))
-        .map_err(|e| NodeError::param(CONFIG.name(), e.to_string()))?;
+    let mesh =
+        shared::scene(shape, entry, RESOLUTION.count(p)).map_err(|e| NodeError::param(CONFIG.name(), e.to_string()))?;
     // Scenes stand on the screen plane z = 0; turned, on their lowest point
     // (a turned scene is a copy of its own).
     let (mesh, floor) = match up {

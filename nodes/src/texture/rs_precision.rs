@@ -55,62 +55,119 @@ pub fn measure(
     method: RsMethod,
     repeats: usize,
 ) -> Result<Precision, RsError> {
-    let y: Vec<f64> = (0..len).map(|n| eval(tones, n as f64)).collect();
-    let mut out = Vec::new();
-    let mut seconds = f64::INFINITY;
-    for _ in 0..repeats.max(1) {
-        let t = Instant::now();
-        out = rs(&y, p, q, method)?;
-        seconds = seconds.min(t.elapsed().as_secs_f64());
-    }
-    let (error, delay) = score(&out, tones, q / p);
-    Ok(Precision { error, delay, seconds, samples: out.len() })
+    Scorer::default().measure(tones, len, p, q, method, repeats)
 }
 
 /// The RMS error of `out` against the test signal read every `step` input
 /// samples, relative to its RMS, after the best constant delay (output
 /// samples, within ±1.5), away from the ends: (error, delay).
 pub fn score(out: &[f64], tones: &[(f64, f64, f64)], step: f64) -> (f64, f64) {
-    let margin = (out.len() / 10).max(64).min(out.len() / 3);
-    let body = margin..out.len().saturating_sub(margin);
-    let rms_of = |delay: f64| {
-        let (mut e, mut r, mut n) = (0.0, 0.0, 0usize);
-        for k in body.clone() {
-            let want = eval(tones, (k as f64 - delay) * step);
-            e += (out[k] - want).powi(2);
-            r += want * want;
-            n += 1;
+    Scorer::default().score(out, tones, step)
+}
+
+/// The delays of the scorer's coarse scan, in steps of 0.05 output samples.
+const SCAN: std::ops::RangeInclusive<i32> = -30..=30;
+
+/// Scores re-sampled signals, keeping the exact signal at the delays of the
+/// coarse scan between calls: every method scored at one ratio (and one
+/// output length) is compared with the same values there, so they are
+/// computed once (the scan is 62 of a score's 143 passes over the signal).
+/// The results are the same bits as a fresh scorer's: each kept value is
+/// computed as the pass would have computed it, and added in the same order.
+#[derive(Debug, Default)]
+pub struct Scorer {
+    scans: Vec<Scan>,
+}
+
+/// The exact signal at every delay of [`SCAN`] for one signal, step and body.
+#[derive(Debug)]
+struct Scan {
+    tones: Vec<[u64; 3]>,
+    step: u64,
+    body: std::ops::Range<usize>,
+    /// `want[i][k − body.start]`: the signal at output sample k, delay `SCAN`'s i-th.
+    want: Vec<Vec<f64>>,
+}
+
+impl Scorer {
+    /// [`measure`], keeping this scorer's scans.
+    pub fn measure(
+        &mut self,
+        tones: &[(f64, f64, f64)],
+        len: usize,
+        p: f64,
+        q: f64,
+        method: RsMethod,
+        repeats: usize,
+    ) -> Result<Precision, RsError> {
+        let y: Vec<f64> = (0..len).map(|n| eval(tones, n as f64)).collect();
+        let mut out = Vec::new();
+        let mut seconds = f64::INFINITY;
+        for _ in 0..repeats.max(1) {
+            let t = Instant::now();
+            out = rs(&y, p, q, method)?;
+            seconds = seconds.min(t.elapsed().as_secs_f64());
         }
-        (e.sqrt() / r.sqrt().max(f64::MIN_POSITIVE), n)
-    };
-    // Coarse scan of the delay over ±1.5 output samples, then golden-section
-    // refinement. Each error is a sum of sines over the whole body, the
-    // same whichever thread takes it: the scan's two halves, and the two
-    // points of each golden step, are computed side by side.
-    let mut best = (0.0, rms_of(0.0).0);
-    let scan = |range: std::ops::RangeInclusive<i32>| -> Vec<(f64, f64)> {
-        range.map(|i| i as f64 * 0.05).map(|d| (d, rms_of(d).0)).collect()
-    };
-    let (low, high) = side_by_side(|| scan(-30..=0), || scan(1..=30));
-    for (d, e) in low.into_iter().chain(high) {
-        if e < best.1 {
-            best = (d, e);
-        }
+        let (error, delay) = self.score(&out, tones, q / p);
+        Ok(Precision { error, delay, seconds, samples: out.len() })
     }
-    let (mut a, mut b) = (best.0 - 0.05, best.0 + 0.05);
-    let g = 0.618_033_988_749_894_9;
-    for _ in 0..40 {
-        let (c, d) = (b - g * (b - a), a + g * (b - a));
-        let (at_c, at_d) = side_by_side(|| rms_of(c).0, || rms_of(d).0);
-        if at_c < at_d {
-            b = d;
-        } else {
-            a = c;
+
+    /// [`score`], keeping this scorer's scans.
+    pub fn score(&mut self, out: &[f64], tones: &[(f64, f64, f64)], step: f64) -> (f64, f64) {
+        let margin = (out.len() / 10).max(64).min(out.len() / 3);
+        let body = margin..out.len().saturating_sub(margin);
+        let want_at =
+            |delay: f64| -> Vec<f64> { body.clone().map(|k| eval(tones, (k as f64 - delay) * step)).collect() };
+        let rms_against = |want: &[f64]| {
+            let (mut e, mut r) = (0.0, 0.0);
+            for (&o, &w) in out[body.clone()].iter().zip(want) {
+                e += (o - w).powi(2);
+                r += w * w;
+            }
+            e.sqrt() / r.sqrt().max(f64::MIN_POSITIVE)
+        };
+        let rms_of = |delay: f64| rms_against(&want_at(delay));
+        // Coarse scan of the delay over ±1.5 output samples, then golden-section
+        // refinement. The scan's signal is kept; each of its halves, and the two
+        // points of each golden step, are computed side by side.
+        let key: Vec<[u64; 3]> = tones.iter().map(|&(f, a, ph)| [f.to_bits(), a.to_bits(), ph.to_bits()]).collect();
+        let found = self.scans.iter().position(|s| s.tones == key && s.step == step.to_bits() && s.body == body);
+        let k = match found {
+            Some(k) => k,
+            None => {
+                let half = |range: std::ops::RangeInclusive<i32>| -> Vec<Vec<f64>> {
+                    range.map(|i| want_at(i as f64 * 0.05)).collect()
+                };
+                let (mut want, high) = side_by_side(|| half(*SCAN.start()..=0), || half(1..=*SCAN.end()));
+                want.extend(high);
+                self.scans.push(Scan { tones: key, step: step.to_bits(), body: body.clone(), want });
+                self.scans.len() - 1
+            }
+        };
+        let scan = &self.scans[k].want;
+        // Delay 0 is the scan's own.
+        let mut best = (0.0, rms_against(&scan[(-SCAN.start()) as usize]));
+        for (i, want) in SCAN.zip(scan) {
+            let e = rms_against(want);
+            if e < best.1 {
+                best = (i as f64 * 0.05, e);
+            }
         }
+        let (mut a, mut b) = (best.0 - 0.05, best.0 + 0.05);
+        let g = 0.618_033_988_749_894_9;
+        for _ in 0..40 {
+            let (c, d) = (b - g * (b - a), a + g * (b - a));
+            let (at_c, at_d) = side_by_side(|| rms_of(c), || rms_of(d));
+            if at_c < at_d {
+                b = d;
+            } else {
+                a = c;
+            }
+        }
+        let delay = 0.5 * (a + b);
+        let error = rms_of(delay).min(best.1);
+        (error, delay)
     }
-    let delay = 0.5 * (a + b);
-    let error = rms_of(delay).0.min(best.1);
-    (error, delay)
 }
 
 /// `a()` on a second thread while `b()` runs on this one (a panic in
@@ -166,6 +223,68 @@ mod tests {
         for p in [fast, balanced, best] {
             assert!(p.delay.abs() <= 0.5 + 1e-3, "{p:?}");
         }
+    }
+
+    /// The scorer as it was before it kept its scans: every pass computes
+    /// the signal it compares with.
+    fn score_recomputing(out: &[f64], tones: &[(f64, f64, f64)], step: f64) -> (f64, f64) {
+        let margin = (out.len() / 10).max(64).min(out.len() / 3);
+        let body = margin..out.len().saturating_sub(margin);
+        let rms_of = |delay: f64| {
+            let (mut e, mut r) = (0.0, 0.0);
+            for k in body.clone() {
+                let want = eval(tones, (k as f64 - delay) * step);
+                e += (out[k] - want).powi(2);
+                r += want * want;
+            }
+            e.sqrt() / r.sqrt().max(f64::MIN_POSITIVE)
+        };
+        let mut best = (0.0, rms_of(0.0));
+        for i in -30..=30 {
+            let d = i as f64 * 0.05;
+            let e = rms_of(d);
+            if e < best.1 {
+                best = (d, e);
+            }
+        }
+        let (mut a, mut b) = (best.0 - 0.05, best.0 + 0.05);
+        let g = 0.618_033_988_749_894_9;
+        for _ in 0..40 {
+            let (c, d) = (b - g * (b - a), a + g * (b - a));
+            if rms_of(c) < rms_of(d) {
+                b = d;
+            } else {
+                a = c;
+            }
+        }
+        let delay = 0.5 * (a + b);
+        (rms_of(delay).min(best.1), delay)
+    }
+
+    #[test]
+    fn a_scorer_that_kept_its_scans_scores_as_one_that_recomputes_them() {
+        let t = tones(6, 0.2, 5);
+        let y: Vec<f64> = (0..3000).map(|n| eval(&t, n as f64)).collect();
+        let mut kept = Scorer::default();
+        // Several methods at two ratios through one scorer, each against the fresh scorer of `score`.
+        for (p, q) in [(3.0, 4.0), (5.0, 4.5)] {
+            for m in [RsMethod::Kernel(4), RsMethod::Kernel(16), RsMethod::RubatoPoly(PolynomialDegree::Cubic)] {
+                let out = rs(&y, p, q, m).unwrap();
+                let (e, d) = kept.score(&out, &t, q / p);
+                let (re, rd) = score_recomputing(&out, &t, q / p);
+                assert_eq!((e.to_bits(), d.to_bits()), (re.to_bits(), rd.to_bits()), "{m:?} at {p}/{q}");
+                let (fe, fd) = score(&out, &t, q / p);
+                assert_eq!((fe.to_bits(), fd.to_bits()), (re.to_bits(), rd.to_bits()), "{m:?} at {p}/{q}, fresh");
+            }
+        }
+        // One scan per ratio (these methods' outputs have one length per ratio), reused by the others.
+        assert_eq!(kept.scans.len(), 2);
+        // Another signal is not scored against the kept scans.
+        let other = tones(6, 0.2, 6);
+        let out = rs(&y, 3.0, 4.0, RsMethod::Kernel(4)).unwrap();
+        let (e, _) = kept.score(&out, &other, 0.75);
+        assert_eq!(e.to_bits(), score_recomputing(&out, &other, 0.75).0.to_bits());
+        assert_eq!(kept.scans.len(), 3);
     }
 
     #[test]

@@ -10,7 +10,7 @@ use super::curve::{Curve, WorkPoint};
 use super::{PrecisionError, Size};
 use evflow_nodes::rate::resampler::Quality;
 use evflow_nodes::texture::rs::RsMethod;
-use evflow_nodes::texture::rs_precision::{measure, tones};
+use evflow_nodes::texture::rs_precision::{tones, Scorer};
 use rubato::PolynomialDegree;
 
 /// Velocity ratios v_j/v_u of a 3–7 cm/s grid (p/q of 𝓡𝓢).
@@ -59,8 +59,11 @@ pub struct MethodRow {
     pub delay: f64,
 }
 
-/// Measures one method on `samples` samples of [`signal`] at every ratio.
+/// Measures one method on `samples` samples of [`signal`] at every ratio;
+/// `scorer` keeps what the methods' scores share (pass the same one for
+/// every method: the same results, sooner).
 pub fn measure_method(
+    scorer: &mut Scorer,
     signal: &[(f64, f64, f64)],
     family: &'static str,
     m: RsMethod,
@@ -69,7 +72,8 @@ pub fn measure_method(
 ) -> Result<MethodRow, PrecisionError> {
     let (mut worst, mut ns, mut delay) = (0.0f64, 0.0f64, 0.0f64);
     for &(p, q) in &RATIOS {
-        let r = measure(signal, samples, p, q, m, repeats)
+        let r = scorer
+            .measure(signal, samples, p, q, m, repeats)
             .map_err(|e| PrecisionError::Method(format!("{}: {e}", m.label())))?;
         worst = worst.max(r.error);
         ns += r.seconds * 1e9 / r.samples.max(1) as f64 / RATIOS.len() as f64;
@@ -106,12 +110,13 @@ fn samples(size: Size) -> usize {
 /// The curve of the resamplers other than `interp`'s kernel.
 pub fn curve(size: Size) -> Result<Curve, PrecisionError> {
     let signal = signal();
+    let mut scorer = Scorer::default();
     let mut points = Vec::new();
     for (family, m) in methods() {
         if matches!(m, RsMethod::Kernel(_)) || (size == Size::Ci && matches!(m, RsMethod::RubatoSinc(16 | 64))) {
             continue;
         }
-        points.push(point(&measure_method(&signal, family, m, samples(size), size.repeats())?, family));
+        points.push(point(&measure_method(&mut scorer, &signal, family, m, samples(size), size.repeats())?, family));
     }
     Ok(Curve {
         name: "resample".into(),
@@ -134,9 +139,17 @@ pub fn interp_curve(size: Size) -> Result<Curve, PrecisionError> {
         Size::Full => &[2, 3, 4, 6, 8, 12, 16, 24, 32, 48, 64],
     };
     let signal = signal();
+    let mut scorer = Scorer::default();
     let mut points = Vec::new();
     for &w in widths {
-        let r = measure_method(&signal, "interp kernel (live)", RsMethod::Kernel(w), samples(size), size.repeats())?;
+        let r = measure_method(
+            &mut scorer,
+            &signal,
+            "interp kernel (live)",
+            RsMethod::Kernel(w),
+            samples(size),
+            size.repeats(),
+        )?;
         points.push(point(&r, "Kaiser-windowed sinc, β 8.6, γ 0.9"));
     }
     Ok(Curve {

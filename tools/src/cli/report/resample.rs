@@ -6,6 +6,7 @@
 //! signal whose re-sampled version is known exactly.
 
 use anyhow::{Context, Result};
+use evflow_nodes::texture::rs_precision::Scorer;
 use evflow_study::precision::resample::{measure_method, methods, signal, RATIOS};
 use evflow_tools::plot::{Plot, Series};
 use std::path::PathBuf;
@@ -39,8 +40,10 @@ pub fn main(a: Args) -> Result<()> {
     println!("| method | relative RMS error (worst ratio) | time per output sample | delay kept (samples) |");
     println!("|---|---:|---:|---:|");
     let mut families: Vec<(&str, Vec<(f64, f64)>)> = Vec::new();
+    let mut scorer = Scorer::default();
     for (family, m) in methods() {
-        let r = measure_method(&signal, family, m, a.samples, a.repeats).map_err(|e| anyhow::anyhow!("{e}"))?;
+        let r = measure_method(&mut scorer, &signal, family, m, a.samples, a.repeats)
+            .map_err(|e| anyhow::anyhow!("{e}"))?;
         println!("| {} | {:.2e} | {:.1} ns | {:+.2} |", m.label(), r.worst, r.ns, r.delay);
         match families.iter_mut().find(|(f, _)| *f == family) {
             Some((_, pts)) => pts.push((r.ns, r.worst)),

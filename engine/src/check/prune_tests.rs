@@ -348,3 +348,80 @@ fn an_output_that_varies_keeps_the_node_only_when_something_reads_it() {
     let plan = Plan::build(&checked(&text), &opts(1)).unwrap();
     assert!(plan.folded().is_empty());
 }
+
+/// Builds and drops of the `t.loads` nodes, in order ("build NAME", "drop NAME").
+static LOADS: Mutex<Vec<String>> = Mutex::new(Vec::new());
+
+/// A node that "loads" something at build and lets it go when dropped;
+/// constant when `flat` (as `mesh.edges` on smooth scenes, whose scenes
+/// `mesh.gradient` shares).
+static LOADS_SPEC: NodeSpec = NodeSpec::new("t.loads", "test", Role::Filter, "logs its build and drop", build_loads)
+    .ports(&[PortSpec::input("in", "1", "x"), PortSpec::output("out", "1", "x or 0")])
+    .params(&[ParamSpec::flag("flat", false, "constant 0")]);
+
+struct Loads {
+    name: String,
+    flat: bool,
+}
+impl Node for Loads {
+    fn process(&mut self, io: &mut Io<'_>) -> Result<(), NodeError> {
+        for k in 0..io.len() {
+            io.output(OutPort::at(0))[k] = io.input(InPort::at(0))[k];
+        }
+        Ok(())
+    }
+    fn reset(&mut self) {}
+    fn constant_output(&self) -> Option<Constant> {
+        self.flat.then(|| Constant::all(1, 0.0, "flat"))
+    }
+}
+impl Drop for Loads {
+    fn drop(&mut self) {
+        LOADS.lock().unwrap().push(format!("drop {}", self.name));
+    }
+}
+
+fn build_loads(p: &Params, ctx: &BuildContext) -> Result<Box<dyn Node>, NodeError> {
+    LOADS.lock().unwrap().push(format!("build {}", ctx.node));
+    Ok(Box::new(Loads { name: ctx.node.clone(), flat: p.bool("flat") }))
+}
+
+#[test]
+fn a_node_folded_into_a_constant_lives_until_every_node_is_built() {
+    // `flat` is built before `x` and `y` (downstream first: both feed `s1`,
+    // which is built before them) and folded; it is dropped only after them,
+    // so what they share with it is loaded once.
+    let text = r#"connections = ["feed.out -> flat.in", "feed.out -> x.in", "feed.out -> y.in", "flat.out -> s1.a", "x.out -> s1.b", "s1.out -> s2.a", "y.out -> s2.b", "s2.out -> tap.in"]
+[nodes.feed]
+type = "harness.feed"
+values = [1.0, 2.0]
+[nodes.flat]
+type = "t.loads"
+flat = true
+[nodes.x]
+type = "t.loads"
+[nodes.y]
+type = "t.loads"
+[nodes.s1]
+type = "t.sum"
+[nodes.s2]
+type = "t.sum"
+[nodes.tap]
+type = "harness.tap"
+"#;
+    let mut r = registry();
+    r.add(&LOADS_SPEC);
+    let doc = format!("[graph]\nformat = 1\nname = \"p\"\nrate = 1000\nduration = 0.02\n{text}");
+    let c = check(&parse_graph(Path::new("p.toml"), &doc).unwrap(), &r, &[]).unwrap_or_else(|e| panic!("{e}"));
+    let mut plan = Plan::build(&c, &opts(2)).unwrap_or_else(|e| panic!("{e}"));
+    assert_eq!(plan.folded().len(), 1);
+    let log = LOADS.lock().unwrap().clone();
+    let at = |what: &str| log.iter().position(|l| l == what).unwrap_or_else(|| panic!("no `{what}` in {log:?}"));
+    // The test means something only if a node is built after `flat`.
+    let last_build = at("build x").max(at("build y"));
+    assert!(at("build flat") < last_build, "{log:?}");
+    assert!(at("drop flat") > last_build, "{log:?}");
+    // The others live on in the plan, which runs.
+    assert!(!log.iter().any(|l| l == "drop x" || l == "drop y"), "{log:?}");
+    assert_eq!(run(&mut plan, "s2", 2), vec![2.0, 4.0]);
+}

@@ -98,6 +98,7 @@ impl Builder<'_> {
             setup: vec![Duration::ZERO; n_nodes],
             notes: Vec::new(),
         };
+        let mut folded = Vec::new();
         for &i in checked.order.iter().rev() {
             if !pruning.needed(i) || pruning.constant(i).is_some() {
                 continue;
@@ -129,8 +130,14 @@ impl Builder<'_> {
             }
             if pruning.constant(i).is_none() {
                 built.nodes[i] = Some(node);
+            } else {
+                folded.push(node);
             }
         }
+        // The nodes folded into constants go only now: a node built after one
+        // may share what it loaded (`mesh.gradient` the scenes of a
+        // `mesh.edges` held constant on smooth scenes), built once that way.
+        drop(folded);
         Ok(built)
     }
 

@@ -164,9 +164,46 @@ impl Box1 {
     }
 }
 
-/// aᵀb over the free variables.
+/// aᵀb over the free variables (summed in order from −0, as `Iterator::sum`).
 fn dot(a: &[f64], b: &[f64], free: &[bool]) -> f64 {
-    a.iter().zip(b).zip(free).filter(|(_, f)| **f).map(|((a, b), _)| a * b).sum()
+    let mut acc = -0.0;
+    for ((&a, &b), &f) in a.iter().zip(b).zip(free) {
+        if f {
+            acc += a * b;
+        }
+    }
+    acc
+}
+
+/// `out[j]` = a_jᵀb_j over the free variables for every j, each summed as
+/// [`dot`] sums it (the same bits), up to four side by side in one pass:
+/// independent sums, so they do not wait on each other's additions.
+fn dots(a: &[&[f64]], b: &[&[f64]], free: &[bool], out: &mut [f64]) {
+    let mut j = 0;
+    while j < a.len() {
+        match a.len() - j {
+            1 => out[j] = dot(a[j], b[j], free),
+            2 => dots_group::<2>(&a[j..], &b[j..], free, &mut out[j..]),
+            3 => dots_group::<3>(&a[j..], &b[j..], free, &mut out[j..]),
+            _ => dots_group::<4>(&a[j..], &b[j..], free, &mut out[j..]),
+        }
+        j += 4;
+    }
+}
+
+fn dots_group<const B: usize>(a: &[&[f64]], b: &[&[f64]], free: &[bool], out: &mut [f64]) {
+    let n = free.len();
+    let a: [&[f64]; B] = std::array::from_fn(|k| &a[k][..n]);
+    let b: [&[f64]; B] = std::array::from_fn(|k| &b[k][..n]);
+    let mut acc = [-0.0f64; B];
+    for i in 0..n {
+        if free[i] {
+            for k in 0..B {
+                acc[k] += a[k][i] * b[k][i];
+            }
+        }
+    }
+    out[..B].copy_from_slice(&acc);
 }
 
 /// The last pairs (s, y) of L-BFGS, oldest first.
@@ -175,51 +212,116 @@ struct Memory {
     s: Vec<Vec<f64>>,
     y: Vec<Vec<f64>>,
     alpha: Vec<f64>,
+    /// sᵀy of each pair over this iteration's free variables, and yᵀy of
+    /// the last (one slot more).
+    sy: Vec<f64>,
+    /// The pairs the two loops use (sᵀy not ≤ 0), in the first loop's order.
+    used: Vec<usize>,
 }
 
 impl Memory {
     fn new(cap: usize) -> Self {
-        Self { cap, s: Vec::with_capacity(cap), y: Vec::with_capacity(cap), alpha: vec![0.0; cap] }
+        Self {
+            cap,
+            s: Vec::with_capacity(cap),
+            y: Vec::with_capacity(cap),
+            alpha: vec![0.0; cap],
+            sy: vec![0.0; cap + 1],
+            used: Vec::with_capacity(cap),
+        }
     }
 
     /// d = −H·g on the free variables (0 on the others): the two-loop
     /// recursion over the pairs kept, scaled by sᵀy/yᵀy of the last.
+    ///
+    /// Every sum is the recursion's as written plainly (each pair's sᵀy
+    /// and the update's dot products, in index order), so d has the same
+    /// bits; but the pairs' sᵀy (used by both loops) are taken once, side by
+    /// side, and each update of d carries the next pair's dot product along
+    /// in the same pass.
     fn direction(&mut self, g: &[f64], free: &[bool], d: &mut [f64]) {
         let n = g.len();
         for i in 0..n {
             d[i] = if free[i] { g[i] } else { 0.0 };
         }
         let k = self.s.len();
+        if k > 0 {
+            let mut a: Vec<&[f64]> = self.s.iter().map(Vec::as_slice).collect();
+            let mut b: Vec<&[f64]> = self.y.iter().map(Vec::as_slice).collect();
+            a.push(&self.y[k - 1]);
+            b.push(&self.y[k - 1]);
+            dots(&a, &b, free, &mut self.sy[..k + 1]);
+        }
+        // First loop, newest pair first.
+        self.used.clear();
         for j in (0..k).rev() {
-            let sy = dot(&self.s[j], &self.y[j], free);
-            if sy <= 0.0 {
+            if self.sy[j] <= 0.0 {
                 self.alpha[j] = 0.0;
-                continue;
+            } else {
+                self.used.push(j);
             }
-            let a = dot(&self.s[j], d, free) / sy;
+        }
+        let mut pending = None;
+        for u in 0..self.used.len() {
+            let j = self.used[u];
+            let sd = pending.take().unwrap_or_else(|| dot(&self.s[j], d, free));
+            let a = sd / self.sy[j];
             self.alpha[j] = a;
-            for i in 0..n {
-                if free[i] {
-                    d[i] -= a * self.y[j][i];
+            let y = &self.y[j][..n];
+            match self.used.get(u + 1) {
+                Some(&next) => {
+                    let s = &self.s[next][..n];
+                    let mut acc = -0.0;
+                    for i in 0..n {
+                        if free[i] {
+                            d[i] -= a * y[i];
+                            acc += s[i] * d[i];
+                        }
+                    }
+                    pending = Some(acc);
+                }
+                None => {
+                    for i in 0..n {
+                        if free[i] {
+                            d[i] -= a * y[i];
+                        }
+                    }
                 }
             }
         }
         if k > 0 {
-            let (sy, yy) = (dot(&self.s[k - 1], &self.y[k - 1], free), dot(&self.y[k - 1], &self.y[k - 1], free));
+            let (sy, yy) = (self.sy[k - 1], self.sy[k]);
             if sy > 0.0 && yy > 0.0 {
                 let gamma = sy / yy;
                 d.iter_mut().for_each(|v| *v *= gamma);
             }
         }
-        for j in 0..k {
-            let sy = dot(&self.s[j], &self.y[j], free);
-            if sy <= 0.0 {
-                continue;
-            }
-            let b = dot(&self.y[j], d, free) / sy;
-            for i in 0..n {
-                if free[i] {
-                    d[i] += self.s[j][i] * (self.alpha[j] - b);
+        // Second loop, oldest pair first.
+        self.used.reverse();
+        let mut pending = None;
+        for u in 0..self.used.len() {
+            let j = self.used[u];
+            let yd = pending.take().unwrap_or_else(|| dot(&self.y[j], d, free));
+            let c = self.alpha[j] - yd / self.sy[j];
+            let s = &self.s[j][..n];
+            match self.used.get(u + 1) {
+                Some(&next) => {
+                    let y = &self.y[next][..n];
+                    let mut acc = -0.0;
+                    for i in 0..n {
+                        if free[i] {
+                            d[i] += s[i] * c;
+                            acc += y[i] * d[i];
+                        }
+                    }
+                    pending = Some(acc);
+                }
+                None => {
+                    for i in 0..n {
+                        if free[i] {
+                            d[i] += s[i] * c;
+                        }
+                    }
                 }
             }
         }
@@ -231,9 +333,14 @@ impl Memory {
     /// variables) or no pair is kept, scaled so that the largest move is
     /// at most the box size.
     fn first_step(&mut self, g: &[f64], free: &[bool], d: &mut [f64], b: &Box1) -> f64 {
-        let gd: f64 = g.iter().zip(d.iter()).map(|(a, b)| a * b).sum();
-        let gnorm = g.iter().map(|v| v * v).sum::<f64>().sqrt();
-        let dnorm = d.iter().map(|v| v * v).sum::<f64>().sqrt();
+        // gᵀd, gᵀg and dᵀd side by side in one pass (each summed in order from −0).
+        let (mut gd, mut gg, mut dd) = (-0.0f64, -0.0f64, -0.0f64);
+        for (&gi, &di) in g.iter().zip(d.iter()) {
+            gd += gi * di;
+            gg += gi * gi;
+            dd += di * di;
+        }
+        let (gnorm, dnorm) = (gg.sqrt(), dd.sqrt());
         let descent = gd.is_finite() && gd < -1e-14 * gnorm * dnorm;
         if !descent {
             // Not a descent direction: forget the curvature pairs, go down the gradient.
@@ -290,10 +397,12 @@ fn line_search(
         if *evals >= opts.max_evals {
             break;
         }
+        // The trial point and gᵀ(x_t − x) in one pass (summed in order from −0).
+        let mut decrease = -0.0;
         for i in 0..x.len() {
             xt[i] = b.proj(x[i] + step * d[i]);
+            decrease += g[i] * (xt[i] - x[i]);
         }
-        let decrease: f64 = g.iter().zip(xt.iter().zip(x)).map(|(gi, (a, b))| gi * (a - b)).sum();
         let ft = f(xt, gt);
         *evals += 1;
         if ft.is_finite() && gt.iter().all(|v| v.is_finite()) && ft <= fx + opts.c1 * decrease && ft <= fx {
@@ -307,6 +416,81 @@ fn line_search(
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// The two-loop recursion as first written: every dot product a pass
+    /// of its own, each pair's sᵀy taken again in each loop.
+    fn direction_plain(m: &Memory, g: &[f64], free: &[bool], d: &mut [f64]) {
+        let dotp = |a: &[f64], b: &[f64]| -> f64 {
+            a.iter().zip(b).zip(free).filter(|(_, f)| **f).map(|((a, b), _)| a * b).sum()
+        };
+        let n = g.len();
+        for i in 0..n {
+            d[i] = if free[i] { g[i] } else { 0.0 };
+        }
+        let k = m.s.len();
+        let mut alpha = vec![0.0; k];
+        for j in (0..k).rev() {
+            let sy = dotp(&m.s[j], &m.y[j]);
+            if sy <= 0.0 {
+                continue;
+            }
+            let a = dotp(&m.s[j], d) / sy;
+            alpha[j] = a;
+            for i in 0..n {
+                if free[i] {
+                    d[i] -= a * m.y[j][i];
+                }
+            }
+        }
+        if k > 0 {
+            let (sy, yy) = (dotp(&m.s[k - 1], &m.y[k - 1]), dotp(&m.y[k - 1], &m.y[k - 1]));
+            if sy > 0.0 && yy > 0.0 {
+                let gamma = sy / yy;
+                d.iter_mut().for_each(|v| *v *= gamma);
+            }
+        }
+        for j in 0..k {
+            let sy = dotp(&m.s[j], &m.y[j]);
+            if sy <= 0.0 {
+                continue;
+            }
+            let b = dotp(&m.y[j], d) / sy;
+            for i in 0..n {
+                if free[i] {
+                    d[i] += m.s[j][i] * (alpha[j] - b);
+                }
+            }
+        }
+        d.iter_mut().for_each(|v| *v = -*v);
+    }
+
+    #[test]
+    fn the_direction_has_the_bits_of_the_plain_two_loop_recursion() {
+        let mut r = crate::rng::Rng::new(17);
+        for n in [1, 2, 3, 7, 64, 301] {
+            for pairs in 0..=11 {
+                let mut m = Memory::new(10);
+                for _ in 0..pairs.min(10) {
+                    let s: Vec<f64> = (0..n).map(|_| r.gaussian() * 10f64.powi((r.uniform() * 12.0) as i32 - 6)).collect();
+                    // Mostly positive curvature, some pairs not (the loops skip those).
+                    let flip = if r.uniform() < 0.2 { -1.0 } else { 1.0 };
+                    let y: Vec<f64> = s.iter().map(|v| flip * v * (0.5 + r.uniform()) + 0.1 * r.gaussian()).collect();
+                    m.s.push(s);
+                    m.y.push(y);
+                }
+                let g: Vec<f64> = (0..n).map(|_| r.gaussian()).collect();
+                for p_free in [1.0, 0.7, 0.0] {
+                    let free: Vec<bool> = (0..n).map(|_| r.uniform() < p_free).collect();
+                    let (mut got, mut want) = (vec![0.0; n], vec![0.0; n]);
+                    m.direction(&g, &free, &mut got);
+                    direction_plain(&m, &g, &free, &mut want);
+                    for i in 0..n {
+                        assert_eq!(got[i].to_bits(), want[i].to_bits(), "n {n}, {pairs} pairs, free {p_free}, i {i}");
+                    }
+                }
+            }
+        }
+    }
 
     #[test]
     fn a_diagonal_quadratic_lands_on_the_clamped_minimum() {

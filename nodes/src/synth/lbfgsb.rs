@@ -471,7 +471,8 @@ mod tests {
             for pairs in 0..=11 {
                 let mut m = Memory::new(10);
                 for _ in 0..pairs.min(10) {
-                    let s: Vec<f64> = (0..n).map(|_| r.gaussian() * 10f64.powi((r.uniform() * 12.0) as i32 - 6)).collect();
+                    let s: Vec<f64> =
+                        (0..n).map(|_| r.gaussian() * 10f64.powi((r.uniform() * 12.0) as i32 - 6)).collect();
                     // Mostly positive curvature, some pairs not (the loops skip those).
                     let flip = if r.uniform() < 0.2 { -1.0 } else { 1.0 };
                     let y: Vec<f64> = s.iter().map(|v| flip * v * (0.5 + r.uniform()) + 0.1 * r.gaussian()).collect();

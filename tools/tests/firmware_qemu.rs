@@ -259,8 +259,13 @@ fn live_texture_rendering_drives_the_emulated_board_sample_for_sample() {
     let got: Vec<i16> = rx.iter().map(|r| r.1).collect();
     let unread = arrived_in_order(&sent, &got, &stats, &text);
     assert!(unread < 3000, "{unread} samples not taken");
+    // Touch frames of the board's scripted stroke (5 cm/s) reached the chain
+    // (checked before the rendering, which needs them: a failure says which).
+    let x = channel(&session, "inputs/device", "x");
+    let moved = x.iter().cloned().fold(f64::NEG_INFINITY, f64::max) - x.iter().cloned().fold(f64::INFINITY, f64::min);
+    assert!(moved > 0.05, "the finger moved {moved} m over {} touch frames\n{text}", x.len());
     let loud = sent.iter().filter(|v| v.unsigned_abs() > 3000).count();
-    assert!(loud > 200, "the texture was rendered: {loud} samples above 0.09\n{text}");
+    assert!(loud > 200, "the texture was rendered: {loud} samples above 0.09 (the finger moved {moved} m)\n{text}");
     // The DAC applied what arrived, in order: each run of equal samples it
     // played is a received sample (a sample held while the FIFO was empty
     // repeats; the watchdog's and the stop's ramps end at zero).
@@ -271,10 +276,6 @@ fn live_texture_rendering_drives_the_emulated_board_sample_for_sample() {
     let (_, not_received) = in_order(&arrived, &played);
     assert!(not_received <= 12, "{not_received} played values never arrived");
     assert_eq!(dac.last(), Some(&0), "the session's end leaves the output at zero");
-    // Touch frames of the board's scripted stroke (5 cm/s) reached the chain.
-    let x = channel(&session, "inputs/device", "x");
-    let moved = x.iter().cloned().fold(f64::NEG_INFINITY, f64::max) - x.iter().cloned().fold(f64::INFINITY, f64::min);
-    assert!(moved > 0.05, "the finger moved {moved} m");
     // The host's session replays bit for bit.
     let r = evflow().arg("replay").arg(&session).args(["--check", "-q"]).output().unwrap();
     assert!(r.status.success(), "{}{}", String::from_utf8_lossy(&r.stdout), String::from_utf8_lossy(&r.stderr));

@@ -419,6 +419,7 @@ mod tests {
 
     /// The two-loop recursion as first written: every dot product a pass
     /// of its own, each pair's sᵀy taken again in each loop.
+    #[allow(clippy::needless_range_loop)] // kept as it was written
     fn direction_plain(m: &Memory, g: &[f64], free: &[bool], d: &mut [f64]) {
         let dotp = |a: &[f64], b: &[f64]| -> f64 {
             a.iter().zip(b).zip(free).filter(|(_, f)| **f).map(|((a, b), _)| a * b).sum()

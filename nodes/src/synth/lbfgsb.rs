@@ -206,6 +206,35 @@ fn dots_group<const B: usize>(a: &[&[f64]], b: &[&[f64]], free: &[bool], out: &m
     out[..B].copy_from_slice(&acc);
 }
 
+/// d += c·v on the free variables and, in the same pass, `next`ᵀd over
+/// them afterwards (summed as [`dot`] sums it), if `next` is given. (In the
+/// recursion's first loop c = −α: d + (−α)·y is d − α·y, the same bits.)
+fn update_and_dot(d: &mut [f64], c: f64, v: &[f64], next: Option<&[f64]>, free: &[bool]) -> Option<f64> {
+    let n = free.len();
+    let (d, v) = (&mut d[..n], &v[..n]);
+    match next {
+        Some(w) => {
+            let w = &w[..n];
+            let mut acc = -0.0;
+            for i in 0..n {
+                if free[i] {
+                    d[i] += c * v[i];
+                    acc += w[i] * d[i];
+                }
+            }
+            Some(acc)
+        }
+        None => {
+            for i in 0..n {
+                if free[i] {
+                    d[i] += c * v[i];
+                }
+            }
+            None
+        }
+    }
+}
+
 /// The last pairs (s, y) of L-BFGS, oldest first.
 struct Memory {
     cap: usize,
@@ -267,27 +296,8 @@ impl Memory {
             let sd = pending.take().unwrap_or_else(|| dot(&self.s[j], d, free));
             let a = sd / self.sy[j];
             self.alpha[j] = a;
-            let y = &self.y[j][..n];
-            match self.used.get(u + 1) {
-                Some(&next) => {
-                    let s = &self.s[next][..n];
-                    let mut acc = -0.0;
-                    for i in 0..n {
-                        if free[i] {
-                            d[i] -= a * y[i];
-                            acc += s[i] * d[i];
-                        }
-                    }
-                    pending = Some(acc);
-                }
-                None => {
-                    for i in 0..n {
-                        if free[i] {
-                            d[i] -= a * y[i];
-                        }
-                    }
-                }
-            }
+            let next = self.used.get(u + 1).map(|&jn| self.s[jn].as_slice());
+            pending = update_and_dot(d, -a, &self.y[j], next, free);
         }
         if k > 0 {
             let (sy, yy) = (self.sy[k - 1], self.sy[k]);
@@ -303,27 +313,8 @@ impl Memory {
             let j = self.used[u];
             let yd = pending.take().unwrap_or_else(|| dot(&self.y[j], d, free));
             let c = self.alpha[j] - yd / self.sy[j];
-            let s = &self.s[j][..n];
-            match self.used.get(u + 1) {
-                Some(&next) => {
-                    let y = &self.y[next][..n];
-                    let mut acc = -0.0;
-                    for i in 0..n {
-                        if free[i] {
-                            d[i] += s[i] * c;
-                            acc += y[i] * d[i];
-                        }
-                    }
-                    pending = Some(acc);
-                }
-                None => {
-                    for i in 0..n {
-                        if free[i] {
-                            d[i] += s[i] * c;
-                        }
-                    }
-                }
-            }
+            let next = self.used.get(u + 1).map(|&jn| self.y[jn].as_slice());
+            pending = update_and_dot(d, c, &self.s[j], next, free);
         }
         d.iter_mut().for_each(|v| *v = -*v);
     }

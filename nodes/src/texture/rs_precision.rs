@@ -44,20 +44,6 @@ pub struct Precision {
     pub samples: usize,
 }
 
-/// Re-samples `len` samples of the test signal by p/q with `method`
-/// (best time of `repeats` runs) and scores it against the exact result.
-/// Content must stay below the new Nyquist frequency: `top` < p/(2q).
-pub fn measure(
-    tones: &[(f64, f64, f64)],
-    len: usize,
-    p: f64,
-    q: f64,
-    method: RsMethod,
-    repeats: usize,
-) -> Result<Precision, RsError> {
-    Scorer::default().measure(tones, len, p, q, method, repeats)
-}
-
 /// The RMS error of `out` against the test signal read every `step` input
 /// samples, relative to its RMS, after the best constant delay (output
 /// samples, within ±1.5), away from the ends: (error, delay).
@@ -90,7 +76,9 @@ struct Scan {
 }
 
 impl Scorer {
-    /// [`measure`], keeping this scorer's scans.
+    /// Re-samples `len` samples of the test signal by p/q with `method`
+    /// (best time of `repeats` runs) and scores it against the exact result.
+    /// Content must stay below the new Nyquist frequency: `top` < p/(2q).
     pub fn measure(
         &mut self,
         tones: &[(f64, f64, f64)],
@@ -198,15 +186,16 @@ mod tests {
     #[test]
     fn the_exact_kernel_and_long_sincs_are_accurate_and_errors_fall_with_length() {
         let t = tones(8, 0.22, 7);
-        let k8 = measure(&t, 4000, 3.0, 4.0, RsMethod::Kernel(8), 1).unwrap();
-        let k32 = measure(&t, 4000, 3.0, 4.0, RsMethod::Kernel(32), 1).unwrap();
+        let k8 = Scorer::default().measure(&t, 4000, 3.0, 4.0, RsMethod::Kernel(8), 1).unwrap();
+        let k32 = Scorer::default().measure(&t, 4000, 3.0, 4.0, RsMethod::Kernel(32), 1).unwrap();
         assert!(k32.error < k8.error, "{k8:?} {k32:?}");
         assert!(k32.error < 1e-3, "{k32:?}");
         assert!(k32.delay.abs() < 0.01, "the kernel is aligned exactly: {k32:?}");
-        let s32 = measure(&t, 4000, 3.0, 4.0, RsMethod::RubatoSinc(32), 1).unwrap();
-        let s256 = measure(&t, 4000, 3.0, 4.0, RsMethod::RubatoSinc(256), 1).unwrap();
+        let s32 = Scorer::default().measure(&t, 4000, 3.0, 4.0, RsMethod::RubatoSinc(32), 1).unwrap();
+        let s256 = Scorer::default().measure(&t, 4000, 3.0, 4.0, RsMethod::RubatoSinc(256), 1).unwrap();
         assert!(s256.error < s32.error, "{s32:?} {s256:?}");
-        let lin = measure(&t, 4000, 3.0, 4.0, RsMethod::RubatoPoly(PolynomialDegree::Linear), 1).unwrap();
+        let lin =
+            Scorer::default().measure(&t, 4000, 3.0, 4.0, RsMethod::RubatoPoly(PolynomialDegree::Linear), 1).unwrap();
         assert!(lin.error > s256.error, "{lin:?} {s256:?}");
     }
 
@@ -215,7 +204,7 @@ mod tests {
         // Content to 0.22 f_s at 3/4 (new Nyquist 0.375 f_s): inside both
         // sincs' passbands (measured 5e-11, 8e-11); the cubic leaves 3e-2.
         let t = tones(8, 0.22, 7);
-        let m = |q| measure(&t, 4000, 3.0, 4.0, RsMethod::Node(q), 1).unwrap();
+        let m = |q| Scorer::default().measure(&t, 4000, 3.0, 4.0, RsMethod::Node(q), 1).unwrap();
         let (fast, balanced, best) = (m(Quality::Fast), m(Quality::Balanced), m(Quality::Best));
         assert!(balanced.error < 1e-9 && best.error < 1e-9, "{balanced:?} {best:?}");
         assert!(fast.error > 1e-3 && fast.error < 0.1, "{fast:?}");

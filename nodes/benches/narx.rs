@@ -138,6 +138,23 @@ fn tanh(c: &mut Criterion) {
             black_box(black_box(xs[i]).map(f64::tanh))
         })
     });
+    g.bench_function("exact written out, one at a time, independent", |b| {
+        b.iter(|| {
+            i = (i + 1) & 1023;
+            black_box(black_box(xs[i]).map(evflow_nodes::narx::exact_tanh::tanh))
+        })
+    });
+    #[cfg(target_arch = "x86_64")]
+    if evflow_nodes::cpu::has_avx2_fma() {
+        use evflow_nodes::narx::exact_tanh_avx2::tanh4;
+        g.bench_function("exact written out, four lanes (AVX2), independent", |b| {
+            b.iter(|| {
+                i = (i + 1) & 1023;
+                // SAFETY: AVX2 and FMA checked above.
+                black_box(unsafe { tanh4(black_box(xs[i])) })
+            })
+        });
+    }
     g.bench_function("fast, independent", |b| {
         b.iter(|| {
             i = (i + 1) & 1023;

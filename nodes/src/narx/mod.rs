@@ -5,6 +5,8 @@
 pub mod closed_loop;
 pub mod error;
 pub mod eval;
+pub mod exact_tanh;
+pub mod exact_tanh_avx2;
 pub mod fast_tanh;
 pub mod fast_tanh_avx2;
 pub mod fit;

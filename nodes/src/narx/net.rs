@@ -6,9 +6,12 @@
 //! layer l (s_l rows × s_{l−1} columns, row-major) followed by its biases.
 //! [`Mlp::jacobian_row`] gives ∂y/∂w for one input by backpropagation — the
 //! row of the Jacobian Levenberg–Marquardt needs; it is checked against
-//! central finite differences in the tests.
+//! central finite differences in the tests. The hidden layers' tanh is
+//! [`super::exact_tanh::tanh`] (glibc's, written out), a layer's neurons
+//! four at a time.
 
 use super::error::NarxError;
+use super::exact_tanh_avx2;
 use crate::rng::Rng;
 
 /// A tanh-hidden, linear-output network with one output.
@@ -161,8 +164,10 @@ impl Mlp {
             let out = &mut next[..s];
             for i in 0..s {
                 let row = &wl[i * r..(i + 1) * r];
-                let z = bl[i] + row.iter().zip(input).map(|(a, b)| a * b).sum::<f64>();
-                out[i] = if l + 1 == layers { z } else { z.tanh() };
+                out[i] = bl[i] + row.iter().zip(input).map(|(a, b)| a * b).sum::<f64>();
+            }
+            if l + 1 < layers {
+                exact_tanh_avx2::tanh_in_place(out);
             }
         }
         ws.act[ws.starts[layers]]

@@ -9,7 +9,8 @@
 //! its inputs that adds `x[j]·Wᵀ[j]` to up to 16 running sums held in
 //! registers — no horizontal sum, no gather — which the compiler turns into
 //! packed SIMD instructions. The activations go through the tanh four
-//! neurons at a time ([`fast_tanh::tanh_lanes`]). On x86-64 CPUs with AVX2
+//! neurons at a time ([`exact_tanh_avx2::tanh4`], [`fast_tanh::tanh_lanes`]).
+//! On x86-64 CPUs with AVX2
 //! and FMA (detected once, at construction) the same code runs compiled
 //! for AVX2: one 4-wide register per block instead of two SSE2 ones.
 //!
@@ -27,7 +28,7 @@
 //! Nothing allocates after [`PackedMlp::new`].
 
 use super::net::Mlp;
-use super::{fast_tanh, fast_tanh_avx2};
+use super::{exact_tanh, exact_tanh_avx2, fast_tanh, fast_tanh_avx2};
 use std::str::FromStr;
 
 /// Neurons per block: the width of the vectors the sums run in.
@@ -36,7 +37,9 @@ pub const LANES: usize = 4;
 /// Which tanh the hidden layers use.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
 pub enum Tanh {
-    /// The standard library's `f64::tanh` (within 1 ulp; about 20–40 ns each).
+    /// [`exact_tanh::tanh`]: glibc's `tanh` written out (within 1 ulp; the
+    /// standard library's bits on Linux x86-64 with FMA, the same bits on
+    /// every platform), four neurons at a time on AVX2.
     #[default]
     Exact,
     /// [`fast_tanh::tanh`]: within [`fast_tanh::MAX_ABS_ERROR`] = 1e-15,
@@ -154,7 +157,7 @@ impl PackedMlp {
             // was built; the function only needs those.
             return unsafe { self.forward_avx2(head, tail) };
         }
-        self.forward_impl::<false>(head, tail)
+        self.forward_impl::<false, false>(head, tail)
     }
 
     /// The forward pass compiled for AVX2 and FMA: the same code, with
@@ -168,21 +171,21 @@ impl PackedMlp {
     #[target_feature(enable = "avx2,fma")]
     unsafe fn forward_avx2(&mut self, head: &[f64], tail: &[f64]) -> f64 {
         match self.tanh {
-            Tanh::Exact => self.forward_impl::<false>(head, tail),
-            Tanh::Fast => self.forward_impl::<true>(head, tail),
+            Tanh::Exact => self.forward_impl::<false, true>(head, tail),
+            Tanh::Fast => self.forward_impl::<true, true>(head, tail),
         }
     }
 
     #[inline(always)]
-    fn forward_impl<const FUSED: bool>(&mut self, head: &[f64], tail: &[f64]) -> f64 {
+    fn forward_impl<const FUSED: bool, const AVX2: bool>(&mut self, head: &[f64], tail: &[f64]) -> f64 {
         let last = self.layers.len() - 1;
         let tanh: Act = self.tanh.into();
         let (first, rest) = self.layers.split_first().expect("a network has an output layer");
-        layer::<FUSED>(first, head, tail, if last == 0 { Act::Linear } else { tanh }, &mut self.a);
+        layer::<FUSED, AVX2>(first, head, tail, if last == 0 { Act::Linear } else { tanh }, &mut self.a);
         let (mut cur, mut next) = (&mut self.a, &mut self.b);
         for (k, lay) in rest.iter().enumerate() {
             let act = if k + 1 == last { Act::Linear } else { tanh };
-            layer::<FUSED>(lay, &cur[..lay.r], &[], act, next);
+            layer::<FUSED, AVX2>(lay, &cur[..lay.r], &[], act, next);
             std::mem::swap(&mut cur, &mut next);
         }
         cur[0]
@@ -213,14 +216,14 @@ const GROUP: usize = 4;
 /// One layer: `out[i] = act(b[i] + Σ_j w[i][j]·x[j])`, x = head ++ tail,
 /// every neuron of the padded output written.
 #[inline(always)]
-fn layer<const FUSED: bool>(lay: &Layer, head: &[f64], tail: &[f64], act: Act, out: &mut [f64]) {
+fn layer<const FUSED: bool, const AVX2: bool>(lay: &Layer, head: &[f64], tail: &[f64], act: Act, out: &mut [f64]) {
     let mut c0 = 0;
     while c0 < lay.sp {
         match (lay.sp - c0) / LANES {
-            1 => group::<1, FUSED>(lay, c0, head, tail, act, out),
-            2 => group::<2, FUSED>(lay, c0, head, tail, act, out),
-            3 => group::<3, FUSED>(lay, c0, head, tail, act, out),
-            _ => group::<GROUP, FUSED>(lay, c0, head, tail, act, out),
+            1 => group::<1, FUSED, AVX2>(lay, c0, head, tail, act, out),
+            2 => group::<2, FUSED, AVX2>(lay, c0, head, tail, act, out),
+            3 => group::<3, FUSED, AVX2>(lay, c0, head, tail, act, out),
+            _ => group::<GROUP, FUSED, AVX2>(lay, c0, head, tail, act, out),
         }
         c0 += GROUP * LANES;
     }
@@ -228,7 +231,7 @@ fn layer<const FUSED: bool>(lay: &Layer, head: &[f64], tail: &[f64], act: Act, o
 
 /// B neuron blocks from column c0: one pass over the inputs, B·LANES sums.
 #[inline(always)]
-fn group<const B: usize, const FUSED: bool>(
+fn group<const B: usize, const FUSED: bool, const AVX2: bool>(
     lay: &Layer,
     c0: usize,
     head: &[f64],
@@ -286,7 +289,9 @@ fn group<const B: usize, const FUSED: bool>(
         }
         let y = match act {
             Act::Linear => z,
-            Act::Exact => z.map(f64::tanh),
+            // SAFETY: AVX2 is instantiated only by `forward_avx2` (as FUSED).
+            Act::Exact if AVX2 => unsafe { exact_tanh_avx2::tanh4_avx2(z) },
+            Act::Exact => z.map(exact_tanh::tanh),
             // SAFETY: FUSED is instantiated only by `forward_avx2`, which
             // runs after `cpu::has_avx2_fma` found AVX2 and FMA.
             Act::Fast if FUSED => unsafe { fast_tanh_avx2::tanh4_fused(z) },

@@ -250,6 +250,17 @@ mod tests {
         assert!(limit_values(&ParamKind::Bool, Size::Full).is_empty());
     }
 
+    #[test]
+    fn a_row_names_the_fixtures_folder_not_the_temporary_path() {
+        // recording.in at its rate limits is refused naming the recording's path.
+        let dir = tempfile::tempdir().unwrap();
+        let env = super::super::prepare(dir.path(), dir.path(), Size::Ci).unwrap();
+        let spec = *evflow_nodes::registry().get("recording.in").unwrap();
+        let row = super::super::run_case(&parameter_case(leak(spec), Size::Ci), &env);
+        assert!(row.detail.contains("<fixtures>/recordings/"), "{}", row.detail);
+        assert!(!row.detail.contains(&dir.path().display().to_string()), "{}", row.detail);
+    }
+
     /// A node type as the registry holds it, changed and kept for the test's run.
     fn leak(spec: NodeSpec) -> &'static NodeSpec {
         Box::leak(Box::new(spec))

@@ -29,7 +29,7 @@ pub struct Cholesky {
 impl Cholesky {
     /// Factors the symmetric matrix whose lower triangle (diagonal
     /// included) `a` holds; its upper triangle is not read. Left-looking
-    /// and blocked: each panel of [`PANEL`] columns is first brought up to
+    /// and blocked: each panel of 48 columns (`PANEL`) is first brought up to
     /// date by one matrix product with the columns left of it (where the
     /// work is), then factored column by column.
     pub fn factor(a: &Array2<f64>) -> Result<Self, NotPositiveDefinite> {

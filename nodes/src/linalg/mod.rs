@@ -2,7 +2,7 @@
 //! the lower triangle of a Gram matrix accumulated tile by tile, the
 //! Cholesky factorization that solves the normal equations, and dot
 //! products — one at a time ([`dot`]) or many rows against one vector at
-//! once with the same bits ([`dot_columns`]). The Gram products run on
+//! once with the same bits ([`dot_columns()`]). The Gram products run on
 //! ndarray's `general_mat_mul` (the `matrixmultiply` kernels, which pick
 //! AVX/FMA at run time); the factorization is written here (Golub & Van
 //! Loan, *Matrix Computations*, 4th ed., Algorithm 4.2.1, the

@@ -192,7 +192,7 @@ impl ForwardDisplay {
 
     /// Optimizes the stroke's actuation through this display towards
     /// `goal` as [`crate::live::floor::optimize_towards`] does through a
-    /// lab profile's twin: the carrier starts at [`START_OFFSETS`] with
+    /// lab profile's twin: the carrier starts at [`crate::live::floor::START_OFFSETS`] with
     /// this display's carrier gain on the stroke, and every seed (clipped
     /// to |u| ≤ 1, cut or padded with 0), `iterations` each.
     pub fn optimize(

@@ -8,6 +8,8 @@ use evflow_tools::batch::{progress_bar, JobsArg};
 use std::path::PathBuf;
 
 /// Arguments of `evflow library from-recordings`.
+// The fields' comments are `--help` text, where `[N]` is a unit, not a link.
+#[allow(rustdoc::broken_intra_doc_links)]
 #[derive(clap::Args, Debug)]
 #[command(after_long_help = AFTER)]
 pub struct Args {

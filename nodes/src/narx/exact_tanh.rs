@@ -182,8 +182,10 @@ unsafe fn tanh_fma(x: f64) -> f64 {
     tanh_body(x)
 }
 
+/// [`tanh`] without the CPU check: inlined into code compiled with FMA
+/// (the lanes' remainders), its multiply-adds are instructions there.
 #[inline(always)]
-fn tanh_body(x: f64) -> f64 {
+pub(super) fn tanh_body(x: f64) -> f64 {
     let bits = x.to_bits();
     let ix = high_abs(x);
     let negative = bits >> 63 != 0;

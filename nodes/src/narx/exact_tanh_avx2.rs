@@ -13,7 +13,7 @@
 //! all four to the scalar function.
 
 #[cfg(target_arch = "x86_64")]
-use super::exact_tanh::{tanh, INV_LN2, LN2_HI, LN2_LO, Q};
+use super::exact_tanh::{tanh_body, INV_LN2, LN2_HI, LN2_LO, Q};
 #[cfg(target_arch = "x86_64")]
 use std::arch::x86_64::*;
 
@@ -29,7 +29,7 @@ pub unsafe fn tanh4(x: [f64; 4]) -> [f64; 4] {
     let splat = |v: f64| _mm256_set1_pd(v);
     let xv = _mm256_loadu_pd(x.as_ptr());
     if _mm256_movemask_pd(_mm256_cmp_pd::<_CMP_UNORD_Q>(xv, xv)) != 0 {
-        return x.map(tanh);
+        return x.map(tanh_body);
     }
     let sign = splat(-0.0);
     let one = splat(1.0);
@@ -148,7 +148,7 @@ unsafe fn tanh_in_place_avx2(v: &mut [f64]) {
         c.copy_from_slice(&y);
     }
     for x in chunks.into_remainder() {
-        *x = tanh(*x);
+        *x = tanh_body(*x);
     }
 }
 

@@ -12,6 +12,7 @@
 
 pub mod analysis;
 pub mod cpu;
+pub mod exact_exp;
 pub mod example_files;
 pub mod families;
 pub mod filters;

@@ -64,7 +64,7 @@ impl Fric {
     /// (μ_k + (μ_s − μ_k)·e^{−(v/v_s)²})·scale·N + c_v·|v| (Stribeck).
     fn slide(&self, speed: f64, n: f64, scale: f64) -> f64 {
         let r = speed / self.v_s;
-        (self.mu_k + (self.mu_s - self.mu_k) * (-r * r).exp()) * scale * n + self.viscous * speed
+        (self.mu_k + (self.mu_s - self.mu_k) * crate::exact_exp::exp(-r * r)) * scale * n + self.viscous * speed
     }
 }
 

@@ -59,11 +59,11 @@ pub fn matvec(m: &[f64], x: &[f64], rows: usize, cols: usize, y: &mut [f64]) {
 }
 
 /// The one-step factor R(z) of `method` on ẏ = λ (y* − y) with y* held,
-/// z = λh ≤ 0: y ← y* + R(z)(y − y*). Exact e^z; RK4 and Euler the
+/// z = λh ≤ 0: y ← y* + R(z)(y − y*). Exact e^z ([`crate::exact_exp::exp`]); RK4 and Euler the
 /// truncated series 1 + z + … + z⁴/24 and 1 + z (their stability functions).
 pub fn decay(method: Method, z: f64) -> f64 {
     match method {
-        Method::Exact => z.exp(),
+        Method::Exact => crate::exact_exp::exp(z),
         Method::Rk4 => 1.0 + z * (1.0 + z / 2.0 * (1.0 + z / 3.0 * (1.0 + z / 4.0))),
         Method::Euler => 1.0 + z,
     }

@@ -105,7 +105,7 @@ impl RefDisplay {
 
     fn slide(&self, speed: f64, n: f64) -> f64 {
         let q = speed / self.v_s;
-        (self.mu_k + (self.mu_s - self.mu_k) * (-q * q).exp()) * n + self.viscous * speed
+        (self.mu_k + (self.mu_s - self.mu_k) * crate::exact_exp::exp(-q * q)) * n + self.viscous * speed
     }
 
     fn normal(&self, s: &[f64; NS], load: f64) -> f64 {

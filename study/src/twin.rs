@@ -23,6 +23,7 @@
 //! rounding as the identity, off by at most half a converter step). The tests check the twin against the lab's models sample by
 //! sample and the gradient against central differences.
 
+use evflow_nodes::exact_exp;
 use evflow_nodes::lab::electrical::{self, Circuit};
 use evflow_nodes::lab::expm::zoh;
 use evflow_nodes::lab::profile::LabProfile;
@@ -76,8 +77,8 @@ pub struct Tape {
 pub struct DisplayTwin {
     sub: usize,
     hs: f64,
-    phi_e: Vec<f64>,
-    gam_e: Vec<f64>,
+    phi_e: [[f64; NE]; NE],
+    gam_e: [f64; NE],
     ke: f64,
     gain: f64,
     vmax: f64,
@@ -91,19 +92,23 @@ pub struct DisplayTwin {
     k: f64,
     c: f64,
     /// Augmented tip map: states (δ, v_tip, s), inputs (v_holder, f).
-    phi_m: Vec<f64>,
-    gam_m: Vec<f64>,
+    phi_m: [[f64; 3]; 3],
+    gam_m: [[f64; 2]; 3],
     x0: [f64; NE],
     /// The actuation path's latency, samples.
     delay: usize,
 }
 
-#[inline]
-fn matvec(m: &[f64], x: &[f64], rows: usize, cols: usize, y: &mut [f64]) {
-    for (i, yi) in y.iter_mut().enumerate().take(rows) {
-        let row = &m[i * cols..(i + 1) * cols];
-        *yi = row.iter().zip(x).map(|(a, b)| a * b).sum();
-    }
+/// y = M·x, each row's products summed in order. The sizes are fixed, so
+/// the loops unroll without bounds checks.
+#[inline(always)]
+fn matvec<const R: usize, const C: usize>(m: &[[f64; C]; R], x: &[f64; C]) -> [f64; R] {
+    std::array::from_fn(|i| m[i].iter().zip(x).map(|(a, b)| a * b).sum())
+}
+
+/// The `R` × `C` matrix stored row by row in `flat`.
+fn rows<const R: usize, const C: usize>(flat: &[f64]) -> [[f64; C]; R] {
+    std::array::from_fn(|i| std::array::from_fn(|j| flat[i * C + j]))
 }
 
 impl DisplayTwin {
@@ -138,8 +143,8 @@ impl DisplayTwin {
         Ok(Self {
             sub,
             hs,
-            phi_e,
-            gam_e,
+            phi_e: rows(&phi_e),
+            gam_e: rows::<1, NE>(&gam_e)[0],
             ke: profile.electrostatic_coefficient(),
             gain: amp.gain_v,
             vmax: amp.max_v,
@@ -152,8 +157,8 @@ impl DisplayTwin {
             lag_slope: 2.0 * std::f64::consts::PI * f.lag_slope_hz_per_mm_s * 1e3,
             k,
             c,
-            phi_m,
-            gam_m,
+            phi_m: rows(&phi_m),
+            gam_m: rows(&gam_m),
             x0,
             delay: evflow_nodes::lab::display_model::delay_samples(amp.delay_ms, rate),
         })
@@ -161,9 +166,10 @@ impl DisplayTwin {
 
     /// The sliding friction at `speed` and load `n`, and the
     /// exp(−(speed/v_s)²) it is made of (for [`Self::slide_grad`]).
+    #[inline(always)]
     fn slide(&self, speed: f64, n: f64) -> (f64, f64) {
         let r = speed / self.v_s;
-        let e = (-r * r).exp();
+        let e = exact_exp::exp_body(-r * r);
         ((self.mu_k + (self.mu_s - self.mu_k) * e) * n + self.viscous * speed, e)
     }
 
@@ -181,6 +187,30 @@ impl DisplayTwin {
     /// holder velocity `velocity` (m/s), sample by sample from the model's
     /// initial state, keeping the tape.
     pub fn forward(&self, u: &[f64], load: &[f64], velocity: &[f64], tape: &mut Tape) -> Vec<f64> {
+        #[cfg(target_arch = "x86_64")]
+        if evflow_nodes::cpu::has_avx2_fma() {
+            // SAFETY: the CPU has AVX2 and FMA.
+            return unsafe { self.forward_avx2(u, load, velocity, tape) };
+        }
+        self.forward_body(u, load, velocity, tape)
+    }
+
+    /// [`Self::forward_body`] compiled for AVX2 and FMA, so that the
+    /// exponentials inline with their multiply-adds as instructions (Rust
+    /// fuses nothing else on its own: the same bits as the portable build).
+    ///
+    /// # Safety
+    ///
+    /// The CPU must have AVX2 and FMA.
+    #[cfg(target_arch = "x86_64")]
+    #[target_feature(enable = "avx2,fma")]
+    unsafe fn forward_avx2(&self, u: &[f64], load: &[f64], velocity: &[f64], tape: &mut Tape) -> Vec<f64> {
+        self.forward_body(u, load, velocity, tape)
+    }
+
+    /// [`Self::forward`]'s pass.
+    #[inline(always)]
+    fn forward_body(&self, u: &[f64], load: &[f64], velocity: &[f64], tape: &mut Tape) -> Vec<f64> {
         tape.steps.clear();
         tape.samples.truncate(u.len());
         tape.velocity.truncate(u.len());
@@ -190,7 +220,7 @@ impl DisplayTwin {
         let mut xm = [0.0f64; 2];
         let mut stuck = true;
         let mut out = Vec::with_capacity(u.len());
-        let ds_df = self.gam_m[2 * 2 + 1];
+        let ds_df = self.gam_m[2][1];
         for n in 0..u.len() {
             let un = if n >= self.delay { u[n - self.delay] } else { 0.0 };
             let uu = if un.is_finite() { un } else { 0.0 };
@@ -207,7 +237,7 @@ impl DisplayTwin {
                 }
                 _ => {
                     let wc = self.lag0 + self.lag_slope * v.abs();
-                    let a = (-wc * self.hs).exp();
+                    let a = exact_exp::exp_body(-wc * self.hs);
                     if n < tape.velocity.len() {
                         tape.samples[n] = (a, clamped);
                         tape.velocity[n] = v;
@@ -220,8 +250,7 @@ impl DisplayTwin {
             };
             for _ in 0..self.sub {
                 let xe0 = xe;
-                let mut y = [0.0; NE];
-                matvec(&self.phi_e, &xe, NE, NE, &mut y);
+                let y = matvec(&self.phi_e, &xe);
                 for i in 0..NE {
                     xe[i] = y[i] + self.gam_e[i] * vcmd;
                 }
@@ -238,10 +267,8 @@ impl DisplayTwin {
                     None => self.mu_s * nf,
                 };
                 let xa = [xm[0], xm[1], 0.0];
-                let mut free = [0.0; 3];
-                matvec(&self.phi_m, &xa, 3, 3, &mut free);
-                let mut g = [0.0; 3];
-                matvec(&self.gam_m, &[v, 0.0], 3, 2, &mut g);
+                let mut free = matvec(&self.phi_m, &xa);
+                let g = matvec(&self.gam_m, &[v, 0.0]);
                 for i in 0..3 {
                     free[i] += g[i];
                 }
@@ -260,7 +287,7 @@ impl DisplayTwin {
                     let force = fs.min(required.abs()) * required.signum();
                     branch = if fs < required.abs() { Branch::Slide } else { Branch::Clipped };
                     for i in 0..2 {
-                        xm[i] = free[i] + self.gam_m[i * 2 + 1] * force;
+                        xm[i] = free[i] + self.gam_m[i][1] * force;
                     }
                     stuck = false;
                 }
@@ -275,8 +302,31 @@ impl DisplayTwin {
     /// Adds to `ubar` the gradient of Σ_n f̄\[n\]·F\[n\] with respect to the
     /// actuation, for the forward pass recorded in `tape`.
     pub fn backward(&self, tape: &Tape, fbar: &[f64], ubar: &mut [f64]) {
+        #[cfg(target_arch = "x86_64")]
+        if evflow_nodes::cpu::has_avx2_fma() {
+            // SAFETY: the CPU has AVX2 and FMA.
+            return unsafe { self.backward_avx2(tape, fbar, ubar) };
+        }
+        self.backward_body(tape, fbar, ubar)
+    }
+
+    /// [`Self::backward_body`] compiled for AVX2 (the same operations in
+    /// the same order: Rust fuses no multiply-add on its own).
+    ///
+    /// # Safety
+    ///
+    /// The CPU must have AVX2 and FMA.
+    #[cfg(target_arch = "x86_64")]
+    #[target_feature(enable = "avx2,fma")]
+    unsafe fn backward_avx2(&self, tape: &Tape, fbar: &[f64], ubar: &mut [f64]) {
+        self.backward_body(tape, fbar, ubar)
+    }
+
+    /// [`Self::backward`]'s pass.
+    #[inline(always)]
+    fn backward_body(&self, tape: &Tape, fbar: &[f64], ubar: &mut [f64]) {
         let (mut bxe, mut bfl, mut bxm) = ([0.0; NE], 0.0, [0.0; 2]);
-        let ds_df = self.gam_m[2 * 2 + 1];
+        let ds_df = self.gam_m[2][1];
         for n in (0..tape.samples.len()).rev() {
             let (a, clamped) = tape.samples[n];
             bxm[0] += self.k * fbar[n];
@@ -292,7 +342,7 @@ impl DisplayTwin {
                         bxm0[0] = bxm[0];
                     }
                     Branch::Slide | Branch::Clipped => {
-                        let bforce = bxm[0] * self.gam_m[1] + bxm[1] * self.gam_m[3];
+                        let bforce = bxm[0] * self.gam_m[0][1] + bxm[1] * self.gam_m[1][1];
                         let mut bfree = [bxm[0], bxm[1], 0.0];
                         if s.branch == Branch::Clipped {
                             bfree[2] += -bforce / ds_df;
@@ -307,7 +357,7 @@ impl DisplayTwin {
                         }
                         for (jj, b) in bxm0.iter_mut().enumerate() {
                             for (i, bf) in bfree.iter().enumerate() {
-                                *b += bf * self.phi_m[i * 3 + jj];
+                                *b += bf * self.phi_m[i][jj];
                             }
                         }
                     }
@@ -327,7 +377,7 @@ impl DisplayTwin {
                 let mut b0 = [0.0; NE];
                 for (i, bi) in bxe1.iter().enumerate() {
                     for (jj, b) in b0.iter_mut().enumerate() {
-                        *b += bi * self.phi_e[i * NE + jj];
+                        *b += bi * self.phi_e[i][jj];
                     }
                     bvcmd += bi * self.gam_e[i];
                 }
@@ -346,8 +396,8 @@ impl DisplayTwin {
 #[derive(Debug, Clone)]
 pub struct SensorTwin {
     sub: usize,
-    phi: Vec<f64>,
-    gam: Vec<f64>,
+    phi: [[f64; 2]; 2],
+    gam: [f64; 2],
     bias_right: f64,
     bias_left: f64,
     a_bias: f64,
@@ -367,8 +417,8 @@ impl SensorTwin {
             .ok_or("the sensor's matrix exponential is not finite")?;
         Ok(Self {
             sub,
-            phi,
-            gam,
+            phi: rows(&phi),
+            gam: rows::<1, 2>(&gam)[0],
             bias_right: s.bias_right_n,
             bias_left: s.bias_left_n,
             a_bias: (-h / s.bias_time_s).exp(),
@@ -398,8 +448,7 @@ impl SensorTwin {
             };
             bias = target + (bias - target) * self.a_bias;
             for _ in 0..self.sub {
-                let mut y = [0.0; 2];
-                matvec(&self.phi, &x, 2, 2, &mut y);
+                let y = matvec(&self.phi, &x);
                 x = [y[0] + self.gam[0] * fi, y[1] + self.gam[1] * fi];
             }
             let raw = x[0] + bias;
@@ -422,7 +471,7 @@ impl SensorTwin {
             for _ in 0..self.sub {
                 // x' = Φx + Γf: x̄ ← Φᵀx̄', f̄ += Γ·x̄'.
                 fbar[n] += self.gam[0] * bx[0] + self.gam[1] * bx[1];
-                bx = [self.phi[0] * bx[0] + self.phi[2] * bx[1], self.phi[1] * bx[0] + self.phi[3] * bx[1]];
+                bx = [self.phi[0][0] * bx[0] + self.phi[1][0] * bx[1], self.phi[0][1] * bx[0] + self.phi[1][1] * bx[1]];
             }
         }
         fbar

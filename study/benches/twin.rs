@@ -1,0 +1,43 @@
+//! One evaluation of the achievable floors' objective through the display's
+//! twin (`study/src/twin.rs`): a forward pass over a tribometer stroke
+//! (85 g at 5 cm/s, the nominal profile, 4 substeps) and the backward pass
+//! of its gradient — the loop `report live` and `report textures` spend
+//! most of their time in. `cargo bench -p evflow-study --bench twin`.
+
+use criterion::{criterion_group, criterion_main, Criterion};
+use evflow_nodes::lab::integrator::Method;
+use evflow_nodes::lab::profile::LabProfile;
+use evflow_nodes::lab::tribometer_model::TribometerModel;
+use evflow_study::twin::{DisplayTwin, Tape};
+use std::hint::black_box;
+
+fn passes(c: &mut Criterion) {
+    let profile = LabProfile::default();
+    let mut t = TribometerModel::new(&profile, 1000.0, 0.05, 0.085, 1, Method::Exact, 4).expect("a valid stroke");
+    let n = t.total_samples().expect("a finite stroke") as usize;
+    let (mut load, mut vel) = (Vec::with_capacity(n), Vec::with_capacity(n));
+    for _ in 0..n {
+        let (_, v, l) = t.step();
+        vel.push(v);
+        load.push(l);
+    }
+    let mut r = evflow_nodes::rng::Rng::new(4);
+    let u: Vec<f64> =
+        (0..n).map(|k| if k % 2 == 0 { 0.6 } else { -0.6 } * (1.0 + 0.4 * (2.0 * r.uniform() - 1.0))).collect();
+    let fbar: Vec<f64> = (0..n).map(|k| ((k * 7 % 13) as f64 - 6.0) * 0.1).collect();
+    let twin = DisplayTwin::new(&profile, 1000.0, 4).expect("the nominal profile");
+    let mut tape = Tape::default();
+    c.bench_function(&format!("twin/forward, {n} samples"), |b| {
+        b.iter(|| black_box(twin.forward(black_box(&u), &load, &vel, &mut tape)))
+    });
+    let mut g = vec![0.0; n];
+    c.bench_function(&format!("twin/backward, {n} samples"), |b| {
+        b.iter(|| {
+            twin.backward(&tape, black_box(&fbar), &mut g);
+            black_box(g[0])
+        })
+    });
+}
+
+criterion_group!(benches, passes);
+criterion_main!(benches);

@@ -608,6 +608,29 @@ mod tests {
     }
 
     #[test]
+    fn the_avx2_build_gives_the_portable_builds_bits() {
+        // forward and backward pick their AVX2 + FMA build on CPUs with
+        // both; the bodies alone are the portable build.
+        for (name, profile) in shipped() {
+            let (load, vel) = pass(&profile, 120.0, 8.0);
+            let n = load.len();
+            let u = actuation(n);
+            let fbar: Vec<f64> = (0..n).map(|k| ((k * 5 % 11) as f64 - 5.0) * 0.2).collect();
+            let twin = DisplayTwin::new(&profile, 1000.0, 4).unwrap();
+            let (mut t1, mut t2) = (Tape::default(), Tape::default());
+            let f1 = twin.forward(&u, &load, &vel, &mut t1);
+            let f2 = twin.forward_body(&u, &load, &vel, &mut t2);
+            let (mut g1, mut g2) = (vec![0.0; n], vec![0.0; n]);
+            twin.backward(&t1, &fbar, &mut g1);
+            twin.backward_body(&t2, &fbar, &mut g2);
+            let bits = |v: &[f64]| v.iter().map(|x| x.to_bits()).collect::<Vec<_>>();
+            assert_eq!(bits(&f1), bits(&f2), "{name}: forward");
+            assert_eq!(bits(&g1), bits(&g2), "{name}: backward");
+            assert!(t1.steps.iter().any(|s| s.branch == Branch::Slide), "{name}: no sliding step");
+        }
+    }
+
+    #[test]
     fn the_sensor_adjoint_satisfies_the_inner_product_identity() {
         let profile = LabProfile::default();
         let s = SensorTwin::new(&profile, 1000.0, 4).unwrap();

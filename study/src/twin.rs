@@ -45,7 +45,6 @@ enum Branch {
 
 #[derive(Debug, Clone, Copy)]
 struct Step {
-    xe0: [f64; NE],
     xm0: [f64; 2],
     /// The square-law voltage v_r = v_g − q after the circuit step.
     vr: f64,
@@ -249,7 +248,6 @@ impl DisplayTwin {
                 }
             };
             for _ in 0..self.sub {
-                let xe0 = xe;
                 let y = matvec(&self.phi_e, &xe);
                 for i in 0..NE {
                     xe[i] = y[i] + self.gam_e[i] * vcmd;
@@ -292,7 +290,7 @@ impl DisplayTwin {
                     stuck = false;
                 }
                 let (slide, slide_exp) = kept;
-                tape.steps.push(Step { xe0, xm0, vr, npre, branch, req_sign: required.signum(), slide, slide_exp });
+                tape.steps.push(Step { xm0, vr, npre, branch, req_sign: required.signum(), slide, slide_exp });
             }
             out.push(self.k * xm[0] + self.c * (v - xm[1]));
         }
@@ -382,7 +380,6 @@ impl DisplayTwin {
                     bvcmd += bi * self.gam_e[i];
                 }
                 bxe = b0;
-                let _ = s.xe0;
             }
             if !clamped && n >= self.delay {
                 ubar[n - self.delay] += bvcmd * self.gain;

@@ -63,10 +63,7 @@ impl OutputFilter {
         if self.sections.is_empty() {
             return;
         }
-        let mut c = Cascade::new(&self.sections);
-        for v in x.iter_mut() {
-            *v = c.tick(*v);
-        }
+        Cascade::new(&self.sections).process_in_place(x);
     }
 
     /// x ← Tᵀ·x in place: the filter run backwards in time.
@@ -74,10 +71,7 @@ impl OutputFilter {
         if self.sections.is_empty() {
             return;
         }
-        let mut c = Cascade::new(&self.sections);
-        for v in x.iter_mut().rev() {
-            *v = c.tick(*v);
-        }
+        Cascade::new(&self.sections).process_reversed_in_place(x);
     }
 }
 

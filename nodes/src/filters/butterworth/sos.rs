@@ -68,16 +68,45 @@ impl Cascade {
         let n = x.len().min(y.len());
         let y = &mut y[..n];
         y.copy_from_slice(&x[..n]);
+        self.run::<false>(y);
+    }
+
+    /// Filters a block in place, `y[0]` first.
+    pub fn process_in_place(&mut self, y: &mut [f64]) {
+        self.run::<false>(y);
+    }
+
+    /// Filters a block in place from its last sample to its first (the
+    /// filter run backwards in time, as an adjoint needs it).
+    pub fn process_reversed_in_place(&mut self, y: &mut [f64]) {
+        self.run::<true>(y);
+    }
+
+    /// The block, two sections at a time over all of it (module
+    /// documentation), in time order or reversed.
+    fn run<const REVERSED: bool>(&mut self, y: &mut [f64]) {
         let mut pairs = self.stages.chunks_exact_mut(2);
         for pair in &mut pairs {
             let [a, b] = pair else { unreachable!("chunks of two") };
-            for v in y.iter_mut() {
-                *v = b.tick(a.tick(*v));
+            if REVERSED {
+                for v in y.iter_mut().rev() {
+                    *v = b.tick(a.tick(*v));
+                }
+            } else {
+                for v in y.iter_mut() {
+                    *v = b.tick(a.tick(*v));
+                }
             }
         }
         for s in pairs.into_remainder() {
-            for v in y.iter_mut() {
-                *v = s.tick(*v);
+            if REVERSED {
+                for v in y.iter_mut().rev() {
+                    *v = s.tick(*v);
+                }
+            } else {
+                for v in y.iter_mut() {
+                    *v = s.tick(*v);
+                }
             }
         }
     }
@@ -139,6 +168,18 @@ mod tests {
                 i += len;
             }
             assert_eq!(one, blocks);
+            // In place, forwards and backwards in time.
+            let mut c = Cascade::new(&sections);
+            let mut inplace = x.clone();
+            c.process_in_place(&mut inplace);
+            assert_eq!(one, inplace);
+            let mut d = Cascade::new(&sections);
+            let mut back: Vec<f64> = x.iter().rev().map(|&v| d.tick(v)).collect();
+            back.reverse();
+            let mut e = Cascade::new(&sections);
+            let mut reversed = x.clone();
+            e.process_reversed_in_place(&mut reversed);
+            assert_eq!(back, reversed);
         }
     }
 

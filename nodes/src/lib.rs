@@ -16,6 +16,8 @@ pub mod exact_exp;
 pub mod example_files;
 pub mod families;
 pub mod filters;
+#[cfg(test)]
+mod glibc_check;
 #[cfg(feature = "lab")]
 pub mod lab;
 #[cfg(feature = "narx")]

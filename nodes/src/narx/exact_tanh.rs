@@ -223,6 +223,7 @@ pub(super) fn tanh_body(x: f64) -> f64 {
 #[cfg(test)]
 pub(super) mod tests {
     use super::*;
+    use crate::glibc_check::{assert_same_bits, is_glibc_with_fma, ulps};
     use crate::rng::Rng;
 
     /// Arguments that cross every branch of tanh and of the expm1 calls it
@@ -276,18 +277,6 @@ pub(super) mod tests {
         xs
     }
 
-    fn ulps(a: f64, b: f64) -> u64 {
-        let key = |v: f64| {
-            let b = v.to_bits() as i64;
-            if b < 0 {
-                i64::MIN - b
-            } else {
-                b
-            }
-        };
-        key(a).abs_diff(key(b))
-    }
-
     #[test]
     fn within_one_ulp_of_the_standard_library_everywhere() {
         for x in sweep() {
@@ -301,22 +290,14 @@ pub(super) mod tests {
     fn equals_glibcs_tanh_bit_for_bit_where_the_platform_is_glibc_with_fma() {
         // glibc picks its FMA build of expm1 on x86-64 CPUs with FMA: there
         // the written-out algorithm must give the library's bits.
-        if !(cfg!(all(target_arch = "x86_64", target_os = "linux", target_env = "gnu")) && crate::cpu::has_avx2_fma()) {
-            return;
+        if is_glibc_with_fma() {
+            assert_same_bits("tanh", &sweep(), tanh, f64::tanh);
         }
-        let mut differ = Vec::new();
-        for x in sweep() {
-            if tanh(x).to_bits() != x.tanh().to_bits() {
-                differ.push(x);
-            }
-        }
-        assert!(differ.is_empty(), "{} arguments differ, e.g. {:?}", differ.len(), &differ[..differ.len().min(5)]);
     }
 
     #[test]
     fn expm1_within_one_ulp_and_glibcs_bits_on_its_whole_range() {
-        let glibc_fma =
-            cfg!(all(target_arch = "x86_64", target_os = "linux", target_env = "gnu")) && crate::cpu::has_avx2_fma();
+        let glibc_fma = is_glibc_with_fma();
         let mut r = Rng::new(2);
         let mut ys: Vec<f64> = (0..200_000).map(|_| 80.0 * (2.0 * r.uniform() - 1.0)).collect();
         // Densely where tanh calls it: (−2, 0) and [2, 44).

@@ -50,7 +50,7 @@ impl Method {
 }
 
 /// `y = M x` for row-major `M` (rows × cols).
-#[inline]
+#[inline(always)]
 pub fn matvec(m: &[f64], x: &[f64], rows: usize, cols: usize, y: &mut [f64]) {
     for (i, yi) in y.iter_mut().enumerate().take(rows) {
         let row = &m[i * cols..(i + 1) * cols];
@@ -142,11 +142,23 @@ impl Lti {
 
     /// Advances `x` by one step with input `u`.
     pub fn step(&self, x: &mut [f64], u: &[f64]) {
-        let n = self.n;
+        // The lab's sizes with their loops unrolled (the same operations).
+        match (self.n, self.m) {
+            (5, 1) => self.step_sized(5, 1, x, u),
+            (2, 1) => self.step_sized(2, 1, x, u),
+            (2, 2) => self.step_sized(2, 2, x, u),
+            (n, m) => self.step_sized(n, m, x, u),
+        }
+    }
+
+    /// [`Self::step`] with the sizes as arguments, so that constant ones
+    /// unroll where it inlines.
+    #[inline(always)]
+    fn step_sized(&self, n: usize, m: usize, x: &mut [f64], u: &[f64]) {
         let mut y = [0.0; MAX_DIM];
         let mut g = [0.0; MAX_DIM];
         matvec(&self.phi, x, n, n, &mut y);
-        matvec(&self.gam, u, n, self.m, &mut g);
+        matvec(&self.gam, u, n, m, &mut g);
         for i in 0..n {
             x[i] = y[i] + g[i];
         }
@@ -249,7 +261,27 @@ impl CoulombLti {
     /// friction the contact holds without slipping (μ_s N), `slide(v)` the
     /// sliding friction at speed |v| (μ_k(v) N + viscous).
     pub fn step(&self, x: &mut [f64], u: &[f64], limit: f64, slide: impl Fn(f64) -> f64) -> FrictionStep {
-        let (n, m, iv) = (self.n, self.m, self.iv);
+        // The lab's sizes with their loops unrolled (the same operations).
+        match (self.n, self.m) {
+            (2, 1) => self.step_sized(2, 1, x, u, limit, slide),
+            (2, 2) => self.step_sized(2, 2, x, u, limit, slide),
+            (n, m) => self.step_sized(n, m, x, u, limit, slide),
+        }
+    }
+
+    /// [`Self::step`] with the sizes as arguments, so that constant ones
+    /// unroll where it inlines.
+    #[inline(always)]
+    fn step_sized(
+        &self,
+        n: usize,
+        m: usize,
+        x: &mut [f64],
+        u: &[f64],
+        limit: f64,
+        slide: impl Fn(f64) -> f64,
+    ) -> FrictionStep {
+        let iv = self.iv;
         let (na, ma) = (n + 1, m + 1);
         // Free motion (f = 0) of the augmented state (x, s = 0).
         let mut xa = [0.0; MAX_DIM];
@@ -337,6 +369,34 @@ mod tests {
         let r1 = err(Method::Euler, 1000) / err(Method::Euler, 2000);
         assert!((r4 - 16.0).abs() < 1.0, "rk4 ratio {r4}");
         assert!((r1 - 2.0).abs() < 0.1, "euler ratio {r1}");
+    }
+
+    #[test]
+    fn the_unrolled_sizes_give_the_general_steps_bits() {
+        // `step` runs the lab's sizes with constant dimensions; the same
+        // body with dimensions it cannot see is the general one.
+        use std::hint::black_box;
+        let mut r = crate::rng::Rng::new(21);
+        for (n, m) in [(5, 1), (2, 1), (2, 2), (3, 1)] {
+            let a: Vec<f64> = (0..n * n).map(|i| if i % (n + 1) == 0 { -3.0 } else { r.gaussian() }).collect();
+            let b: Vec<f64> = (0..n * m).map(|_| r.gaussian()).collect();
+            let lti = Lti::new(a.clone(), b.clone(), n, m, 1e-3, Method::Exact).unwrap();
+            let bf: Vec<f64> = (0..n).map(|i| if i == 1 { -2.0 } else { 0.0 }).collect();
+            let c = CoulombLti::new(Plant { a, b, n, m }, bf, 1, 1e-3, Method::Exact).unwrap();
+            let (mut x1, mut x2, mut y1, mut y2) = (vec![0.1; n], vec![0.1; n], vec![0.0; n], vec![0.0; n]);
+            for k in 0..2000 {
+                let u: Vec<f64> = (0..m).map(|j| (0.01 * (k * (j + 1)) as f64).sin() * 40.0).collect();
+                lti.step(&mut x1, &u);
+                lti.step_sized(black_box(n), black_box(m), &mut x2, &u);
+                let slide = |v: f64| 0.3 + 0.1 * v;
+                let f1 = c.step(&mut y1, &u, 0.5, slide);
+                let f2 = c.step_sized(black_box(n), black_box(m), &mut y2, &u, 0.5, slide);
+                let bits = |v: &[f64]| v.iter().map(|x| x.to_bits()).collect::<Vec<_>>();
+                assert_eq!(bits(&x1), bits(&x2), "Lti {n}×{m}, step {k}");
+                assert_eq!(bits(&y1), bits(&y2), "CoulombLti {n}×{m}, step {k}");
+                assert_eq!(f1.force.to_bits(), f2.force.to_bits(), "CoulombLti {n}×{m}, step {k}");
+            }
+        }
     }
 
     /// Mass on a spring to a fixed holder with Coulomb friction on the ground:

@@ -41,6 +41,9 @@ pub struct Foaw {
     /// Ring of the last N + 1 positions; `head` is the newest.
     ring: Vec<f64>,
     head: usize,
+    /// The ring's positions newest first (`win[j]` = y_{k−j}), laid out by
+    /// each push so that the window's tests read a slice.
+    win: Vec<f64>,
     len: usize,
     velocity: f64,
 }
@@ -50,7 +53,7 @@ impl Foaw {
     /// period `period` (s) and windows of at most `max_window` ≥ 1 samples.
     pub fn new(fit: Fit, noise: f64, period: f64, max_window: usize) -> Self {
         let cap = max_window.max(1) + 1;
-        Foaw { fit, noise, period, ring: vec![0.0; cap], head: 0, len: 0, velocity: 0.0 }
+        Foaw { fit, noise, period, ring: vec![0.0; cap], head: 0, win: vec![0.0; cap], len: 0, velocity: 0.0 }
     }
 
     /// Forgets every position (velocity 0).
@@ -60,11 +63,16 @@ impl Foaw {
         self.velocity = 0.0;
     }
 
-    /// The position `j` samples before the newest.
-    #[inline]
-    fn back(&self, j: usize) -> f64 {
-        let cap = self.ring.len();
-        self.ring[(self.head + cap - j) % cap]
+    /// Lays the ring out newest first in `win` (its first `len` values).
+    fn unroll(&mut self) {
+        let (head, len) = (self.head, self.len);
+        let upto = (head + 1).min(len);
+        for (w, &v) in self.win[..upto].iter_mut().zip(self.ring[..=head].iter().rev()) {
+            *w = v;
+        }
+        for (w, &v) in self.win[upto..len].iter_mut().zip(self.ring[head + 1..].iter().rev()) {
+            *w = v;
+        }
     }
 
     /// Takes the next position and returns the velocity estimate (position
@@ -82,14 +90,16 @@ impl Foaw {
             self.velocity = 0.0;
             return 0.0;
         }
+        self.unroll();
+        let w = &self.win[..self.len];
         let t = self.period;
-        let mut accepted = (y - self.back(1)) / t;
+        let mut accepted = (y - w[1]) / t;
         // Running sums over i = 0 … n for the best fit, of positions
         // relative to y_k (the slope is shift-invariant; this way a resting
         // finger gives exactly 0 and large coordinates lose no precision).
-        let (mut s0, mut s1) = (self.back(1) - y, self.back(1) - y);
-        for n in 2..self.len {
-            let yn = self.back(n);
+        let (mut s0, mut s1) = (w[1] - y, w[1] - y);
+        for n in 2..w.len() {
+            let yn = w[n];
             s0 += yn - y;
             s1 += n as f64 * (yn - y);
             let nf = n as f64;
@@ -97,7 +107,7 @@ impl Foaw {
                 Fit::End => (y - yn) / (nf * t),
                 Fit::Best => (nf * s0 - 2.0 * s1) / (t * nf * (nf + 1.0) * (nf + 2.0) / 6.0),
             };
-            let fits = (1..n).all(|j| (self.back(j) - (y - b * j as f64 * t)).abs() <= self.noise);
+            let fits = (1..n).zip(&w[1..n]).all(|(j, &wj)| (wj - (y - b * j as f64 * t)).abs() <= self.noise);
             if !fits {
                 break;
             }
@@ -124,6 +134,57 @@ mod tests {
             let mut rest = Foaw::new(fit, 1e-4, 0.025, 16);
             for _ in 0..40 {
                 assert_eq!(rest.push(0.3), 0.0);
+            }
+        }
+    }
+
+    /// The estimate as first written, reading the ring through a modular
+    /// index per position: the unrolled window must give its bits.
+    fn by_modular_index(fit: Fit, noise: f64, t: f64, max_window: usize, ys: &[f64]) -> Vec<f64> {
+        let cap = max_window + 1;
+        let (mut ring, mut head, mut len, mut out) = (vec![0.0; cap], 0usize, 0usize, Vec::new());
+        for &y in ys {
+            head = (head + 1) % cap;
+            ring[head] = y;
+            len = (len + 1).min(cap);
+            if len < 2 {
+                out.push(0.0);
+                continue;
+            }
+            let back = |j: usize| ring[(head + cap - j) % cap];
+            let mut accepted = (y - back(1)) / t;
+            let (mut s0, mut s1) = (back(1) - y, back(1) - y);
+            for n in 2..len {
+                let yn = back(n);
+                s0 += yn - y;
+                s1 += n as f64 * (yn - y);
+                let nf = n as f64;
+                let b = match fit {
+                    Fit::End => (y - yn) / (nf * t),
+                    Fit::Best => (nf * s0 - 2.0 * s1) / (t * nf * (nf + 1.0) * (nf + 2.0) / 6.0),
+                };
+                if !(1..n).all(|j| (back(j) - (y - b * j as f64 * t)).abs() <= noise) {
+                    break;
+                }
+                accepted = b;
+            }
+            out.push(if accepted.is_finite() { accepted } else { 0.0 });
+        }
+        out
+    }
+
+    #[test]
+    fn the_unrolled_window_gives_the_modular_rings_bits() {
+        let mut r = crate::rng::Rng::new(17);
+        // A stroke with noise: steady stretches (long windows) and turns.
+        let ys: Vec<f64> = (0..3000).map(|k| 0.05 * (k as f64 * 0.004).sin() + 2e-5 * r.gaussian() + 0.3).collect();
+        for fit in [Fit::End, Fit::Best] {
+            for max_window in [1, 2, 7, 16, 40] {
+                let mut f = Foaw::new(fit, 5e-5, 1e-3, max_window);
+                let got: Vec<u64> = ys.iter().map(|&y| f.push(y).to_bits()).collect();
+                let want: Vec<u64> =
+                    by_modular_index(fit, 5e-5, 1e-3, max_window, &ys).iter().map(|v| v.to_bits()).collect();
+                assert_eq!(got, want, "{fit:?}, window {max_window}");
             }
         }
     }

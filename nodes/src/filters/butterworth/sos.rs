@@ -19,6 +19,16 @@
 
 use super::design::Section;
 
+/// `v ← f(v)` for every value of `y`, first to last or last to first.
+#[inline(always)]
+fn each<const REVERSED: bool>(y: &mut [f64], mut f: impl FnMut(f64) -> f64) {
+    if REVERSED {
+        y.iter_mut().rev().for_each(|v| *v = f(*v));
+    } else {
+        y.iter_mut().for_each(|v| *v = f(*v));
+    }
+}
+
 /// One section with its state.
 #[derive(Debug, Clone, Copy)]
 struct Stage {
@@ -88,26 +98,10 @@ impl Cascade {
         let mut pairs = self.stages.chunks_exact_mut(2);
         for pair in &mut pairs {
             let [a, b] = pair else { unreachable!("chunks of two") };
-            if REVERSED {
-                for v in y.iter_mut().rev() {
-                    *v = b.tick(a.tick(*v));
-                }
-            } else {
-                for v in y.iter_mut() {
-                    *v = b.tick(a.tick(*v));
-                }
-            }
+            each::<REVERSED>(y, |v| b.tick(a.tick(v)));
         }
         for s in pairs.into_remainder() {
-            if REVERSED {
-                for v in y.iter_mut().rev() {
-                    *v = s.tick(*v);
-                }
-            } else {
-                for v in y.iter_mut() {
-                    *v = s.tick(*v);
-                }
-            }
+            each::<REVERSED>(y, |v| s.tick(v));
         }
     }
 

@@ -38,11 +38,8 @@ pub struct Foaw {
     noise: f64,
     /// Sample period T, s.
     period: f64,
-    /// Ring of the last N + 1 positions; `head` is the newest.
-    ring: Vec<f64>,
-    head: usize,
-    /// The ring's positions newest first (`win[j]` = y_{k−j}), laid out by
-    /// each push so that the window's tests read a slice.
+    /// The last N + 1 positions, newest first (`win[j]` = y_{k−j}): each
+    /// push shifts them by one, so the window's tests read a slice.
     win: Vec<f64>,
     len: usize,
     velocity: f64,
@@ -53,26 +50,13 @@ impl Foaw {
     /// period `period` (s) and windows of at most `max_window` ≥ 1 samples.
     pub fn new(fit: Fit, noise: f64, period: f64, max_window: usize) -> Self {
         let cap = max_window.max(1) + 1;
-        Foaw { fit, noise, period, ring: vec![0.0; cap], head: 0, win: vec![0.0; cap], len: 0, velocity: 0.0 }
+        Foaw { fit, noise, period, win: vec![0.0; cap], len: 0, velocity: 0.0 }
     }
 
     /// Forgets every position (velocity 0).
     pub fn reset(&mut self) {
         self.len = 0;
-        self.head = 0;
         self.velocity = 0.0;
-    }
-
-    /// Lays the ring out newest first in `win` (its first `len` values).
-    fn unroll(&mut self) {
-        let (head, len) = (self.head, self.len);
-        let upto = (head + 1).min(len);
-        for (w, &v) in self.win[..upto].iter_mut().zip(self.ring[..=head].iter().rev()) {
-            *w = v;
-        }
-        for (w, &v) in self.win[upto..len].iter_mut().zip(self.ring[head + 1..].iter().rev()) {
-            *w = v;
-        }
     }
 
     /// Takes the next position and returns the velocity estimate (position
@@ -82,15 +66,14 @@ impl Foaw {
         if !y.is_finite() {
             return self.velocity;
         }
-        let cap = self.ring.len();
-        self.head = (self.head + 1) % cap;
-        self.ring[self.head] = y;
+        let cap = self.win.len();
+        self.win.copy_within(..cap - 1, 1);
+        self.win[0] = y;
         self.len = (self.len + 1).min(cap);
         if self.len < 2 {
             self.velocity = 0.0;
             return 0.0;
         }
-        self.unroll();
         let w = &self.win[..self.len];
         let t = self.period;
         let mut accepted = (y - w[1]) / t;
@@ -139,7 +122,7 @@ mod tests {
     }
 
     /// The estimate as first written, reading the ring through a modular
-    /// index per position: the unrolled window must give its bits.
+    /// index per position: the shifted window must give its bits.
     fn by_modular_index(fit: Fit, noise: f64, t: f64, max_window: usize, ys: &[f64]) -> Vec<f64> {
         let cap = max_window + 1;
         let (mut ring, mut head, mut len, mut out) = (vec![0.0; cap], 0usize, 0usize, Vec::new());
@@ -174,7 +157,7 @@ mod tests {
     }
 
     #[test]
-    fn the_unrolled_window_gives_the_modular_rings_bits() {
+    fn the_shifted_window_gives_the_modular_rings_bits() {
         let mut r = crate::rng::Rng::new(17);
         // A stroke with noise: steady stretches (long windows) and turns.
         let ys: Vec<f64> = (0..3000).map(|k| 0.05 * (k as f64 * 0.004).sin() + 2e-5 * r.gaussian() + 0.3).collect();

@@ -1,6 +1,6 @@
 //! What this CPU can run: the one check behind every kernel that has an
 //! AVX2 build beside its portable one (the NARX forward pass, the Volterra
-//! model, the live synthesis' horizon).
+//! model, the live synthesis' horizon, `interp`'s kernel taps).
 
 /// Whether this CPU has AVX2 and FMA, so that a function compiled with
 /// `#[target_feature(enable = "avx2,fma")]` may run (std caches the answer;

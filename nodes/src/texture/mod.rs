@@ -11,6 +11,7 @@ pub mod freqvel;
 pub mod grid;
 pub mod interp;
 pub mod kernel;
+mod kernel_avx2;
 pub mod playback;
 pub mod rs;
 pub mod rs_precision;

@@ -267,7 +267,7 @@ impl Mix {
                 }
                 Scheme::Improved => {
                     let p = self.start[b] + k as f64 * self.step[b];
-                    kernel.eval(p, self.cut[b], n, |q| a0 * u0[q] + a1 * u1[q])
+                    kernel.eval_mix(p, self.cut[b], u0, u1, a0, a1)
                 }
             };
             y += self.wv[b] * v;

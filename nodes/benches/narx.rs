@@ -154,6 +154,18 @@ fn tanh(c: &mut Criterion) {
                 black_box(unsafe { tanh4(black_box(xs[i])) })
             })
         });
+        // Each call waits on the last: the latency a hidden layer's tanh
+        // adds to a closed-loop sample (docs/benchmarks.md, "the closed
+        // loop's floor").
+        let mut v = [0.1, 0.2, 0.3, 0.4];
+        g.bench_function("exact written out, four lanes (AVX2), dependent chain", |b| {
+            b.iter(|| {
+                // SAFETY: AVX2 and FMA checked above.
+                let y = unsafe { tanh4(v) };
+                v = [y[0] + 0.5, y[1] - 0.5, y[2] * 2.0, y[3] + 0.25];
+            })
+        });
+        black_box(v);
     }
     g.bench_function("fast, independent", |b| {
         b.iter(|| {

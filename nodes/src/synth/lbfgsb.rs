@@ -95,56 +95,229 @@ pub struct Outcome {
 /// `f(x, g)` returns f(x) and writes ∇f(x) into `g`. A non-finite value
 /// counts as +∞ (the line search backs off from it).
 pub fn minimize(f: &mut dyn FnMut(&[f64], &mut [f64]) -> f64, x0: &[f64], lo: f64, hi: f64, opts: &Options) -> Outcome {
-    let n = x0.len();
-    let b = Box1 { lo, hi };
-    let mut x: Vec<f64> = x0.iter().map(|&v| b.proj(v)).collect();
-    let mut g = vec![0.0; n];
-    let mut fx = f(&x, &mut g);
-    let mut evals = 1;
-    if !fx.is_finite() || g.iter().any(|v| !v.is_finite()) {
-        return Outcome { x, f: fx, history: vec![fx], evaluations: evals, stop: Stop::LineSearch };
+    let mut m = Minimizer::new(x0, lo, hi, opts);
+    while let Some((x, g)) = m.request() {
+        let fx = f(x, g);
+        m.reply(fx);
     }
-    let mut history = vec![fx];
-    let mut mem = Memory::new(opts.memory.max(1));
-    let (mut d, mut xt, mut gt) = (vec![0.0; n], vec![0.0; n], vec![0.0; n]);
-    let mut free = vec![true; n];
-    let eps = 1e-12 * (hi - lo).abs().max(1.0);
-    let mut stop = Stop::MaxIter;
-    for _ in 0..opts.max_iter {
+    m.finish()
+}
+
+/// An objective evaluated at several points at once: `f(x, g, fx)` writes
+/// the gradient at `x[k]` into `g[k]` and the value into `fx[k]`.
+pub type PointsObjective<'a> = dyn FnMut(&[&[f64]], &mut [&mut [f64]], &mut [f64]) + 'a;
+
+/// Two minimizations over one box, side by side: each takes the steps
+/// [`minimize`] would take with the same objective from its own start,
+/// but their evaluations are asked for together, so that the objective can
+/// run both at once. `f(x, g, fx)` evaluates the objective at each point
+/// of `x` — two, or one once the other minimization has finished — writing
+/// each gradient into `g` and each value into `fx`, in the same order.
+pub fn minimize_pair(f: &mut PointsObjective, x0: [&[f64]; 2], lo: f64, hi: f64, opts: &Options) -> [Outcome; 2] {
+    let [mut a, mut b] = x0.map(|x| Minimizer::new(x, lo, hi, opts));
+    loop {
+        match (a.request(), b.request()) {
+            (Some((xa, ga)), Some((xb, gb))) => {
+                let mut fx = [0.0; 2];
+                f(&[xa, xb], &mut [ga, gb], &mut fx);
+                a.reply(fx[0]);
+                b.reply(fx[1]);
+            }
+            (Some((x, g)), None) => {
+                let mut fx = [0.0];
+                f(&[x], &mut [g], &mut fx);
+                a.reply(fx[0]);
+            }
+            (None, Some((x, g))) => {
+                let mut fx = [0.0];
+                f(&[x], &mut [g], &mut fx);
+                b.reply(fx[0]);
+            }
+            (None, None) => break,
+        }
+    }
+    [a.finish(), b.finish()]
+}
+
+/// [`minimize`] driven from outside: it asks for the objective at one
+/// point at a time ([`Minimizer::request`]) and takes the answer
+/// ([`Minimizer::reply`]), so a caller can run several minimizations side
+/// by side and evaluate their points together. Each one takes the same
+/// steps as [`minimize`] with the same objective.
+pub struct Minimizer {
+    opts: Options,
+    b: Box1,
+    /// How near a bound a variable counts as at it.
+    eps: f64,
+    x: Vec<f64>,
+    g: Vec<f64>,
+    fx: f64,
+    history: Vec<f64>,
+    mem: Memory,
+    d: Vec<f64>,
+    xt: Vec<f64>,
+    gt: Vec<f64>,
+    free: Vec<bool>,
+    evals: usize,
+    /// Iterations begun.
+    iterations: usize,
+    /// The line search's step, trials made, and gᵀ(x_t − x) of the trial asked for.
+    step: f64,
+    trials: usize,
+    decrease: f64,
+    state: State,
+}
+
+/// Where a [`Minimizer`] is.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+enum State {
+    /// The objective at the start is asked for (into `x`, `g`).
+    Start,
+    /// A line-search trial is asked for (into `xt`, `gt`).
+    Trial,
+    /// Finished.
+    Done(Stop),
+}
+
+impl Minimizer {
+    /// A minimization of an objective over lo ≤ x ≤ hi from `x0`
+    /// (projected into the box); it first asks for the objective there.
+    pub fn new(x0: &[f64], lo: f64, hi: f64, opts: &Options) -> Self {
+        let n = x0.len();
+        let b = Box1 { lo, hi };
+        Minimizer {
+            opts: *opts,
+            x: x0.iter().map(|&v| b.proj(v)).collect(),
+            b,
+            eps: 1e-12 * (hi - lo).abs().max(1.0),
+            g: vec![0.0; n],
+            fx: f64::NAN,
+            history: Vec::new(),
+            mem: Memory::new(opts.memory.max(1)),
+            d: vec![0.0; n],
+            xt: vec![0.0; n],
+            gt: vec![0.0; n],
+            free: vec![true; n],
+            evals: 0,
+            iterations: 0,
+            step: 1.0,
+            trials: 0,
+            decrease: -0.0,
+            state: State::Start,
+        }
+    }
+
+    /// The point whose objective is wanted next, and where its gradient
+    /// goes; `None` once finished.
+    pub fn request(&mut self) -> Option<(&[f64], &mut [f64])> {
+        match self.state {
+            State::Start => Some((&self.x, &mut self.g)),
+            State::Trial => Some((&self.xt, &mut self.gt)),
+            State::Done(_) => None,
+        }
+    }
+
+    /// The objective at the point [`Minimizer::request`] gave, its
+    /// gradient written where it said. Ignored once finished.
+    pub fn reply(&mut self, f: f64) {
+        match self.state {
+            State::Start => {
+                self.fx = f;
+                self.evals = 1;
+                self.history.push(f);
+                if !f.is_finite() || self.g.iter().any(|v| !v.is_finite()) {
+                    self.state = State::Done(Stop::LineSearch);
+                } else {
+                    self.begin_iteration();
+                }
+            }
+            State::Trial => {
+                self.evals += 1;
+                let accepted = f.is_finite()
+                    && self.gt.iter().all(|v| v.is_finite())
+                    && f <= self.fx + self.opts.c1 * self.decrease
+                    && f <= self.fx;
+                if accepted {
+                    self.accept(f);
+                } else {
+                    self.step *= 0.5;
+                    self.trials += 1;
+                    self.next_trial();
+                }
+            }
+            State::Done(_) => {}
+        }
+    }
+
+    /// The best point found, f there, and why it stopped (a minimization
+    /// left unfinished reports its point so far as stopped by `max_evals`).
+    pub fn finish(self) -> Outcome {
+        let stop = match self.state {
+            State::Done(stop) => stop,
+            _ => Stop::MaxEvals,
+        };
+        Outcome { x: self.x, f: self.fx, history: self.history, evaluations: self.evals, stop }
+    }
+
+    /// Steps 1 and 2 of an iteration, then the line search's first trial.
+    fn begin_iteration(&mut self) {
+        if self.iterations >= self.opts.max_iter {
+            self.state = State::Done(Stop::MaxIter);
+            return;
+        }
+        self.iterations += 1;
+        let (b, x, g) = (&self.b, &self.x, &self.g);
         // 1. Stationarity.
-        let pg = x.iter().zip(&g).map(|(&xi, &gi)| (xi - b.proj(xi - gi)).abs()).fold(0.0, f64::max);
-        if pg < opts.pg_tol {
-            stop = Stop::Stationary;
-            break;
+        let pg = x.iter().zip(g).map(|(&xi, &gi)| (xi - b.proj(xi - gi)).abs()).fold(0.0, f64::max);
+        if pg < self.opts.pg_tol {
+            self.state = State::Done(Stop::Stationary);
+            return;
         }
         // 2. Free variables and the two-loop recursion on them.
-        for i in 0..n {
-            free[i] = !((x[i] <= lo + eps && g[i] > 0.0) || (x[i] >= hi - eps && g[i] < 0.0));
+        let (lo, hi, eps) = (b.lo, b.hi, self.eps);
+        for i in 0..x.len() {
+            self.free[i] = !((x[i] <= lo + eps && g[i] > 0.0) || (x[i] >= hi - eps && g[i] < 0.0));
         }
-        mem.direction(&g, &free, &mut d);
-        let step = mem.first_step(&g, &free, &mut d, &b);
-        // 3. Backtracking along the projection arc.
-        let Some(f_new) = line_search(f, &b, (&x, &g, fx), &d, step, (&mut xt, &mut gt), &mut evals, opts) else {
-            stop = if evals >= opts.max_evals { Stop::MaxEvals } else { Stop::LineSearch };
-            break;
-        };
-        // 4. Curvature pair.
-        mem.remember(&x, &xt, &g, &gt);
-        let fprev = fx;
-        std::mem::swap(&mut x, &mut xt);
-        std::mem::swap(&mut g, &mut gt);
-        fx = f_new;
-        history.push(fx);
-        if fprev - fx <= opts.f_rel_tol * fprev.abs().max(fx.abs()).max(f64::MIN_POSITIVE) {
-            stop = Stop::Converged;
-            break;
+        self.mem.direction(g, &self.free, &mut self.d);
+        self.step = self.mem.first_step(g, &self.free, &mut self.d, b);
+        self.trials = 0;
+        self.next_trial();
+    }
+
+    /// Step 3, backtracking along the projection arc: the next trial
+    /// point, from the step halving up to 60 times, or the search given up.
+    fn next_trial(&mut self) {
+        if self.trials >= 60 || self.evals >= self.opts.max_evals {
+            let stop = if self.evals >= self.opts.max_evals { Stop::MaxEvals } else { Stop::LineSearch };
+            self.state = State::Done(stop);
+            return;
         }
-        if evals >= opts.max_evals {
-            stop = Stop::MaxEvals;
-            break;
+        // The trial point and gᵀ(x_t − x) in one pass (summed in order from −0).
+        let mut decrease = -0.0;
+        for i in 0..self.x.len() {
+            self.xt[i] = self.b.proj(self.x[i] + self.step * self.d[i]);
+            decrease += self.g[i] * (self.xt[i] - self.x[i]);
+        }
+        self.decrease = decrease;
+        self.state = State::Trial;
+    }
+
+    /// Step 4, the trial accepted: the curvature pair, the move, the stops.
+    fn accept(&mut self, f_new: f64) {
+        self.mem.remember(&self.x, &self.xt, &self.g, &self.gt);
+        let fprev = self.fx;
+        std::mem::swap(&mut self.x, &mut self.xt);
+        std::mem::swap(&mut self.g, &mut self.gt);
+        self.fx = f_new;
+        self.history.push(f_new);
+        if fprev - f_new <= self.opts.f_rel_tol * fprev.abs().max(f_new.abs()).max(f64::MIN_POSITIVE) {
+            self.state = State::Done(Stop::Converged);
+        } else if self.evals >= self.opts.max_evals {
+            self.state = State::Done(Stop::MaxEvals);
+        } else {
+            self.begin_iteration();
         }
     }
-    Outcome { x, f: fx, history, evaluations: evals, stop }
 }
 
 /// The box lo ≤ x_i ≤ hi.
@@ -369,44 +542,166 @@ impl Memory {
     }
 }
 
-/// Backtracking along the projection arc from `x` (gradient `g`, value
-/// `fx`) in direction `d`, from `step` halving up to 60 times: the first
-/// trial point with the Armijo decrease, left in `xt` (gradient in `gt`),
-/// and its value; `None` when none was found (or `max_evals` was reached).
-#[allow(clippy::too_many_arguments)]
-fn line_search(
-    f: &mut dyn FnMut(&[f64], &mut [f64]) -> f64,
-    b: &Box1,
-    (x, g, fx): (&[f64], &[f64], f64),
-    d: &[f64],
-    mut step: f64,
-    (xt, gt): (&mut [f64], &mut [f64]),
-    evals: &mut usize,
-    opts: &Options,
-) -> Option<f64> {
-    for _ in 0..60 {
-        if *evals >= opts.max_evals {
-            break;
-        }
-        // The trial point and gᵀ(x_t − x) in one pass (summed in order from −0).
-        let mut decrease = -0.0;
-        for i in 0..x.len() {
-            xt[i] = b.proj(x[i] + step * d[i]);
-            decrease += g[i] * (xt[i] - x[i]);
-        }
-        let ft = f(xt, gt);
-        *evals += 1;
-        if ft.is_finite() && gt.iter().all(|v| v.is_finite()) && ft <= fx + opts.c1 * decrease && ft <= fx {
-            return Some(ft);
-        }
-        step *= 0.5;
-    }
-    None
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// `minimize` as it was written before it became [`Minimizer`]: one
+    /// loop calling the objective, its line search a function of its own.
+    fn minimize_loop(
+        f: &mut dyn FnMut(&[f64], &mut [f64]) -> f64,
+        x0: &[f64],
+        lo: f64,
+        hi: f64,
+        opts: &Options,
+    ) -> Outcome {
+        let n = x0.len();
+        let b = Box1 { lo, hi };
+        let mut x: Vec<f64> = x0.iter().map(|&v| b.proj(v)).collect();
+        let mut g = vec![0.0; n];
+        let mut fx = f(&x, &mut g);
+        let mut evals = 1;
+        if !fx.is_finite() || g.iter().any(|v| !v.is_finite()) {
+            return Outcome { x, f: fx, history: vec![fx], evaluations: evals, stop: Stop::LineSearch };
+        }
+        let mut history = vec![fx];
+        let mut mem = Memory::new(opts.memory.max(1));
+        let (mut d, mut xt, mut gt) = (vec![0.0; n], vec![0.0; n], vec![0.0; n]);
+        let mut free = vec![true; n];
+        let eps = 1e-12 * (hi - lo).abs().max(1.0);
+        let mut stop = Stop::MaxIter;
+        for _ in 0..opts.max_iter {
+            let pg = x.iter().zip(&g).map(|(&xi, &gi)| (xi - b.proj(xi - gi)).abs()).fold(0.0, f64::max);
+            if pg < opts.pg_tol {
+                stop = Stop::Stationary;
+                break;
+            }
+            for i in 0..n {
+                free[i] = !((x[i] <= lo + eps && g[i] > 0.0) || (x[i] >= hi - eps && g[i] < 0.0));
+            }
+            mem.direction(&g, &free, &mut d);
+            let mut step = mem.first_step(&g, &free, &mut d, &b);
+            let mut found = None;
+            for _ in 0..60 {
+                if evals >= opts.max_evals {
+                    break;
+                }
+                let mut decrease = -0.0;
+                for i in 0..n {
+                    xt[i] = b.proj(x[i] + step * d[i]);
+                    decrease += g[i] * (xt[i] - x[i]);
+                }
+                let ft = f(&xt, &mut gt);
+                evals += 1;
+                if ft.is_finite() && gt.iter().all(|v| v.is_finite()) && ft <= fx + opts.c1 * decrease && ft <= fx {
+                    found = Some(ft);
+                    break;
+                }
+                step *= 0.5;
+            }
+            let Some(f_new) = found else {
+                stop = if evals >= opts.max_evals { Stop::MaxEvals } else { Stop::LineSearch };
+                break;
+            };
+            mem.remember(&x, &xt, &g, &gt);
+            let fprev = fx;
+            std::mem::swap(&mut x, &mut xt);
+            std::mem::swap(&mut g, &mut gt);
+            fx = f_new;
+            history.push(fx);
+            if fprev - fx <= opts.f_rel_tol * fprev.abs().max(fx.abs()).max(f64::MIN_POSITIVE) {
+                stop = Stop::Converged;
+                break;
+            }
+            if evals >= opts.max_evals {
+                stop = Stop::MaxEvals;
+                break;
+            }
+        }
+        Outcome { x, f: fx, history, evaluations: evals, stop }
+    }
+
+    #[test]
+    fn the_driven_form_takes_the_loops_steps_bit_for_bit() {
+        // Rosenbrock in 6 dimensions on a box that binds, a function that
+        // goes non-finite off a region, and limits on iterations and
+        // evaluations: every stop reason.
+        let rosen = |x: &[f64], g: &mut [f64]| -> f64 {
+            let mut f = 0.0;
+            g.iter_mut().for_each(|v| *v = 0.0);
+            for i in 0..x.len() - 1 {
+                let (a, b) = (1.0 - x[i], x[i + 1] - x[i] * x[i]);
+                f += a * a + 100.0 * b * b;
+                g[i] += -2.0 * a - 400.0 * x[i] * b;
+                g[i + 1] += 200.0 * b;
+            }
+            f
+        };
+        let wall = |x: &[f64], g: &mut [f64]| -> f64 {
+            g[0] = 2.0 * (x[0] - 0.9);
+            if x[0] > 0.5 {
+                f64::NAN
+            } else {
+                (x[0] - 0.9).powi(2)
+            }
+        };
+        type Objective<'a> = &'a dyn Fn(&[f64], &mut [f64]) -> f64;
+        let cases: [(Objective, Vec<f64>, f64, f64, Options); 6] = [
+            (&rosen, vec![-1.2, 1.0, -0.5, 0.3, 0.8, -1.0], -2.0, 0.7, Options::default()),
+            (&rosen, vec![0.0; 6], -2.0, 2.0, Options { max_iter: 7, ..Options::default() }),
+            (&rosen, vec![0.5; 6], -2.0, 2.0, Options { max_evals: 13, ..Options::default() }),
+            (&rosen, vec![0.5; 6], -2.0, 2.0, Options { max_iter: 0, ..Options::default() }),
+            (&wall, vec![0.0], -1.0, 1.0, Options::default()),
+            (&wall, vec![0.8], -1.0, 1.0, Options::default()),
+        ];
+        let mut stops = Vec::new();
+        for (f, x0, lo, hi, opts) in cases {
+            let want = minimize_loop(&mut |x, g| f(x, g), &x0, lo, hi, &opts);
+            let got = minimize(&mut |x, g| f(x, g), &x0, lo, hi, &opts);
+            let bits = |o: &Outcome| {
+                (
+                    o.x.iter().map(|v| v.to_bits()).collect::<Vec<_>>(),
+                    o.history.iter().map(|v| v.to_bits()).collect::<Vec<_>>(),
+                )
+            };
+            assert_eq!(bits(&got), bits(&want), "{x0:?}");
+            assert_eq!((got.evaluations, got.stop), (want.evaluations, want.stop), "{x0:?}");
+            stops.push(got.stop);
+        }
+        for stop in [Stop::Converged, Stop::MaxIter, Stop::MaxEvals, Stop::LineSearch] {
+            assert!(stops.contains(&stop), "{stop:?} not reached: {stops:?}");
+        }
+    }
+
+    #[test]
+    fn two_minimizations_driven_side_by_side_are_each_their_own() {
+        let f = |c: f64| {
+            move |x: &[f64], g: &mut [f64]| -> f64 {
+                let mut s = 0.0;
+                for i in 0..x.len() {
+                    let d = x[i] - c * (i as f64 - 1.5);
+                    s += d * d * (1.0 + i as f64) + 0.1 * d.powi(4);
+                    g[i] = 2.0 * d * (1.0 + i as f64) + 0.4 * d.powi(3);
+                }
+                s
+            }
+        };
+        let (fa, fb) = (f(0.3), f(-0.7));
+        let opts = Options::default();
+        let mut calls = [0usize; 2];
+        let mut both = |x: &[&[f64]], g: &mut [&mut [f64]], fx: &mut [f64]| {
+            calls[x.len() - 1] += 1;
+            // a has four variables, b three: each point tells whose it is.
+            for k in 0..x.len() {
+                fx[k] = if x[k].len() == 4 { fa(x[k], g[k]) } else { fb(x[k], g[k]) };
+            }
+        };
+        let [ga, gb] = minimize_pair(&mut both, [&[0.9; 4], &[-0.2; 3]], -1.0, 1.0, &opts);
+        assert_eq!(ga, minimize(&mut |x, g| fa(x, g), &[0.9; 4], -1.0, 1.0, &opts));
+        assert_eq!(gb, minimize(&mut |x, g| fb(x, g), &[-0.2; 3], -1.0, 1.0, &opts));
+        assert!(calls[1] > 0 && calls[0] > 0, "{calls:?}: both the paired and the lone path ran");
+        assert_ne!(ga.evaluations, 0);
+    }
 
     /// The two-loop recursion as first written: every dot product a pass
     /// of its own, each pair's sᵀy taken again in each loop.

@@ -2,7 +2,8 @@
 //! twin (`study/src/twin.rs`): a forward pass over a tribometer stroke
 //! (85 g at 5 cm/s, the nominal profile, 4 substeps) and the backward pass
 //! of its gradient — the loop `report live` and `report textures` spend
-//! most of their time in. `cargo bench -p evflow-study --bench twin`.
+//! most of their time in; and both passes of two actuations side by side
+//! (`forward2`, `backward2`). `cargo bench -p evflow-study --bench twin`.
 
 use criterion::{criterion_group, criterion_main, Criterion};
 use evflow_nodes::lab::integrator::Method;
@@ -35,6 +36,20 @@ fn passes(c: &mut Criterion) {
         b.iter(|| {
             twin.backward(&tape, black_box(&fbar), &mut g);
             black_box(g[0])
+        })
+    });
+    // Two actuations side by side (two floors' starts in lockstep): time
+    // per pair, against twice the single pass above.
+    let u2: Vec<f64> = u.iter().map(|v| -0.8 * v).collect();
+    let mut tape2 = Tape::default();
+    c.bench_function(&format!("twin/forward2, two passes of {n} samples"), |b| {
+        b.iter(|| black_box(twin.forward2([black_box(&u), &u2], &load, &vel, [&mut tape, &mut tape2])))
+    });
+    let mut g2 = vec![0.0; n];
+    c.bench_function(&format!("twin/backward2, two passes of {n} samples"), |b| {
+        b.iter(|| {
+            twin.backward2([&tape, &tape2], [black_box(&fbar), &fbar], [&mut g, &mut g2]);
+            black_box(g[0] + g2[0])
         })
     });
 }

@@ -189,9 +189,26 @@ impl DisplayTwin {
         #[cfg(target_arch = "x86_64")]
         if evflow_nodes::cpu::has_avx2_fma() {
             // SAFETY: the CPU has AVX2 and FMA.
-            return unsafe { self.forward_avx2(u, load, velocity, tape) };
+            let [f] = unsafe { self.forward_avx2([u], load, velocity, [tape]) };
+            return f;
         }
-        self.forward_body(u, load, velocity, tape)
+        let [f] = self.forward_body([u], load, velocity, [tape]);
+        f
+    }
+
+    /// [`Self::forward`] of two actuations along the same path at once,
+    /// each with its own tape: their steps alternate, so that one pass's
+    /// chain of dependent operations runs while the other's waits. Each
+    /// force (and tape) is the one [`Self::forward`] gives, bit for bit.
+    /// The actuations must have one length.
+    pub fn forward2(&self, u: [&[f64]; 2], load: &[f64], velocity: &[f64], tapes: [&mut Tape; 2]) -> [Vec<f64>; 2] {
+        debug_assert_eq!(u[0].len(), u[1].len());
+        #[cfg(target_arch = "x86_64")]
+        if evflow_nodes::cpu::has_avx2_fma() {
+            // SAFETY: the CPU has AVX2 and FMA.
+            return unsafe { self.forward_avx2(u, load, velocity, tapes) };
+        }
+        self.forward_body(u, load, velocity, tapes)
     }
 
     /// [`Self::forward_body`] compiled for AVX2 and FMA, so that the
@@ -203,98 +220,131 @@ impl DisplayTwin {
     /// The CPU must have AVX2 and FMA.
     #[cfg(target_arch = "x86_64")]
     #[target_feature(enable = "avx2,fma")]
-    unsafe fn forward_avx2(&self, u: &[f64], load: &[f64], velocity: &[f64], tape: &mut Tape) -> Vec<f64> {
-        self.forward_body(u, load, velocity, tape)
+    unsafe fn forward_avx2<const K: usize>(
+        &self,
+        u: [&[f64]; K],
+        load: &[f64],
+        velocity: &[f64],
+        tapes: [&mut Tape; K],
+    ) -> [Vec<f64>; K] {
+        self.forward_body(u, load, velocity, tapes)
     }
 
-    /// [`Self::forward`]'s pass.
+    /// The forward pass of K actuations of one length along one path,
+    /// step by step side by side (each its own state and tape).
     #[inline(always)]
-    fn forward_body(&self, u: &[f64], load: &[f64], velocity: &[f64], tape: &mut Tape) -> Vec<f64> {
-        tape.steps.clear();
-        tape.samples.truncate(u.len());
-        tape.velocity.truncate(u.len());
-        let mut xe = self.x0;
+    fn forward_body<const K: usize>(
+        &self,
+        u: [&[f64]; K],
+        load: &[f64],
+        velocity: &[f64],
+        mut tapes: [&mut Tape; K],
+    ) -> [Vec<f64>; K] {
+        let len = u[0].len();
+        for tape in tapes.iter_mut() {
+            tape.steps.clear();
+            tape.samples.truncate(len);
+            tape.velocity.truncate(len);
+        }
         let vr0 = electrical::force_voltage(&self.x0);
-        let mut fl = self.ke * vr0 * vr0;
-        let mut xm = [0.0f64; 2];
-        let mut stuck = true;
-        let mut out = Vec::with_capacity(u.len());
-        let ds_df = self.gam_m[2][1];
-        for n in 0..u.len() {
-            let un = if n >= self.delay { u[n - self.delay] } else { 0.0 };
-            let uu = if un.is_finite() { un } else { 0.0 };
+        let mut runs = [(); K].map(|_| Run { xe: self.x0, fl: self.ke * vr0 * vr0, xm: [0.0; 2], stuck: true });
+        let mut out = [(); K].map(|_| Vec::with_capacity(len));
+        for n in 0..len {
             let ld = if load[n].is_finite() { load[n].max(0.0) } else { 0.0 };
             let v = if velocity[n].is_finite() { velocity[n] } else { 0.0 };
-            let raw = self.gain * uu + self.offset;
-            let vcmd = raw.clamp(-self.vmax, self.vmax);
-            let clamped = vcmd != raw;
-            let a = match tape.velocity.get(n) {
-                Some(&vk) if vk.to_bits() == v.to_bits() => {
-                    let a = tape.samples[n].0;
-                    tape.samples[n] = (a, clamped);
-                    a
-                }
-                _ => {
-                    let wc = self.lag0 + self.lag_slope * v.abs();
-                    let a = exact_exp::exp_body(-wc * self.hs);
-                    if n < tape.velocity.len() {
-                        tape.samples[n] = (a, clamped);
-                        tape.velocity[n] = v;
-                    } else {
-                        tape.samples.push((a, clamped));
-                        tape.velocity.push(v);
-                    }
-                    a
-                }
-            };
-            for _ in 0..self.sub {
-                let y = matvec(&self.phi_e, &xe);
-                for i in 0..NE {
-                    xe[i] = y[i] + self.gam_e[i] * vcmd;
-                }
-                let vr = electrical::force_voltage(&xe);
-                let fe = self.ke * vr * vr;
-                fl = a * fl + (1.0 - a) * fe;
-                let npre = ld + fl;
-                let nf = npre.max(0.0);
-                // The sliding friction at this speed and load, when the
-                // contact was sliding (the limit) or starts to (the force).
-                let mut sliding = if stuck { None } else { Some(self.slide(xm[1].abs(), nf)) };
-                let limit = match sliding {
-                    Some((fs, _)) => fs,
-                    None => self.mu_s * nf,
-                };
-                let xa = [xm[0], xm[1], 0.0];
-                let mut free = matvec(&self.phi_m, &xa);
-                let g = matvec(&self.gam_m, &[v, 0.0]);
-                for i in 0..3 {
-                    free[i] += g[i];
-                }
-                let required = if ds_df != 0.0 { -free[2] / ds_df } else { 0.0 };
-                let xm0 = xm;
-                let branch;
-                let mut kept = (0.0, 0.0);
-                if required.abs() <= limit.max(0.0) {
-                    branch = Branch::Stuck;
-                    xm[0] += v * self.hs;
-                    xm[1] = 0.0;
-                    stuck = true;
-                } else {
-                    kept = *sliding.get_or_insert_with(|| self.slide(xm[1].abs(), nf));
-                    let fs = kept.0.max(0.0);
-                    let force = fs.min(required.abs()) * required.signum();
-                    branch = if fs < required.abs() { Branch::Slide } else { Branch::Clipped };
-                    for i in 0..2 {
-                        xm[i] = free[i] + self.gam_m[i][1] * force;
-                    }
-                    stuck = false;
-                }
-                let (slide, slide_exp) = kept;
-                tape.steps.push(Step { xm0, vr, npre, branch, req_sign: required.signum(), slide, slide_exp });
+            let (mut vcmd, mut a) = ([0.0; K], [0.0; K]);
+            for k in 0..K {
+                let un = if n >= self.delay { u[k][n - self.delay] } else { 0.0 };
+                let uu = if un.is_finite() { un } else { 0.0 };
+                let raw = self.gain * uu + self.offset;
+                vcmd[k] = raw.clamp(-self.vmax, self.vmax);
+                a[k] = self.lag_factor(tapes[k], n, v, vcmd[k] != raw);
             }
-            out.push(self.k * xm[0] + self.c * (v - xm[1]));
+            for _ in 0..self.sub {
+                for k in 0..K {
+                    self.substep(&mut runs[k], vcmd[k], a[k], ld, v, tapes[k]);
+                }
+            }
+            for k in 0..K {
+                out[k].push(self.k * runs[k].xm[0] + self.c * (v - runs[k].xm[1]));
+            }
         }
         out
+    }
+
+    /// Sample n's lag factor a = exp(−ω_c(v)·h) for holder velocity `v`,
+    /// from the tape when it holds one for the same velocity; records it
+    /// and whether V_cmd was `clamped`.
+    #[inline(always)]
+    fn lag_factor(&self, tape: &mut Tape, n: usize, v: f64, clamped: bool) -> f64 {
+        match tape.velocity.get(n) {
+            Some(&vk) if vk.to_bits() == v.to_bits() => {
+                let a = tape.samples[n].0;
+                tape.samples[n] = (a, clamped);
+                a
+            }
+            _ => {
+                let wc = self.lag0 + self.lag_slope * v.abs();
+                let a = exact_exp::exp_body(-wc * self.hs);
+                if n < tape.velocity.len() {
+                    tape.samples[n] = (a, clamped);
+                    tape.velocity[n] = v;
+                } else {
+                    tape.samples.push((a, clamped));
+                    tape.velocity.push(v);
+                }
+                a
+            }
+        }
+    }
+
+    /// One substep of one pass: circuit, lag, load, contact; recorded.
+    #[inline(always)]
+    fn substep(&self, r: &mut Run, vcmd: f64, a: f64, ld: f64, v: f64, tape: &mut Tape) {
+        let ds_df = self.gam_m[2][1];
+        let y = matvec(&self.phi_e, &r.xe);
+        for ((x, yi), ge) in r.xe.iter_mut().zip(y).zip(self.gam_e) {
+            *x = yi + ge * vcmd;
+        }
+        let vr = electrical::force_voltage(&r.xe);
+        let fe = self.ke * vr * vr;
+        r.fl = a * r.fl + (1.0 - a) * fe;
+        let npre = ld + r.fl;
+        let nf = npre.max(0.0);
+        // The sliding friction at this speed and load, when the
+        // contact was sliding (the limit) or starts to (the force).
+        let mut sliding = if r.stuck { None } else { Some(self.slide(r.xm[1].abs(), nf)) };
+        let limit = match sliding {
+            Some((fs, _)) => fs,
+            None => self.mu_s * nf,
+        };
+        let xa = [r.xm[0], r.xm[1], 0.0];
+        let mut free = matvec(&self.phi_m, &xa);
+        let g = matvec(&self.gam_m, &[v, 0.0]);
+        for i in 0..3 {
+            free[i] += g[i];
+        }
+        let required = if ds_df != 0.0 { -free[2] / ds_df } else { 0.0 };
+        let xm0 = r.xm;
+        let branch;
+        let mut kept = (0.0, 0.0);
+        if required.abs() <= limit.max(0.0) {
+            branch = Branch::Stuck;
+            r.xm[0] += v * self.hs;
+            r.xm[1] = 0.0;
+            r.stuck = true;
+        } else {
+            kept = *sliding.get_or_insert_with(|| self.slide(r.xm[1].abs(), nf));
+            let fs = kept.0.max(0.0);
+            let force = fs.min(required.abs()) * required.signum();
+            branch = if fs < required.abs() { Branch::Slide } else { Branch::Clipped };
+            for (i, x) in r.xm.iter_mut().enumerate() {
+                *x = free[i] + self.gam_m[i][1] * force;
+            }
+            r.stuck = false;
+        }
+        let (slide, slide_exp) = kept;
+        tape.steps.push(Step { xm0, vr, npre, branch, req_sign: required.signum(), slide, slide_exp });
     }
 
     /// Adds to `ubar` the gradient of Σ_n f̄\[n\]·F\[n\] with respect to the
@@ -303,9 +353,22 @@ impl DisplayTwin {
         #[cfg(target_arch = "x86_64")]
         if evflow_nodes::cpu::has_avx2_fma() {
             // SAFETY: the CPU has AVX2 and FMA.
-            return unsafe { self.backward_avx2(tape, fbar, ubar) };
+            return unsafe { self.backward_avx2([tape], [fbar], [ubar]) };
         }
-        self.backward_body(tape, fbar, ubar)
+        self.backward_body([tape], [fbar], [ubar])
+    }
+
+    /// [`Self::backward`] of two passes of one length at once (as
+    /// [`Self::forward2`] ran them), their steps alternating; each gradient
+    /// the one [`Self::backward`] gives, bit for bit.
+    pub fn backward2(&self, tapes: [&Tape; 2], fbar: [&[f64]; 2], ubar: [&mut [f64]; 2]) {
+        debug_assert_eq!(tapes[0].samples.len(), tapes[1].samples.len());
+        #[cfg(target_arch = "x86_64")]
+        if evflow_nodes::cpu::has_avx2_fma() {
+            // SAFETY: the CPU has AVX2 and FMA.
+            return unsafe { self.backward_avx2(tapes, fbar, ubar) };
+        }
+        self.backward_body(tapes, fbar, ubar)
     }
 
     /// [`Self::backward_body`] compiled for AVX2 (the same operations in
@@ -316,76 +379,106 @@ impl DisplayTwin {
     /// The CPU must have AVX2 and FMA.
     #[cfg(target_arch = "x86_64")]
     #[target_feature(enable = "avx2,fma")]
-    unsafe fn backward_avx2(&self, tape: &Tape, fbar: &[f64], ubar: &mut [f64]) {
-        self.backward_body(tape, fbar, ubar)
+    unsafe fn backward_avx2<const K: usize>(&self, tapes: [&Tape; K], fbar: [&[f64]; K], ubar: [&mut [f64]; K]) {
+        self.backward_body(tapes, fbar, ubar)
     }
 
-    /// [`Self::backward`]'s pass.
+    /// The backward pass of K recorded passes of one length, step by step
+    /// side by side.
     #[inline(always)]
-    fn backward_body(&self, tape: &Tape, fbar: &[f64], ubar: &mut [f64]) {
-        let (mut bxe, mut bfl, mut bxm) = ([0.0; NE], 0.0, [0.0; 2]);
-        let ds_df = self.gam_m[2][1];
-        for n in (0..tape.samples.len()).rev() {
-            let (a, clamped) = tape.samples[n];
-            bxm[0] += self.k * fbar[n];
-            bxm[1] -= self.c * fbar[n];
-            let mut bvcmd = 0.0;
-            for j in (0..self.sub).rev() {
-                let s = &tape.steps[n * self.sub + j];
-                // (5) contact step.
-                let mut bn = 0.0;
-                let mut bxm0 = [0.0; 2];
-                match s.branch {
-                    Branch::Stuck => {
-                        bxm0[0] = bxm[0];
-                    }
-                    Branch::Slide | Branch::Clipped => {
-                        let bforce = bxm[0] * self.gam_m[0][1] + bxm[1] * self.gam_m[1][1];
-                        let mut bfree = [bxm[0], bxm[1], 0.0];
-                        if s.branch == Branch::Clipped {
-                            bfree[2] += -bforce / ds_df;
-                        } else {
-                            let w = s.xm0[1].abs();
-                            let nf = s.npre.max(0.0);
-                            if s.slide > 0.0 {
-                                let (dw, dn) = self.slide_grad(w, nf, s.slide_exp);
-                                bn += bforce * s.req_sign * dn;
-                                bxm0[1] += bforce * s.req_sign * dw * s.xm0[1].signum();
-                            }
-                        }
-                        for (jj, b) in bxm0.iter_mut().enumerate() {
-                            for (i, bf) in bfree.iter().enumerate() {
-                                *b += bf * self.phi_m[i][jj];
-                            }
-                        }
-                    }
-                }
-                bxm = bxm0;
-                // (3) N = max(0, F_n + F_l).
-                if s.npre > 0.0 {
-                    bfl += bn;
-                }
-                // (2) lag and square law.
-                let bfe = (1.0 - a) * bfl;
-                bfl *= a;
-                let mut bxe1 = bxe;
-                bxe1[electrical::GAP] += bfe * 2.0 * self.ke * s.vr;
-                bxe1[electrical::RELAX] -= bfe * 2.0 * self.ke * s.vr;
-                // (1) circuit.
-                let mut b0 = [0.0; NE];
-                for (i, bi) in bxe1.iter().enumerate() {
-                    for (jj, b) in b0.iter_mut().enumerate() {
-                        *b += bi * self.phi_e[i][jj];
-                    }
-                    bvcmd += bi * self.gam_e[i];
-                }
-                bxe = b0;
+    fn backward_body<const K: usize>(&self, tapes: [&Tape; K], fbar: [&[f64]; K], mut ubar: [&mut [f64]; K]) {
+        let mut adj = [Adjoint { bxe: [0.0; NE], bfl: 0.0, bxm: [0.0; 2] }; K];
+        for n in (0..tapes[0].samples.len()).rev() {
+            let mut bvcmd = [0.0; K];
+            for k in 0..K {
+                adj[k].bxm[0] += self.k * fbar[k][n];
+                adj[k].bxm[1] -= self.c * fbar[k][n];
             }
-            if !clamped && n >= self.delay {
-                ubar[n - self.delay] += bvcmd * self.gain;
+            for j in (0..self.sub).rev() {
+                for k in 0..K {
+                    let a = tapes[k].samples[n].0;
+                    self.substep_adjoint(&mut adj[k], &tapes[k].steps[n * self.sub + j], a, &mut bvcmd[k]);
+                }
+            }
+            for (k, ub) in ubar.iter_mut().enumerate() {
+                if !tapes[k].samples[n].1 && n >= self.delay {
+                    ub[n - self.delay] += bvcmd[k] * self.gain;
+                }
             }
         }
     }
+
+    /// One substep of [`Self::substep`] transposed: the adjoints `b` of
+    /// the state after step `s` become those before it; the adjoint of
+    /// V_cmd accumulates in `bvcmd`.
+    #[inline(always)]
+    fn substep_adjoint(&self, b: &mut Adjoint, s: &Step, a: f64, bvcmd: &mut f64) {
+        let ds_df = self.gam_m[2][1];
+        // (5) contact step.
+        let mut bn = 0.0;
+        let mut bxm0 = [0.0; 2];
+        match s.branch {
+            Branch::Stuck => {
+                bxm0[0] = b.bxm[0];
+            }
+            Branch::Slide | Branch::Clipped => {
+                let bforce = b.bxm[0] * self.gam_m[0][1] + b.bxm[1] * self.gam_m[1][1];
+                let mut bfree = [b.bxm[0], b.bxm[1], 0.0];
+                if s.branch == Branch::Clipped {
+                    bfree[2] += -bforce / ds_df;
+                } else {
+                    let w = s.xm0[1].abs();
+                    let nf = s.npre.max(0.0);
+                    if s.slide > 0.0 {
+                        let (dw, dn) = self.slide_grad(w, nf, s.slide_exp);
+                        bn += bforce * s.req_sign * dn;
+                        bxm0[1] += bforce * s.req_sign * dw * s.xm0[1].signum();
+                    }
+                }
+                for (jj, bm) in bxm0.iter_mut().enumerate() {
+                    for (i, bf) in bfree.iter().enumerate() {
+                        *bm += bf * self.phi_m[i][jj];
+                    }
+                }
+            }
+        }
+        b.bxm = bxm0;
+        // (3) N = max(0, F_n + F_l).
+        if s.npre > 0.0 {
+            b.bfl += bn;
+        }
+        // (2) lag and square law.
+        let bfe = (1.0 - a) * b.bfl;
+        b.bfl *= a;
+        let mut bxe1 = b.bxe;
+        bxe1[electrical::GAP] += bfe * 2.0 * self.ke * s.vr;
+        bxe1[electrical::RELAX] -= bfe * 2.0 * self.ke * s.vr;
+        // (1) circuit.
+        let mut b0 = [0.0; NE];
+        for (i, bi) in bxe1.iter().enumerate() {
+            for (jj, bj) in b0.iter_mut().enumerate() {
+                *bj += bi * self.phi_e[i][jj];
+            }
+            *bvcmd += bi * self.gam_e[i];
+        }
+        b.bxe = b0;
+    }
+}
+
+/// One forward pass's state: circuit, lag, tip, contact.
+struct Run {
+    xe: [f64; NE],
+    fl: f64,
+    xm: [f64; 2],
+    stuck: bool,
+}
+
+/// One backward pass's adjoints of circuit, lag and tip.
+#[derive(Clone, Copy)]
+struct Adjoint {
+    bxe: [f64; NE],
+    bfl: f64,
+    bxm: [f64; 2],
 }
 
 /// The force sensor's twin: resonance (exact map, substeps), direction
@@ -616,14 +709,56 @@ mod tests {
             let twin = DisplayTwin::new(&profile, 1000.0, 4).unwrap();
             let (mut t1, mut t2) = (Tape::default(), Tape::default());
             let f1 = twin.forward(&u, &load, &vel, &mut t1);
-            let f2 = twin.forward_body(&u, &load, &vel, &mut t2);
+            let [f2] = twin.forward_body([&u], &load, &vel, [&mut t2]);
             let (mut g1, mut g2) = (vec![0.0; n], vec![0.0; n]);
             twin.backward(&t1, &fbar, &mut g1);
-            twin.backward_body(&t2, &fbar, &mut g2);
+            twin.backward_body([&t2], [&fbar], [&mut g2]);
             let bits = |v: &[f64]| v.iter().map(|x| x.to_bits()).collect::<Vec<_>>();
             assert_eq!(bits(&f1), bits(&f2), "{name}: forward");
             assert_eq!(bits(&g1), bits(&g2), "{name}: backward");
             assert!(t1.steps.iter().any(|s| s.branch == Branch::Slide), "{name}: no sliding step");
+        }
+    }
+
+    #[test]
+    fn two_passes_side_by_side_are_each_the_single_pass_bit_for_bit() {
+        // Both builds (the bodies alone are the portable one), on every
+        // shipped profile: forces, tapes and gradients as one pass alone.
+        let bits = |v: &[f64]| v.iter().map(|x| x.to_bits()).collect::<Vec<_>>();
+        for (name, profile) in shipped() {
+            let (load, vel) = pass(&profile, 120.0, 8.0);
+            let n = load.len();
+            let ua = actuation(n);
+            let ub: Vec<f64> = ua.iter().enumerate().map(|(k, v)| if k % 7 < 3 { -0.6 * v } else { 0.9 }).collect();
+            let fa: Vec<f64> = (0..n).map(|k| ((k * 5 % 11) as f64 - 5.0) * 0.2).collect();
+            let fb: Vec<f64> = (0..n).map(|k| ((k * 3 % 7) as f64 - 3.0) * 0.1).collect();
+            let twin = DisplayTwin::new(&profile, 1000.0, 4).unwrap();
+            let (mut ta, mut tb) = (Tape::default(), Tape::default());
+            let want = [twin.forward(&ua, &load, &vel, &mut ta), twin.forward(&ub, &load, &vel, &mut tb)];
+            let (mut ga, mut gb) = (vec![0.0; n], vec![0.0; n]);
+            twin.backward(&ta, &fa, &mut ga);
+            twin.backward(&tb, &fb, &mut gb);
+            for portable in [false, true] {
+                // A reused tape (the velocity's factors kept) and a fresh one.
+                let (mut t1, mut t2) = (ta.clone(), Tape::default());
+                let got = if portable {
+                    twin.forward_body([&ua, &ub], &load, &vel, [&mut t1, &mut t2])
+                } else {
+                    twin.forward2([&ua, &ub], &load, &vel, [&mut t1, &mut t2])
+                };
+                let (mut g1, mut g2) = (vec![0.0; n], vec![0.0; n]);
+                if portable {
+                    twin.backward_body([&t1, &t2], [&fa, &fb], [&mut g1, &mut g2]);
+                } else {
+                    twin.backward2([&t1, &t2], [&fa, &fb], [&mut g1, &mut g2]);
+                }
+                for k in 0..2 {
+                    assert_eq!(bits(&got[k]), bits(&want[k]), "{name}: force {k}");
+                }
+                assert_eq!((bits(&g1), bits(&g2)), (bits(&ga), bits(&gb)), "{name}: gradients");
+                assert_eq!(t2.steps.len(), tb.steps.len());
+            }
+            assert!(ta.steps.iter().any(|s| s.branch == Branch::Slide), "{name}: no sliding step");
         }
     }
 

@@ -27,7 +27,7 @@ use crate::StudyError;
 use evflow_nodes::lab::profile::LabProfile;
 use evflow_nodes::metric::spectral_error::Band;
 use evflow_nodes::metric::spectrum::{SpectrumConfig, Window};
-use evflow_nodes::synth::lbfgsb::{minimize, Options};
+use evflow_nodes::synth::lbfgsb::{minimize, minimize_pair, Options};
 use evflow_nodes::synth::output_filter::OutputFilter;
 use evflow_nodes::synth::spectral::SpectralTarget;
 use evflow_nodes::synth::start::carrier_scaled;
@@ -80,24 +80,45 @@ struct Chain<'a> {
     filter: OutputFilter,
     stroke: &'a Stroke,
     target: SpectralTarget,
-    tape: Tape,
-    y: Vec<f64>,
+    /// Tapes and force adjoints of two evaluations side by side (one uses the first).
+    tape: [Tape; 2],
+    y: [Vec<f64>; 2],
 }
 
 impl Chain<'_> {
     fn force(&mut self, u: &[f64]) -> Vec<f64> {
-        self.twin.forward(u, &self.stroke.load, &self.stroke.velocity, &mut self.tape)
+        self.twin.forward(u, &self.stroke.load, &self.stroke.velocity, &mut self.tape[0])
     }
 
     /// J = E_s² and ∂J/∂u.
     fn value_grad(&mut self, u: &[f64], g: &mut [f64]) -> f64 {
-        let mut y = self.force(u);
-        self.filter.apply_in_place(&mut y);
-        self.y.resize(y.len(), 0.0);
-        let j = self.target.value_grad(&y, &mut self.y);
-        self.filter.adjoint_in_place(&mut self.y);
+        let y = self.force(u);
+        let j = self.force_adjoint(y, 0);
         g.iter_mut().for_each(|v| *v = 0.0);
-        self.twin.backward(&self.tape, &self.y, g);
+        self.twin.backward(&self.tape[0], &self.y[0], g);
+        j
+    }
+
+    /// [`Chain::value_grad`] at two points, their twin passes side by
+    /// side (each value and gradient the one it gives alone).
+    fn value_grad2(&mut self, u: [&[f64]; 2], g: [&mut [f64]; 2]) -> [f64; 2] {
+        let [ta, tb] = &mut self.tape;
+        let [ya, yb] = self.twin.forward2(u, &self.stroke.load, &self.stroke.velocity, [ta, tb]);
+        let j = [self.force_adjoint(ya, 0), self.force_adjoint(yb, 1)];
+        let [ga, gb] = g;
+        ga.iter_mut().for_each(|v| *v = 0.0);
+        gb.iter_mut().for_each(|v| *v = 0.0);
+        let [ta, tb] = &self.tape;
+        self.twin.backward2([ta, tb], [&self.y[0], &self.y[1]], [ga, gb]);
+        j
+    }
+
+    /// J for the twin's force `y`, and ∂J/∂(the force) into `self.y[k]`.
+    fn force_adjoint(&mut self, mut y: Vec<f64>, k: usize) -> f64 {
+        self.filter.apply_in_place(&mut y);
+        self.y[k].resize(y.len(), 0.0);
+        let j = self.target.value_grad(&y, &mut self.y[k]);
+        self.filter.adjoint_in_place(&mut self.y[k]);
         j
     }
 
@@ -195,8 +216,8 @@ pub fn optimize_towards(
         filter: OutputFilter::highpass(4, 10.0, rate)?,
         stroke,
         target: SpectralTarget::new(&goal.highpassed, cfg, band)?,
-        tape: Tape::default(),
-        y: Vec::new(),
+        tape: Default::default(),
+        y: Default::default(),
     };
     let kappa = chain.carrier_gain();
     from_starts(&mut chain, &goal.magnitude, kappa, stroke.len(), seeds, iterations)
@@ -209,6 +230,12 @@ pub(crate) trait Objective {
     fn value(&mut self, u: &[f64]) -> f64;
     /// The objective at `u`, its gradient into `g`.
     fn value_grad(&mut self, u: &[f64], g: &mut [f64]) -> f64;
+    /// [`Objective::value_grad`] at two points (an objective that can run
+    /// both at once does; each result must be the one it gives alone).
+    fn value_grad2(&mut self, u: [&[f64]; 2], g: [&mut [f64]; 2]) -> [f64; 2] {
+        let [ga, gb] = g;
+        [self.value_grad(u[0], ga), self.value_grad(u[1], gb)]
+    }
 }
 
 impl Objective for Chain<'_> {
@@ -218,13 +245,18 @@ impl Objective for Chain<'_> {
     fn value_grad(&mut self, u: &[f64], g: &mut [f64]) -> f64 {
         Chain::value_grad(self, u, g)
     }
+    fn value_grad2(&mut self, u: [&[f64]; 2], g: [&mut [f64]; 2]) -> [f64; 2] {
+        Chain::value_grad2(self, u, g)
+    }
 }
 
 /// The floors' optimization of `objective` over `n` samples: the carrier
 /// starts at [`START_OFFSETS`] for the goal's `magnitude` (when the carrier
 /// gain `kappa` is positive) and every seed (cut or padded with 0 to `n`,
 /// within |u| ≤ 1), each followed by `iterations` of L-BFGS-B within
-/// |u| ≤ 1.
+/// |u| ≤ 1. The starts run two at a time, side by side
+/// ([`minimize_pair`], [`Objective::value_grad2`]): each start's optimum
+/// is the one it reaches alone.
 pub(crate) fn from_starts(
     objective: &mut impl Objective,
     magnitude: &[f64],
@@ -247,11 +279,27 @@ pub(crate) fn from_starts(
     }
     let opts = Options { max_iter: iterations, ..Options::default() };
     let mut out = Vec::with_capacity(starts.len());
-    for (start, u0) in starts {
-        let start_objective = objective.value(&u0);
-        let mut f = |u: &[f64], g: &mut [f64]| objective.value_grad(u, g);
-        let r = minimize(&mut f, &u0, -1.0, 1.0, &opts);
-        out.push(Candidate { start, start_objective, objective: r.f, u: r.x });
+    for pair in starts.chunks(2) {
+        let start_objective: Vec<f64> = pair.iter().map(|(_, u0)| objective.value(u0)).collect();
+        let results = match pair {
+            [(_, ua), (_, ub)] => {
+                let mut f = |x: &[&[f64]], g: &mut [&mut [f64]], fx: &mut [f64]| match (x, g) {
+                    ([xa, xb], [ga, gb]) => fx.copy_from_slice(&objective.value_grad2([xa, xb], [ga, gb])),
+                    ([x], [g]) => fx[0] = objective.value_grad(x, g),
+                    _ => {} // minimize_pair asks for one point or two.
+                };
+                minimize_pair(&mut f, [ua, ub], -1.0, 1.0, &opts).to_vec()
+            }
+            _ => pair
+                .iter()
+                .map(|(_, u0)| {
+                    minimize(&mut |u: &[f64], g: &mut [f64]| objective.value_grad(u, g), u0, -1.0, 1.0, &opts)
+                })
+                .collect(),
+        };
+        for (((start, _), start_objective), r) in pair.iter().zip(start_objective).zip(results) {
+            out.push(Candidate { start: start.clone(), start_objective, objective: r.f, u: r.x });
+        }
     }
     Ok(out)
 }

@@ -17,6 +17,7 @@
 
 use super::gains::{AtGain, Chosen};
 use super::graphs::{run_graph, value, Sets};
+use super::live::floor::{minimize_starts, Objective};
 use super::recordings::{self, channel};
 use super::row::{Achievable, Reading, RowInputs};
 use super::twin::{DisplayTwin, SensorTwin, Tape};
@@ -27,7 +28,7 @@ use evflow_nodes::lab::tribometer_model::TribometerModel;
 use evflow_nodes::metric::spectral_error::Band;
 use evflow_nodes::metric::spectrum::{SpectrumConfig, Window};
 use evflow_nodes::recording::format::{Channel, RecordingMeta, RecordingWriter};
-use evflow_nodes::synth::lbfgsb::{minimize, Options};
+use evflow_nodes::synth::lbfgsb::Options;
 use evflow_nodes::synth::output_filter::OutputFilter;
 use evflow_nodes::synth::spectral::SpectralTarget;
 use evflow_nodes::synth::start::carrier_scaled;
@@ -51,15 +52,40 @@ struct Chain {
     velocity: Vec<f64>,
     keep: Vec<bool>,
     target: SpectralTarget,
-    tape: Tape,
+    /// The display's tapes of two evaluations side by side (one uses the first).
+    tape: [Tape; 2],
+}
+
+impl Objective for Chain {
+    /// J = E_s² and ∂J/∂u.
+    fn value_grad(&mut self, u: &[f64], g: &mut [f64]) -> f64 {
+        let f = self.display.forward(u, &self.load, &self.velocity, &mut self.tape[0]);
+        let (j, fbar) = self.force_adjoint(&f);
+        g.iter_mut().for_each(|v| *v = 0.0);
+        self.display.backward(&self.tape[0], &fbar, g);
+        j
+    }
+
+    /// Both display passes side by side (each result the one it gives alone).
+    fn value_grad2(&mut self, u: [&[f64]; 2], g: [&mut [f64]; 2]) -> [f64; 2] {
+        let [ta, tb] = &mut self.tape;
+        let [fa, fb] = self.display.forward2(u, &self.load, &self.velocity, [ta, tb]);
+        let ((ja, bara), (jb, barb)) = (self.force_adjoint(&fa), self.force_adjoint(&fb));
+        let [ga, gb] = g;
+        ga.iter_mut().for_each(|v| *v = 0.0);
+        gb.iter_mut().for_each(|v| *v = 0.0);
+        let [ta, tb] = &self.tape;
+        self.display.backward2([ta, tb], [&bara, &barb], [ga, gb]);
+        [ja, jb]
+    }
 }
 
 impl Chain {
-    /// J = E_s² and ∂J/∂u.
-    fn value_grad(&mut self, u: &[f64], g: &mut [f64]) -> f64 {
-        let f = self.display.forward(u, &self.load, &self.velocity, &mut self.tape);
+    /// J for the display force `f` (through the sensor, the high-pass and
+    /// the gate), and ∂J/∂f.
+    fn force_adjoint(&mut self, f: &[f64]) -> (f64, Vec<f64>) {
         let mut pass = Vec::new();
-        let mut y = self.sensor.forward(&f, &self.velocity, &mut pass);
+        let mut y = self.sensor.forward(f, &self.velocity, &mut pass);
         self.filter.apply_in_place(&mut y);
         let kept: Vec<f64> = y.iter().zip(&self.keep).filter(|(_, k)| **k).map(|(v, _)| *v).collect();
         let mut gk = vec![0.0; kept.len()];
@@ -72,10 +98,7 @@ impl Chain {
             }
         }
         self.filter.adjoint_in_place(&mut ybar);
-        let fbar = self.sensor.backward(&pass, &ybar);
-        g.iter_mut().for_each(|v| *v = 0.0);
-        self.display.backward(&self.tape, &fbar, g);
-        j
+        (j, self.sensor.backward(&pass, &ybar))
     }
 
     /// The steady friction a unit Nyquist-rate carrier adds on this pass (N):
@@ -83,8 +106,8 @@ impl Chain {
     fn carrier_gain(&mut self) -> f64 {
         let n = self.load.len();
         let unit: Vec<f64> = (0..n).map(|k| if k % 2 == 0 { 1.0 } else { -1.0 }).collect();
-        let on = self.display.forward(&unit, &self.load, &self.velocity, &mut self.tape);
-        let off = self.display.forward(&vec![0.0; n], &self.load, &self.velocity, &mut self.tape);
+        let on = self.display.forward(&unit, &self.load, &self.velocity, &mut self.tape[0]);
+        let off = self.display.forward(&vec![0.0; n], &self.load, &self.velocity, &mut self.tape[0]);
         let (mut s, mut c) = (0.0, 0);
         for k in 0..n {
             if self.keep[k] {
@@ -129,7 +152,7 @@ pub fn achievable(i: &RowInputs<'_>) -> Result<Achievable, StudyError> {
         velocity,
         keep: keep.clone(),
         target: SpectralTarget::new(&kept, cfg, band)?,
-        tape: Tape::default(),
+        tape: Default::default(),
     };
     let kappa = chain.carrier_gain();
     let mut starts = Vec::new();
@@ -143,12 +166,9 @@ pub fn achievable(i: &RowInputs<'_>) -> Result<Achievable, StudyError> {
         }
     }
     let opts = Options { max_iter: ITERATIONS, ..Options::default() };
-    let mut optimized = Vec::new();
-    for s in &starts {
-        let mut f = |u: &[f64], g: &mut [f64]| chain.value_grad(u, g);
-        let out = minimize(&mut f, s, -1.0, 1.0, &opts);
-        optimized.push((out.f, out.x));
-    }
+    let points: Vec<&[f64]> = starts.iter().map(Vec::as_slice).collect();
+    let optimized: Vec<(f64, Vec<f64>)> =
+        minimize_starts(&mut chain, &points, &opts).into_iter().map(|out| (out.f, out.x)).collect();
     let seconds = t0.elapsed().as_secs_f64();
     // Play each start's optimum like every method; the floor is the best.
     let graph = i.graphs.join("play-actuation.toml");

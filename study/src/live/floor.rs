@@ -27,7 +27,7 @@ use crate::StudyError;
 use evflow_nodes::lab::profile::LabProfile;
 use evflow_nodes::metric::spectral_error::Band;
 use evflow_nodes::metric::spectrum::{SpectrumConfig, Window};
-use evflow_nodes::synth::lbfgsb::{minimize, minimize_pair, Options};
+use evflow_nodes::synth::lbfgsb::{minimize, minimize_pair, Options, Outcome};
 use evflow_nodes::synth::output_filter::OutputFilter;
 use evflow_nodes::synth::spectral::SpectralTarget;
 use evflow_nodes::synth::start::carrier_scaled;
@@ -226,8 +226,10 @@ pub fn optimize_towards(
 /// An objective over a whole stroke's actuation that the floors minimize:
 /// its value, and its value with the gradient written into `g`.
 pub(crate) trait Objective {
-    /// The objective at `u`.
-    fn value(&mut self, u: &[f64]) -> f64;
+    /// The objective at `u` (by default through [`Objective::value_grad`]).
+    fn value(&mut self, u: &[f64]) -> f64 {
+        self.value_grad(u, &mut vec![0.0; u.len()])
+    }
     /// The objective at `u`, its gradient into `g`.
     fn value_grad(&mut self, u: &[f64], g: &mut [f64]) -> f64;
     /// [`Objective::value_grad`] at two points (an objective that can run
@@ -278,30 +280,43 @@ pub(crate) fn from_starts(
         starts.push((name.clone(), u));
     }
     let opts = Options { max_iter: iterations, ..Options::default() };
+    let start_objective: Vec<f64> = starts.iter().map(|(_, u0)| objective.value(u0)).collect();
+    let points: Vec<&[f64]> = starts.iter().map(|(_, u0)| u0.as_slice()).collect();
+    let results = minimize_starts(objective, &points, &opts);
+    let out = starts.iter().zip(start_objective).zip(results);
+    Ok(out
+        .map(|(((start, _), start_objective), r)| Candidate {
+            start: start.clone(),
+            start_objective,
+            objective: r.f,
+            u: r.x,
+        })
+        .collect())
+}
+
+/// Minimizes `objective` within |u| ≤ 1 from each start, two starts at a
+/// time side by side ([`minimize_pair`], [`Objective::value_grad2`]): the
+/// outcomes in the starts' order, each the one a run of its own reaches.
+pub(crate) fn minimize_starts(objective: &mut impl Objective, starts: &[&[f64]], opts: &Options) -> Vec<Outcome> {
     let mut out = Vec::with_capacity(starts.len());
     for pair in starts.chunks(2) {
-        let start_objective: Vec<f64> = pair.iter().map(|(_, u0)| objective.value(u0)).collect();
-        let results = match pair {
-            [(_, ua), (_, ub)] => {
+        match *pair {
+            [ua, ub] => {
                 let mut f = |x: &[&[f64]], g: &mut [&mut [f64]], fx: &mut [f64]| match (x, g) {
                     ([xa, xb], [ga, gb]) => fx.copy_from_slice(&objective.value_grad2([xa, xb], [ga, gb])),
                     ([x], [g]) => fx[0] = objective.value_grad(x, g),
                     _ => {} // minimize_pair asks for one point or two.
                 };
-                minimize_pair(&mut f, [ua, ub], -1.0, 1.0, &opts).to_vec()
+                out.extend(minimize_pair(&mut f, [ua, ub], -1.0, 1.0, opts));
             }
-            _ => pair
-                .iter()
-                .map(|(_, u0)| {
-                    minimize(&mut |u: &[f64], g: &mut [f64]| objective.value_grad(u, g), u0, -1.0, 1.0, &opts)
-                })
-                .collect(),
-        };
-        for (((start, _), start_objective), r) in pair.iter().zip(start_objective).zip(results) {
-            out.push(Candidate { start: start.clone(), start_objective, objective: r.f, u: r.x });
+            _ => {
+                for u0 in pair {
+                    out.push(minimize(&mut |u: &[f64], g: &mut [f64]| objective.value_grad(u, g), u0, -1.0, 1.0, opts));
+                }
+            }
         }
     }
-    Ok(out)
+    out
 }
 
 #[cfg(test)]

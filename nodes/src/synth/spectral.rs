@@ -71,8 +71,11 @@ pub struct SpectralTarget {
     r: Vec<f64>,
     r_norm2: f64,
     seg: SegmentFft,
-    /// Per segment, X on the band's bins (kept from the forward pass).
+    /// Per segment, X on the band's bins and |X| (kept from the forward pass).
     x: Vec<Complex<f64>>,
+    mag: Vec<f64>,
+    /// The forward pass's mean magnitudes S on the band's bins.
+    s: Vec<f64>,
     starts: Vec<usize>,
 }
 
@@ -129,6 +132,8 @@ impl SpectralTarget {
                 scratch,
             },
             x: vec![Complex::default(); starts.len() * band.len()],
+            mag: vec![0.0; starts.len() * band.len()],
+            s: vec![0.0; band.len()],
             starts,
         })
     }
@@ -148,20 +153,22 @@ impl SpectralTarget {
         self.forward(v).sqrt()
     }
 
-    /// J = E_s² and its forward-pass spectra.
+    /// J = E_s² and its forward-pass spectra (X, |X| and S, kept).
     fn forward(&mut self, v: &[f64]) -> f64 {
         let (nb, first) = (self.band.len(), self.band.first());
         let p = self.starts.len() as f64;
-        let mut s = vec![0.0; nb];
+        self.s.fill(0.0);
         for (seg, &start) in self.starts.iter().enumerate() {
             self.seg.transform(v, start);
-            for (b, sb) in s.iter_mut().enumerate() {
+            for (b, sb) in self.s.iter_mut().enumerate() {
                 let xk = self.seg.buf[first + b];
+                let mag = xk.norm();
                 self.x[seg * nb + b] = xk;
-                *sb += xk.norm() / p;
+                self.mag[seg * nb + b] = mag;
+                *sb += mag / p;
             }
         }
-        s.iter().zip(&self.r).map(|(a, b)| (a - b) * (a - b)).sum::<f64>() / self.r_norm2
+        self.s.iter().zip(&self.r).map(|(a, b)| (a - b) * (a - b)).sum::<f64>() / self.r_norm2
     }
 
     /// J = E_s² of the spectrum `v` is expected to have once the noise of
@@ -234,19 +241,12 @@ impl SpectralTarget {
         let j = self.forward(v);
         let (nfft, nb, first) = (self.cfg.nfft, self.band.len(), self.band.first());
         let p = self.starts.len() as f64;
-        // S again (cheap: from the kept X).
-        let mut s = vec![0.0; nb];
-        for seg in 0..self.starts.len() {
-            for (b, sb) in s.iter_mut().enumerate() {
-                *sb += self.x[seg * nb + b].norm() / p;
-            }
-        }
         g.iter_mut().for_each(|v| *v = 0.0);
         for (seg, &start) in self.starts.iter().enumerate() {
             self.seg.buf.iter_mut().for_each(|c| *c = Complex::default());
-            for (b, (sb, rb)) in s.iter().zip(&self.r).enumerate() {
+            for (b, (sb, rb)) in self.s.iter().zip(&self.r).enumerate() {
                 let xk = self.x[seg * nb + b];
-                let mag = xk.norm();
+                let mag = self.mag[seg * nb + b];
                 if mag > 0.0 {
                     let a = 2.0 * (sb - rb) / self.r_norm2;
                     self.seg.buf[first + b] = xk.conj() * (a / mag);

@@ -1,12 +1,13 @@
 //! One table sample of `interp` (`nodes/src/texture/kernel.rs`): the
 //! windowed-sinc evaluation of a mix of two cells, as the scalar loop
 //! ([`SincKernel::eval`] with the mix as a closure) and as `interp` runs it
-//! ([`SincKernel::eval_mix`]: four taps at a time on AVX2), side by side.
+//! ([`eval_mix`]: four taps at a time on AVX2), side by side.
 //! Shipped kernel (W = 16) at the cutoff of a ratio ≤ 1 (0.9: 36 taps) and
 //! of a ratio of 2 (0.45: 72 taps). `cargo bench -p evflow-nodes --bench interp`.
 
 use criterion::{criterion_group, criterion_main, Criterion};
 use evflow_nodes::texture::kernel::SincKernel;
+use evflow_nodes::texture::kernel_mix::eval_mix;
 use std::hint::black_box;
 
 fn sample(c: &mut Criterion) {
@@ -26,7 +27,7 @@ fn sample(c: &mut Criterion) {
         c.bench_function(&format!("interp_sample/eval_mix, cutoff {cut}"), |b| {
             b.iter(|| {
                 p = if p > 3800.0 { 100.0 } else { p + 1.37 };
-                black_box(k.eval_mix(black_box(p), cut, &u0, &u1, a0, a1))
+                black_box(eval_mix(&k, black_box(p), cut, &u0, &u1, a0, a1))
             })
         });
     }

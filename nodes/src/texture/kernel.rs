@@ -39,7 +39,7 @@ pub struct SincKernel {
     cutoff: f64,
     /// g(u) = sinc(u)·kaiser(u/W) at u = i / OVERSAMPLING, i = 0 ..= W·OVERSAMPLING + 1.
     table: Vec<f64>,
-    /// The CPU has AVX2: [`SincKernel::eval_mix`] runs its taps four at a time.
+    /// The CPU has AVX2: [`super::kernel_mix::eval_mix`] weighs four taps at a time.
     avx2: bool,
 }
 
@@ -94,6 +94,11 @@ impl SincKernel {
         &self.table
     }
 
+    /// Whether the CPU has AVX2 (found when the kernel was built).
+    pub(super) fn avx2(&self) -> bool {
+        self.avx2
+    }
+
     /// g(u), linearly interpolated in the table; 0 beyond it.
     #[inline(always)]
     fn g(&self, u: f64) -> f64 {
@@ -119,31 +124,10 @@ impl SincKernel {
         ratio(acc, norm)
     }
 
-    /// [`SincKernel::eval`] of the mix a0·u0\[n\] + a1·u1\[n\] (n below the
-    /// shorter length), bit for bit: what `interp` computes for each table
-    /// sample. On CPUs with AVX2 four taps are weighed at a time (each lane
-    /// the scalar operations, the sums still added tap by tap in order).
-    #[inline]
-    pub fn eval_mix(&self, p: f64, c: f64, u0: &[f64], u1: &[f64], a0: f64, a1: f64) -> f64 {
-        let len = u0.len().min(u1.len());
-        let (u0, u1) = (&u0[..len], &u1[..len]);
-        let Some((first, last)) = self.span(p, c, len) else { return 0.0 };
-        #[cfg(target_arch = "x86_64")]
-        if self.avx2 {
-            // SAFETY: `cpu::has_avx2_fma` found AVX2 when the kernel was
-            // built; `span` keeps `first ..= last` below `len`.
-            let (acc, norm) = unsafe { super::kernel_avx2::mix_sums(self, p, c, first, last, u0, u1, a0, a1) };
-            return ratio(acc, norm);
-        }
-        let (mut acc, mut norm) = (0.0, 0.0);
-        self.taps(p, c, first, last + 1, &mut acc, &mut norm, |q| a0 * u0[q] + a1 * u1[q]);
-        ratio(acc, norm)
-    }
-
     /// The taps under position `p` at cutoff `c` that lie in `0 .. len`:
     /// `first ..= last`, or `None` when there are none.
     #[inline(always)]
-    fn span(&self, p: f64, c: f64, len: usize) -> Option<(usize, usize)> {
+    pub(super) fn span(&self, p: f64, c: f64, len: usize) -> Option<(usize, usize)> {
         let reach = self.reach(c);
         let first = (p - reach).ceil().max(0.0);
         let last = (p + reach).floor().min(len as f64 - 1.0);
@@ -188,7 +172,7 @@ impl SincKernel {
 
 /// The weighted sum over the sum of weights (0 when the weights vanish).
 #[inline(always)]
-fn ratio(acc: f64, norm: f64) -> f64 {
+pub(super) fn ratio(acc: f64, norm: f64) -> f64 {
     if norm.abs() < 1e-12 {
         0.0
     } else {

@@ -11,7 +11,7 @@ pub mod freqvel;
 pub mod grid;
 pub mod interp;
 pub mod kernel;
-mod kernel_avx2;
+pub mod kernel_mix;
 pub mod playback;
 pub mod rs;
 pub mod rs_precision;

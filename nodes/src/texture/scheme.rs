@@ -32,6 +32,7 @@
 
 use super::grid::Grid;
 use super::kernel::SincKernel;
+use super::kernel_mix;
 use super::wa::weights;
 
 /// Which scheme.
@@ -267,7 +268,7 @@ impl Mix {
                 }
                 Scheme::Improved => {
                     let p = self.start[b] + k as f64 * self.step[b];
-                    kernel.eval_mix(p, self.cut[b], u0, u1, a0, a1)
+                    kernel_mix::eval_mix(kernel, p, self.cut[b], u0, u1, a0, a1)
                 }
             };
             y += self.wv[b] * v;

@@ -1,6 +1,8 @@
-//! The taps of [`SincKernel::eval_mix`] four at a time in AVX2 intrinsics:
-//! what `interp` spends its time on (each table sample weighs 2·W/c taps
-//! of two cells).
+//! What `interp` computes for each column of a table sample: the
+//! windowed-sinc evaluation ([`SincKernel::eval`]) of the mix
+//! a0·u0\[n\] + a1·u1\[n\] of two cells, bit for bit, with its taps four
+//! at a time in AVX2 intrinsics on CPUs that have them (each table sample
+//! weighs 2·W/c taps of two cells: the texture chains' largest cost).
 //!
 //! Each lane performs the scalar tap's operations in the same order —
 //! u = c·(p − n), x = |u|·512, i = ⌊x⌋, h = g\[i\] + (x − i)·(g\[i+1\] − g\[i\]),
@@ -10,8 +12,29 @@
 //! does. A block whose x is not below the table's last point (which the
 //! scalar code reads as 0, or NaN) goes through the scalar taps.
 
+use super::kernel::{ratio, SincKernel};
+
+/// [`SincKernel::eval`] of the mix a0·u0\[n\] + a1·u1\[n\] (n below the
+/// shorter length) at position `p` with cutoff `c`, bit for bit.
+#[inline]
+pub fn eval_mix(k: &SincKernel, p: f64, c: f64, u0: &[f64], u1: &[f64], a0: f64, a1: f64) -> f64 {
+    let len = u0.len().min(u1.len());
+    let (u0, u1) = (&u0[..len], &u1[..len]);
+    let Some((first, last)) = k.span(p, c, len) else { return 0.0 };
+    #[cfg(target_arch = "x86_64")]
+    if k.avx2() {
+        // SAFETY: `cpu::has_avx2_fma` found AVX2 when the kernel was
+        // built; `span` keeps `first ..= last` below `len`.
+        let (acc, norm) = unsafe { mix_sums(k, p, c, first, last, u0, u1, a0, a1) };
+        return ratio(acc, norm);
+    }
+    let (mut acc, mut norm) = (0.0, 0.0);
+    k.taps(p, c, first, last + 1, &mut acc, &mut norm, |q| a0 * u0[q] + a1 * u1[q]);
+    ratio(acc, norm)
+}
+
 #[cfg(target_arch = "x86_64")]
-use super::kernel::{SincKernel, OVERSAMPLING};
+use super::kernel::OVERSAMPLING;
 #[cfg(target_arch = "x86_64")]
 use std::arch::x86_64::*;
 
@@ -26,7 +49,7 @@ use std::arch::x86_64::*;
 #[cfg(target_arch = "x86_64")]
 #[target_feature(enable = "avx2")]
 #[allow(clippy::too_many_arguments)]
-pub(super) unsafe fn mix_sums(
+unsafe fn mix_sums(
     k: &SincKernel,
     p: f64,
     c: f64,
@@ -93,15 +116,13 @@ pub(super) unsafe fn mix_sums(
     (acc, norm)
 }
 
-#[cfg(all(test, target_arch = "x86_64"))]
+#[cfg(test)]
 mod tests {
-    use super::super::kernel::SincKernel;
+    use super::eval_mix;
+    use crate::texture::kernel::SincKernel;
 
     #[test]
-    fn four_taps_at_a_time_give_the_scalar_bits() {
-        if !crate::cpu::has_avx2_fma() {
-            return;
-        }
+    fn the_mix_gives_the_scalar_loops_bits() {
         let mut r = crate::rng::Rng::new(11);
         let u0: Vec<f64> = (0..3000).map(|_| r.gaussian()).collect();
         let u1: Vec<f64> = (0..2500).map(|n| (n as f64 * 0.37).sin() + 1e-3 * n as f64).collect();
@@ -112,14 +133,14 @@ mod tests {
                 let c = [1.0, 0.9, 0.45, 0.05, 1e-3, 0.9 / (1.0 + 9.0 * r.uniform())][case % 6];
                 let (a0, a1) = (r.uniform(), r.gaussian());
                 let want = k.eval(p, c, u0.len().min(u1.len()), |q| a0 * u0[q] + a1 * u1[q]);
-                let got = k.eval_mix(p, c, &u0, &u1, a0, a1);
+                let got = eval_mix(&k, p, c, &u0, &u1, a0, a1);
                 assert_eq!(got.to_bits(), want.to_bits(), "p {p}, c {c}");
             }
             // Ends, integer positions, a position past the cells, NaN.
             for p in [0.0, 3.0, 2499.0, 2499.5, 2510.0, 1e9, f64::NAN, f64::INFINITY] {
                 for c in [1.0, 0.3, 1e-3] {
                     let want = k.eval(p, c, 2500, |q| 0.25 * u0[q] - 2.0 * u1[q]);
-                    let got = k.eval_mix(p, c, &u0, &u1, 0.25, -2.0);
+                    let got = eval_mix(&k, p, c, &u0, &u1, 0.25, -2.0);
                     assert_eq!(got.to_bits(), want.to_bits(), "p {p}, c {c}");
                 }
             }

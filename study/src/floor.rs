@@ -46,46 +46,43 @@ pub const START_OFFSETS: [f64; 3] = [0.5, 1.0, 2.0];
 /// sensor twins, high-pass, E_s against the target.
 struct Chain {
     display: DisplayTwin,
-    sensor: SensorTwin,
-    filter: OutputFilter,
     load: Vec<f64>,
     velocity: Vec<f64>,
-    keep: Vec<bool>,
-    target: SpectralTarget,
     /// The display's tapes of two evaluations side by side (one uses the first).
     tape: [Tape; 2],
+    score: Score,
+}
+
+/// What the display's force goes through to the objective: the sensor's
+/// twin, the high-pass, the constant-speed gate, E_s against the target.
+struct Score {
+    sensor: SensorTwin,
+    filter: OutputFilter,
+    keep: Vec<bool>,
+    target: SpectralTarget,
 }
 
 impl Objective for Chain {
     /// J = E_s² and ∂J/∂u.
     fn value_grad(&mut self, u: &[f64], g: &mut [f64]) -> f64 {
-        let f = self.display.forward(u, &self.load, &self.velocity, &mut self.tape[0]);
-        let (j, fbar) = self.force_adjoint(&f);
-        g.iter_mut().for_each(|v| *v = 0.0);
-        self.display.backward(&self.tape[0], &fbar, g);
-        j
+        let (score, velocity) = (&mut self.score, &self.velocity[..]);
+        let path = (&self.load[..], velocity);
+        self.display.objective_grad(u, path, &mut self.tape[0], g, |f| score.adjoint(&f, velocity))
     }
 
     /// Both display passes side by side (each result the one it gives alone).
     fn value_grad2(&mut self, u: [&[f64]; 2], g: [&mut [f64]; 2]) -> [f64; 2] {
-        let [ta, tb] = &mut self.tape;
-        let [fa, fb] = self.display.forward2(u, &self.load, &self.velocity, [ta, tb]);
-        let ((ja, bara), (jb, barb)) = (self.force_adjoint(&fa), self.force_adjoint(&fb));
-        let [ga, gb] = g;
-        ga.iter_mut().for_each(|v| *v = 0.0);
-        gb.iter_mut().for_each(|v| *v = 0.0);
-        let [ta, tb] = &self.tape;
-        self.display.backward2([ta, tb], [&bara, &barb], [ga, gb]);
-        [ja, jb]
+        let (score, velocity) = (&mut self.score, &self.velocity[..]);
+        let path = (&self.load[..], velocity);
+        self.display.objective_grad2(u, path, &mut self.tape, g, |f| score.adjoint(&f, velocity))
     }
 }
 
-impl Chain {
-    /// J for the display force `f` (through the sensor, the high-pass and
-    /// the gate), and ∂J/∂f.
-    fn force_adjoint(&mut self, f: &[f64]) -> (f64, Vec<f64>) {
+impl Score {
+    /// J for the display force `f` along holder velocity `velocity`, and ∂J/∂f.
+    fn adjoint(&mut self, f: &[f64], velocity: &[f64]) -> (f64, Vec<f64>) {
         let mut pass = Vec::new();
-        let mut y = self.sensor.forward(f, &self.velocity, &mut pass);
+        let mut y = self.sensor.forward(f, velocity, &mut pass);
         self.filter.apply_in_place(&mut y);
         let kept: Vec<f64> = y.iter().zip(&self.keep).filter(|(_, k)| **k).map(|(v, _)| *v).collect();
         let mut gk = vec![0.0; kept.len()];
@@ -100,7 +97,9 @@ impl Chain {
         self.filter.adjoint_in_place(&mut ybar);
         (j, self.sensor.backward(&pass, &ybar))
     }
+}
 
+impl Chain {
     /// The steady friction a unit Nyquist-rate carrier adds on this pass (N):
     /// the display's true carrier gain, from the twin.
     fn carrier_gain(&mut self) -> f64 {
@@ -110,7 +109,7 @@ impl Chain {
         let off = self.display.forward(&vec![0.0; n], &self.load, &self.velocity, &mut self.tape[0]);
         let (mut s, mut c) = (0.0, 0);
         for k in 0..n {
-            if self.keep[k] {
+            if self.score.keep[k] {
                 s += on[k] - off[k];
                 c += 1;
             }
@@ -146,13 +145,15 @@ pub fn achievable(i: &RowInputs<'_>) -> Result<Achievable, StudyError> {
     let band = Band::new(rate, nfft, 2.0, 200.0, false).map_err(|e| StudyError::Config(e.message))?;
     let mut chain = Chain {
         display: DisplayTwin::new(&profile, rate, 4).map_err(bad)?,
-        sensor: SensorTwin::new(&profile, rate, 4).map_err(bad)?,
-        filter: OutputFilter::highpass(4, 10.0, rate)?,
         load,
         velocity,
-        keep: keep.clone(),
-        target: SpectralTarget::new(&kept, cfg, band)?,
         tape: Default::default(),
+        score: Score {
+            sensor: SensorTwin::new(&profile, rate, 4).map_err(bad)?,
+            filter: OutputFilter::highpass(4, 10.0, rate)?,
+            keep: keep.clone(),
+            target: SpectralTarget::new(&kept, cfg, band)?,
+        },
     };
     let kappa = chain.carrier_gain();
     let mut starts = Vec::new();

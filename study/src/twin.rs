@@ -211,6 +211,44 @@ impl DisplayTwin {
         self.forward_body(u, load, velocity, tapes)
     }
 
+    /// J(F(u)) for an objective J of the display force F along the path
+    /// (`load`, `velocity`), with ∂J/∂u written into `g`: the forward pass,
+    /// then `adjoint(F)` = (J, ∂J/∂F), then the backward pass.
+    pub fn objective_grad(
+        &self,
+        u: &[f64],
+        (load, velocity): (&[f64], &[f64]),
+        tape: &mut Tape,
+        g: &mut [f64],
+        adjoint: impl FnOnce(Vec<f64>) -> (f64, Vec<f64>),
+    ) -> f64 {
+        let (j, fbar) = adjoint(self.forward(u, load, velocity, tape));
+        g.iter_mut().for_each(|v| *v = 0.0);
+        self.backward(tape, &fbar, g);
+        j
+    }
+
+    /// [`Self::objective_grad`] at two actuations of one length, their
+    /// passes side by side ([`Self::forward2`], [`Self::backward2`]); each
+    /// value and gradient the one it gives alone.
+    pub fn objective_grad2(
+        &self,
+        u: [&[f64]; 2],
+        (load, velocity): (&[f64], &[f64]),
+        tapes: &mut [Tape; 2],
+        g: [&mut [f64]; 2],
+        mut adjoint: impl FnMut(Vec<f64>) -> (f64, Vec<f64>),
+    ) -> [f64; 2] {
+        let [ta, tb] = tapes;
+        let [fa, fb] = self.forward2(u, load, velocity, [&mut *ta, &mut *tb]);
+        let ((ja, bara), (jb, barb)) = (adjoint(fa), adjoint(fb));
+        let [ga, gb] = g;
+        ga.iter_mut().for_each(|v| *v = 0.0);
+        gb.iter_mut().for_each(|v| *v = 0.0);
+        self.backward2([&*ta, &*tb], [&bara, &barb], [ga, gb]);
+        [ja, jb]
+    }
+
     /// [`Self::forward_body`] compiled for AVX2 and FMA, so that the
     /// exponentials inline with their multiply-adds as instructions (Rust
     /// fuses nothing else on its own: the same bits as the portable build).

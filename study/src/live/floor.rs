@@ -80,9 +80,8 @@ struct Chain<'a> {
     filter: OutputFilter,
     stroke: &'a Stroke,
     target: SpectralTarget,
-    /// Tapes and force adjoints of two evaluations side by side (one uses the first).
+    /// The twin's tapes of two evaluations side by side (one uses the first).
     tape: [Tape; 2],
-    y: [Vec<f64>; 2],
 }
 
 impl Chain<'_> {
@@ -92,34 +91,17 @@ impl Chain<'_> {
 
     /// J = E_s² and ∂J/∂u.
     fn value_grad(&mut self, u: &[f64], g: &mut [f64]) -> f64 {
-        let y = self.force(u);
-        let j = self.force_adjoint(y, 0);
-        g.iter_mut().for_each(|v| *v = 0.0);
-        self.twin.backward(&self.tape[0], &self.y[0], g);
-        j
+        let (filter, target) = (&self.filter, &mut self.target);
+        let path = (&self.stroke.load[..], &self.stroke.velocity[..]);
+        self.twin.objective_grad(u, path, &mut self.tape[0], g, |y| force_adjoint(filter, target, y))
     }
 
     /// [`Chain::value_grad`] at two points, their twin passes side by
     /// side (each value and gradient the one it gives alone).
     fn value_grad2(&mut self, u: [&[f64]; 2], g: [&mut [f64]; 2]) -> [f64; 2] {
-        let [ta, tb] = &mut self.tape;
-        let [ya, yb] = self.twin.forward2(u, &self.stroke.load, &self.stroke.velocity, [ta, tb]);
-        let j = [self.force_adjoint(ya, 0), self.force_adjoint(yb, 1)];
-        let [ga, gb] = g;
-        ga.iter_mut().for_each(|v| *v = 0.0);
-        gb.iter_mut().for_each(|v| *v = 0.0);
-        let [ta, tb] = &self.tape;
-        self.twin.backward2([ta, tb], [&self.y[0], &self.y[1]], [ga, gb]);
-        j
-    }
-
-    /// J for the twin's force `y`, and ∂J/∂(the force) into `self.y[k]`.
-    fn force_adjoint(&mut self, mut y: Vec<f64>, k: usize) -> f64 {
-        self.filter.apply_in_place(&mut y);
-        self.y[k].resize(y.len(), 0.0);
-        let j = self.target.value_grad(&y, &mut self.y[k]);
-        self.filter.adjoint_in_place(&mut self.y[k]);
-        j
+        let (filter, target) = (&self.filter, &mut self.target);
+        let path = (&self.stroke.load[..], &self.stroke.velocity[..]);
+        self.twin.objective_grad2(u, path, &mut self.tape, g, |y| force_adjoint(filter, target, y))
     }
 
     fn value(&mut self, u: &[f64]) -> f64 {
@@ -140,6 +122,15 @@ impl Chain<'_> {
         let s: f64 = moving.iter().map(|&k| (on[k] - off[k]) * v[k].signum()).sum();
         s / moving.len().max(1) as f64
     }
+}
+
+/// J = E_s² of the twin's force `y` high-passed, and ∂J/∂y.
+fn force_adjoint(filter: &OutputFilter, target: &mut SpectralTarget, mut y: Vec<f64>) -> (f64, Vec<f64>) {
+    filter.apply_in_place(&mut y);
+    let mut ybar = vec![0.0; y.len()];
+    let j = target.value_grad(&y, &mut ybar);
+    filter.adjoint_in_place(&mut ybar);
+    (j, ybar)
 }
 
 /// What a floor optimizes towards: the force the display should give
@@ -217,7 +208,6 @@ pub fn optimize_towards(
         stroke,
         target: SpectralTarget::new(&goal.highpassed, cfg, band)?,
         tape: Default::default(),
-        y: Default::default(),
     };
     let kappa = chain.carrier_gain();
     from_starts(&mut chain, &goal.magnitude, kappa, stroke.len(), seeds, iterations)

@@ -39,8 +39,6 @@ pub struct SincKernel {
     cutoff: f64,
     /// g(u) = sinc(u)·kaiser(u/W) at u = i / OVERSAMPLING, i = 0 ..= W·OVERSAMPLING + 1.
     table: Vec<f64>,
-    /// The CPU has AVX2: [`super::kernel_mix::eval_mix`] weighs four taps at a time.
-    avx2: bool,
 }
 
 impl SincKernel {
@@ -61,7 +59,7 @@ impl SincKernel {
                 sinc * bessel_i0(beta * (1.0 - r * r).sqrt()) / i0b
             })
             .collect();
-        Self { half_width, cutoff: cutoff.clamp(1e-3, 1.0), table, avx2: crate::cpu::has_avx2_fma() }
+        Self { half_width, cutoff: cutoff.clamp(1e-3, 1.0), table }
     }
 
     /// The kernel `interp` runs: [`INTERP_CUTOFF`], [`INTERP_BETA`], half-width `half_width`.
@@ -92,11 +90,6 @@ impl SincKernel {
     /// The table of g: g(i / [`OVERSAMPLING`]) at index i.
     pub(super) fn table(&self) -> &[f64] {
         &self.table
-    }
-
-    /// Whether the CPU has AVX2 (found when the kernel was built).
-    pub(super) fn avx2(&self) -> bool {
-        self.avx2
     }
 
     /// g(u), linearly interpolated in the table; 0 beyond it.

@@ -22,9 +22,8 @@ pub fn eval_mix(k: &SincKernel, p: f64, c: f64, u0: &[f64], u1: &[f64], a0: f64,
     let (u0, u1) = (&u0[..len], &u1[..len]);
     let Some((first, last)) = k.span(p, c, len) else { return 0.0 };
     #[cfg(target_arch = "x86_64")]
-    if k.avx2() {
-        // SAFETY: `cpu::has_avx2_fma` found AVX2 when the kernel was
-        // built; `span` keeps `first ..= last` below `len`.
+    if crate::cpu::has_avx2_fma() {
+        // SAFETY: the CPU has AVX2; `span` keeps `first ..= last` below `len`.
         let (acc, norm) = unsafe { mix_sums(k, p, c, first, last, u0, u1, a0, a1) };
         return ratio(acc, norm);
     }

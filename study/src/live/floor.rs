@@ -89,27 +89,6 @@ impl Chain<'_> {
         self.twin.forward(u, &self.stroke.load, &self.stroke.velocity, &mut self.tape[0])
     }
 
-    /// J = E_s² and ∂J/∂u.
-    fn value_grad(&mut self, u: &[f64], g: &mut [f64]) -> f64 {
-        let (filter, target) = (&self.filter, &mut self.target);
-        let path = (&self.stroke.load[..], &self.stroke.velocity[..]);
-        self.twin.objective_grad(u, path, &mut self.tape[0], g, |y| force_adjoint(filter, target, y))
-    }
-
-    /// [`Chain::value_grad`] at two points, their twin passes side by
-    /// side (each value and gradient the one it gives alone).
-    fn value_grad2(&mut self, u: [&[f64]; 2], g: [&mut [f64]; 2]) -> [f64; 2] {
-        let (filter, target) = (&self.filter, &mut self.target);
-        let path = (&self.stroke.load[..], &self.stroke.velocity[..]);
-        self.twin.objective_grad2(u, path, &mut self.tape, g, |y| force_adjoint(filter, target, y))
-    }
-
-    fn value(&mut self, u: &[f64]) -> f64 {
-        let mut y = self.force(u);
-        self.filter.apply_in_place(&mut y);
-        self.target.es(&y).powi(2)
-    }
-
     /// The steady friction a unit Nyquist-rate carrier adds on this stroke
     /// in the direction of motion (N): the display's true carrier gain.
     fn carrier_gain(&mut self) -> f64 {
@@ -231,14 +210,25 @@ pub(crate) trait Objective {
 }
 
 impl Objective for Chain<'_> {
+    /// J = E_s² of the twin's force, high-passed.
     fn value(&mut self, u: &[f64]) -> f64 {
-        Chain::value(self, u)
+        let mut y = self.force(u);
+        self.filter.apply_in_place(&mut y);
+        self.target.es(&y).powi(2)
     }
+
+    /// J and ∂J/∂u.
     fn value_grad(&mut self, u: &[f64], g: &mut [f64]) -> f64 {
-        Chain::value_grad(self, u, g)
+        let (filter, target) = (&self.filter, &mut self.target);
+        let path = (&self.stroke.load[..], &self.stroke.velocity[..]);
+        self.twin.objective_grad(u, path, &mut self.tape[0], g, |y| force_adjoint(filter, target, y))
     }
+
+    /// Both twin passes side by side (each result the one it gives alone).
     fn value_grad2(&mut self, u: [&[f64]; 2], g: [&mut [f64]; 2]) -> [f64; 2] {
-        Chain::value_grad2(self, u, g)
+        let (filter, target) = (&self.filter, &mut self.target);
+        let path = (&self.stroke.load[..], &self.stroke.velocity[..]);
+        self.twin.objective_grad2(u, path, &mut self.tape, g, |y| force_adjoint(filter, target, y))
     }
 }
 

@@ -107,36 +107,51 @@ pub fn minimize(f: &mut dyn FnMut(&[f64], &mut [f64]) -> f64, x0: &[f64], lo: f6
 /// the gradient at `x[k]` into `g[k]` and the value into `fx[k]`.
 pub type PointsObjective<'a> = dyn FnMut(&[&[f64]], &mut [&mut [f64]], &mut [f64]) + 'a;
 
-/// Two minimizations over one box, side by side: each takes the steps
-/// [`minimize`] would take with the same objective from its own start,
-/// but their evaluations are asked for together, so that the objective can
-/// run both at once. `f(x, g, fx)` evaluates the objective at each point
-/// of `x` — two, or one once the other minimization has finished — writing
-/// each gradient into `g` and each value into `fx`, in the same order.
-pub fn minimize_pair(f: &mut PointsObjective, x0: [&[f64]; 2], lo: f64, hi: f64, opts: &Options) -> [Outcome; 2] {
-    let [mut a, mut b] = x0.map(|x| Minimizer::new(x, lo, hi, opts));
+/// Minimizations over one box from each start of `x0`, two side by side
+/// at a time: each takes the steps [`minimize`] would take with the same
+/// objective from its start, but their evaluations are asked for
+/// together, so that the objective can run both at once; when one
+/// finishes, the next start takes its place. `f(x, g, fx)` evaluates the
+/// objective at each point of `x` — two, or one when no other start is
+/// left — writing each gradient into `g` and each value into `fx`, in the
+/// same order. The outcomes come in the starts' order.
+pub fn minimize_each(f: &mut PointsObjective, x0: &[&[f64]], lo: f64, hi: f64, opts: &Options) -> Vec<Outcome> {
+    let mut out: Vec<Option<Outcome>> = x0.iter().map(|_| None).collect();
+    let mut queue = x0.iter().enumerate();
+    let mut slots: [Option<(usize, Minimizer)>; 2] = [None, None];
     loop {
-        match (a.request(), b.request()) {
+        // Each slot holds a minimization that asks for a point, while starts are left.
+        for slot in &mut slots {
+            loop {
+                match slot {
+                    Some((_, m)) if !m.finished() => break,
+                    Some(_) => {
+                        let (i, m) = slot.take().expect("the slot holds one");
+                        out[i] = Some(m.finish());
+                    }
+                    None => match queue.next() {
+                        Some((i, x)) => *slot = Some((i, Minimizer::new(x, lo, hi, opts))),
+                        None => break,
+                    },
+                }
+            }
+        }
+        let [a, b] = &mut slots;
+        match (a.as_mut().and_then(|(_, m)| m.request()), b.as_mut().and_then(|(_, m)| m.request())) {
             (Some((xa, ga)), Some((xb, gb))) => {
                 let mut fx = [0.0; 2];
                 f(&[xa, xb], &mut [ga, gb], &mut fx);
-                a.reply(fx[0]);
-                b.reply(fx[1]);
+                slots.iter_mut().zip(fx).for_each(|(s, v)| s.as_mut().expect("both asked").1.reply(v));
             }
-            (Some((x, g)), None) => {
+            (Some((x, g)), None) | (None, Some((x, g))) => {
                 let mut fx = [0.0];
                 f(&[x], &mut [g], &mut fx);
-                a.reply(fx[0]);
-            }
-            (None, Some((x, g))) => {
-                let mut fx = [0.0];
-                f(&[x], &mut [g], &mut fx);
-                b.reply(fx[0]);
+                slots.iter_mut().flatten().for_each(|(_, m)| m.reply(fx[0]));
             }
             (None, None) => break,
         }
     }
-    [a.finish(), b.finish()]
+    out.into_iter().map(|o| o.expect("every start ran")).collect()
 }
 
 /// [`minimize`] driven from outside: it asks for the objective at one
@@ -215,6 +230,11 @@ impl Minimizer {
             State::Trial => Some((&self.xt, &mut self.gt)),
             State::Done(_) => None,
         }
+    }
+
+    /// Whether it has stopped (and asks for nothing more).
+    pub fn finished(&self) -> bool {
+        matches!(self.state, State::Done(_))
     }
 
     /// The objective at the point [`Minimizer::request`] gave, its
@@ -674,7 +694,7 @@ mod tests {
     }
 
     #[test]
-    fn two_minimizations_driven_side_by_side_are_each_their_own() {
+    fn minimizations_driven_side_by_side_are_each_their_own() {
         let f = |c: f64| {
             move |x: &[f64], g: &mut [f64]| -> f64 {
                 let mut s = 0.0;
@@ -696,11 +716,26 @@ mod tests {
                 fx[k] = if x[k].len() == 4 { fa(x[k], g[k]) } else { fb(x[k], g[k]) };
             }
         };
-        let [ga, gb] = minimize_pair(&mut both, [&[0.9; 4], &[-0.2; 3]], -1.0, 1.0, &opts);
-        assert_eq!(ga, minimize(&mut |x, g| fa(x, g), &[0.9; 4], -1.0, 1.0, &opts));
-        assert_eq!(gb, minimize(&mut |x, g| fb(x, g), &[-0.2; 3], -1.0, 1.0, &opts));
+        // Five starts: the odd one, and each one that finishes first, leave a place to the next.
+        let starts: [&[f64]; 5] = [&[0.9; 4], &[-0.2; 3], &[0.1, 0.5, -0.3, 0.8], &[2.0; 3], &[-1.0; 4]];
+        let got = minimize_each(&mut both, &starts, -1.0, 1.0, &opts);
+        assert_eq!(got.len(), starts.len());
+        for (o, x0) in got.iter().zip(starts) {
+            let alone = if x0.len() == 4 {
+                minimize(&mut |x, g| fa(x, g), x0, -1.0, 1.0, &opts)
+            } else {
+                minimize(&mut |x, g| fb(x, g), x0, -1.0, 1.0, &opts)
+            };
+            assert_eq!(*o, alone);
+            assert_ne!(o.evaluations, 0);
+        }
         assert!(calls[1] > 0 && calls[0] > 0, "{calls:?}: both the paired and the lone path ran");
-        assert_ne!(ga.evaluations, 0);
+        // Only the last minimization runs alone, once no start is left to pair it with.
+        let evals: Vec<usize> = got.iter().map(|o| o.evaluations).collect();
+        assert_eq!(2 * calls[1] + calls[0], evals.iter().sum::<usize>());
+        assert!(calls[0] <= *evals.iter().max().unwrap(), "{calls:?} {evals:?}");
+        let mut none = |_: &[&[f64]], _: &mut [&mut [f64]], _: &mut [f64]| panic!("no start, no evaluation");
+        assert!(minimize_each(&mut none, &[], -1.0, 1.0, &opts).is_empty());
     }
 
     /// The two-loop recursion as first written: every dot product a pass

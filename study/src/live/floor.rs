@@ -27,7 +27,7 @@ use crate::StudyError;
 use evflow_nodes::lab::profile::LabProfile;
 use evflow_nodes::metric::spectral_error::Band;
 use evflow_nodes::metric::spectrum::{SpectrumConfig, Window};
-use evflow_nodes::synth::lbfgsb::{minimize, minimize_pair, Options, Outcome};
+use evflow_nodes::synth::lbfgsb::{minimize_each, Options, Outcome};
 use evflow_nodes::synth::output_filter::OutputFilter;
 use evflow_nodes::synth::spectral::SpectralTarget;
 use evflow_nodes::synth::start::carrier_scaled;
@@ -237,7 +237,7 @@ impl Objective for Chain<'_> {
 /// gain `kappa` is positive) and every seed (cut or padded with 0 to `n`,
 /// within |u| ≤ 1), each followed by `iterations` of L-BFGS-B within
 /// |u| ≤ 1. The starts run two at a time, side by side
-/// ([`minimize_pair`], [`Objective::value_grad2`]): each start's optimum
+/// ([`minimize_each`], [`Objective::value_grad2`]): each start's optimum
 /// is the one it reaches alone.
 pub(crate) fn from_starts(
     objective: &mut impl Objective,
@@ -275,28 +275,15 @@ pub(crate) fn from_starts(
 }
 
 /// Minimizes `objective` within |u| ≤ 1 from each start, two starts at a
-/// time side by side ([`minimize_pair`], [`Objective::value_grad2`]): the
+/// time side by side ([`minimize_each`], [`Objective::value_grad2`]): the
 /// outcomes in the starts' order, each the one a run of its own reaches.
 pub(crate) fn minimize_starts(objective: &mut impl Objective, starts: &[&[f64]], opts: &Options) -> Vec<Outcome> {
-    let mut out = Vec::with_capacity(starts.len());
-    for pair in starts.chunks(2) {
-        match *pair {
-            [ua, ub] => {
-                let mut f = |x: &[&[f64]], g: &mut [&mut [f64]], fx: &mut [f64]| match (x, g) {
-                    ([xa, xb], [ga, gb]) => fx.copy_from_slice(&objective.value_grad2([xa, xb], [ga, gb])),
-                    ([x], [g]) => fx[0] = objective.value_grad(x, g),
-                    _ => {} // minimize_pair asks for one point or two.
-                };
-                out.extend(minimize_pair(&mut f, [ua, ub], -1.0, 1.0, opts));
-            }
-            _ => {
-                for u0 in pair {
-                    out.push(minimize(&mut |u: &[f64], g: &mut [f64]| objective.value_grad(u, g), u0, -1.0, 1.0, opts));
-                }
-            }
-        }
-    }
-    out
+    let mut f = |x: &[&[f64]], g: &mut [&mut [f64]], fx: &mut [f64]| match (x, g) {
+        ([xa, xb], [ga, gb]) => fx.copy_from_slice(&objective.value_grad2([xa, xb], [ga, gb])),
+        ([x], [g]) => fx[0] = objective.value_grad(x, g),
+        _ => {} // minimize_each asks for one point or two.
+    };
+    minimize_each(&mut f, starts, -1.0, 1.0, opts)
 }
 
 #[cfg(test)]

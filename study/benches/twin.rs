@@ -1,9 +1,10 @@
 //! One evaluation of the achievable floors' objective through the display's
-//! twin (`study/src/twin.rs`): a forward pass over a tribometer stroke
+//! twin (`study/src/twin/`): a forward pass over a tribometer stroke
 //! (85 g at 5 cm/s, the nominal profile, 4 substeps) and the backward pass
 //! of its gradient — the loop `report live` and `report textures` spend
 //! most of their time in; and both passes of two actuations side by side
-//! (`forward2`, `backward2`). `cargo bench -p evflow-study --bench twin`.
+//! (`forward2`, `backward2`), and four passes in the lanes of one
+//! register (`forward4`, `backward4`). `cargo bench -p evflow-study --bench twin`.
 
 use criterion::{criterion_group, criterion_main, Criterion};
 use evflow_nodes::lab::integrator::Method;
@@ -45,11 +46,28 @@ fn passes(c: &mut Criterion) {
     c.bench_function(&format!("twin/forward2, two passes of {n} samples"), |b| {
         b.iter(|| black_box(twin.forward2([black_box(&u), &u2], &load, &vel, [&mut tape, &mut tape2])))
     });
+    // Four in the lanes of one register (`forward4`): time per four.
+    let (u3, u4): (Vec<f64>, Vec<f64>) = (u.iter().map(|v| 0.5 * v).collect(), u.iter().map(|v| -v).collect());
+    let (mut tape3, mut tape4) = (Tape::default(), Tape::default());
+    c.bench_function(&format!("twin/forward4, four passes of {n} samples"), |b| {
+        b.iter(|| {
+            let tapes = [&mut tape, &mut tape2, &mut tape3, &mut tape4];
+            black_box(twin.forward4([black_box(&u), &u2, &u3, &u4], &load, &vel, tapes))
+        })
+    });
     let mut g2 = vec![0.0; n];
     c.bench_function(&format!("twin/backward2, two passes of {n} samples"), |b| {
         b.iter(|| {
             twin.backward2([&tape, &tape2], [black_box(&fbar), &fbar], [&mut g, &mut g2]);
             black_box(g[0] + g2[0])
+        })
+    });
+    let (mut g3, mut g4) = (vec![0.0; n], vec![0.0; n]);
+    c.bench_function(&format!("twin/backward4, four passes of {n} samples"), |b| {
+        b.iter(|| {
+            let tapes = [&tape, &tape2, &tape3, &tape4];
+            twin.backward4(tapes, [black_box(&fbar), &fbar, &fbar, &fbar], [&mut g, &mut g2, &mut g3, &mut g4]);
+            black_box(g[0] + g4[0])
         })
     });
 }

@@ -48,8 +48,8 @@ struct Chain {
     display: DisplayTwin,
     load: Vec<f64>,
     velocity: Vec<f64>,
-    /// The display's tapes of two evaluations side by side (one uses the first).
-    tape: [Tape; 2],
+    /// The display's tapes of up to four evaluations side by side (one uses the first).
+    tape: [Tape; 4],
     score: Score,
 }
 
@@ -70,11 +70,11 @@ impl Objective for Chain {
         self.display.objective_grad(u, path, &mut self.tape[0], g, |f| score.adjoint(&f, velocity))
     }
 
-    /// Both display passes side by side (each result the one it gives alone).
-    fn value_grad2(&mut self, u: [&[f64]; 2], g: [&mut [f64]; 2]) -> [f64; 2] {
+    /// The display passes side by side (each result the one it gives alone).
+    fn value_grad_each(&mut self, u: &[&[f64]], g: &mut [&mut [f64]], fx: &mut [f64]) {
         let (score, velocity) = (&mut self.score, &self.velocity[..]);
         let path = (&self.load[..], velocity);
-        self.display.objective_grad2(u, path, &mut self.tape, g, |f| score.adjoint(&f, velocity))
+        self.display.objective_grad_each(u, path, &mut self.tape, g, fx, |f| score.adjoint(&f, velocity))
     }
 }
 

@@ -107,18 +107,26 @@ pub fn minimize(f: &mut dyn FnMut(&[f64], &mut [f64]) -> f64, x0: &[f64], lo: f6
 /// the gradient at `x[k]` into `g[k]` and the value into `fx[k]`.
 pub type PointsObjective<'a> = dyn FnMut(&[&[f64]], &mut [&mut [f64]], &mut [f64]) + 'a;
 
-/// Minimizations over one box from each start of `x0`, two side by side
-/// at a time: each takes the steps [`minimize`] would take with the same
-/// objective from its start, but their evaluations are asked for
-/// together, so that the objective can run both at once; when one
-/// finishes, the next start takes its place. `f(x, g, fx)` evaluates the
-/// objective at each point of `x` — two, or one when no other start is
-/// left — writing each gradient into `g` and each value into `fx`, in the
-/// same order. The outcomes come in the starts' order.
-pub fn minimize_each(f: &mut PointsObjective, x0: &[&[f64]], lo: f64, hi: f64, opts: &Options) -> Vec<Outcome> {
+/// Minimizations over one box from each start of `x0`, up to `width`
+/// (at least 1) side by side: each takes the steps [`minimize`] would
+/// take with the same objective from its start, but their evaluations are
+/// asked for together, so that the objective can run them at once; when
+/// one finishes, the next start takes its place. `f(x, g, fx)` evaluates
+/// the objective at each point of `x` — `width`, or fewer once no start
+/// is left — writing each gradient into `g` and each value into `fx`, in
+/// the same order. The outcomes come in the starts' order.
+pub fn minimize_each(
+    f: &mut PointsObjective,
+    x0: &[&[f64]],
+    width: usize,
+    lo: f64,
+    hi: f64,
+    opts: &Options,
+) -> Vec<Outcome> {
     let mut out: Vec<Option<Outcome>> = x0.iter().map(|_| None).collect();
     let mut queue = x0.iter().enumerate();
-    let mut slots: [Option<(usize, Minimizer)>; 2] = [None, None];
+    let mut slots: Vec<Option<(usize, Minimizer)>> = (0..width.max(1)).map(|_| None).collect();
+    let mut fx = Vec::with_capacity(slots.len());
     loop {
         // Each slot holds a minimization that asks for a point, while starts are left.
         for slot in &mut slots {
@@ -136,20 +144,16 @@ pub fn minimize_each(f: &mut PointsObjective, x0: &[&[f64]], lo: f64, hi: f64, o
                 }
             }
         }
-        let [a, b] = &mut slots;
-        match (a.as_mut().and_then(|(_, m)| m.request()), b.as_mut().and_then(|(_, m)| m.request())) {
-            (Some((xa, ga)), Some((xb, gb))) => {
-                let mut fx = [0.0; 2];
-                f(&[xa, xb], &mut [ga, gb], &mut fx);
-                slots.iter_mut().zip(fx).for_each(|(s, v)| s.as_mut().expect("both asked").1.reply(v));
-            }
-            (Some((x, g)), None) | (None, Some((x, g))) => {
-                let mut fx = [0.0];
-                f(&[x], &mut [g], &mut fx);
-                slots.iter_mut().flatten().for_each(|(_, m)| m.reply(fx[0]));
-            }
-            (None, None) => break,
+        let (x, mut g): (Vec<&[f64]>, Vec<&mut [f64]>) =
+            slots.iter_mut().flatten().filter_map(|(_, m)| m.request()).unzip();
+        if x.is_empty() {
+            break;
         }
+        fx.clear();
+        fx.resize(x.len(), 0.0);
+        f(&x, &mut g, &mut fx);
+        let asked = slots.iter_mut().flatten().filter(|(_, m)| !m.finished());
+        asked.zip(&fx).for_each(|((_, m), &v)| m.reply(v));
     }
     out.into_iter().map(|o| o.expect("every start ran")).collect()
 }
@@ -708,34 +712,37 @@ mod tests {
         };
         let (fa, fb) = (f(0.3), f(-0.7));
         let opts = Options::default();
-        let mut calls = [0usize; 2];
-        let mut both = |x: &[&[f64]], g: &mut [&mut [f64]], fx: &mut [f64]| {
-            calls[x.len() - 1] += 1;
-            // a has four variables, b three: each point tells whose it is.
-            for k in 0..x.len() {
-                fx[k] = if x[k].len() == 4 { fa(x[k], g[k]) } else { fb(x[k], g[k]) };
-            }
-        };
         // Five starts: the odd one, and each one that finishes first, leave a place to the next.
         let starts: [&[f64]; 5] = [&[0.9; 4], &[-0.2; 3], &[0.1, 0.5, -0.3, 0.8], &[2.0; 3], &[-1.0; 4]];
-        let got = minimize_each(&mut both, &starts, -1.0, 1.0, &opts);
-        assert_eq!(got.len(), starts.len());
-        for (o, x0) in got.iter().zip(starts) {
-            let alone = if x0.len() == 4 {
-                minimize(&mut |x, g| fa(x, g), x0, -1.0, 1.0, &opts)
-            } else {
-                minimize(&mut |x, g| fb(x, g), x0, -1.0, 1.0, &opts)
+        let alone: Vec<Outcome> = starts
+            .iter()
+            .map(|x0| match x0.len() {
+                4 => minimize(&mut |x, g| fa(x, g), x0, -1.0, 1.0, &opts),
+                _ => minimize(&mut |x, g| fb(x, g), x0, -1.0, 1.0, &opts),
+            })
+            .collect();
+        let evals: Vec<usize> = alone.iter().map(|o| o.evaluations).collect();
+        for width in 1..=4 {
+            let mut calls = [0usize; 4];
+            let mut both = |x: &[&[f64]], g: &mut [&mut [f64]], fx: &mut [f64]| {
+                calls[x.len() - 1] += 1;
+                // a has four variables, b three: each point tells whose it is.
+                for k in 0..x.len() {
+                    fx[k] = if x[k].len() == 4 { fa(x[k], g[k]) } else { fb(x[k], g[k]) };
+                }
             };
-            assert_eq!(*o, alone);
-            assert_ne!(o.evaluations, 0);
+            let got = minimize_each(&mut both, &starts, width, -1.0, 1.0, &opts);
+            assert_eq!(got, alone, "width {width}");
+            assert!(calls[width - 1] > 0 && calls[width..].iter().all(|c| *c == 0), "width {width}: {calls:?}");
+            let asked: usize = calls.iter().enumerate().map(|(k, c)| (k + 1) * c).sum();
+            assert_eq!(asked, evals.iter().sum::<usize>(), "width {width}");
+            // Fewer than `width` run only once no start is left: at most
+            // the longest run's evaluations.
+            let fewer: usize = calls[..width - 1].iter().sum();
+            assert!(fewer <= *evals.iter().max().unwrap(), "width {width}: {calls:?} {evals:?}");
         }
-        assert!(calls[1] > 0 && calls[0] > 0, "{calls:?}: both the paired and the lone path ran");
-        // Only the last minimization runs alone, once no start is left to pair it with.
-        let evals: Vec<usize> = got.iter().map(|o| o.evaluations).collect();
-        assert_eq!(2 * calls[1] + calls[0], evals.iter().sum::<usize>());
-        assert!(calls[0] <= *evals.iter().max().unwrap(), "{calls:?} {evals:?}");
         let mut none = |_: &[&[f64]], _: &mut [&mut [f64]], _: &mut [f64]| panic!("no start, no evaluation");
-        assert!(minimize_each(&mut none, &[], -1.0, 1.0, &opts).is_empty());
+        assert!(minimize_each(&mut none, &[], 2, -1.0, 1.0, &opts).is_empty());
     }
 
     /// The two-loop recursion as first written: every dot product a pass

@@ -81,7 +81,7 @@ struct Chain<'a> {
     stroke: &'a Stroke,
     target: SpectralTarget,
     /// The twin's tapes of two evaluations side by side (one uses the first).
-    tape: [Tape; 2],
+    tape: [Tape; 4],
 }
 
 impl Chain<'_> {
@@ -201,11 +201,13 @@ pub(crate) trait Objective {
     }
     /// The objective at `u`, its gradient into `g`.
     fn value_grad(&mut self, u: &[f64], g: &mut [f64]) -> f64;
-    /// [`Objective::value_grad`] at two points (an objective that can run
-    /// both at once does; each result must be the one it gives alone).
-    fn value_grad2(&mut self, u: [&[f64]; 2], g: [&mut [f64]; 2]) -> [f64; 2] {
-        let [ga, gb] = g;
-        [self.value_grad(u[0], ga), self.value_grad(u[1], gb)]
+    /// [`Objective::value_grad`] at each of up to four points, values into
+    /// `fx` (an objective that can run them at once does; each result
+    /// must be the one it gives alone).
+    fn value_grad_each(&mut self, u: &[&[f64]], g: &mut [&mut [f64]], fx: &mut [f64]) {
+        for ((u, g), fx) in u.iter().zip(g.iter_mut()).zip(fx.iter_mut()) {
+            *fx = self.value_grad(u, g);
+        }
     }
 }
 
@@ -224,11 +226,11 @@ impl Objective for Chain<'_> {
         self.twin.objective_grad(u, path, &mut self.tape[0], g, |y| force_adjoint(filter, target, y))
     }
 
-    /// Both twin passes side by side (each result the one it gives alone).
-    fn value_grad2(&mut self, u: [&[f64]; 2], g: [&mut [f64]; 2]) -> [f64; 2] {
+    /// The twin passes side by side (each result the one it gives alone).
+    fn value_grad_each(&mut self, u: &[&[f64]], g: &mut [&mut [f64]], fx: &mut [f64]) {
         let (filter, target) = (&self.filter, &mut self.target);
         let path = (&self.stroke.load[..], &self.stroke.velocity[..]);
-        self.twin.objective_grad2(u, path, &mut self.tape, g, |y| force_adjoint(filter, target, y))
+        self.twin.objective_grad_each(u, path, &mut self.tape, g, fx, |y| force_adjoint(filter, target, y))
     }
 }
 
@@ -236,8 +238,8 @@ impl Objective for Chain<'_> {
 /// starts at [`START_OFFSETS`] for the goal's `magnitude` (when the carrier
 /// gain `kappa` is positive) and every seed (cut or padded with 0 to `n`,
 /// within |u| ≤ 1), each followed by `iterations` of L-BFGS-B within
-/// |u| ≤ 1. The starts run two at a time, side by side
-/// ([`minimize_each`], [`Objective::value_grad2`]): each start's optimum
+/// |u| ≤ 1. The starts run four at a time, side by side
+/// ([`minimize_each`], [`Objective::value_grad_each`]): each start's optimum
 /// is the one it reaches alone.
 pub(crate) fn from_starts(
     objective: &mut impl Objective,
@@ -274,17 +276,16 @@ pub(crate) fn from_starts(
         .collect())
 }
 
-/// Minimizes `objective` within |u| ≤ 1 from each start, two starts at a
-/// time side by side ([`minimize_each`], [`Objective::value_grad2`]): the
+/// Minimizes `objective` within |u| ≤ 1 from each start, four starts at a
+/// time side by side ([`minimize_each`], [`Objective::value_grad_each`]): the
 /// outcomes in the starts' order, each the one a run of its own reaches.
 pub(crate) fn minimize_starts(objective: &mut impl Objective, starts: &[&[f64]], opts: &Options) -> Vec<Outcome> {
-    let mut f = |x: &[&[f64]], g: &mut [&mut [f64]], fx: &mut [f64]| match (x, g) {
-        ([xa, xb], [ga, gb]) => fx.copy_from_slice(&objective.value_grad2([xa, xb], [ga, gb])),
-        ([x], [g]) => fx[0] = objective.value_grad(x, g),
-        _ => {} // minimize_each asks for one point or two.
-    };
-    minimize_each(&mut f, starts, -1.0, 1.0, opts)
+    let mut f = |x: &[&[f64]], g: &mut [&mut [f64]], fx: &mut [f64]| objective.value_grad_each(x, g, fx);
+    minimize_each(&mut f, starts, SIDE_BY_SIDE, -1.0, 1.0, opts)
 }
+
+/// How many of the floors' minimizations run side by side.
+const SIDE_BY_SIDE: usize = 4;
 
 #[cfg(test)]
 mod tests {

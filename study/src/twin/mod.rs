@@ -28,6 +28,8 @@ use evflow_nodes::lab::electrical::{self, Circuit};
 use evflow_nodes::lab::expm::zoh;
 use evflow_nodes::lab::profile::LabProfile;
 
+mod lanes;
+
 /// States of the circuit with its relaxation state.
 const NE: usize = electrical::NR;
 
@@ -228,25 +230,53 @@ impl DisplayTwin {
         j
     }
 
-    /// [`Self::objective_grad`] at two actuations of one length, their
-    /// passes side by side ([`Self::forward2`], [`Self::backward2`]); each
-    /// value and gradient the one it gives alone.
-    pub fn objective_grad2(
+    /// [`Self::objective_grad`] at each of up to four actuations of one
+    /// length, values into `fx`: their forward passes side by side
+    /// ([`Self::forward4`], [`Self::backward4`] for three or four, the
+    /// fourth lane then a copy of the third; [`Self::forward2`],
+    /// [`Self::backward2`] for two); each value and gradient the one it
+    /// gives alone. `adjoint` is called for each force in order.
+    pub fn objective_grad_each(
         &self,
-        u: [&[f64]; 2],
+        u: &[&[f64]],
         (load, velocity): (&[f64], &[f64]),
-        tapes: &mut [Tape; 2],
-        g: [&mut [f64]; 2],
+        tapes: &mut [Tape; 4],
+        g: &mut [&mut [f64]],
+        fx: &mut [f64],
         mut adjoint: impl FnMut(Vec<f64>) -> (f64, Vec<f64>),
-    ) -> [f64; 2] {
-        let [ta, tb] = tapes;
-        let [fa, fb] = self.forward2(u, load, velocity, [&mut *ta, &mut *tb]);
-        let ((ja, bara), (jb, barb)) = (adjoint(fa), adjoint(fb));
-        let [ga, gb] = g;
-        ga.iter_mut().for_each(|v| *v = 0.0);
-        gb.iter_mut().for_each(|v| *v = 0.0);
-        self.backward2([&*ta, &*tb], [&bara, &barb], [ga, gb]);
-        [ja, jb]
+    ) {
+        let m = u.len();
+        assert!(m <= 4 && g.len() == m && fx.len() == m, "up to four actuations, each with its gradient and value");
+        let [ta, tb, tc, td] = tapes;
+        let forces: Vec<Vec<f64>> = match u {
+            [] => return,
+            [x] => vec![self.forward(x, load, velocity, ta)],
+            [x, y] => self.forward2([x, y], load, velocity, [ta, tb]).into(),
+            [x, y, z, rest @ ..] => {
+                let w = rest.first().unwrap_or(z);
+                let mut f: Vec<Vec<f64>> = self.forward4([x, y, z, w], load, velocity, [ta, tb, tc, td]).into();
+                f.truncate(m);
+                f
+            }
+        };
+        let mut bars = Vec::with_capacity(m);
+        for (k, f) in forces.into_iter().enumerate() {
+            let (j, bar) = adjoint(f);
+            fx[k] = j;
+            bars.push(bar);
+        }
+        g.iter_mut().for_each(|gk| gk.iter_mut().for_each(|v| *v = 0.0));
+        let tapes = [&*ta, &*tb, &*tc, &*td];
+        match (&mut *g, &bars[..]) {
+            ([ga], [ba]) => self.backward(tapes[0], ba, ga),
+            ([ga, gb], [ba, bb]) => self.backward2([tapes[0], tapes[1]], [ba, bb], [ga, gb]),
+            ([ga, gb, gc], [ba, bb, bc]) => {
+                let mut spare = vec![0.0; gc.len()];
+                self.backward4([tapes[0], tapes[1], tapes[2], tapes[2]], [ba, bb, bc, bc], [ga, gb, gc, &mut spare]);
+            }
+            ([ga, gb, gc, gd], [ba, bb, bc, bd]) => self.backward4(tapes, [ba, bb, bc, bd], [ga, gb, gc, gd]),
+            _ => unreachable!("one gradient per actuation, up to four"),
+        }
     }
 
     /// [`Self::forward_body`] compiled for AVX2 and FMA, so that the
@@ -292,11 +322,7 @@ impl DisplayTwin {
             let v = if velocity[n].is_finite() { velocity[n] } else { 0.0 };
             let (mut vcmd, mut a) = ([0.0; K], [0.0; K]);
             for k in 0..K {
-                let un = if n >= self.delay { u[k][n - self.delay] } else { 0.0 };
-                let uu = if un.is_finite() { un } else { 0.0 };
-                let raw = self.gain * uu + self.offset;
-                vcmd[k] = raw.clamp(-self.vmax, self.vmax);
-                a[k] = self.lag_factor(tapes[k], n, v, vcmd[k] != raw);
+                (vcmd[k], a[k]) = self.drive(u[k], n, v, tapes[k]);
             }
             for _ in 0..self.sub {
                 for k in 0..K {
@@ -308,6 +334,18 @@ impl DisplayTwin {
             }
         }
         out
+    }
+
+    /// Sample n's amplifier voltage V_cmd for actuation `u` (delayed,
+    /// non-finite samples 0, clamped to the amplifier's range) and its lag
+    /// factor for holder velocity `v` ([`Self::lag_factor`]).
+    #[inline(always)]
+    fn drive(&self, u: &[f64], n: usize, v: f64, tape: &mut Tape) -> (f64, f64) {
+        let un = if n >= self.delay { u[n - self.delay] } else { 0.0 };
+        let uu = if un.is_finite() { un } else { 0.0 };
+        let raw = self.gain * uu + self.offset;
+        let vcmd = raw.clamp(-self.vmax, self.vmax);
+        (vcmd, self.lag_factor(tape, n, v, vcmd != raw))
     }
 
     /// Sample n's lag factor a = exp(−ω_c(v)·h) for holder velocity `v`,
@@ -607,7 +645,7 @@ impl SensorTwin {
 }
 
 #[cfg(test)]
-mod tests {
+pub(crate) mod tests {
     use super::*;
     use evflow_nodes::lab::display_model::DisplayModel;
     use evflow_nodes::lab::integrator::Method;
@@ -616,7 +654,7 @@ mod tests {
 
     /// Every profile shipped in graphs/lab (new ones included as they
     /// come), and the nominal one with a 2 ms latency.
-    fn shipped() -> Vec<(String, LabProfile)> {
+    pub(super) fn shipped() -> Vec<(String, LabProfile)> {
         let dir = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../graphs/lab");
         let mut files: Vec<_> = std::fs::read_dir(&dir).unwrap().filter_map(|e| e.ok().map(|e| e.path())).collect();
         files.sort();
@@ -631,7 +669,7 @@ mod tests {
         v
     }
 
-    fn pass(profile: &LabProfile, mass_g: f64, speed: f64) -> (Vec<f64>, Vec<f64>) {
+    pub(super) fn pass(profile: &LabProfile, mass_g: f64, speed: f64) -> (Vec<f64>, Vec<f64>) {
         let mut t = TribometerModel::new(profile, 1000.0, speed * 1e-2, mass_g * 1e-3, 1, Method::Exact, 4).unwrap();
         let n = t.total_samples().unwrap() as usize;
         let (mut load, mut vel) = (Vec::with_capacity(n), Vec::with_capacity(n));
@@ -643,7 +681,7 @@ mod tests {
         (load, vel)
     }
 
-    fn actuation(n: usize) -> Vec<f64> {
+    pub(super) fn actuation(n: usize) -> Vec<f64> {
         let mut r = evflow_nodes::rng::Rng::new(4);
         (0..n).map(|k| if k % 2 == 0 { 0.6 } else { -0.6 } * (1.0 + 0.4 * (2.0 * r.uniform() - 1.0))).collect()
     }

@@ -4,13 +4,15 @@
 //! of its gradient — the loop `report live` and `report textures` spend
 //! most of their time in; and both passes of two actuations side by side
 //! (`forward2`, `backward2`), and four passes in the lanes of one
-//! register (`forward4`, `backward4`). `cargo bench -p evflow-study --bench twin`.
+//! register (`forward4`, `backward4`); and the objective's value and
+//! gradient at one, two and four actuations (`objective_grad_each`).
+//! `cargo bench -p evflow-study --bench twin`.
 
 use criterion::{criterion_group, criterion_main, Criterion};
 use evflow_nodes::lab::integrator::Method;
 use evflow_nodes::lab::profile::LabProfile;
 use evflow_nodes::lab::tribometer_model::TribometerModel;
-use evflow_study::twin::{DisplayTwin, Tape};
+use evflow_study::twin::{DisplayTwin, Tape, Tapes};
 use std::hint::black_box;
 
 fn passes(c: &mut Criterion) {
@@ -72,5 +74,42 @@ fn passes(c: &mut Criterion) {
     });
 }
 
-criterion_group!(benches, passes);
+/// An objective's value and gradient (J = Σ f̄·F) at one, two and four
+/// actuations side by side (`objective_grad_each`): time per call.
+fn objectives(c: &mut Criterion) {
+    let profile = LabProfile::default();
+    let mut t = TribometerModel::new(&profile, 1000.0, 0.05, 0.085, 1, Method::Exact, 4).expect("a valid stroke");
+    let n = t.total_samples().expect("a finite stroke") as usize;
+    let (mut load, mut vel) = (Vec::with_capacity(n), Vec::with_capacity(n));
+    for _ in 0..n {
+        let (_, v, l) = t.step();
+        vel.push(v);
+        load.push(l);
+    }
+    let mut r = evflow_nodes::rng::Rng::new(4);
+    let us: Vec<Vec<f64>> = (0..4)
+        .map(|k| {
+            (0..n).map(|j| if j % 2 == 0 { 0.6 } else { -0.6 } * (1.0 - 0.2 * k as f64 + 0.3 * r.uniform())).collect()
+        })
+        .collect();
+    let fbar: Vec<f64> = (0..n).map(|k| ((k * 7 % 13) as f64 - 6.0) * 0.1).collect();
+    let twin = DisplayTwin::new(&profile, 1000.0, 4).expect("the nominal profile");
+    let mut tapes = Tapes::default();
+    let mut gs: Vec<Vec<f64>> = (0..4).map(|_| vec![0.0; n]).collect();
+    for m in [1, 2, 4] {
+        c.bench_function(&format!("twin/objective, {m} side by side"), |b| {
+            b.iter(|| {
+                let u: Vec<&[f64]> = us[..m].iter().map(|u| black_box(u.as_slice())).collect();
+                let mut g: Vec<&mut [f64]> = gs[..m].iter_mut().map(|g| g.as_mut_slice()).collect();
+                let mut fx = [0.0; 4];
+                twin.objective_grad_each(&u, (&load, &vel), &mut tapes, &mut g, &mut fx[..m], |f| {
+                    (f.iter().zip(&fbar).map(|(a, b)| a * b).sum(), fbar.clone())
+                });
+                black_box(fx)
+            })
+        });
+    }
+}
+
+criterion_group!(benches, passes, objectives);
 criterion_main!(benches);

@@ -20,7 +20,7 @@ use super::graphs::{run_graph, value, Sets};
 use super::live::floor::{minimize_starts, Objective};
 use super::recordings::{self, channel};
 use super::row::{Achievable, Reading, RowInputs};
-use super::twin::{DisplayTwin, SensorTwin, Tape};
+use super::twin::{DisplayTwin, SensorTwin, Tapes};
 use super::StudyError;
 use evflow_nodes::lab::integrator::Method;
 use evflow_nodes::lab::profile::LabProfile;
@@ -49,7 +49,7 @@ struct Chain {
     load: Vec<f64>,
     velocity: Vec<f64>,
     /// The display's tapes of up to four evaluations side by side (one uses the first).
-    tape: [Tape; 4],
+    tape: Tapes,
     score: Score,
 }
 
@@ -67,7 +67,7 @@ impl Objective for Chain {
     fn value_grad(&mut self, u: &[f64], g: &mut [f64]) -> f64 {
         let (score, velocity) = (&mut self.score, &self.velocity[..]);
         let path = (&self.load[..], velocity);
-        self.display.objective_grad(u, path, &mut self.tape[0], g, |f| score.adjoint(&f, velocity))
+        self.display.objective_grad(u, path, self.tape.first(), g, |f| score.adjoint(&f, velocity))
     }
 
     /// The display passes side by side (each result the one it gives alone).
@@ -105,8 +105,8 @@ impl Chain {
     fn carrier_gain(&mut self) -> f64 {
         let n = self.load.len();
         let unit: Vec<f64> = (0..n).map(|k| if k % 2 == 0 { 1.0 } else { -1.0 }).collect();
-        let on = self.display.forward(&unit, &self.load, &self.velocity, &mut self.tape[0]);
-        let off = self.display.forward(&vec![0.0; n], &self.load, &self.velocity, &mut self.tape[0]);
+        let on = self.display.forward(&unit, &self.load, &self.velocity, self.tape.first());
+        let off = self.display.forward(&vec![0.0; n], &self.load, &self.velocity, self.tape.first());
         let (mut s, mut c) = (0.0, 0);
         for k in 0..n {
             if self.score.keep[k] {

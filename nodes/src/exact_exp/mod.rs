@@ -29,6 +29,7 @@
 //! exponent could leave the range and is rebuilt (`special_case`), with
 //! the subnormal results rounded once; ±∞ and NaN as IEEE says.
 
+pub mod lanes;
 mod table;
 
 use table::TAB;
@@ -154,7 +155,7 @@ mod tests {
     /// sweeps where the lab's models call exp (−50 … 1), the whole range,
     /// every binade, each k mod 128 at and around its rounding points,
     /// ulp walks across each threshold, and the special values.
-    fn sweep() -> Vec<f64> {
+    pub(super) fn sweep() -> Vec<f64> {
         let n = |k: usize| if cfg!(miri) { k / 1000 } else { k };
         let mut xs = vec![0.0, -0.0, f64::INFINITY, f64::NEG_INFINITY, f64::MIN_POSITIVE, 5e-324, f64::MAX, f64::MIN];
         let mut r = Rng::new(13);

@@ -22,7 +22,7 @@
 //! seeded with, before the noise.
 
 use super::stroke::Stroke;
-use crate::twin::{DisplayTwin, Tape};
+use crate::twin::{DisplayTwin, Tapes};
 use crate::StudyError;
 use evflow_nodes::lab::profile::LabProfile;
 use evflow_nodes::metric::spectral_error::Band;
@@ -81,12 +81,12 @@ struct Chain<'a> {
     stroke: &'a Stroke,
     target: SpectralTarget,
     /// The twin's tapes of two evaluations side by side (one uses the first).
-    tape: [Tape; 4],
+    tape: Tapes,
 }
 
 impl Chain<'_> {
     fn force(&mut self, u: &[f64]) -> Vec<f64> {
-        self.twin.forward(u, &self.stroke.load, &self.stroke.velocity, &mut self.tape[0])
+        self.twin.forward(u, &self.stroke.load, &self.stroke.velocity, self.tape.first())
     }
 
     /// The steady friction a unit Nyquist-rate carrier adds on this stroke
@@ -223,7 +223,7 @@ impl Objective for Chain<'_> {
     fn value_grad(&mut self, u: &[f64], g: &mut [f64]) -> f64 {
         let (filter, target) = (&self.filter, &mut self.target);
         let path = (&self.stroke.load[..], &self.stroke.velocity[..]);
-        self.twin.objective_grad(u, path, &mut self.tape[0], g, |y| force_adjoint(filter, target, y))
+        self.twin.objective_grad(u, path, self.tape.first(), g, |y| force_adjoint(filter, target, y))
     }
 
     /// The twin passes side by side (each result the one it gives alone).

@@ -10,11 +10,77 @@
 //! so each force and each tape is the one [`DisplayTwin::forward`] gives,
 //! bit for bit. Where the scalar code branches (stuck or sliding, the
 //! clamps), every lane computes both sides and keeps its own; the sliding
-//! friction's exponential is taken lane by lane with the scalar
-//! [`exact_exp::exp_body`](evflow_nodes::exact_exp::exp_body). On CPUs
-//! without AVX2 and FMA, the four passes run as two pairs.
+//! friction's exponential is the scalar one's lanes
+//! ([`evflow_nodes::exact_exp::lanes`]). On CPUs without AVX2 and FMA, the
+//! four passes run as two pairs.
 
-use super::{DisplayTwin, Tape};
+use super::{Branch, DisplayTwin, Step, Tape};
+
+/// One substep of four passes, lane k for pass k: what
+/// [`super::Step`] records, as the lanes' backward pass reads it.
+#[derive(Debug, Clone, Copy)]
+struct LaneStep {
+    xm0: [[f64; 4]; 2],
+    vr: [f64; 4],
+    npre: [f64; 4],
+    req_sign: [f64; 4],
+    slide: [f64; 4],
+    slide_exp: [f64; 4],
+    /// All bits set in the lanes whose contact stuck, in those clipped.
+    stuck: [f64; 4],
+    clipped: [f64; 4],
+}
+
+impl LaneStep {
+    /// Pass k's step.
+    fn step(&self, k: usize) -> Step {
+        let set = |m: &[f64; 4]| m[k].to_bits() != 0;
+        Step {
+            xm0: [self.xm0[0][k], self.xm0[1][k]],
+            vr: self.vr[k],
+            npre: self.npre[k],
+            branch: match (set(&self.stuck), set(&self.clipped)) {
+                (true, _) => Branch::Stuck,
+                (false, true) => Branch::Clipped,
+                (false, false) => Branch::Slide,
+            },
+            req_sign: self.req_sign[k],
+            slide: self.slide[k],
+            slide_exp: self.slide_exp[k],
+        }
+    }
+
+    /// The four passes' steps side by side.
+    fn of(s: [&Step; 4]) -> Self {
+        let flag = |b: Branch| s.map(|s| if s.branch == b { f64::from_bits(u64::MAX) } else { 0.0 });
+        LaneStep {
+            xm0: [s.map(|s| s.xm0[0]), s.map(|s| s.xm0[1])],
+            vr: s.map(|s| s.vr),
+            npre: s.map(|s| s.npre),
+            req_sign: s.map(|s| s.req_sign),
+            slide: s.map(|s| s.slide),
+            slide_exp: s.map(|s| s.slide_exp),
+            stuck: flag(Branch::Stuck),
+            clipped: flag(Branch::Clipped),
+        }
+    }
+}
+
+/// The tapes of up to four forward passes side by side, for
+/// [`DisplayTwin::objective_grad_each`]: each pass's own (its lag factors),
+/// and the contact steps of four passes in lanes.
+#[derive(Debug, Clone, Default)]
+pub struct Tapes {
+    each: [Tape; 4],
+    steps: Vec<LaneStep>,
+}
+
+impl Tapes {
+    /// The first pass's tape (for a pass run alone).
+    pub fn first(&mut self) -> &mut Tape {
+        &mut self.each[0]
+    }
+}
 
 impl DisplayTwin {
     /// [`Self::forward`] of four actuations of one length along the same
@@ -24,8 +90,15 @@ impl DisplayTwin {
         debug_assert!(u.iter().all(|x| x.len() == u[0].len()));
         #[cfg(target_arch = "x86_64")]
         if evflow_nodes::cpu::has_avx2_fma() {
+            let mut steps = Vec::new();
+            let [ta, tb, tc, td] = tapes;
+            let mut tapes = [ta, tb, tc, td];
             // SAFETY: the CPU has AVX2 and FMA.
-            return unsafe { avx2::forward4(self, u, load, velocity, tapes) };
+            let f = unsafe { avx2::forward4(self, u, load, velocity, &mut tapes, &mut steps) };
+            for (k, tape) in tapes.iter_mut().enumerate() {
+                tape.steps.extend(steps.iter().map(|s| s.step(k)));
+            }
+            return f;
         }
         let [ta, tb, tc, td] = tapes;
         let [fa, fb] = self.forward2([u[0], u[1]], load, velocity, [ta, tb]);
@@ -40,20 +113,97 @@ impl DisplayTwin {
         debug_assert!(tapes.iter().all(|t| t.samples.len() == tapes[0].samples.len()));
         #[cfg(target_arch = "x86_64")]
         if evflow_nodes::cpu::has_avx2_fma() {
+            let steps: Vec<LaneStep> = (0..tapes[0].steps.len())
+                .map(|i| LaneStep::of([&tapes[0].steps[i], &tapes[1].steps[i], &tapes[2].steps[i], &tapes[3].steps[i]]))
+                .collect();
             // SAFETY: the CPU has AVX2 and FMA.
-            return unsafe { avx2::backward4(self, tapes, fbar, ubar) };
+            return unsafe { avx2::backward4(self, tapes, &steps, fbar, ubar) };
         }
         let [ga, gb, gc, gd] = ubar;
         self.backward2([tapes[0], tapes[1]], [fbar[0], fbar[1]], [ga, gb]);
         self.backward2([tapes[2], tapes[3]], [fbar[2], fbar[3]], [gc, gd]);
+    }
+
+    /// [`Self::objective_grad`] at each of up to four actuations of one
+    /// length, values into `fx`: their passes side by side (three or four
+    /// in lanes, the fourth lane then a copy of the third, their steps kept
+    /// in lanes; two as [`Self::forward2`], [`Self::backward2`]); each value
+    /// and gradient the one it gives alone. `adjoint` is called for each
+    /// force in order.
+    #[allow(clippy::too_many_arguments)]
+    pub fn objective_grad_each(
+        &self,
+        u: &[&[f64]],
+        (load, velocity): (&[f64], &[f64]),
+        tapes: &mut Tapes,
+        g: &mut [&mut [f64]],
+        fx: &mut [f64],
+        mut adjoint: impl FnMut(Vec<f64>) -> (f64, Vec<f64>),
+    ) {
+        let m = u.len();
+        assert!(m <= 4 && g.len() == m && fx.len() == m, "up to four actuations, each with its gradient and value");
+        let lanes = m >= 3 && cfg!(target_arch = "x86_64") && evflow_nodes::cpu::has_avx2_fma();
+        let [ta, tb, tc, td] = &mut tapes.each;
+        let forces: Vec<Vec<f64>> = match u {
+            [] => return,
+            [x] => vec![self.forward(x, load, velocity, ta)],
+            [x, y] => self.forward2([x, y], load, velocity, [ta, tb]).into(),
+            [x, y, z, rest @ ..] => {
+                let w = rest.first().unwrap_or(z);
+                let mut f: Vec<Vec<f64>> = if lanes {
+                    #[cfg(target_arch = "x86_64")]
+                    // SAFETY: the CPU has AVX2 and FMA (`lanes`).
+                    let f = unsafe {
+                        avx2::forward4(self, [x, y, z, w], load, velocity, &mut [ta, tb, tc, td], &mut tapes.steps)
+                    };
+                    #[cfg(not(target_arch = "x86_64"))]
+                    let f = unreachable!("lanes only on x86-64");
+                    f.into()
+                } else {
+                    self.forward4([x, y, z, w], load, velocity, [ta, tb, tc, td]).into()
+                };
+                f.truncate(m);
+                f
+            }
+        };
+        let mut bars = Vec::with_capacity(m);
+        for (k, f) in forces.into_iter().enumerate() {
+            let (j, bar) = adjoint(f);
+            fx[k] = j;
+            bars.push(bar);
+        }
+        g.iter_mut().for_each(|gk| gk.iter_mut().for_each(|v| *v = 0.0));
+        let [ta, tb, tc, td] = &tapes.each;
+        let mut spare = Vec::new();
+        let (fb, gs): ([&[f64]; 4], [&mut [f64]; 4]) = match (&mut *g, &bars[..]) {
+            ([ga], [ba]) => return self.backward(ta, ba, ga),
+            ([ga, gb], [ba, bb]) => return self.backward2([ta, tb], [ba, bb], [ga, gb]),
+            ([ga, gb, gc], [ba, bb, bc]) => {
+                spare.resize(gc.len(), 0.0);
+                ([ba, bb, bc, bc], [ga, gb, gc, &mut spare])
+            }
+            ([ga, gb, gc, gd], [ba, bb, bc, bd]) => ([ba, bb, bc, bd], [ga, gb, gc, gd]),
+            _ => unreachable!("one gradient per actuation, up to four"),
+        };
+        let each = [ta, tb, tc, if m == 3 { tc } else { td }];
+        if lanes {
+            #[cfg(target_arch = "x86_64")]
+            // SAFETY: the CPU has AVX2 and FMA (`lanes`).
+            unsafe {
+                avx2::backward4(self, each, &tapes.steps, fb, gs)
+            };
+        } else {
+            self.backward4(each, fb, gs);
+        }
     }
 }
 
 #[cfg(target_arch = "x86_64")]
 mod avx2 {
     use super::super::electrical::{GAP, RELAX};
-    use super::super::{Branch, DisplayTwin, Step, Tape, NE};
-    use evflow_nodes::exact_exp;
+    use super::super::{DisplayTwin, Tape, NE};
+    use super::LaneStep;
+    use evflow_nodes::exact_exp::lanes::exp4;
     use evflow_nodes::lab::electrical;
     use std::arch::x86_64::*;
 
@@ -148,22 +298,16 @@ mod avx2 {
         unsafe { _mm256_cmp_pd::<_CMP_GT_OQ>(a, b) }
     }
 
-    /// All ones in lane k where `set[k]`.
+    /// Every bit set.
     #[inline(always)]
-    fn flags(set: [bool; 4]) -> V {
-        let m = set.map(|b| if b { -1i64 } else { 0 });
-        unsafe { _mm256_castsi256_pd(_mm256_set_epi64x(m[3], m[2], m[1], m[0])) }
+    fn all_ones() -> V {
+        unsafe { _mm256_castsi256_pd(_mm256_set1_epi64x(-1)) }
     }
 
     /// a < b (false where either is NaN).
     #[inline(always)]
     fn lt(a: V, b: V) -> V {
         unsafe { _mm256_cmp_pd::<_CMP_LT_OQ>(a, b) }
-    }
-
-    #[inline(always)]
-    fn mask(a: V) -> i32 {
-        unsafe { _mm256_movemask_pd(a) }
     }
 
     /// The four passes' state, lane k for pass k.
@@ -184,14 +328,18 @@ mod avx2 {
         u: [&[f64]; 4],
         load: &[f64],
         velocity: &[f64],
-        mut tapes: [&mut Tape; 4],
+        tapes: &mut [&mut Tape; 4],
+        steps: &mut Vec<LaneStep>,
     ) -> [Vec<f64>; 4] {
         let len = u[0].len();
+        // Each pass's tape keeps its lag factors; the steps go to `steps`.
         for tape in tapes.iter_mut() {
             tape.steps.clear();
             tape.samples.truncate(len);
             tape.velocity.truncate(len);
         }
+        steps.clear();
+        steps.reserve(len * t.sub);
         // The scalar sums start where `Iterator::sum` starts.
         let sum0 = splat(std::iter::empty::<f64>().sum());
         let vr0 = electrical::force_voltage(&t.x0);
@@ -199,12 +347,7 @@ mod avx2 {
         for (x, x0) in xe.iter_mut().zip(t.x0) {
             *x = splat(x0);
         }
-        let mut r = Runs {
-            xe,
-            fl: splat(t.ke * vr0 * vr0),
-            xm: [splat(0.0); 2],
-            stuck: _mm256_castsi256_pd(_mm256_set1_epi64x(-1)),
-        };
+        let mut r = Runs { xe, fl: splat(t.ke * vr0 * vr0), xm: [splat(0.0); 2], stuck: all_ones() };
         let mut out: [Vec<f64>; 4] = Default::default();
         for o in out.iter_mut() {
             o.reserve(len);
@@ -221,7 +364,7 @@ mod avx2 {
             // The holder's term of the contact's free motion: one path, one value.
             let g = super::super::matvec(&t.gam_m, &[v, 0.0]);
             for _ in 0..t.sub {
-                substep(t, &mut r, sum0, vcmd, a, one_minus_a, ld, v, g, &mut tapes);
+                steps.push(substep(t, &mut r, sum0, vcmd, a, one_minus_a, ld, v, g));
             }
             let f = lanes(add(mul(splat(t.k), r.xm[0]), mul(splat(t.c), sub(splat(v), r.xm[1]))));
             for k in 0..4 {
@@ -245,8 +388,7 @@ mod avx2 {
         ld: f64,
         v: f64,
         g: [f64; 3],
-        tapes: &mut [&mut Tape; 4],
-    ) {
+    ) -> LaneStep {
         let ds_df = t.gam_m[2][1];
         // (No closures here: they would not be compiled for AVX2.)
         let mut y = [sum0; NE];
@@ -267,11 +409,8 @@ mod avx2 {
         // scalar pass takes it where the contact slides or starts to).
         let speed = abs(r.xm[1]);
         let q = div(speed, splat(t.v_s));
-        let mut e = lanes(mul(neg(q), q));
-        for x in e.iter_mut() {
-            *x = exact_exp::exp_body(*x);
-        }
-        let e = of(e);
+        // SAFETY: the CPU has AVX2 and FMA (`forward4`'s condition).
+        let e = unsafe { exp4(mul(neg(q), q)) };
         let fs_slide = add(mul(add(splat(t.mu_k), mul(splat(t.mu_s - t.mu_k), e)), nf), mul(splat(t.viscous), speed));
         let limit = select(r.stuck, mul(splat(t.mu_s), nf), fs_slide);
         let xa = [r.xm[0], r.xm[1], splat(0.0)];
@@ -288,35 +427,23 @@ mod avx2 {
         let fs = max(fs_slide, splat(0.0));
         let sign = signum(required);
         let force = mul(min(fs, req_abs), sign);
-        let slides = mask(lt(fs, req_abs));
         let xm0 = r.xm;
+        let zero = splat(0.0);
         r.xm = [
             select(stick, add(xm0[0], splat(v * t.hs)), add(free[0], mul(splat(t.gam_m[0][1]), force))),
             select(stick, splat(0.0), add(free[1], mul(splat(t.gam_m[1][1]), force))),
         ];
         r.stuck = stick;
-        let sticks = mask(stick);
-        let (x0, x1, vr, npre) = (lanes(xm0[0]), lanes(xm0[1]), lanes(vr), lanes(npre));
-        let (sign, fs_slide, e) = (lanes(sign), lanes(fs_slide), lanes(e));
-        for (k, tape) in tapes.iter_mut().enumerate() {
-            let stuck = sticks >> k & 1 != 0;
-            let branch = if stuck {
-                Branch::Stuck
-            } else if slides >> k & 1 != 0 {
-                Branch::Slide
-            } else {
-                Branch::Clipped
-            };
-            let (slide, slide_exp) = if stuck { (0.0, 0.0) } else { (fs_slide[k], e[k]) };
-            tape.steps.push(Step {
-                xm0: [x0[k], x1[k]],
-                vr: vr[k],
-                npre: npre[k],
-                branch,
-                req_sign: sign[k],
-                slide,
-                slide_exp,
-            });
+        let clipped = unsafe { _mm256_andnot_pd(_mm256_or_pd(stick, lt(fs, req_abs)), all_ones()) };
+        LaneStep {
+            xm0: [lanes(xm0[0]), lanes(xm0[1])],
+            vr: lanes(vr),
+            npre: lanes(npre),
+            req_sign: lanes(sign),
+            slide: lanes(select(stick, zero, fs_slide)),
+            slide_exp: lanes(select(stick, zero, e)),
+            stuck: lanes(stick),
+            clipped: lanes(clipped),
         }
     }
 
@@ -331,7 +458,13 @@ mod avx2 {
     ///
     /// The CPU must have AVX2 and FMA.
     #[target_feature(enable = "avx2,fma")]
-    pub(super) unsafe fn backward4(t: &DisplayTwin, tapes: [&Tape; 4], fbar: [&[f64]; 4], ubar: [&mut [f64]; 4]) {
+    pub(super) unsafe fn backward4(
+        t: &DisplayTwin,
+        tapes: [&Tape; 4],
+        steps: &[LaneStep],
+        fbar: [&[f64]; 4],
+        ubar: [&mut [f64]; 4],
+    ) {
         let zero = splat(0.0);
         let mut b = Adjoints { bxe: [zero; NE], bfl: zero, bxm: [zero; 2] };
         let [ga, gb, gc, gd] = ubar;
@@ -343,9 +476,7 @@ mod avx2 {
             let a = of([0, 1, 2, 3].map(|k| tapes[k].samples[n].0));
             let mut bvcmd = zero;
             for j in (0..t.sub).rev() {
-                let i = n * t.sub + j;
-                let steps = [&tapes[0].steps[i], &tapes[1].steps[i], &tapes[2].steps[i], &tapes[3].steps[i]];
-                substep_adjoint(t, &mut b, steps, a, &mut bvcmd);
+                substep_adjoint(t, &mut b, &steps[n * t.sub + j], a, &mut bvcmd);
             }
             let bv = lanes(bvcmd);
             for (k, ub) in ubar.iter_mut().enumerate() {
@@ -360,17 +491,18 @@ mod avx2 {
     /// `DisplayTwin::substep_adjoint` (both sides of its branches taken,
     /// each lane keeping its own).
     #[inline(always)]
-    fn substep_adjoint(t: &DisplayTwin, b: &mut Adjoints, s: [&Step; 4], a: V, bvcmd: &mut V) {
+    fn substep_adjoint(t: &DisplayTwin, b: &mut Adjoints, s: &LaneStep, a: V, bvcmd: &mut V) {
         let zero = splat(0.0);
         let ds_df = t.gam_m[2][1];
-        let stuck = flags(s.map(|s| s.branch == Branch::Stuck));
-        let clipped = flags(s.map(|s| s.branch == Branch::Clipped));
-        let sliding = flags(s.map(|s| s.branch == Branch::Slide && s.slide > 0.0));
-        let xm01 = of(s.map(|s| s.xm0[1]));
-        let npre = of(s.map(|s| s.npre));
-        let req_sign = of(s.map(|s| s.req_sign));
-        let slide_exp = of(s.map(|s| s.slide_exp));
-        let vr = of(s.map(|s| s.vr));
+        let (stuck, clipped) = (of(s.stuck), of(s.clipped));
+        let slide = of(s.slide);
+        // Sliding with a positive friction (neither stuck nor clipped).
+        let sliding = unsafe { _mm256_andnot_pd(_mm256_or_pd(stuck, clipped), gt(slide, zero)) };
+        let xm01 = of(s.xm0[1]);
+        let npre = of(s.npre);
+        let req_sign = of(s.req_sign);
+        let slide_exp = of(s.slide_exp);
+        let vr = of(s.vr);
         // (5) contact step, sliding side.
         let bforce = add(mul(b.bxm[0], splat(t.gam_m[0][1])), mul(b.bxm[1], splat(t.gam_m[1][1])));
         let bfree2 = select(clipped, add(zero, div(neg(bforce), splat(ds_df))), zero);
@@ -493,7 +625,7 @@ mod tests {
             })
             .collect();
         for m in 1..=4 {
-            let mut tapes: [Tape; 4] = Default::default();
+            let mut tapes = super::Tapes::default();
             let mut gs: Vec<Vec<f64>> = (0..m).map(|_| vec![7.0; n]).collect();
             let mut g: Vec<&mut [f64]> = gs.iter_mut().map(|g| g.as_mut_slice()).collect();
             let mut fx = vec![0.0; m];

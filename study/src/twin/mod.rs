@@ -29,6 +29,7 @@ use evflow_nodes::lab::expm::zoh;
 use evflow_nodes::lab::profile::LabProfile;
 
 mod lanes;
+pub use lanes::Tapes;
 
 /// States of the circuit with its relaxation state.
 const NE: usize = electrical::NR;
@@ -228,55 +229,6 @@ impl DisplayTwin {
         g.iter_mut().for_each(|v| *v = 0.0);
         self.backward(tape, &fbar, g);
         j
-    }
-
-    /// [`Self::objective_grad`] at each of up to four actuations of one
-    /// length, values into `fx`: their forward passes side by side
-    /// ([`Self::forward4`], [`Self::backward4`] for three or four, the
-    /// fourth lane then a copy of the third; [`Self::forward2`],
-    /// [`Self::backward2`] for two); each value and gradient the one it
-    /// gives alone. `adjoint` is called for each force in order.
-    pub fn objective_grad_each(
-        &self,
-        u: &[&[f64]],
-        (load, velocity): (&[f64], &[f64]),
-        tapes: &mut [Tape; 4],
-        g: &mut [&mut [f64]],
-        fx: &mut [f64],
-        mut adjoint: impl FnMut(Vec<f64>) -> (f64, Vec<f64>),
-    ) {
-        let m = u.len();
-        assert!(m <= 4 && g.len() == m && fx.len() == m, "up to four actuations, each with its gradient and value");
-        let [ta, tb, tc, td] = tapes;
-        let forces: Vec<Vec<f64>> = match u {
-            [] => return,
-            [x] => vec![self.forward(x, load, velocity, ta)],
-            [x, y] => self.forward2([x, y], load, velocity, [ta, tb]).into(),
-            [x, y, z, rest @ ..] => {
-                let w = rest.first().unwrap_or(z);
-                let mut f: Vec<Vec<f64>> = self.forward4([x, y, z, w], load, velocity, [ta, tb, tc, td]).into();
-                f.truncate(m);
-                f
-            }
-        };
-        let mut bars = Vec::with_capacity(m);
-        for (k, f) in forces.into_iter().enumerate() {
-            let (j, bar) = adjoint(f);
-            fx[k] = j;
-            bars.push(bar);
-        }
-        g.iter_mut().for_each(|gk| gk.iter_mut().for_each(|v| *v = 0.0));
-        let tapes = [&*ta, &*tb, &*tc, &*td];
-        match (&mut *g, &bars[..]) {
-            ([ga], [ba]) => self.backward(tapes[0], ba, ga),
-            ([ga, gb], [ba, bb]) => self.backward2([tapes[0], tapes[1]], [ba, bb], [ga, gb]),
-            ([ga, gb, gc], [ba, bb, bc]) => {
-                let mut spare = vec![0.0; gc.len()];
-                self.backward4([tapes[0], tapes[1], tapes[2], tapes[2]], [ba, bb, bc, bc], [ga, gb, gc, &mut spare]);
-            }
-            ([ga, gb, gc, gd], [ba, bb, bc, bd]) => self.backward4(tapes, [ba, bb, bc, bd], [ga, gb, gc, gd]),
-            _ => unreachable!("one gradient per actuation, up to four"),
-        }
     }
 
     /// [`Self::forward_body`] compiled for AVX2 and FMA, so that the

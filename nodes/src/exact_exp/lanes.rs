@@ -14,11 +14,12 @@ use std::arch::x86_64::*;
 ///
 /// # Safety
 ///
-/// The CPU must have AVX2 and FMA.
+/// Code compiled with AVX2 and FMA calls it as a safe function; elsewhere
+/// the CPU must have both.
 #[cfg(target_arch = "x86_64")]
 #[inline]
 #[target_feature(enable = "avx2,fma")]
-pub unsafe fn exp4(x: __m256d) -> __m256d {
+pub fn exp4(x: __m256d) -> __m256d {
     let abstop = _mm256_and_si256(_mm256_srli_epi64::<52>(_mm256_castpd_si256(x)), _mm256_set1_epi64x(0x7ff));
     // 512 ≤ |x|, ∞ and NaN (exponent 0x408 and up): the scalar function's special paths.
     if _mm256_movemask_pd(_mm256_castsi256_pd(_mm256_cmpgt_epi64(abstop, _mm256_set1_epi64x(0x407)))) != 0 {
@@ -52,7 +53,7 @@ pub unsafe fn exp4(x: __m256d) -> __m256d {
 #[cfg(target_arch = "x86_64")]
 #[cold]
 #[target_feature(enable = "avx2,fma")]
-unsafe fn scalar(x: __m256d) -> __m256d {
+fn scalar(x: __m256d) -> __m256d {
     let mut v = [0.0; 4];
     // SAFETY: `v` holds four f64.
     unsafe { _mm256_storeu_pd(v.as_mut_ptr(), x) };

@@ -142,26 +142,14 @@ impl DisplayTwin {
     ) {
         let m = u.len();
         assert!(m <= 4 && g.len() == m && fx.len() == m, "up to four actuations, each with its gradient and value");
-        let lanes = m >= 3 && cfg!(target_arch = "x86_64") && evflow_nodes::cpu::has_avx2_fma();
-        let [ta, tb, tc, td] = &mut tapes.each;
+        let [ta, tb, ..] = &mut tapes.each;
         let forces: Vec<Vec<f64>> = match u {
             [] => return,
             [x] => vec![self.forward(x, load, velocity, ta)],
             [x, y] => self.forward2([x, y], load, velocity, [ta, tb]).into(),
             [x, y, z, rest @ ..] => {
                 let w = rest.first().unwrap_or(z);
-                let mut f: Vec<Vec<f64>> = if lanes {
-                    #[cfg(target_arch = "x86_64")]
-                    // SAFETY: the CPU has AVX2 and FMA (`lanes`).
-                    let f = unsafe {
-                        avx2::forward4(self, [x, y, z, w], load, velocity, &mut [ta, tb, tc, td], &mut tapes.steps)
-                    };
-                    #[cfg(not(target_arch = "x86_64"))]
-                    let f = unreachable!("lanes only on x86-64");
-                    f.into()
-                } else {
-                    self.forward4([x, y, z, w], load, velocity, [ta, tb, tc, td]).into()
-                };
+                let mut f: Vec<Vec<f64>> = self.forward_lanes([x, y, z, w], load, velocity, tapes).into();
                 f.truncate(m);
                 f
             }
@@ -173,28 +161,41 @@ impl DisplayTwin {
             bars.push(bar);
         }
         g.iter_mut().for_each(|gk| gk.iter_mut().for_each(|v| *v = 0.0));
-        let [ta, tb, tc, td] = &tapes.each;
+        let [ta, tb, ..] = &tapes.each;
         let mut spare = Vec::new();
-        let (fb, gs): ([&[f64]; 4], [&mut [f64]; 4]) = match (&mut *g, &bars[..]) {
-            ([ga], [ba]) => return self.backward(ta, ba, ga),
-            ([ga, gb], [ba, bb]) => return self.backward2([ta, tb], [ba, bb], [ga, gb]),
+        match (&mut *g, &bars[..]) {
+            ([ga], [ba]) => self.backward(ta, ba, ga),
+            ([ga, gb], [ba, bb]) => self.backward2([ta, tb], [ba, bb], [ga, gb]),
             ([ga, gb, gc], [ba, bb, bc]) => {
                 spare.resize(gc.len(), 0.0);
-                ([ba, bb, bc, bc], [ga, gb, gc, &mut spare])
+                self.backward_lanes(tapes, [ba, bb, bc, bc], [ga, gb, gc, &mut spare]);
             }
-            ([ga, gb, gc, gd], [ba, bb, bc, bd]) => ([ba, bb, bc, bd], [ga, gb, gc, gd]),
+            ([ga, gb, gc, gd], [ba, bb, bc, bd]) => self.backward_lanes(tapes, [ba, bb, bc, bd], [ga, gb, gc, gd]),
             _ => unreachable!("one gradient per actuation, up to four"),
-        };
-        let each = [ta, tb, tc, if m == 3 { tc } else { td }];
-        if lanes {
-            #[cfg(target_arch = "x86_64")]
-            // SAFETY: the CPU has AVX2 and FMA (`lanes`).
-            unsafe {
-                avx2::backward4(self, each, &tapes.steps, fb, gs)
-            };
-        } else {
-            self.backward4(each, fb, gs);
         }
+    }
+
+    /// Four passes side by side into `tapes`: in lanes, their steps kept
+    /// in lanes, on CPUs with AVX2 and FMA; else [`Self::forward4`].
+    fn forward_lanes(&self, u: [&[f64]; 4], load: &[f64], velocity: &[f64], tapes: &mut Tapes) -> [Vec<f64>; 4] {
+        let [ta, tb, tc, td] = &mut tapes.each;
+        #[cfg(target_arch = "x86_64")]
+        if evflow_nodes::cpu::has_avx2_fma() {
+            // SAFETY: the CPU has AVX2 and FMA.
+            return unsafe { avx2::forward4(self, u, load, velocity, &mut [ta, tb, tc, td], &mut tapes.steps) };
+        }
+        self.forward4(u, load, velocity, [ta, tb, tc, td])
+    }
+
+    /// The gradients of the four passes [`Self::forward_lanes`] recorded.
+    fn backward_lanes(&self, tapes: &Tapes, fbar: [&[f64]; 4], ubar: [&mut [f64]; 4]) {
+        let [ta, tb, tc, td] = &tapes.each;
+        #[cfg(target_arch = "x86_64")]
+        if evflow_nodes::cpu::has_avx2_fma() {
+            // SAFETY: the CPU has AVX2 and FMA.
+            return unsafe { avx2::backward4(self, [ta, tb, tc, td], &tapes.steps, fbar, ubar) };
+        }
+        self.backward4([ta, tb, tc, td], fbar, ubar)
     }
 }
 
@@ -210,76 +211,93 @@ mod avx2 {
     /// Four lanes.
     type V = __m256d;
 
+    // The helpers below run AVX2 instructions: they are called only from
+    // `forward4` and `backward4` (compiled for AVX2 and FMA, entered on
+    // CPUs with both) and the tests (after the same check), and inline
+    // there. (Helpers compiled for AVX2 themselves would inline later,
+    // and the passes measured 4 % slower.)
+
     #[inline(always)]
     fn splat(x: f64) -> V {
-        // SAFETY (every helper here): called only from `forward4`, which
-        // runs on CPUs with AVX2 and FMA.
+        // SAFETY: AVX2 and FMA are there (above).
         unsafe { _mm256_set1_pd(x) }
     }
 
     #[inline(always)]
     fn add(a: V, b: V) -> V {
+        // SAFETY: AVX2 and FMA are there (above).
         unsafe { _mm256_add_pd(a, b) }
     }
 
     #[inline(always)]
     fn sub(a: V, b: V) -> V {
+        // SAFETY: AVX2 and FMA are there (above).
         unsafe { _mm256_sub_pd(a, b) }
     }
 
     #[inline(always)]
     fn mul(a: V, b: V) -> V {
+        // SAFETY: AVX2 and FMA are there (above).
         unsafe { _mm256_mul_pd(a, b) }
     }
 
     #[inline(always)]
     fn div(a: V, b: V) -> V {
+        // SAFETY: AVX2 and FMA are there (above).
         unsafe { _mm256_div_pd(a, b) }
     }
 
     #[inline(always)]
     fn lanes(a: V) -> [f64; 4] {
         let mut out = [0.0; 4];
+        // SAFETY: `out` holds four f64.
         unsafe { _mm256_storeu_pd(out.as_mut_ptr(), a) };
         out
     }
 
     #[inline(always)]
     fn of(x: [f64; 4]) -> V {
+        // SAFETY: `x` holds four f64.
         unsafe { _mm256_loadu_pd(x.as_ptr()) }
     }
 
     /// `a` where `mask` is set, else `b`.
     #[inline(always)]
     fn select(mask: V, a: V, b: V) -> V {
+        // SAFETY: AVX2 and FMA are there (above).
         unsafe { _mm256_blendv_pd(b, a, mask) }
     }
 
     #[inline(always)]
     fn abs(a: V) -> V {
+        // SAFETY: AVX2 and FMA are there (above).
         unsafe { _mm256_andnot_pd(_mm256_set1_pd(-0.0), a) }
     }
 
     #[inline(always)]
     fn neg(a: V) -> V {
+        // SAFETY: AVX2 and FMA are there (above).
         unsafe { _mm256_xor_pd(_mm256_set1_pd(-0.0), a) }
     }
 
     /// `f64::max` lane by lane: the other operand where one is NaN.
     #[inline(always)]
     pub(super) fn max(x: V, y: V) -> V {
+        // SAFETY: AVX2 and FMA are there (above).
         unsafe { select(_mm256_cmp_pd::<_CMP_UNORD_Q>(x, x), y, _mm256_max_pd(y, x)) }
     }
 
     /// `f64::min` lane by lane: the other operand where one is NaN.
     #[inline(always)]
     pub(super) fn min(x: V, y: V) -> V {
+        // SAFETY: AVX2 and FMA are there (above).
         unsafe { select(_mm256_cmp_pd::<_CMP_UNORD_Q>(x, x), y, _mm256_min_pd(y, x)) }
     }
 
     /// `f64::signum` lane by lane: ±1 by the sign bit, NaN where NaN.
     #[inline(always)]
     pub(super) fn signum(x: V) -> V {
+        // SAFETY: AVX2 and FMA are there (above).
         unsafe {
             let one = _mm256_or_pd(_mm256_and_pd(_mm256_set1_pd(-0.0), x), _mm256_set1_pd(1.0));
             select(_mm256_cmp_pd::<_CMP_UNORD_Q>(x, x), _mm256_set1_pd(f64::NAN), one)
@@ -289,24 +307,28 @@ mod avx2 {
     /// a ≤ b (false where either is NaN).
     #[inline(always)]
     fn le(a: V, b: V) -> V {
+        // SAFETY: AVX2 and FMA are there (above).
         unsafe { _mm256_cmp_pd::<_CMP_LE_OQ>(a, b) }
     }
 
     /// a > b (false where either is NaN).
     #[inline(always)]
     fn gt(a: V, b: V) -> V {
+        // SAFETY: AVX2 and FMA are there (above).
         unsafe { _mm256_cmp_pd::<_CMP_GT_OQ>(a, b) }
     }
 
     /// Every bit set.
     #[inline(always)]
     fn all_ones() -> V {
+        // SAFETY: AVX2 and FMA are there (above).
         unsafe { _mm256_castsi256_pd(_mm256_set1_epi64x(-1)) }
     }
 
     /// a < b (false where either is NaN).
     #[inline(always)]
     fn lt(a: V, b: V) -> V {
+        // SAFETY: AVX2 and FMA are there (above).
         unsafe { _mm256_cmp_pd::<_CMP_LT_OQ>(a, b) }
     }
 
@@ -319,11 +341,10 @@ mod avx2 {
         stuck: V,
     }
 
-    /// # Safety
-    ///
-    /// The CPU must have AVX2 and FMA.
+    /// The four passes (`DisplayTwin::forward4`), their steps into
+    /// `steps`, each pass's lag factors into its tape.
     #[target_feature(enable = "avx2,fma")]
-    pub(super) unsafe fn forward4(
+    pub(super) fn forward4(
         t: &DisplayTwin,
         u: [&[f64]; 4],
         load: &[f64],
@@ -375,7 +396,7 @@ mod avx2 {
     }
 
     /// One substep of the four passes: circuit, lag, load, contact;
-    /// recorded lane by lane.
+    /// recorded in lanes.
     #[inline(always)]
     #[allow(clippy::too_many_arguments)]
     fn substep(
@@ -409,7 +430,7 @@ mod avx2 {
         // scalar pass takes it where the contact slides or starts to).
         let speed = abs(r.xm[1]);
         let q = div(speed, splat(t.v_s));
-        // SAFETY: the CPU has AVX2 and FMA (`forward4`'s condition).
+        // SAFETY: AVX2 and FMA are there (`forward4`'s condition).
         let e = unsafe { exp4(mul(neg(q), q)) };
         let fs_slide = add(mul(add(splat(t.mu_k), mul(splat(t.mu_s - t.mu_k), e)), nf), mul(splat(t.viscous), speed));
         let limit = select(r.stuck, mul(splat(t.mu_s), nf), fs_slide);
@@ -434,6 +455,7 @@ mod avx2 {
             select(stick, splat(0.0), add(free[1], mul(splat(t.gam_m[1][1]), force))),
         ];
         r.stuck = stick;
+        // SAFETY: as above.
         let clipped = unsafe { _mm256_andnot_pd(_mm256_or_pd(stick, lt(fs, req_abs)), all_ones()) };
         LaneStep {
             xm0: [lanes(xm0[0]), lanes(xm0[1])],
@@ -454,11 +476,10 @@ mod avx2 {
         bxm: [V; 2],
     }
 
-    /// # Safety
-    ///
-    /// The CPU must have AVX2 and FMA.
+    /// The four passes' gradients (`DisplayTwin::backward4`) from their
+    /// steps in lanes and their tapes' lag factors.
     #[target_feature(enable = "avx2,fma")]
-    pub(super) unsafe fn backward4(
+    pub(super) fn backward4(
         t: &DisplayTwin,
         tapes: [&Tape; 4],
         steps: &[LaneStep],
@@ -497,6 +518,7 @@ mod avx2 {
         let (stuck, clipped) = (of(s.stuck), of(s.clipped));
         let slide = of(s.slide);
         // Sliding with a positive friction (neither stuck nor clipped).
+        // SAFETY: AVX2 and FMA are there (`backward4`'s condition).
         let sliding = unsafe { _mm256_andnot_pd(_mm256_or_pd(stuck, clipped), gt(slide, zero)) };
         let xm01 = of(s.xm0[1]);
         let npre = of(s.npre);

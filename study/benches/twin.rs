@@ -15,7 +15,8 @@ use evflow_nodes::lab::tribometer_model::TribometerModel;
 use evflow_study::twin::{DisplayTwin, Tape, Tapes};
 use std::hint::black_box;
 
-fn passes(c: &mut Criterion) {
+/// The nominal profile's twin and its tribometer stroke (load, velocity).
+fn stroke() -> (DisplayTwin, Vec<f64>, Vec<f64>) {
     let profile = LabProfile::default();
     let mut t = TribometerModel::new(&profile, 1000.0, 0.05, 0.085, 1, Method::Exact, 4).expect("a valid stroke");
     let n = t.total_samples().expect("a finite stroke") as usize;
@@ -25,11 +26,16 @@ fn passes(c: &mut Criterion) {
         vel.push(v);
         load.push(l);
     }
+    (DisplayTwin::new(&profile, 1000.0, 4).expect("the nominal profile"), load, vel)
+}
+
+fn passes(c: &mut Criterion) {
+    let (twin, load, vel) = stroke();
+    let n = load.len();
     let mut r = evflow_nodes::rng::Rng::new(4);
     let u: Vec<f64> =
         (0..n).map(|k| if k % 2 == 0 { 0.6 } else { -0.6 } * (1.0 + 0.4 * (2.0 * r.uniform() - 1.0))).collect();
     let fbar: Vec<f64> = (0..n).map(|k| ((k * 7 % 13) as f64 - 6.0) * 0.1).collect();
-    let twin = DisplayTwin::new(&profile, 1000.0, 4).expect("the nominal profile");
     let mut tape = Tape::default();
     c.bench_function(&format!("twin/forward, {n} samples"), |b| {
         b.iter(|| black_box(twin.forward(black_box(&u), &load, &vel, &mut tape)))
@@ -77,15 +83,8 @@ fn passes(c: &mut Criterion) {
 /// An objective's value and gradient (J = Σ f̄·F) at one, two and four
 /// actuations side by side (`objective_grad_each`): time per call.
 fn objectives(c: &mut Criterion) {
-    let profile = LabProfile::default();
-    let mut t = TribometerModel::new(&profile, 1000.0, 0.05, 0.085, 1, Method::Exact, 4).expect("a valid stroke");
-    let n = t.total_samples().expect("a finite stroke") as usize;
-    let (mut load, mut vel) = (Vec::with_capacity(n), Vec::with_capacity(n));
-    for _ in 0..n {
-        let (_, v, l) = t.step();
-        vel.push(v);
-        load.push(l);
-    }
+    let (twin, load, vel) = stroke();
+    let n = load.len();
     let mut r = evflow_nodes::rng::Rng::new(4);
     let us: Vec<Vec<f64>> = (0..4)
         .map(|k| {
@@ -93,7 +92,6 @@ fn objectives(c: &mut Criterion) {
         })
         .collect();
     let fbar: Vec<f64> = (0..n).map(|k| ((k * 7 % 13) as f64 - 6.0) * 0.1).collect();
-    let twin = DisplayTwin::new(&profile, 1000.0, 4).expect("the nominal profile");
     let mut tapes = Tapes::default();
     let mut gs: Vec<Vec<f64>> = (0..4).map(|_| vec![0.0; n]).collect();
     for m in [1, 2, 4] {

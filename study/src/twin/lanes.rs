@@ -568,7 +568,7 @@ mod avx2 {
 
 #[cfg(test)]
 mod tests {
-    use super::super::tests::{actuation, pass, shipped};
+    use super::super::tests::{actuation, bits, pass, shipped, two_actuations};
     use super::super::{Branch, DisplayTwin, Tape};
 
     #[test]
@@ -576,12 +576,9 @@ mod tests {
         // On every shipped profile: four actuations (one past the
         // amplifier's range, one with non-finite samples), fresh and
         // reused tapes; forces and tapes as each pass alone.
-        let bits = |v: &[f64]| v.iter().map(|x| x.to_bits()).collect::<Vec<_>>();
         for (name, profile) in shipped() {
-            let (load, vel) = pass(&profile, 120.0, 8.0);
+            let (load, vel, ua, ub) = two_actuations(&profile);
             let n = load.len();
-            let ua = actuation(n);
-            let ub: Vec<f64> = ua.iter().enumerate().map(|(k, v)| if k % 7 < 3 { -0.6 * v } else { 0.9 }).collect();
             let uc: Vec<f64> = ua.iter().map(|v| 40.0 * v).collect();
             let ud: Vec<f64> =
                 ua.iter().enumerate().map(|(k, v)| if k % 97 == 5 { f64::NAN } else { -0.3 * v }).collect();
@@ -626,7 +623,6 @@ mod tests {
     #[test]
     fn objectives_side_by_side_are_each_the_objective_alone() {
         // One to four actuations: values and gradients as each alone.
-        let bits = |v: &[f64]| v.iter().map(|x| x.to_bits()).collect::<Vec<_>>();
         let profile = evflow_nodes::lab::profile::LabProfile::default();
         let (load, vel) = pass(&profile, 85.0, 5.0);
         let n = load.len();

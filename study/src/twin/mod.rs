@@ -633,6 +633,20 @@ pub(crate) mod tests {
         (load, vel)
     }
 
+    /// A profile's heavy, fast stroke and two actuations along it (the
+    /// second with runs held at 0.9).
+    pub(super) fn two_actuations(profile: &LabProfile) -> (Vec<f64>, Vec<f64>, Vec<f64>, Vec<f64>) {
+        let (load, vel) = pass(profile, 120.0, 8.0);
+        let ua = actuation(load.len());
+        let ub: Vec<f64> = ua.iter().enumerate().map(|(k, v)| if k % 7 < 3 { -0.6 * v } else { 0.9 }).collect();
+        (load, vel, ua, ub)
+    }
+
+    /// Each value's bits.
+    pub(super) fn bits(v: &[f64]) -> Vec<u64> {
+        v.iter().map(|x| x.to_bits()).collect()
+    }
+
     pub(super) fn actuation(n: usize) -> Vec<f64> {
         let mut r = evflow_nodes::rng::Rng::new(4);
         (0..n).map(|k| if k % 2 == 0 { 0.6 } else { -0.6 } * (1.0 + 0.4 * (2.0 * r.uniform() - 1.0))).collect()
@@ -712,7 +726,6 @@ pub(crate) mod tests {
             twin.backward(tape, &fbar, &mut g);
             (f, g)
         };
-        let bits = |v: &[f64]| v.iter().map(|x| x.to_bits()).collect::<Vec<_>>();
         let mut kept = Tape::default();
         for round in 0..3 {
             if round == 2 {
@@ -741,7 +754,6 @@ pub(crate) mod tests {
             let (mut g1, mut g2) = (vec![0.0; n], vec![0.0; n]);
             twin.backward(&t1, &fbar, &mut g1);
             twin.backward_body([&t2], [&fbar], [&mut g2]);
-            let bits = |v: &[f64]| v.iter().map(|x| x.to_bits()).collect::<Vec<_>>();
             assert_eq!(bits(&f1), bits(&f2), "{name}: forward");
             assert_eq!(bits(&g1), bits(&g2), "{name}: backward");
             assert!(t1.steps.iter().any(|s| s.branch == Branch::Slide), "{name}: no sliding step");
@@ -752,12 +764,9 @@ pub(crate) mod tests {
     fn two_passes_side_by_side_are_each_the_single_pass_bit_for_bit() {
         // Both builds (the bodies alone are the portable one), on every
         // shipped profile: forces, tapes and gradients as one pass alone.
-        let bits = |v: &[f64]| v.iter().map(|x| x.to_bits()).collect::<Vec<_>>();
         for (name, profile) in shipped() {
-            let (load, vel) = pass(&profile, 120.0, 8.0);
+            let (load, vel, ua, ub) = two_actuations(&profile);
             let n = load.len();
-            let ua = actuation(n);
-            let ub: Vec<f64> = ua.iter().enumerate().map(|(k, v)| if k % 7 < 3 { -0.6 * v } else { 0.9 }).collect();
             let fa: Vec<f64> = (0..n).map(|k| ((k * 5 % 11) as f64 - 5.0) * 0.2).collect();
             let fb: Vec<f64> = (0..n).map(|k| ((k * 3 % 7) as f64 - 3.0) * 0.1).collect();
             let twin = DisplayTwin::new(&profile, 1000.0, 4).unwrap();

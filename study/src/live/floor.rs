@@ -22,7 +22,7 @@
 //! seeded with, before the noise.
 
 use super::stroke::Stroke;
-use crate::twin::{DisplayTwin, Tapes};
+use crate::twin::{DisplayTwin, Tapes, LANES};
 use crate::StudyError;
 use evflow_nodes::lab::profile::LabProfile;
 use evflow_nodes::metric::spectral_error::Band;
@@ -80,7 +80,7 @@ struct Chain<'a> {
     filter: OutputFilter,
     stroke: &'a Stroke,
     target: SpectralTarget,
-    /// The twin's tapes of two evaluations side by side (one uses the first).
+    /// The twin's tapes of up to four evaluations side by side (one uses the first).
     tape: Tapes,
 }
 
@@ -281,11 +281,8 @@ pub(crate) fn from_starts(
 /// outcomes in the starts' order, each the one a run of its own reaches.
 pub(crate) fn minimize_starts(objective: &mut impl Objective, starts: &[&[f64]], opts: &Options) -> Vec<Outcome> {
     let mut f = |x: &[&[f64]], g: &mut [&mut [f64]], fx: &mut [f64]| objective.value_grad_each(x, g, fx);
-    minimize_each(&mut f, starts, SIDE_BY_SIDE, -1.0, 1.0, opts)
+    minimize_each(&mut f, starts, LANES, -1.0, 1.0, opts)
 }
-
-/// How many of the floors' minimizations run side by side.
-const SIDE_BY_SIDE: usize = 4;
 
 #[cfg(test)]
 mod tests {

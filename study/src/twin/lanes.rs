@@ -16,6 +16,10 @@
 
 use super::{Branch, DisplayTwin, Step, Tape};
 
+/// The most actuations [`DisplayTwin::objective_grad_each`] runs side by
+/// side: the lanes of one AVX2 register.
+pub const LANES: usize = 4;
+
 /// One substep of four passes, lane k for pass k: what
 /// [`super::Step`] records, as the lanes' backward pass reads it.
 #[derive(Debug, Clone, Copy)]
@@ -141,7 +145,7 @@ impl DisplayTwin {
         mut adjoint: impl FnMut(Vec<f64>) -> (f64, Vec<f64>),
     ) {
         let m = u.len();
-        assert!(m <= 4 && g.len() == m && fx.len() == m, "up to four actuations, each with its gradient and value");
+        assert!(m <= LANES && g.len() == m && fx.len() == m, "up to four actuations, each with its gradient and value");
         let [ta, tb, ..] = &mut tapes.each;
         let forces: Vec<Vec<f64>> = match u {
             [] => return,

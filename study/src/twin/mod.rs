@@ -29,7 +29,7 @@ use evflow_nodes::lab::expm::zoh;
 use evflow_nodes::lab::profile::LabProfile;
 
 mod lanes;
-pub use lanes::Tapes;
+pub use lanes::{Tapes, LANES};
 
 /// States of the circuit with its relaxation state.
 const NE: usize = electrical::NR;

@@ -218,8 +218,9 @@ mod avx2 {
     // The helpers below run AVX2 instructions: they are called only from
     // `forward4` and `backward4` (compiled for AVX2 and FMA, entered on
     // CPUs with both) and the tests (after the same check), and inline
-    // there. (Helpers compiled for AVX2 themselves would inline later,
-    // and the passes measured 4 % slower.)
+    // there. (Helpers compiled for AVX2 themselves inline later; the
+    // objective at four actuations measured no faster with them, 596
+    // against 574 µs in one pair of runs.)
 
     #[inline(always)]
     fn splat(x: f64) -> V {

@@ -41,8 +41,31 @@ struct Queue<I> {
 /// calling thread, no thread started) and calls `receive(index, outcome)`
 /// in the calling thread, in item order. When `stop` becomes true, no
 /// further item starts; those running finish and are received. Returns how
-/// many items were received (all of them unless stopped).
-pub fn for_each_ordered<T, R, W, C>(items: Vec<T>, jobs: usize, stop: &AtomicBool, work: W, mut receive: C) -> usize
+/// many items were received (all of them unless stopped). At most `2·jobs`
+/// finished results wait for an earlier one ([`for_each_ordered_ahead`]).
+pub fn for_each_ordered<T, R, W, C>(items: Vec<T>, jobs: usize, stop: &AtomicBool, work: W, receive: C) -> usize
+where
+    T: Send,
+    R: Send,
+    W: Fn(usize, T) -> R + Sync,
+    C: FnMut(usize, Outcome<R>),
+{
+    for_each_ordered_ahead(items, jobs, 2 * jobs.max(1), stop, work, receive)
+}
+
+/// [`for_each_ordered`], with a worker starting item `i` only once every
+/// item before `i - ahead` has been received: `ahead` bounds how many
+/// finished results wait in memory for a slow earlier one. A batch whose
+/// results are small and whose items differ widely in length passes the
+/// number of items, so that no worker ever waits.
+pub fn for_each_ordered_ahead<T, R, W, C>(
+    items: Vec<T>,
+    jobs: usize,
+    ahead: usize,
+    stop: &AtomicBool,
+    work: W,
+    mut receive: C,
+) -> usize
 where
     T: Send,
     R: Send,
@@ -62,7 +85,7 @@ where
         }
         return received;
     }
-    let window = 2 * jobs;
+    let window = ahead.max(jobs);
     let queue = Mutex::new(Queue { items: items.into_iter(), next: 0, received: 0, stopped: false });
     let moved = Condvar::new();
     let (tx, rx) = mpsc::channel::<(usize, Outcome<R>)>();
@@ -190,6 +213,38 @@ mod tests {
         );
         let a = ahead.load(Ordering::SeqCst);
         assert!(a <= 4, "{a} items started before the first was received");
+    }
+
+    /// With `ahead` the number of items, a slow first item holds no one
+    /// back, and the results still arrive in item order.
+    #[test]
+    fn a_slow_item_holds_no_one_back_when_all_may_run_ahead() {
+        let started = AtomicUsize::new(0);
+        let ahead = AtomicUsize::new(0);
+        let mut got = Vec::new();
+        for_each_ordered_ahead(
+            (0..40).collect::<Vec<usize>>(),
+            2,
+            40,
+            &AtomicBool::new(false),
+            |i, _| {
+                started.fetch_add(1, Ordering::SeqCst);
+                if i == 0 {
+                    // Wait (at most 5 s) until every other item has started.
+                    for _ in 0..5000 {
+                        if started.load(Ordering::SeqCst) == 40 {
+                            break;
+                        }
+                        std::thread::sleep(Duration::from_millis(1));
+                    }
+                    ahead.store(started.load(Ordering::SeqCst), Ordering::SeqCst);
+                }
+                i
+            },
+            |i, r| got.push((i, r.unwrap())),
+        );
+        assert_eq!(ahead.load(Ordering::SeqCst), 40, "every item started while the first ran");
+        assert_eq!(got, (0..40).map(|i| (i, i)).collect::<Vec<_>>());
     }
 
     /// A panic is that item's outcome; the other items still run.

@@ -17,7 +17,7 @@ fn the_ci_suite_covers_every_node_type_and_graph_family_and_passes_but_for_its_f
     let dir = tempfile::tempdir().unwrap();
     let root = evflow_tests::root();
     let env = stability::prepare(dir.path(), &root.join("graphs"), Size::Ci).unwrap_or_else(|e| panic!("{e}"));
-    let rows = stability::run(&env, "", &mut |_| {});
+    let rows = stability::run(&env, "", 2, &mut |_| {});
     assert!(rows.len() >= 60, "{} cases", rows.len());
     let mut names: Vec<&str> = rows.iter().map(|r| r.case.as_str()).collect();
     names.sort();

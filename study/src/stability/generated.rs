@@ -7,7 +7,7 @@
 use super::bounds::{bound, capped, from_table};
 use super::invariant::{Invariant, Observed};
 use super::signals::Extreme;
-use super::{single, Case, Env, Group, Size};
+use super::{single, Case, Env, Group, Size, Work};
 use evflow_engine::spec::ParamKind;
 use evflow_engine::{Direction, NodeSpec};
 use evflow_nodes::example_files::signal;
@@ -169,7 +169,7 @@ fn parameter_case(spec: &'static NodeSpec, size: Size) -> Case {
         family: None,
         extreme,
         invariant,
-        body: Box::new(body),
+        work: Work::Whole(Box::new(body)),
     }
 }
 
@@ -214,7 +214,7 @@ fn input_case(spec: &'static NodeSpec, e: Extreme, size: Size) -> Case {
         family: None,
         extreme,
         invariant,
-        body: Box::new(body),
+        work: Work::Whole(Box::new(body)),
     }
 }
 

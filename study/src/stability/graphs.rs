@@ -4,7 +4,7 @@
 
 use super::bounds::{bound, from_params};
 use super::invariant::{Invariant, Observed};
-use super::{Case, Env, Group};
+use super::{Body, Case, Env, Group, Work};
 use evflow_engine::graph::parse_graph;
 use evflow_engine::{check, Checked, Plan, PlanOptions, Registry};
 use std::path::{Path, PathBuf};
@@ -149,29 +149,37 @@ pub fn cases(env: &Env) -> Vec<Case> {
                 }
             }
             let seconds = env.size.graph_seconds();
-            let body = move |env: &Env| {
-                let mut o = Observed::default();
-                let out = env.dir.join("graph-out");
-                for f in &files {
-                    let name = f.display().to_string();
-                    let checked = match evflow_engine::load_file(f, &registry(), &[]) {
-                        Ok(c) => c,
-                        Err(e) => {
-                            o.error = Some(format!("{name}: {e}"));
-                            return o;
+            // One piece per graph: a graph that does not load ends the case.
+            let pieces = files
+                .iter()
+                .map(|f| {
+                    let f = f.clone();
+                    let body = move |env: &Env| {
+                        let name = f.display().to_string();
+                        let checked = match evflow_engine::load_file(&f, &registry(), &[]) {
+                            Ok(c) => c,
+                            Err(e) => {
+                                return Observed {
+                                    error: Some(format!("{name}: {e}")),
+                                    ends_case: true,
+                                    ..Observed::default()
+                                }
+                            }
+                        };
+                        let base = f.parent().map(Path::to_path_buf).unwrap_or_default();
+                        let run = Running { base_dir: base, out_dir: env.dir.join("graph-out"), seconds, block: 4096 };
+                        let mut g = run_checked(&checked, &run);
+                        if let Some(e) = g.error.take() {
+                            g.error = Some(format!("{name}: {e}"));
                         }
+                        // A graph that stopped before its first step has no count of ticks.
+                        let ran = g.notes.first().cloned().unwrap_or_else(|| "did not start".into());
+                        g.notes = vec![format!("{}: {ran}", f.file_name().unwrap_or_default().to_string_lossy())];
+                        g
                     };
-                    let base = f.parent().map(Path::to_path_buf).unwrap_or_default();
-                    let run = Running { base_dir: base, out_dir: out.clone(), seconds, block: 4096 };
-                    let mut g = run_checked(&checked, &run);
-                    if let Some(e) = g.error.take() {
-                        o.error = Some(format!("{name}: {e}"));
-                    }
-                    g.notes = vec![format!("{}: {}", f.file_name().unwrap_or_default().to_string_lossy(), g.notes[0])];
-                    o.merge(g);
-                }
-                o
-            };
+                    Box::new(body) as Body
+                })
+                .collect();
             Case {
                 name: format!("graphs · {family}"),
                 group: Group::Graph,
@@ -182,7 +190,7 @@ pub fn cases(env: &Env) -> Vec<Case> {
                     names.join(", ")
                 ),
                 invariant: Invariant::Finite { refusal_ok: false },
-                body: Box::new(body),
+                work: Work::Pieces(pieces),
             }
         })
         .collect()
@@ -199,6 +207,31 @@ mod tests {
         let root = Path::new(env!("CARGO_MANIFEST_DIR")).join("../graphs");
         let f = families(&root);
         assert!(f.iter().any(|(n, v)| n == "texture" && v.len() > 3), "{f:?}");
+    }
+
+    #[test]
+    fn a_graph_that_does_not_load_or_start_fails_its_family_naming_it() {
+        let dir = tempfile::tempdir().unwrap();
+        // Loads, but its recording is missing: the plan cannot start.
+        let start = "[graph]\nformat = 1\nname = \"t\"\nrate = 1000\nconnections = [\"r.force -> t.in\"]\n\
+                     [nodes.r]\ntype = \"recording.in\"\npath = \"missing\"\nchannels = [\"force\"]\nrate = 1000\n\
+                     [nodes.t]\ntype = \"harness.tap\"\n";
+        std::fs::write(dir.path().join("start-missing.toml"), start).unwrap();
+        std::fs::write(dir.path().join("start-zz.toml"), "[graph]\nformat = 1\n").unwrap();
+        std::fs::write(dir.path().join("load-broken.toml"), "[graph]\nformat = 1\n").unwrap();
+        let env = Env { dir: dir.path().join("fixtures"), graphs: dir.path().into(), size: super::super::Size::Ci };
+        let rows: Vec<_> = cases(&env).iter().map(|c| super::super::run_case(c, &env)).collect();
+        assert_eq!(rows.len(), 2);
+        for r in &rows {
+            assert!(!r.verdict.passed(), "{}: {}", r.case, r.detail);
+            assert!(!r.detail.contains("panicked"), "{}: {}", r.case, r.detail);
+        }
+        assert!(rows[0].detail.contains("load-broken.toml"), "{}", rows[0].detail);
+        // The missing recording is named, and the graph after it, which
+        // does not load, is the case's error.
+        let d = &rows[1].detail;
+        assert!(d.contains("start-missing.toml: did not start") && d.contains("missing"), "{d}");
+        assert!(d.contains("start-zz.toml"), "{d}");
     }
 
     #[test]

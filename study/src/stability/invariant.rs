@@ -29,6 +29,10 @@ pub struct Observed {
     pub violations: Vec<String>,
     /// Anything else worth a word in the table.
     pub notes: Vec<String>,
+    /// Set by a piece of a case run in pieces ([`super::Work::Pieces`])
+    /// that ends the case: its error is the case's, and what it and the
+    /// pieces after it saw is left out ([`super::join`]).
+    pub ends_case: bool,
 }
 
 impl Default for Observed {
@@ -46,6 +50,7 @@ impl Default for Observed {
             energy: None,
             violations: Vec::new(),
             notes: Vec::new(),
+            ends_case: false,
         }
     }
 }

@@ -29,7 +29,9 @@ pub mod table;
 
 pub use invariant::{Invariant, Observed, Verdict};
 
+use evflow_engine::batch::for_each_ordered_ahead;
 use std::path::{Path, PathBuf};
+use std::sync::atomic::AtomicBool;
 use std::time::Instant;
 
 /// How much of each case runs.
@@ -131,8 +133,18 @@ pub struct Env {
     pub size: Size,
 }
 
-/// The body of a case.
-pub type Body = Box<dyn Fn(&Env) -> Observed>;
+/// The body of a case, or of one piece of a case.
+pub type Body = Box<dyn Fn(&Env) -> Observed + Send + Sync>;
+
+/// How a case runs.
+pub enum Work {
+    /// One body.
+    Whole(Body),
+    /// Independent pieces, which [`run`] may run side by side, joined in
+    /// order as one body running them one after the other would have been
+    /// ([`join`]).
+    Pieces(Vec<Body>),
+}
 
 /// One case of the suite.
 pub struct Case {
@@ -149,7 +161,7 @@ pub struct Case {
     /// What must hold.
     pub invariant: Invariant,
     /// Runs it.
-    pub body: Body,
+    pub work: Work,
 }
 
 /// One row of the table: a case and its verdict.
@@ -203,21 +215,42 @@ pub fn prepare(dir: &Path, graphs: &Path, size: Size) -> Result<Env, SuiteError>
     Ok(Env { dir: dir.to_path_buf(), graphs: graphs.to_path_buf(), size })
 }
 
-/// Runs one case: its body (a panic is caught and fails it), then its
-/// invariant.
-pub fn run_case(case: &Case, env: &Env) -> Row {
-    let started = Instant::now();
-    let observed = match std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| (case.body)(env))) {
-        Ok(o) => o,
-        Err(payload) => {
-            let msg = payload
-                .downcast_ref::<&str>()
-                .map(|s| s.to_string())
-                .or_else(|| payload.downcast_ref::<String>().cloned())
-                .unwrap_or_else(|| "a panic".into());
-            Observed { panic: Some(msg), ..Observed::default() }
+/// Runs one body, catching a panic (its message is the outcome).
+fn attempt(body: &Body, env: &Env) -> Result<Observed, String> {
+    std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| body(env))).map_err(|payload| {
+        payload
+            .downcast_ref::<&str>()
+            .map(|s| s.to_string())
+            .or_else(|| payload.downcast_ref::<String>().cloned())
+            .unwrap_or_else(|| "a panic".into())
+    })
+}
+
+/// What a case split into pieces saw, from each piece's outcome in order,
+/// as one body running the pieces one after the other would have seen
+/// it: the first panic is the case's (what the pieces before it saw is
+/// lost, as a panic loses it); a piece's error becomes the case's (a later
+/// one replaces it, the earlier stays among the notes); a piece marked
+/// [`Observed::ends_case`] ends the case with its error, and what it and
+/// the pieces after it saw is left out.
+pub fn join(outcomes: Vec<Result<Observed, String>>) -> Result<Observed, String> {
+    let mut o = Observed::default();
+    for outcome in outcomes {
+        let mut piece = outcome?;
+        if let Some(e) = piece.error.take() {
+            o.error = Some(e);
         }
-    };
+        if piece.ends_case {
+            return Ok(o);
+        }
+        o.merge(piece);
+    }
+    Ok(o)
+}
+
+/// The row of `case`, from what it saw (or its panic's message).
+fn row(case: &Case, outcome: Result<Observed, String>, seconds: f64, env: &Env) -> Row {
+    let observed = outcome.unwrap_or_else(|msg| Observed { panic: Some(msg), ..Observed::default() });
     let verdict = case.invariant.judge(&observed);
     Row {
         case: case.name.clone(),
@@ -232,29 +265,189 @@ pub fn run_case(case: &Case, env: &Env) -> Row {
         // The fixtures' folder is a fresh temporary one each run: named
         // `<fixtures>` so that a row reads the same from run to run.
         detail: observed.detail().replace(&env.dir.display().to_string(), "<fixtures>"),
-        seconds: started.elapsed().as_secs_f64(),
+        seconds,
     }
 }
 
-/// Runs every case whose name contains `only` (all when empty), in
-/// order, calling `each` after each row; panics inside cases are caught
+/// Runs one case in the calling thread, its pieces one after the other:
+/// its body (a panic is caught and fails it), then its invariant.
+pub fn run_case(case: &Case, env: &Env) -> Row {
+    let started = Instant::now();
+    let outcome = match &case.work {
+        Work::Whole(body) => attempt(body, env),
+        Work::Pieces(pieces) => join(pieces.iter().map(|p| attempt(p, env)).collect()),
+    };
+    row(case, outcome, started.elapsed().as_secs_f64(), env)
+}
+
+/// Runs every case whose name contains `only` (all when empty) on `jobs`
+/// threads, calling `each` as each row is done; returns the rows in the
+/// suite's order, the same for any `jobs`. Panics inside cases are caught
 /// (and kept off the terminal while the suite runs).
-pub fn run(env: &Env, only: &str, each: &mut dyn FnMut(&Row)) -> Vec<Row> {
+///
+/// The pieces of every case are one queue. The shipped graphs' pieces go
+/// first: each runs minutes of simulated time, most other cases a few
+/// seconds, so the longest work starts first and the two threads end
+/// together. A row's seconds are its pieces' seconds summed.
+pub fn run(env: &Env, only: &str, jobs: usize, each: &mut dyn FnMut(&Row)) -> Vec<Row> {
     let env = &Env { graphs: std::path::absolute(&env.graphs).unwrap_or_else(|_| env.graphs.clone()), ..env.clone() };
     let cases: Vec<Case> = cases(env).into_iter().filter(|c| only.is_empty() || c.name.contains(only)).collect();
+    run_cases(&cases, env, jobs, each)
+}
+
+/// Runs `cases` as [`run`] does.
+pub fn run_cases(cases: &[Case], env: &Env, jobs: usize, each: &mut dyn FnMut(&Row)) -> Vec<Row> {
+    let pieces = |c: &Case| match &c.work {
+        Work::Whole(_) => 1,
+        Work::Pieces(p) => p.len(),
+    };
+    // (case, piece), the shipped graphs' first.
+    let mut queue: Vec<(usize, usize)> =
+        cases.iter().enumerate().flat_map(|(k, c)| (0..pieces(c)).map(move |p| (k, p))).collect();
+    queue.sort_by_key(|&(k, _)| cases[k].group != Group::Graph);
     let hook = std::panic::take_hook();
     std::panic::set_hook(Box::new(|_| {}));
-    let mut rows = Vec::with_capacity(cases.len());
-    for c in &cases {
-        let row = run_case(c, env);
-        each(&row);
-        rows.push(row);
-    }
+    let mut outcomes: Vec<Vec<Option<Result<Observed, String>>>> =
+        cases.iter().map(|c| (0..pieces(c)).map(|_| None).collect()).collect();
+    let mut seconds = vec![0.0; cases.len()];
+    let mut rows: Vec<Option<Row>> = cases.iter().map(|_| None).collect();
+    let work = |_: usize, (k, p): (usize, usize)| {
+        let started = Instant::now();
+        let body = match &cases[k].work {
+            Work::Whole(body) => body,
+            Work::Pieces(pieces) => &pieces[p],
+        };
+        (k, p, attempt(body, env), started.elapsed().as_secs_f64())
+    };
+    let all = queue.len();
+    for_each_ordered_ahead(queue, jobs, all, &AtomicBool::new(false), work, |_, done| {
+        // `attempt` catches every panic, so the pool's own catch never fires.
+        let Ok((k, p, outcome, s)) = done else { return };
+        outcomes[k][p] = Some(outcome);
+        seconds[k] += s;
+        if outcomes[k].iter().all(Option::is_some) {
+            let mut got: Vec<Result<Observed, String>> = outcomes[k].iter_mut().filter_map(Option::take).collect();
+            let outcome = match cases[k].work {
+                Work::Whole(_) => got.remove(0),
+                Work::Pieces(_) => join(got),
+            };
+            let r = row(&cases[k], outcome, seconds[k], env);
+            each(&r);
+            rows[k] = Some(r);
+        }
+    });
     std::panic::set_hook(hook);
-    rows
+    rows.into_iter().flatten().collect()
 }
 
 /// How many rows failed.
 pub fn failures(rows: &[Row]) -> usize {
     rows.iter().filter(|r| !r.verdict.passed()).count()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn seen(max: f64, port: &str) -> Observed {
+        Observed {
+            max_abs: max,
+            ports: vec![(port.into(), max)],
+            samples: 1,
+            notes: vec![format!("{port} ran")],
+            ..Observed::default()
+        }
+    }
+
+    fn case(name: &str, group: Group, work: Work) -> Case {
+        Case {
+            name: name.into(),
+            group,
+            covers: Vec::new(),
+            family: None,
+            extreme: String::new(),
+            invariant: Invariant::Finite { refusal_ok: true },
+            work,
+        }
+    }
+
+    fn body(f: impl Fn(&Env) -> Observed + Send + Sync + 'static) -> Body {
+        Box::new(f)
+    }
+
+    /// Whole cases and cases in pieces: errors, a piece that ends its
+    /// case, a panicking piece, a slow case.
+    fn suite() -> Vec<Case> {
+        vec![
+            case("whole", Group::Generated, Work::Whole(body(|_| seen(1.0, "a")))),
+            case(
+                "an error",
+                Group::Graph,
+                Work::Pieces(vec![
+                    body(|_| seen(2.0, "b")),
+                    body(|_| Observed { error: Some("c stopped".into()), ..seen(3.0, "c") }),
+                    body(|_| seen(0.5, "d")),
+                ]),
+            ),
+            case(
+                "ended",
+                Group::Graph,
+                Work::Pieces(vec![
+                    body(|_| seen(2.0, "e")),
+                    body(|_| Observed { error: Some("f does not load".into()), ends_case: true, ..seen(7.0, "f") }),
+                    body(|_| panic!("after the end")),
+                ]),
+            ),
+            case(
+                "a panic",
+                Group::Graph,
+                Work::Pieces(vec![body(|_| seen(2.0, "g")), body(|_| panic!("piece two")), body(|_| seen(9.0, "h"))]),
+            ),
+            case(
+                "slow",
+                Group::Stiff,
+                Work::Whole(body(|_| {
+                    std::thread::sleep(std::time::Duration::from_millis(30));
+                    seen(4.0, "i")
+                })),
+            ),
+        ]
+    }
+
+    fn shown(r: &Row) -> String {
+        format!("{:?}", Row { seconds: 0.0, ..r.clone() })
+    }
+
+    #[test]
+    fn pieces_join_as_one_body_running_them_in_order_would() {
+        let env = Env { dir: PathBuf::from("."), graphs: PathBuf::from("."), size: Size::Ci };
+        let cases = suite();
+        let rows: Vec<Row> = cases.iter().map(|c| run_case(c, &env)).collect();
+        assert_eq!(rows[1].max_abs, 3.0);
+        assert!(rows[1].detail.contains("c stopped") && rows[1].detail.contains("d ran"), "{}", rows[1].detail);
+        // Ended by its second piece: the first piece's notes, the second's
+        // error, nothing of the second's or the third's outputs.
+        assert_eq!(rows[2].max_abs, 2.0);
+        assert!(rows[2].detail.contains("f does not load") && rows[2].detail.contains("e ran"), "{}", rows[2].detail);
+        assert!(!rows[2].detail.contains("f ran") && !rows[2].detail.contains("after the end"), "{}", rows[2].detail);
+        assert_eq!(rows[3].detail, "panicked: piece two");
+        assert_eq!(rows[3].max_abs, 0.0);
+        assert!(!rows[3].verdict.passed());
+    }
+
+    #[test]
+    fn the_rows_are_the_same_for_any_number_of_jobs() {
+        let env = Env { dir: PathBuf::from("."), graphs: PathBuf::from("."), size: Size::Ci };
+        let cases = suite();
+        let alone: Vec<String> = cases.iter().map(|c| shown(&run_case(c, &env))).collect();
+        for jobs in [1, 2, 3, 8] {
+            let mut done = Vec::new();
+            let rows = run_cases(&cases, &env, jobs, &mut |r| done.push(r.case.clone()));
+            assert_eq!(rows.iter().map(shown).collect::<Vec<_>>(), alone, "jobs {jobs}");
+            done.sort();
+            let mut names: Vec<String> = cases.iter().map(|c| c.name.clone()).collect();
+            names.sort();
+            assert_eq!(done, names, "jobs {jobs}: each row reported once");
+        }
+    }
 }

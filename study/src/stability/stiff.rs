@@ -8,7 +8,7 @@
 
 use super::graphs::{check_text, run_checked, Running};
 use super::invariant::{Invariant, Observed};
-use super::{single, Case, Env, Group};
+use super::{single, Case, Env, Group, Work};
 use evflow_engine::params::toml_string;
 use evflow_engine::NodeSpec;
 use evflow_nodes::example_files as fixtures;
@@ -24,7 +24,7 @@ fn case(
     covers: &[&'static str],
     extreme: &str,
     invariant: Invariant,
-    body: impl Fn(&Env) -> Observed + 'static,
+    body: impl Fn(&Env) -> Observed + Send + Sync + 'static,
 ) -> Case {
     Case {
         name: name.to_string(),
@@ -33,7 +33,7 @@ fn case(
         family: None,
         extreme: extreme.to_string(),
         invariant,
-        body: Box::new(body),
+        work: Work::Whole(Box::new(body)),
     }
 }
 

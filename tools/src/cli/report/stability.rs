@@ -5,6 +5,7 @@
 
 use anyhow::{Context, Result};
 use evflow_study::stability::{self, table, Size};
+use evflow_tools::batch::JobsArg;
 use std::path::PathBuf;
 use std::time::Instant;
 
@@ -24,6 +25,10 @@ pub struct Args {
     /// The shipped graphs' folder.
     #[arg(long, default_value = "graphs")]
     graphs: PathBuf,
+    #[command(flatten)]
+    /// `--jobs`: cases (and the shipped graphs of a family) run side by
+    /// side; the rows are the same for any number.
+    jobs: JobsArg,
 }
 
 /// Runs `evflow report stability`.
@@ -33,7 +38,7 @@ pub fn main(a: Args) -> Result<()> {
     let work = tempfile::tempdir().context("a temporary folder for the fixtures")?;
     let env = stability::prepare(work.path(), &a.graphs, a.size)?;
     let started = Instant::now();
-    let rows = stability::run(&env, &a.only, &mut |r| {
+    let rows = stability::run(&env, &a.only, a.jobs.jobs(), &mut |r| {
         if !r.verdict.passed() {
             eprintln!("FAIL {}: {}", r.case, r.verdict.text());
         } else if r.seconds > 10.0 {

@@ -123,10 +123,30 @@ pub fn minimize_each(
     hi: f64,
     opts: &Options,
 ) -> Vec<Outcome> {
+    minimize_each_of(&mut |_, x, g, fx| f(x, g, fx), x0, width, lo, hi, opts)
+}
+
+/// Objectives evaluated at several points at once, each point of its own
+/// start: `f(starts, x, g, fx)` writes the gradient at `x[k]` (a point of
+/// the minimization from start `starts[k]`) into `g[k]` and the value
+/// into `fx[k]`.
+pub type StartsObjective<'a> = dyn FnMut(&[usize], &[&[f64]], &mut [&mut [f64]], &mut [f64]) + 'a;
+
+/// [`minimize_each`] where each start may have an objective of its own:
+/// `f` is told which start each point belongs to (its index in `x0`).
+pub fn minimize_each_of(
+    f: &mut StartsObjective,
+    x0: &[&[f64]],
+    width: usize,
+    lo: f64,
+    hi: f64,
+    opts: &Options,
+) -> Vec<Outcome> {
     let mut out: Vec<Option<Outcome>> = x0.iter().map(|_| None).collect();
     let mut queue = x0.iter().enumerate();
     let mut slots: Vec<Option<(usize, Minimizer)>> = (0..width.max(1)).map(|_| None).collect();
     let mut fx = Vec::with_capacity(slots.len());
+    let mut starts = Vec::with_capacity(slots.len());
     loop {
         // Each slot holds a minimization that asks for a point, while starts are left.
         for slot in &mut slots {
@@ -144,14 +164,22 @@ pub fn minimize_each(
                 }
             }
         }
-        let (x, mut g): (Vec<&[f64]>, Vec<&mut [f64]>) =
-            slots.iter_mut().flatten().filter_map(|(_, m)| m.request()).unzip();
+        starts.clear();
+        let (x, mut g): (Vec<&[f64]>, Vec<&mut [f64]>) = slots
+            .iter_mut()
+            .flatten()
+            .filter_map(|(i, m)| {
+                let point = m.request()?;
+                starts.push(*i);
+                Some(point)
+            })
+            .unzip();
         if x.is_empty() {
             break;
         }
         fx.clear();
         fx.resize(x.len(), 0.0);
-        f(&x, &mut g, &mut fx);
+        f(&starts, &x, &mut g, &mut fx);
         let asked = slots.iter_mut().flatten().filter(|(_, m)| !m.finished());
         asked.zip(&fx).for_each(|((_, m), &v)| m.reply(v));
     }
@@ -743,6 +771,44 @@ mod tests {
         }
         let mut none = |_: &[&[f64]], _: &mut [&mut [f64]], _: &mut [f64]| panic!("no start, no evaluation");
         assert!(minimize_each(&mut none, &[], 2, -1.0, 1.0, &opts).is_empty());
+    }
+
+    #[test]
+    fn each_start_may_have_an_objective_of_its_own() {
+        // Three objectives over the same four variables: only the start's
+        // index tells them apart.
+        let f = |c: f64| {
+            move |x: &[f64], g: &mut [f64]| -> f64 {
+                let mut s = 0.0;
+                for i in 0..x.len() {
+                    let d = x[i] - c * (i as f64 - 1.5);
+                    s += d * d * (2.0 + i as f64) + 0.2 * d.powi(4);
+                    g[i] = 2.0 * d * (2.0 + i as f64) + 0.8 * d.powi(3);
+                }
+                s
+            }
+        };
+        let objectives = [f(0.3), f(-0.7), f(0.05)];
+        let whose = [0, 1, 2, 1, 0, 2, 2];
+        let starts: Vec<Vec<f64>> =
+            (0..whose.len()).map(|k| (0..4).map(|i| ((k * 7 + i * 3) % 5) as f64 * 0.4 - 0.8).collect()).collect();
+        let points: Vec<&[f64]> = starts.iter().map(Vec::as_slice).collect();
+        let opts = Options::default();
+        let alone: Vec<Outcome> = points
+            .iter()
+            .zip(whose)
+            .map(|(x0, w)| minimize(&mut |x, g| objectives[w](x, g), x0, -1.0, 1.0, &opts))
+            .collect();
+        for width in 1..=4 {
+            let mut each = |i: &[usize], x: &[&[f64]], g: &mut [&mut [f64]], fx: &mut [f64]| {
+                for k in 0..x.len() {
+                    fx[k] = objectives[whose[i[k]]](x[k], g[k]);
+                }
+            };
+            assert_eq!(minimize_each_of(&mut each, &points, width, -1.0, 1.0, &opts), alone, "width {width}");
+        }
+        // The objectives differ enough that a point given the wrong one goes elsewhere.
+        assert_ne!(alone[0].x, minimize(&mut |x, g| objectives[1](x, g), points[0], -1.0, 1.0, &opts).x);
     }
 
     /// The two-loop recursion as first written: every dot product a pass

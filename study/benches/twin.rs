@@ -100,7 +100,7 @@ fn objectives(c: &mut Criterion) {
                 let u: Vec<&[f64]> = us[..m].iter().map(|u| black_box(u.as_slice())).collect();
                 let mut g: Vec<&mut [f64]> = gs[..m].iter_mut().map(|g| g.as_mut_slice()).collect();
                 let mut fx = [0.0; 4];
-                twin.objective_grad_each(&u, (&load, &vel), &mut tapes, &mut g, &mut fx[..m], |f| {
+                twin.objective_grad_each(&u, (&load, &vel), &mut tapes, &mut g, &mut fx[..m], |_, f| {
                     (f.iter().zip(&fbar).map(|(a, b)| a * b).sum(), fbar.clone())
                 });
                 black_box(fx)

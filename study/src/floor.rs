@@ -74,7 +74,7 @@ impl Objective for Chain {
     fn value_grad_each(&mut self, u: &[&[f64]], g: &mut [&mut [f64]], fx: &mut [f64]) {
         let (score, velocity) = (&mut self.score, &self.velocity[..]);
         let path = (&self.load[..], velocity);
-        self.display.objective_grad_each(u, path, &mut self.tape, g, fx, |f| score.adjoint(&f, velocity))
+        self.display.objective_grad_each(u, path, &mut self.tape, g, fx, |_, f| score.adjoint(&f, velocity))
     }
 }
 

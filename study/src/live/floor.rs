@@ -27,10 +27,13 @@ use crate::StudyError;
 use evflow_nodes::lab::profile::LabProfile;
 use evflow_nodes::metric::spectral_error::Band;
 use evflow_nodes::metric::spectrum::{SpectrumConfig, Window};
-use evflow_nodes::synth::lbfgsb::{minimize_each, Options, Outcome};
+use evflow_nodes::synth::lbfgsb::{minimize_each, minimize_each_of, Options, Outcome};
 use evflow_nodes::synth::output_filter::OutputFilter;
 use evflow_nodes::synth::spectral::SpectralTarget;
 use evflow_nodes::synth::start::carrier_scaled;
+
+/// Named starts: `(name, actuation)`.
+pub type Seeds = [(String, Vec<f64>)];
 
 /// The carrier starts' offsets, relative to the least that keeps the
 /// envelope real.
@@ -74,12 +77,13 @@ pub struct Candidate {
     pub u: Vec<f64>,
 }
 
-/// The display's twin, the high-pass and the target of one stroke.
+/// The display's twin and the high-pass of one stroke, and the target of
+/// each goal optimized towards.
 struct Chain<'a> {
     twin: DisplayTwin,
     filter: OutputFilter,
     stroke: &'a Stroke,
-    target: SpectralTarget,
+    targets: Vec<SpectralTarget>,
     /// The twin's tapes of up to four evaluations side by side (one uses the first).
     tape: Tapes,
 }
@@ -177,23 +181,45 @@ pub fn optimize_towards(
     seeds: &[(String, Vec<f64>)],
     iterations: usize,
 ) -> Result<Vec<Candidate>, StudyError> {
+    let mut each = optimize_goals(stroke, profile, &[(goal, seeds)], iterations)?;
+    Ok(each.pop().map(|(c, _)| c).unwrap_or_default())
+}
+
+/// [`optimize_towards`] for each `(goal, seeds)` on one stroke, every
+/// goal's starts in one queue ([`from_starts_goals`]): each goal's
+/// candidates are the ones [`optimize_towards`] gives it alone, and a goal
+/// whose starts end early leaves its lanes to another's. With each goal's
+/// candidates, the share of the L-BFGS-B evaluations that were its own.
+pub fn optimize_goals(
+    stroke: &Stroke,
+    profile: &LabProfile,
+    goals: &[(&Goal, &Seeds)],
+    iterations: usize,
+) -> Result<Vec<(Vec<Candidate>, f64)>, StudyError> {
     let rate = stroke.rate;
     let nfft = rate.round() as usize;
     let cfg = SpectrumConfig { rate, nfft, window: Window::Hann, overlap: 0.5 };
     let band = Band::new(rate, nfft, 2.0, 200.0, false).map_err(|e| StudyError::Config(e.message))?;
+    let mut targets = Vec::with_capacity(goals.len());
+    for (goal, _) in goals {
+        targets.push(SpectralTarget::new(&goal.highpassed, cfg, band)?);
+    }
     let mut chain = Chain {
         twin: DisplayTwin::new(profile, rate, 4).map_err(StudyError::Config)?,
         filter: OutputFilter::highpass(4, 10.0, rate)?,
         stroke,
-        target: SpectralTarget::new(&goal.highpassed, cfg, band)?,
+        targets,
         tape: Default::default(),
     };
     let kappa = chain.carrier_gain();
-    from_starts(&mut chain, &goal.magnitude, kappa, stroke.len(), seeds, iterations)
+    let each: Vec<(&[f64], &Seeds)> = goals.iter().map(|(g, s)| (g.magnitude.as_slice(), *s)).collect();
+    from_starts_goals(&mut chain, &each, kappa, stroke.len(), iterations)
 }
 
 /// An objective over a whole stroke's actuation that the floors minimize:
-/// its value, and its value with the gradient written into `g`.
+/// its value, and its value with the gradient written into `g` — towards
+/// one goal, or towards each of several (`goal` its index; an objective
+/// of one goal takes only 0).
 pub(crate) trait Objective {
     /// The objective at `u` (by default through [`Objective::value_grad`]).
     fn value(&mut self, u: &[f64]) -> f64 {
@@ -209,28 +235,48 @@ pub(crate) trait Objective {
             *fx = self.value_grad(u, g);
         }
     }
+    /// The objective of goal `goal` at `u`.
+    fn value_of(&mut self, goal: usize, u: &[f64]) -> f64 {
+        assert_eq!(goal, 0, "an objective of one goal");
+        self.value(u)
+    }
+    /// [`Objective::value_grad_each`], point `k` towards goal `goals[k]`.
+    fn value_grad_each_of(&mut self, goals: &[usize], u: &[&[f64]], g: &mut [&mut [f64]], fx: &mut [f64]) {
+        assert!(goals.iter().all(|&k| k == 0), "an objective of one goal");
+        self.value_grad_each(u, g, fx)
+    }
 }
 
 impl Objective for Chain<'_> {
-    /// J = E_s² of the twin's force, high-passed.
+    /// J = E_s² of the twin's force, high-passed, towards the first goal.
     fn value(&mut self, u: &[f64]) -> f64 {
-        let mut y = self.force(u);
-        self.filter.apply_in_place(&mut y);
-        self.target.es(&y).powi(2)
+        self.value_of(0, u)
     }
 
-    /// J and ∂J/∂u.
+    /// J and ∂J/∂u towards the first goal.
     fn value_grad(&mut self, u: &[f64], g: &mut [f64]) -> f64 {
-        let (filter, target) = (&self.filter, &mut self.target);
+        let (filter, target) = (&self.filter, &mut self.targets[0]);
         let path = (&self.stroke.load[..], &self.stroke.velocity[..]);
         self.twin.objective_grad(u, path, self.tape.first(), g, |y| force_adjoint(filter, target, y))
     }
 
     /// The twin passes side by side (each result the one it gives alone).
     fn value_grad_each(&mut self, u: &[&[f64]], g: &mut [&mut [f64]], fx: &mut [f64]) {
-        let (filter, target) = (&self.filter, &mut self.target);
+        self.value_grad_each_of(&vec![0; u.len()], u, g, fx)
+    }
+
+    fn value_of(&mut self, goal: usize, u: &[f64]) -> f64 {
+        let mut y = self.force(u);
+        self.filter.apply_in_place(&mut y);
+        self.targets[goal].es(&y).powi(2)
+    }
+
+    /// The twin passes side by side, each force scored against its own goal.
+    fn value_grad_each_of(&mut self, goals: &[usize], u: &[&[f64]], g: &mut [&mut [f64]], fx: &mut [f64]) {
+        let (filter, targets) = (&self.filter, &mut self.targets);
         let path = (&self.stroke.load[..], &self.stroke.velocity[..]);
-        self.twin.objective_grad_each(u, path, &mut self.tape, g, fx, |y| force_adjoint(filter, target, y))
+        let adjoint = |k: usize, y| force_adjoint(filter, &mut targets[goals[k]], y);
+        self.twin.objective_grad_each(u, path, &mut self.tape, g, fx, adjoint)
     }
 }
 
@@ -249,31 +295,56 @@ pub(crate) fn from_starts(
     seeds: &[(String, Vec<f64>)],
     iterations: usize,
 ) -> Result<Vec<Candidate>, StudyError> {
+    let mut each = from_starts_goals(objective, &[(magnitude, seeds)], kappa, n, iterations)?;
+    Ok(each.pop().map(|(c, _)| c).unwrap_or_default())
+}
+
+/// [`from_starts`] for each goal `(magnitude, seeds)` of `objective`, every
+/// goal's starts in one queue, four at a time side by side
+/// ([`minimize_each_of`], [`Objective::value_grad_each_of`]); each goal's
+/// candidates, in its starts' order, with the share of the evaluations
+/// that were its own.
+pub(crate) fn from_starts_goals(
+    objective: &mut impl Objective,
+    goals: &[(&[f64], &Seeds)],
+    kappa: f64,
+    n: usize,
+    iterations: usize,
+) -> Result<Vec<(Vec<Candidate>, f64)>, StudyError> {
     let keep = vec![true; n];
-    let mut starts: Vec<(String, Vec<f64>)> = Vec::new();
-    if kappa.is_finite() && kappa > 0.0 {
-        for scale in START_OFFSETS {
-            starts.push((format!("carrier ×{scale}"), carrier_scaled(magnitude, &keep, kappa, 1.0, scale)?));
+    // (goal, name, start)
+    let mut starts: Vec<(usize, String, Vec<f64>)> = Vec::new();
+    for (goal, (magnitude, seeds)) in goals.iter().enumerate() {
+        if kappa.is_finite() && kappa > 0.0 {
+            for scale in START_OFFSETS {
+                starts.push((goal, format!("carrier ×{scale}"), carrier_scaled(magnitude, &keep, kappa, 1.0, scale)?));
+            }
+        }
+        for (name, u) in *seeds {
+            let mut u: Vec<f64> =
+                u.iter().take(n).map(|v| if v.is_finite() { v.clamp(-1.0, 1.0) } else { 0.0 }).collect();
+            u.resize(n, 0.0);
+            starts.push((goal, name.clone(), u));
         }
     }
-    for (name, u) in seeds {
-        let mut u: Vec<f64> = u.iter().take(n).map(|v| if v.is_finite() { v.clamp(-1.0, 1.0) } else { 0.0 }).collect();
-        u.resize(n, 0.0);
-        starts.push((name.clone(), u));
-    }
     let opts = Options { max_iter: iterations, ..Options::default() };
-    let start_objective: Vec<f64> = starts.iter().map(|(_, u0)| objective.value(u0)).collect();
-    let points: Vec<&[f64]> = starts.iter().map(|(_, u0)| u0.as_slice()).collect();
-    let results = minimize_starts(objective, &points, &opts);
-    let out = starts.iter().zip(start_objective).zip(results);
-    Ok(out
-        .map(|(((start, _), start_objective), r)| Candidate {
-            start: start.clone(),
-            start_objective,
-            objective: r.f,
-            u: r.x,
-        })
-        .collect())
+    let start_objective: Vec<f64> = starts.iter().map(|(goal, _, u0)| objective.value_of(*goal, u0)).collect();
+    let points: Vec<&[f64]> = starts.iter().map(|(_, _, u0)| u0.as_slice()).collect();
+    let whose: Vec<usize> = starts.iter().map(|(goal, _, _)| *goal).collect();
+    let mut goals_of = Vec::with_capacity(LANES);
+    let mut f = |i: &[usize], x: &[&[f64]], g: &mut [&mut [f64]], fx: &mut [f64]| {
+        goals_of.clear();
+        goals_of.extend(i.iter().map(|&s| whose[s]));
+        objective.value_grad_each_of(&goals_of, x, g, fx)
+    };
+    let results = minimize_each_of(&mut f, &points, LANES, -1.0, 1.0, &opts);
+    let all: usize = results.iter().map(|r| r.evaluations).sum();
+    let mut out: Vec<(Vec<Candidate>, f64)> = goals.iter().map(|_| (Vec::new(), 0.0)).collect();
+    for (((goal, start, _), start_objective), r) in starts.into_iter().zip(start_objective).zip(results) {
+        out[goal].1 += r.evaluations as f64 / all.max(1) as f64;
+        out[goal].0.push(Candidate { start, start_objective, objective: r.f, u: r.x });
+    }
+    Ok(out)
 }
 
 /// Minimizes `objective` within |u| ≤ 1 from each start, four starts at a
@@ -336,6 +407,36 @@ mod tests {
         // The real goal is the high-passed real force.
         let real = Goal::real(&stroke).unwrap();
         assert_eq!(real.highpassed, stroke.real_highpassed().unwrap());
+    }
+
+    #[test]
+    fn goals_in_one_queue_reach_what_each_reaches_alone() {
+        let user = User { name: "t".into(), seed: 9, speed: [3.0, 7.0], mass: [60.0, 110.0], travel_cm: 8.0 };
+        let stroke = Stroke::of(&user, "felt-fabric", 3.0, 1000.0).unwrap();
+        let n = stroke.len();
+        let real = Goal::real(&stroke).unwrap();
+        let wanted: Vec<f64> = (0..n).map(|k| 0.05 + 0.02 * (k as f64 * 0.09).sin()).collect();
+        let target = Goal::chain_target(&stroke, &wanted).unwrap();
+        let carrier: Vec<f64> = (0..n).map(|k| if k % 2 == 0 { 0.6 } else { -0.6 }).collect();
+        let stroke_seeds = vec![("held carrier".to_string(), carrier.clone()), ("quiet".to_string(), vec![0.1; n])];
+        let target_seeds = vec![("half carrier".to_string(), carrier.iter().map(|u| u / 2.0).collect())];
+        let profile = LabProfile::default();
+        let alone = [
+            optimize_towards(&stroke, &profile, &target, &target_seeds, 6).unwrap(),
+            optimize_towards(&stroke, &profile, &real, &stroke_seeds, 6).unwrap(),
+        ];
+        let goals: Vec<(&Goal, &Seeds)> = vec![(&target, &target_seeds), (&real, &stroke_seeds)];
+        let together = optimize_goals(&stroke, &profile, &goals, 6).unwrap();
+        assert_eq!(together.len(), 2);
+        for (k, ((c, share), a)) in together.iter().zip(&alone).enumerate() {
+            assert_eq!(c, a, "goal {k}");
+            assert!(*share > 0.0 && *share < 1.0, "goal {k}: {share}");
+        }
+        assert!((together[0].1 + together[1].1 - 1.0).abs() < 1e-12);
+        // The two goals lead the same start to different optima, so a
+        // point scored against the other goal's target would show.
+        let crossed = optimize_towards(&stroke, &profile, &real, &target_seeds, 6).unwrap();
+        assert_ne!(crossed.last().unwrap().u, alone[0].last().unwrap().u);
     }
 
     #[test]

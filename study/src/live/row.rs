@@ -83,7 +83,9 @@ pub struct StrokeFloor {
     /// floor lies in the sliding alone (a live chain knows neither when a
     /// reversal comes nor how the display behaves through one).
     pub sliding_only: Reading,
-    /// Seconds the optimizations took.
+    /// Seconds the optimizations took: both floors' starts run in one
+    /// queue, so the joint run's seconds times this floor's share of the
+    /// evaluations.
     #[serde(with = "exact")]
     pub seconds: f64,
 }
@@ -107,7 +109,9 @@ pub struct TargetFloor {
     /// Its objective through the twin towards the target, noise off (E_s²).
     #[serde(with = "exact")]
     pub objective: f64,
-    /// Seconds the optimizations took.
+    /// Seconds the optimizations took: both floors' starts run in one
+    /// queue, so the joint run's seconds times this floor's share of the
+    /// evaluations.
     #[serde(with = "exact")]
     pub seconds: f64,
 }

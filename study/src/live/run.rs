@@ -202,8 +202,8 @@ fn one(cfg: &LiveConfig, profile: &Profile, sample: &str, user: &User) -> Result
             Some(p) => LabProfile::load(p).map_err(|e| StudyError::Config(e.issues_text()))?,
             None => LabProfile::default(),
         };
-        let target = if s.chains.contains(&Chain::Live) { Some(target_floor(&at, &stroke, &lab, &ran)?) } else { None };
-        (Some(stroke_floor(&at, &stroke, &lab, &ran)?), target)
+        let (stroke_floor, target_floor) = floors(&at, &stroke, &lab, &ran)?;
+        (Some(stroke_floor), target_floor)
     } else {
         (None, None)
     };
@@ -266,20 +266,61 @@ fn play_best(
     Ok(p)
 }
 
-/// The stroke's floor: every start optimized through the twin, each
-/// optimum played over the gain sweep, the best kept.
-fn stroke_floor(
+/// The stroke's floor and, when the live synthesis ran, the target's
+/// floor. Both optimize through the twin of one stroke, so their starts
+/// run in one queue ([`floor::optimize_goals`]); each floor's candidates
+/// are the ones it reaches alone, and its seconds are the joint run's
+/// seconds times its share of the evaluations.
+///
+/// The stroke's floor: the carrier starts for the real force and every
+/// chain's actuation, optimized towards the real force; each optimum
+/// played over the gain sweep, the best kept. The target's floor: the
+/// carrier starts for the live synthesis' target and its own actuation,
+/// optimized towards that target, played alike.
+fn floors(
     at: &Stage<'_>,
     stroke: &Stroke,
     lab: &LabProfile,
     ran: &chains::ChainsRun,
-) -> Result<StrokeFloor, StudyError> {
+) -> Result<(StrokeFloor, Option<TargetFloor>), StudyError> {
     let s = at.scope;
-    let seeds: Vec<(String, Vec<f64>)> =
+    let stroke_seeds: Vec<(String, Vec<f64>)> =
         ran.actuations.iter().map(|(c, u)| (c.label().to_string(), u.clone())).collect();
+    let target_seeds: Vec<(String, Vec<f64>)> = ran
+        .actuations
+        .iter()
+        .filter(|(c, _)| *c == Chain::Live)
+        .map(|(c, u)| (c.label().to_string(), u.clone()))
+        .collect();
     let t = Instant::now();
-    let candidates = floor::optimize(stroke, lab, &seeds, s.floor_iterations)?;
+    let real = Goal::real(stroke)?;
+    // The target's starts first (fewer, and those the stroke's then
+    // follow fill the lanes its shorter runs leave).
+    let target_goal =
+        if s.chains.contains(&Chain::Live) { Some(Goal::chain_target(stroke, &ran.live_target)?) } else { None };
+    let mut goals: Vec<(&Goal, &floor::Seeds)> = Vec::new();
+    if let Some(g) = &target_goal {
+        goals.push((g, &target_seeds));
+    }
+    goals.push((&real, &stroke_seeds));
+    let mut each = floor::optimize_goals(stroke, lab, &goals, s.floor_iterations)?;
     let seconds = t.elapsed().as_secs_f64();
+    let (candidates, share) = each.pop().ok_or_else(|| StudyError::Config("the stroke's floor did not run".into()))?;
+    let target = match each.pop() {
+        Some((target_candidates, target_share)) => {
+            let p = play_best(at, stroke, &target_candidates, "target-floor", "the target's floor")?;
+            let c = &target_candidates[p.best];
+            let seconds = seconds * target_share;
+            Some(TargetFloor {
+                sweep: p.sweep,
+                reached: p.reached,
+                start: c.start.clone(),
+                objective: c.objective,
+                seconds,
+            })
+        }
+        None => None,
+    };
     let p = play_best(at, stroke, &candidates, "floor", "the stroke's floor")?;
     let c = &candidates[p.best];
     // The best optimum without its reversals, played alike.
@@ -293,36 +334,13 @@ fn stroke_floor(
     )?;
     let sweep = play::sweep(at, &file, &s.gains)?;
     let chosen = choose(&sweep).ok_or_else(|| StudyError::Config("an empty gain sweep".into()))?;
-    Ok(StrokeFloor {
+    let stroke_floor = StrokeFloor {
         sweep: p.sweep,
         reached: p.reached,
         start: c.start.clone(),
         objective: c.objective,
         sliding_only: Reading { rect: chosen.best_rect.rect, welch: chosen.best_welch.welch },
-        seconds,
-    })
-}
-
-/// The target's floor: the carrier starts for the live synthesis' target
-/// and its own actuation, optimized through the twin towards that target,
-/// each optimum played over the gain sweep, the best kept.
-fn target_floor(
-    at: &Stage<'_>,
-    stroke: &Stroke,
-    lab: &LabProfile,
-    ran: &chains::ChainsRun,
-) -> Result<TargetFloor, StudyError> {
-    let seeds: Vec<(String, Vec<f64>)> = ran
-        .actuations
-        .iter()
-        .filter(|(c, _)| *c == Chain::Live)
-        .map(|(c, u)| (c.label().to_string(), u.clone()))
-        .collect();
-    let t = Instant::now();
-    let goal = Goal::chain_target(stroke, &ran.live_target)?;
-    let candidates = floor::optimize_towards(stroke, lab, &goal, &seeds, at.scope.floor_iterations)?;
-    let seconds = t.elapsed().as_secs_f64();
-    let p = play_best(at, stroke, &candidates, "target-floor", "the target's floor")?;
-    let c = &candidates[p.best];
-    Ok(TargetFloor { sweep: p.sweep, reached: p.reached, start: c.start.clone(), objective: c.objective, seconds })
+        seconds: seconds * share,
+    };
+    Ok((stroke_floor, target))
 }

@@ -132,8 +132,9 @@ impl DisplayTwin {
     /// length, values into `fx`: their passes side by side (three or four
     /// in lanes, the fourth lane then a copy of the third, their steps kept
     /// in lanes; two as [`Self::forward2`], [`Self::backward2`]); each value
-    /// and gradient the one it gives alone. `adjoint` is called for each
-    /// force in order.
+    /// and gradient the one it gives alone. `adjoint(k, force)` is called
+    /// for each actuation's force in order (`k` its index in `u`), so each
+    /// may have an objective of its own.
     #[allow(clippy::too_many_arguments)]
     pub fn objective_grad_each(
         &self,
@@ -142,7 +143,7 @@ impl DisplayTwin {
         tapes: &mut Tapes,
         g: &mut [&mut [f64]],
         fx: &mut [f64],
-        mut adjoint: impl FnMut(Vec<f64>) -> (f64, Vec<f64>),
+        mut adjoint: impl FnMut(usize, Vec<f64>) -> (f64, Vec<f64>),
     ) {
         let m = u.len();
         assert!(m <= LANES && g.len() == m && fx.len() == m, "up to four actuations, each with its gradient and value");
@@ -160,7 +161,7 @@ impl DisplayTwin {
         };
         let mut bars = Vec::with_capacity(m);
         for (k, f) in forces.into_iter().enumerate() {
-            let (j, bar) = adjoint(f);
+            let (j, bar) = adjoint(k, f);
             fx[k] = j;
             bars.push(bar);
         }
@@ -634,16 +635,18 @@ mod tests {
         let twin = DisplayTwin::new(&profile, 1000.0, 4).unwrap();
         let us: Vec<Vec<f64>> =
             (0..4).map(|k| actuation(n).iter().map(|v| v * (1.0 - 0.3 * k as f64)).collect()).collect();
-        // J = Σ w·F², ∂J/∂F = 2·w·F.
-        let adjoint = |f: Vec<f64>| {
-            let j = f.iter().enumerate().map(|(k, x)| (1.0 + (k % 5) as f64) * x * x).sum();
-            (j, f.iter().enumerate().map(|(k, x)| 2.0 * (1.0 + (k % 5) as f64) * x).collect())
+        // J = Σ w·F², ∂J/∂F = 2·w·F, the weights w of each actuation its own.
+        let adjoint = |which: usize, f: Vec<f64>| {
+            let w = |k: usize| 1.0 + ((k + 2 * which) % 5) as f64;
+            let j = f.iter().enumerate().map(|(k, x)| w(k) * x * x).sum();
+            (j, f.iter().enumerate().map(|(k, x)| 2.0 * w(k) * x).collect())
         };
         let alone: Vec<(f64, Vec<f64>)> = us
             .iter()
-            .map(|u| {
+            .enumerate()
+            .map(|(which, u)| {
                 let mut g = vec![0.0; n];
-                let j = twin.objective_grad(u, (&load, &vel), &mut Tape::default(), &mut g, adjoint);
+                let j = twin.objective_grad(u, (&load, &vel), &mut Tape::default(), &mut g, |f| adjoint(which, f));
                 (j, g)
             })
             .collect();

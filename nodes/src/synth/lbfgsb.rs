@@ -725,20 +725,23 @@ mod tests {
         }
     }
 
+    /// Σ (w + i)·dᵢ² + q·dᵢ⁴ with dᵢ = xᵢ − c·(i − 1.5), and its gradient:
+    /// a smooth bowl whose minimum moves with `c`.
+    fn bowl(c: f64, w: f64, q: f64) -> impl Fn(&[f64], &mut [f64]) -> f64 {
+        move |x: &[f64], g: &mut [f64]| -> f64 {
+            let mut s = 0.0;
+            for i in 0..x.len() {
+                let d = x[i] - c * (i as f64 - 1.5);
+                s += d * d * (w + i as f64) + q * d.powi(4);
+                g[i] = 2.0 * d * (w + i as f64) + 4.0 * q * d.powi(3);
+            }
+            s
+        }
+    }
+
     #[test]
     fn minimizations_driven_side_by_side_are_each_their_own() {
-        let f = |c: f64| {
-            move |x: &[f64], g: &mut [f64]| -> f64 {
-                let mut s = 0.0;
-                for i in 0..x.len() {
-                    let d = x[i] - c * (i as f64 - 1.5);
-                    s += d * d * (1.0 + i as f64) + 0.1 * d.powi(4);
-                    g[i] = 2.0 * d * (1.0 + i as f64) + 0.4 * d.powi(3);
-                }
-                s
-            }
-        };
-        let (fa, fb) = (f(0.3), f(-0.7));
+        let (fa, fb) = (bowl(0.3, 1.0, 0.1), bowl(-0.7, 1.0, 0.1));
         let opts = Options::default();
         // Five starts: the odd one, and each one that finishes first, leave a place to the next.
         let starts: [&[f64]; 5] = [&[0.9; 4], &[-0.2; 3], &[0.1, 0.5, -0.3, 0.8], &[2.0; 3], &[-1.0; 4]];
@@ -777,18 +780,7 @@ mod tests {
     fn each_start_may_have_an_objective_of_its_own() {
         // Three objectives over the same four variables: only the start's
         // index tells them apart.
-        let f = |c: f64| {
-            move |x: &[f64], g: &mut [f64]| -> f64 {
-                let mut s = 0.0;
-                for i in 0..x.len() {
-                    let d = x[i] - c * (i as f64 - 1.5);
-                    s += d * d * (2.0 + i as f64) + 0.2 * d.powi(4);
-                    g[i] = 2.0 * d * (2.0 + i as f64) + 0.8 * d.powi(3);
-                }
-                s
-            }
-        };
-        let objectives = [f(0.3), f(-0.7), f(0.05)];
+        let objectives = [bowl(0.3, 2.0, 0.2), bowl(-0.7, 2.0, 0.2), bowl(0.05, 2.0, 0.2)];
         let whose = [0, 1, 2, 1, 0, 2, 2];
         let starts: Vec<Vec<f64>> =
             (0..whose.len()).map(|k| (0..4).map(|i| ((k * 7 + i * 3) % 5) as f64 * 0.4 - 0.8).collect()).collect();

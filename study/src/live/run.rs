@@ -294,8 +294,9 @@ fn floors(
         .collect();
     let t = Instant::now();
     let real = Goal::real(stroke)?;
-    // The target's starts first (fewer, and those the stroke's then
-    // follow fill the lanes its shorter runs leave).
+    // The target's starts first: fewer evaluations then run alone or in
+    // pairs at the queue's end (a probe of the nominal 2-user run, in
+    // docs/benchmarks.md).
     let target_goal =
         if s.chains.contains(&Chain::Live) { Some(Goal::chain_target(stroke, &ran.live_target)?) } else { None };
     let mut goals: Vec<(&Goal, &floor::Seeds)> = Vec::new();

@@ -17,11 +17,11 @@
 
 use super::gains::{AtGain, Chosen};
 use super::graphs::{run_graph, value, Sets};
-use super::live::floor::{minimize_starts, Objective};
 use super::recordings::{self, channel};
 use super::row::{Achievable, Reading, RowInputs};
 use super::twin::{DisplayTwin, SensorTwin, Tapes};
 use super::StudyError;
+use crate::starts::{minimize_starts, Objective};
 use evflow_nodes::lab::integrator::Method;
 use evflow_nodes::lab::profile::LabProfile;
 use evflow_nodes::lab::tribometer_model::TribometerModel;

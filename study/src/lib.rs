@@ -70,6 +70,8 @@ pub mod shard_file;
 #[cfg(feature = "synth")]
 pub mod spectrum;
 #[cfg(feature = "synth")]
+pub(crate) mod starts;
+#[cfg(feature = "synth")]
 pub mod summary;
 #[cfg(feature = "synth")]
 pub mod twin;

@@ -22,12 +22,13 @@
 //! seeded with, before the noise.
 
 use super::stroke::Stroke;
+use crate::starts::Objective;
 use crate::twin::{DisplayTwin, Tapes, LANES};
 use crate::StudyError;
 use evflow_nodes::lab::profile::LabProfile;
 use evflow_nodes::metric::spectral_error::Band;
 use evflow_nodes::metric::spectrum::{SpectrumConfig, Window};
-use evflow_nodes::synth::lbfgsb::{minimize_each, minimize_each_of, Options, Outcome};
+use evflow_nodes::synth::lbfgsb::{minimize_each_of, Options};
 use evflow_nodes::synth::output_filter::OutputFilter;
 use evflow_nodes::synth::spectral::SpectralTarget;
 use evflow_nodes::synth::start::carrier_scaled;
@@ -186,7 +187,7 @@ pub fn optimize_towards(
 }
 
 /// [`optimize_towards`] for each `(goal, seeds)` on one stroke, every
-/// goal's starts in one queue ([`from_starts_goals`]): each goal's
+/// goal's starts in one queue (`from_starts_goals`): each goal's
 /// candidates are the ones [`optimize_towards`] gives it alone, and a goal
 /// whose starts end early leaves its lanes to another's. With each goal's
 /// candidates, the share of the L-BFGS-B evaluations that were its own.
@@ -214,37 +215,6 @@ pub fn optimize_goals(
     let kappa = chain.carrier_gain();
     let each: Vec<(&[f64], &Seeds)> = goals.iter().map(|(g, s)| (g.magnitude.as_slice(), *s)).collect();
     from_starts_goals(&mut chain, &each, kappa, stroke.len(), iterations)
-}
-
-/// An objective over a whole stroke's actuation that the floors minimize:
-/// its value, and its value with the gradient written into `g` — towards
-/// one goal, or towards each of several (`goal` its index; an objective
-/// of one goal takes only 0).
-pub(crate) trait Objective {
-    /// The objective at `u` (by default through [`Objective::value_grad`]).
-    fn value(&mut self, u: &[f64]) -> f64 {
-        self.value_grad(u, &mut vec![0.0; u.len()])
-    }
-    /// The objective at `u`, its gradient into `g`.
-    fn value_grad(&mut self, u: &[f64], g: &mut [f64]) -> f64;
-    /// [`Objective::value_grad`] at each of up to four points, values into
-    /// `fx` (an objective that can run them at once does; each result
-    /// must be the one it gives alone).
-    fn value_grad_each(&mut self, u: &[&[f64]], g: &mut [&mut [f64]], fx: &mut [f64]) {
-        for ((u, g), fx) in u.iter().zip(g.iter_mut()).zip(fx.iter_mut()) {
-            *fx = self.value_grad(u, g);
-        }
-    }
-    /// The objective of goal `goal` at `u`.
-    fn value_of(&mut self, goal: usize, u: &[f64]) -> f64 {
-        assert_eq!(goal, 0, "an objective of one goal");
-        self.value(u)
-    }
-    /// [`Objective::value_grad_each`], point `k` towards goal `goals[k]`.
-    fn value_grad_each_of(&mut self, goals: &[usize], u: &[&[f64]], g: &mut [&mut [f64]], fx: &mut [f64]) {
-        assert!(goals.iter().all(|&k| k == 0), "an objective of one goal");
-        self.value_grad_each(u, g, fx)
-    }
 }
 
 impl Objective for Chain<'_> {
@@ -285,7 +255,7 @@ impl Objective for Chain<'_> {
 /// gain `kappa` is positive) and every seed (cut or padded with 0 to `n`,
 /// within |u| ≤ 1), each followed by `iterations` of L-BFGS-B within
 /// |u| ≤ 1. The starts run four at a time, side by side
-/// ([`minimize_each`], [`Objective::value_grad_each`]): each start's optimum
+/// ([`evflow_nodes::synth::lbfgsb::minimize_each`], [`Objective::value_grad_each`]): each start's optimum
 /// is the one it reaches alone.
 pub(crate) fn from_starts(
     objective: &mut impl Objective,
@@ -345,14 +315,6 @@ pub(crate) fn from_starts_goals(
         out[goal].0.push(Candidate { start, start_objective, objective: r.f, u: r.x });
     }
     Ok(out)
-}
-
-/// Minimizes `objective` within |u| ≤ 1 from each start, four starts at a
-/// time side by side ([`minimize_each`], [`Objective::value_grad_each`]): the
-/// outcomes in the starts' order, each the one a run of its own reaches.
-pub(crate) fn minimize_starts(objective: &mut impl Objective, starts: &[&[f64]], opts: &Options) -> Vec<Outcome> {
-    let mut f = |x: &[&[f64]], g: &mut [&mut [f64]], fx: &mut [f64]| objective.value_grad_each(x, g, fx);
-    minimize_each(&mut f, starts, LANES, -1.0, 1.0, opts)
 }
 
 #[cfg(test)]

@@ -27,8 +27,9 @@
 //! ([`crate::live::floor`]): E_s² in the Welch reading of the high-passed
 //! force against the goal, L-BFGS-B within |u| ≤ 1.
 
-use crate::live::floor::{from_starts, Candidate, Goal, Objective};
+use crate::live::floor::{from_starts, Candidate, Goal};
 use crate::live::stroke::Stroke;
+use crate::starts::Objective;
 use crate::StudyError;
 use evflow_nodes::metric::spectral_error::Band;
 use evflow_nodes::metric::spectrum::{SpectrumConfig, Window};

@@ -250,30 +250,15 @@ impl Objective for Chain<'_> {
     }
 }
 
-/// The floors' optimization of `objective` over `n` samples: the carrier
-/// starts at [`START_OFFSETS`] for the goal's `magnitude` (when the carrier
-/// gain `kappa` is positive) and every seed (cut or padded with 0 to `n`,
-/// within |u| ≤ 1), each followed by `iterations` of L-BFGS-B within
-/// |u| ≤ 1. The starts run four at a time, side by side
-/// ([`evflow_nodes::synth::lbfgsb::minimize_each`], [`Objective::value_grad_each`]): each start's optimum
-/// is the one it reaches alone.
-pub(crate) fn from_starts(
-    objective: &mut impl Objective,
-    magnitude: &[f64],
-    kappa: f64,
-    n: usize,
-    seeds: &[(String, Vec<f64>)],
-    iterations: usize,
-) -> Result<Vec<Candidate>, StudyError> {
-    let mut each = from_starts_goals(objective, &[(magnitude, seeds)], kappa, n, iterations)?;
-    Ok(each.pop().map(|(c, _)| c).unwrap_or_default())
-}
-
-/// [`from_starts`] for each goal `(magnitude, seeds)` of `objective`, every
-/// goal's starts in one queue, four at a time side by side
-/// ([`minimize_each_of`], [`Objective::value_grad_each_of`]); each goal's
-/// candidates, in its starts' order, with the share of the evaluations
-/// that were its own.
+/// The floors' optimization of `objective` over `n` samples towards each
+/// goal `(magnitude, seeds)`: the carrier starts at [`START_OFFSETS`] for
+/// the goal's `magnitude` (when the carrier gain `kappa` is positive) and
+/// every seed (cut or padded with 0 to `n`, within |u| ≤ 1), each followed
+/// by `iterations` of L-BFGS-B within |u| ≤ 1. Every goal's starts run in
+/// one queue, four at a time side by side ([`minimize_each_of`],
+/// [`Objective::value_grad_each_of`]): each start's optimum is the one it
+/// reaches alone. Each goal's candidates, in its starts' order, with the
+/// share of the evaluations that were its own.
 pub(crate) fn from_starts_goals(
     objective: &mut impl Objective,
     goals: &[(&[f64], &Seeds)],

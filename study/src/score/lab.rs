@@ -203,19 +203,18 @@ impl super::Player for LabPlayer {
         Ok(Played { at, rendered: ch("rendered"), real: ch("real") })
     }
 
-    fn optimize(
+    fn optimize_goals(
         &mut self,
         stroke: &crate::live::stroke::Stroke,
-        goal: &crate::live::floor::Goal,
-        seeds: &[(String, Vec<f64>)],
+        goals: &[(&crate::live::floor::Goal, &crate::live::floor::Seeds)],
         iterations: usize,
-    ) -> Result<Vec<crate::live::floor::Candidate>, StudyError> {
+    ) -> Result<Vec<(Vec<crate::live::floor::Candidate>, f64)>, StudyError> {
         let lab = match &self.profile.path {
             Some(p) => {
                 evflow_nodes::lab::profile::LabProfile::load(p).map_err(|e| StudyError::Config(e.issues_text()))?
             }
             None => evflow_nodes::lab::profile::LabProfile::default(),
         };
-        crate::live::floor::optimize_towards(stroke, &lab, goal, seeds, iterations)
+        crate::live::floor::optimize_goals(stroke, &lab, goals, iterations)
     }
 }

@@ -26,7 +26,7 @@ pub mod models;
 pub mod report;
 
 use crate::gains::{choose, AtGain};
-use crate::live::floor::{self, Candidate, Goal};
+use crate::live::floor::{self, Candidate, Goal, Seeds};
 use crate::live::row::{Chain, ChainResult, LiveRow, StrokeFloor, TargetFloor};
 use crate::live::stroke::Stroke;
 use crate::row::Reading;
@@ -113,14 +113,16 @@ pub trait Player {
     fn sweep(&mut self, name: &str, u: &[f64], add: &[f64], gains: &[f64]) -> Result<Vec<AtGain>, StudyError>;
     /// Plays `u` with `add` at gain 1, keeping the forces.
     fn play(&mut self, name: &str, u: &[f64], add: &[f64]) -> Result<Played, StudyError>;
-    /// The stroke's actuation optimized through the display's twin towards `goal`.
-    fn optimize(
+    /// The stroke's actuation optimized through the display's twin towards
+    /// each `(goal, seeds)`, every goal's starts in one queue: each goal's
+    /// candidates (the ones it reaches alone) and its share of the
+    /// evaluations.
+    fn optimize_goals(
         &mut self,
         stroke: &Stroke,
-        goal: &Goal,
-        seeds: &[(String, Vec<f64>)],
+        goals: &[(&Goal, &Seeds)],
         iterations: usize,
-    ) -> Result<Vec<Candidate>, StudyError>;
+    ) -> Result<Vec<(Vec<Candidate>, f64)>, StudyError>;
 }
 
 /// The forward-model display as a player: played in memory, no noise.
@@ -152,14 +154,13 @@ impl Player for ModelPlayer<'_> {
         Ok(Played { at, rendered, real: self.real_hp.clone() })
     }
 
-    fn optimize(
+    fn optimize_goals(
         &mut self,
         stroke: &Stroke,
-        goal: &Goal,
-        seeds: &[(String, Vec<f64>)],
+        goals: &[(&Goal, &Seeds)],
         iterations: usize,
-    ) -> Result<Vec<Candidate>, StudyError> {
-        self.display.optimize(stroke, goal, seeds, iterations)
+    ) -> Result<Vec<(Vec<Candidate>, f64)>, StudyError> {
+        self.display.optimize_goals(stroke, goals, iterations)
     }
 }
 
@@ -324,25 +325,28 @@ fn floors(
     let path = &inputs.path;
     let rate = path.rate;
     let seeds = vec![(Chain::Live.label().to_string(), inputs.u.clone())];
-    let starts = seeds.len() + floor::START_OFFSETS.len();
-    // The target's floor: towards the chain's own target.
-    progress(Step::Optimizing("the target's floor", starts));
+    let starts = 2 * (seeds.len() + floor::START_OFFSETS.len());
+    // Both floors' starts in one queue: the target's floor (towards the
+    // chain's own target) first, then the stroke's (towards the real force).
+    progress(Step::Optimizing("both floors", starts));
     let t = Instant::now();
-    let goal = Goal::chain_target(path, &inputs.target)?;
-    let candidates = player.optimize(path, &goal, &seeds, cfg.floor_iterations)?;
+    let (target, real) = (Goal::chain_target(path, &inputs.target)?, Goal::real(path)?);
+    let mut each = player.optimize_goals(path, &[(&target, &seeds), (&real, &seeds)], cfg.floor_iterations)?;
     let secs = t.elapsed().as_secs_f64();
-    progress(Step::Optimized("the target's floor", secs));
-    progress(Step::Playing("the target's floor", candidates.len() * cfg.gains.len()));
-    let (sweep, reached, best) = play_best(player, &candidates, "target-floor", &cfg.gains)?;
-    let c = &candidates[best];
-    let target_floor =
-        Some(TargetFloor { sweep, reached, start: c.start.clone(), objective: c.objective, seconds: secs });
-    // The stroke's floor: towards the real force.
-    progress(Step::Optimizing("the stroke's floor", starts));
-    let t = Instant::now();
-    let candidates = player.optimize(path, &Goal::real(path)?, &seeds, cfg.floor_iterations)?;
-    let secs = t.elapsed().as_secs_f64();
-    progress(Step::Optimized("the stroke's floor", secs));
+    progress(Step::Optimized("both floors", secs));
+    let (Some((candidates, stroke_share)), Some((target_candidates, target_share))) = (each.pop(), each.pop()) else {
+        return Err(StudyError::Config("the floors did not run".into()));
+    };
+    progress(Step::Playing("the target's floor", target_candidates.len() * cfg.gains.len()));
+    let (sweep, reached, best) = play_best(player, &target_candidates, "target-floor", &cfg.gains)?;
+    let c = &target_candidates[best];
+    let target_floor = Some(TargetFloor {
+        sweep,
+        reached,
+        start: c.start.clone(),
+        objective: c.objective,
+        seconds: secs * target_share,
+    });
     progress(Step::Playing("the stroke's floor", (candidates.len() + 1) * cfg.gains.len() + 1));
     let (sweep, reached, best) = play_best(player, &candidates, "floor", &cfg.gains)?;
     let c = &candidates[best];
@@ -355,7 +359,7 @@ fn floors(
         start: c.start.clone(),
         objective: c.objective,
         sliding_only: Reading { rect: s.best_rect.rect, welch: s.best_welch.welch },
-        seconds: secs,
+        seconds: secs * stroke_share,
     });
     Ok((achievable, target_floor, floor_spectrum))
 }

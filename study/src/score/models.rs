@@ -27,7 +27,7 @@
 //! ([`crate::live::floor`]): E_s² in the Welch reading of the high-passed
 //! force against the goal, L-BFGS-B within |u| ≤ 1.
 
-use crate::live::floor::{from_starts, Candidate, Goal};
+use crate::live::floor::{from_starts_goals, Candidate, Goal, Seeds};
 use crate::live::stroke::Stroke;
 use crate::starts::Objective;
 use crate::StudyError;
@@ -203,61 +203,87 @@ impl ForwardDisplay {
         seeds: &[(String, Vec<f64>)],
         iterations: usize,
     ) -> Result<Vec<Candidate>, StudyError> {
+        let mut each = self.optimize_goals(path, &[(goal, seeds)], iterations)?;
+        Ok(each.pop().map(|(c, _)| c).unwrap_or_default())
+    }
+
+    /// [`Self::optimize`] towards each `(goal, seeds)`, every goal's starts
+    /// in one queue as [`crate::live::floor::optimize_goals`] runs them:
+    /// each goal's candidates the ones it reaches alone, with its share of
+    /// the evaluations.
+    pub fn optimize_goals(
+        &self,
+        path: &Stroke,
+        goals: &[(&Goal, &Seeds)],
+        iterations: usize,
+    ) -> Result<Vec<(Vec<Candidate>, f64)>, StudyError> {
         let rate = path.rate;
         let nfft = rate.round() as usize;
         let cfg = SpectrumConfig { rate, nfft, window: Window::Hann, overlap: 0.5 };
         let band = Band::new(rate, nfft, 2.0, 200.0, false).map_err(|e| StudyError::Config(e.message))?;
+        let mut targets = Vec::with_capacity(goals.len());
+        for (goal, _) in goals {
+            targets.push(SpectralTarget::new(&goal.highpassed, cfg, band)?);
+        }
         let mut chain = Chain {
             display: self,
             along: self.along(path),
             filter: OutputFilter::highpass(4, 10.0, rate)?,
-            target: SpectralTarget::new(&goal.highpassed, cfg, band)?,
+            targets,
             y: Vec::new(),
         };
         let kappa = chain.carrier_gain(path);
-        from_starts(&mut chain, &goal.magnitude, kappa, path.len(), seeds, iterations)
+        let each: Vec<(&[f64], &Seeds)> = goals.iter().map(|(g, s)| (g.magnitude.as_slice(), *s)).collect();
+        from_starts_goals(&mut chain, &each, kappa, path.len(), iterations)
     }
 }
 
 /// Grams per newton (the load cell's N to the grid's g, as the chain converts).
 pub const G_PER_N: f64 = 101.97162129779282;
 
-/// The display, the high-pass and the goal of one stroke.
+/// The display and the high-pass of one stroke, and the target of each
+/// goal optimized towards.
 struct Chain<'a> {
     display: &'a ForwardDisplay,
     along: Vec<Vec<f64>>,
     filter: OutputFilter,
-    target: SpectralTarget,
+    targets: Vec<SpectralTarget>,
     y: Vec<f64>,
 }
 
 impl Objective for Chain<'_> {
     fn value(&mut self, u: &[f64]) -> f64 {
-        Chain::value(self, u)
+        self.value_of(0, u)
     }
     fn value_grad(&mut self, u: &[f64], g: &mut [f64]) -> f64 {
-        Chain::value_grad(self, u, g)
+        self.value_grad_of(0, u, g)
+    }
+    fn value_of(&mut self, goal: usize, u: &[f64]) -> f64 {
+        let mut y = self.display.force(u, &self.along);
+        self.filter.apply_in_place(&mut y);
+        self.targets[goal].es(&y).powi(2)
+    }
+    /// One point after the other (the forward models run no lanes).
+    fn value_grad_each_of(&mut self, goals: &[usize], u: &[&[f64]], g: &mut [&mut [f64]], fx: &mut [f64]) {
+        for (((goal, u), g), fx) in goals.iter().zip(u).zip(g.iter_mut()).zip(fx.iter_mut()) {
+            *fx = self.value_grad_of(*goal, u, g);
+        }
     }
 }
 
 impl Chain<'_> {
-    fn value_grad(&mut self, u: &[f64], g: &mut [f64]) -> f64 {
+    /// J towards goal `goal` at `u`, ∂J/∂u into `g`.
+    fn value_grad_of(&mut self, goal: usize, u: &[f64], g: &mut [f64]) -> f64 {
         // The forward pass first, for the objective's gradient with respect to the force.
         let mut y = self.display.force(u, &self.along);
         self.filter.apply_in_place(&mut y);
         self.y.resize(y.len(), 0.0);
-        let j = self.target.value_grad(&y, &mut self.y);
+        let j = self.targets[goal].value_grad(&y, &mut self.y);
         self.filter.adjoint_in_place(&mut self.y);
         let fbar = std::mem::take(&mut self.y);
         self.display.force_grad(u, &self.along, &fbar, g);
         self.y = fbar;
         j
-    }
-
-    fn value(&mut self, u: &[f64]) -> f64 {
-        let mut y = self.display.force(u, &self.along);
-        self.filter.apply_in_place(&mut y);
-        self.target.es(&y).powi(2)
     }
 
     /// The steady friction a unit Nyquist-rate carrier adds on this stroke

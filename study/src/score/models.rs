@@ -466,12 +466,22 @@ mod tests {
         let fwd = (0..n).find(|&k| path.velocity[k] > 0.01 && k > 100).unwrap();
         assert!(fu[fwd] > 0.0 && fu[back] < 0.0, "{} {}", fu[fwd], fu[back]);
         // The floor through the models: never above its starts, within |u| ≤ 1.
-        let c = d.optimize(&path, &Goal::real(&path).unwrap(), &[("seed".into(), unit)], 4).unwrap();
+        let real = Goal::real(&path).unwrap();
+        let seeds = [("seed".to_string(), unit)];
+        let c = d.optimize(&path, &real, &seeds, 4).unwrap();
         assert_eq!(c.len(), 3);
         for cand in &c {
             assert!(cand.objective <= cand.start_objective, "{}", cand.start);
             assert!(cand.u.iter().all(|x| x.abs() <= 1.0));
         }
+        // Two goals in one queue: each goal's candidates as alone.
+        let wanted: Vec<f64> = (0..n).map(|k| 0.05 + 0.02 * (k as f64 * 0.09).sin()).collect();
+        let target = Goal::chain_target(&path, &wanted).unwrap();
+        let alone = d.optimize(&path, &target, &seeds, 4).unwrap();
+        let both = d.optimize_goals(&path, &[(&target, &seeds), (&real, &seeds)], 4).unwrap();
+        assert_eq!(both[0].0, alone);
+        assert_eq!(both[1].0, c);
+        assert_ne!(alone[2].u, c[2].u, "the goals differ");
     }
 
     #[test]

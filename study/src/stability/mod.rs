@@ -281,9 +281,10 @@ pub fn run_case(case: &Case, env: &Env) -> Row {
 }
 
 /// Runs every case whose name contains `only` (all when empty) on `jobs`
-/// threads, calling `each` as each row is done; returns the rows in the
-/// suite's order, the same for any `jobs`. Panics inside cases are caught
-/// (and kept off the terminal while the suite runs).
+/// threads, calling `each` with each row in the suite's order as soon as
+/// it and the rows before it are done; returns the rows in that order,
+/// the same for any `jobs`. Panics inside cases are caught (and kept off
+/// the terminal while the suite runs).
 ///
 /// The pieces of every case are one queue. The shipped graphs' pieces go
 /// first: each runs minutes of simulated time, most other cases a few
@@ -311,6 +312,8 @@ pub fn run_cases(cases: &[Case], env: &Env, jobs: usize, each: &mut dyn FnMut(&R
         cases.iter().map(|c| (0..pieces(c)).map(|_| None).collect()).collect();
     let mut seconds = vec![0.0; cases.len()];
     let mut rows: Vec<Option<Row>> = cases.iter().map(|_| None).collect();
+    // The rows handed to `each` so far: a prefix of the suite.
+    let mut reported = 0;
     let work = |_: usize, (k, p): (usize, usize)| {
         let started = Instant::now();
         let body = match &cases[k].work {
@@ -331,9 +334,11 @@ pub fn run_cases(cases: &[Case], env: &Env, jobs: usize, each: &mut dyn FnMut(&R
                 Work::Whole(_) => got.remove(0),
                 Work::Pieces(_) => join(got),
             };
-            let r = row(&cases[k], outcome, seconds[k], env);
-            each(&r);
-            rows[k] = Some(r);
+            rows[k] = Some(row(&cases[k], outcome, seconds[k], env));
+            while let Some(Some(r)) = rows.get(reported) {
+                each(r);
+                reported += 1;
+            }
         }
     });
     std::panic::set_hook(hook);
@@ -444,10 +449,8 @@ mod tests {
             let mut done = Vec::new();
             let rows = run_cases(&cases, &env, jobs, &mut |r| done.push(r.case.clone()));
             assert_eq!(rows.iter().map(shown).collect::<Vec<_>>(), alone, "jobs {jobs}");
-            done.sort();
-            let mut names: Vec<String> = cases.iter().map(|c| c.name.clone()).collect();
-            names.sort();
-            assert_eq!(done, names, "jobs {jobs}: each row reported once");
+            let names: Vec<String> = cases.iter().map(|c| c.name.clone()).collect();
+            assert_eq!(done, names, "jobs {jobs}: each row reported once, in the suite's order");
         }
     }
 }

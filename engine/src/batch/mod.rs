@@ -18,5 +18,5 @@ pub mod shard;
 
 pub use clash::{check_outputs, output_files, ClashError};
 pub use failures::Failures;
-pub use pool::{default_jobs, for_each_ordered, for_each_ordered_ahead, Outcome};
+pub use pool::{default_jobs, for_each_ordered, for_each_ordered_ahead, panic_message, Outcome};
 pub use shard::{Shard, ShardError};

@@ -11,7 +11,8 @@
 //! Memory is bounded: at most `jobs` items run at once, and a worker does
 //! not start item `i` until every item before `i - 2·jobs` has been handed
 //! to the caller, so at most `2·jobs` finished results wait in the
-//! reordering buffer.
+//! reordering buffer ([`for_each_ordered`]; [`for_each_ordered_ahead`]
+//! takes that bound from its caller, for batches of small results).
 
 use std::collections::BTreeMap;
 use std::panic::{catch_unwind, AssertUnwindSafe};
@@ -135,12 +136,16 @@ where
 
 /// The text of a panic's payload.
 fn panic_text(p: Box<dyn std::any::Any + Send>) -> String {
-    let text = p
-        .downcast_ref::<&str>()
+    format!("panicked: {}", panic_message(p.as_ref()))
+}
+
+/// The message a panic's payload carries (`panic!`'s text), or
+/// `(no message)`.
+pub fn panic_message(p: &(dyn std::any::Any + Send)) -> String {
+    p.downcast_ref::<&str>()
         .map(|s| s.to_string())
         .or_else(|| p.downcast_ref::<String>().cloned())
-        .unwrap_or_else(|| "(no message)".into());
-    format!("panicked: {text}")
+        .unwrap_or_else(|| "(no message)".into())
 }
 
 #[cfg(test)]

@@ -29,7 +29,7 @@ pub mod table;
 
 pub use invariant::{Invariant, Observed, Verdict};
 
-use evflow_engine::batch::for_each_ordered_ahead;
+use evflow_engine::batch::{for_each_ordered_ahead, panic_message};
 use std::path::{Path, PathBuf};
 use std::sync::atomic::AtomicBool;
 use std::time::Instant;
@@ -217,13 +217,7 @@ pub fn prepare(dir: &Path, graphs: &Path, size: Size) -> Result<Env, SuiteError>
 
 /// Runs one body, catching a panic (its message is the outcome).
 fn attempt(body: &Body, env: &Env) -> Result<Observed, String> {
-    std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| body(env))).map_err(|payload| {
-        payload
-            .downcast_ref::<&str>()
-            .map(|s| s.to_string())
-            .or_else(|| payload.downcast_ref::<String>().cloned())
-            .unwrap_or_else(|| "a panic".into())
-    })
+    std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| body(env))).map_err(|p| panic_message(p.as_ref()))
 }
 
 /// What a case split into pieces saw, from each piece's outcome in order,
